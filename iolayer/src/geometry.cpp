@@ -1,0 +1,105 @@
+#include "basalt/io/geometry.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <unordered_set>
+
+#include <fmt/format.h>
+
+namespace basalt::io {
+
+namespace fs = std::filesystem;
+
+FormatError::FormatError(const fs::path& file, const std::string& where, const std::string& what)
+    : std::runtime_error(fmt::format("{}{}{}: {}", file.string(), where.empty() ? "" : ": ", where, what)),
+      file_(file),
+      where_(where) {}
+
+void Geometry::add_particle(std::int64_t pid, const Vec3& pos, double r, std::int32_t ptag) {
+  id.push_back(pid);
+  position.push_back(pos);
+  radius.push_back(r);
+  tag.push_back(ptag);
+}
+
+void Geometry::sort_by_id() {
+  for (auto& b : bonds)
+    if (b.a > b.b) std::swap(b.a, b.b);
+  if (std::is_sorted(id.begin(), id.end())) return;
+  std::vector<std::size_t> order(id.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t i, std::size_t j) { return id[i] < id[j]; });
+  auto permute = [&](auto& v) {
+    if (v.empty()) return;
+    auto copy = v;
+    for (std::size_t k = 0; k < order.size(); ++k) v[k] = copy[order[k]];
+  };
+  permute(id);
+  permute(position);
+  permute(radius);
+  permute(tag);
+  permute(mass);
+}
+
+std::int64_t Geometry::index_of(std::int64_t pid) const {
+  auto it = std::lower_bound(id.begin(), id.end(), pid);
+  if (it == id.end() || *it != pid) return -1;
+  return it - id.begin();
+}
+
+void Geometry::validate(const fs::path& source) const {
+  const std::size_t n = id.size();
+  if (position.size() != n || radius.size() != n || tag.size() != n)
+    throw FormatError(source, "particles",
+                      fmt::format("array lengths differ (id {}, position {}, radius {}, tag {})", n,
+                                  position.size(), radius.size(), tag.size()));
+  if (!mass.empty() && mass.size() != n)
+    throw FormatError(source, "particles/mass", fmt::format("{} masses for {} particles", mass.size(), n));
+  std::unordered_set<std::int64_t> seen;
+  seen.reserve(n * 2);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!seen.insert(id[i]).second)
+      throw FormatError(source, fmt::format("particle {}", i), fmt::format("duplicate id {}", id[i]));
+    const auto& p = position[i];
+    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
+      throw FormatError(source, fmt::format("particle id {}", id[i]), "position is not finite");
+    if (!(radius[i] > 0) || !std::isfinite(radius[i]))
+      throw FormatError(source, fmt::format("particle id {}", id[i]),
+                        fmt::format("radius must be finite and > 0, got {}", radius[i]));
+    if (!mass.empty() && (!(mass[i] > 0) || !std::isfinite(mass[i])))
+      throw FormatError(source, fmt::format("particle id {}", id[i]),
+                        fmt::format("mass must be finite and > 0, got {}", mass[i]));
+  }
+  for (std::size_t k = 0; k < bonds.size(); ++k) {
+    const auto& b = bonds[k];
+    if (b.a == b.b)
+      throw FormatError(source, fmt::format("bond {}", k), fmt::format("joins particle {} to itself", b.a));
+    for (auto e : {b.a, b.b})
+      if (!seen.count(e))
+        throw FormatError(source, fmt::format("bond {}", k),
+                          fmt::format("refers to particle id {}, which does not exist", e));
+  }
+}
+
+static std::string lower_extension(const fs::path& file) {
+  std::string ext = file.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext;
+}
+
+Geometry read_geometry(const fs::path& file) {
+  const auto ext = lower_extension(file);
+  if (ext == ".h5" || ext == ".hdf5") return read_h5(file);
+  if (ext == ".geo") return read_geo(file);
+  throw FormatError(file, "", "unknown geometry format (expected .h5, .hdf5 or .geo)");
+}
+
+void write_geometry(const Geometry& g, const fs::path& file) {
+  const auto ext = lower_extension(file);
+  if (ext == ".h5" || ext == ".hdf5") return write_h5(g, file);
+  if (ext == ".geo") return write_geo(g, file);
+  throw FormatError(file, "", "unknown geometry format (expected .h5, .hdf5 or .geo)");
+}
+
+}  // namespace basalt::io
