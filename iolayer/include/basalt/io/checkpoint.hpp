@@ -1,0 +1,58 @@
+#pragma once
+// A checkpoint: the full restartable state of a run at one step, as written by the I/O layer
+// (schema "basalt-checkpoint" version 1, docs/formats.md). It extends the geometry schema:
+// the same /particles group (sorted by id) plus velocities, the bond state and the run's clock.
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "basalt/io/geometry.hpp"
+
+namespace basalt::io {
+
+struct WallState {
+  std::string name;
+  Vec3 position{0, 0, 0};  ///< a point on the plane
+  Vec3 normal{0, 0, 1};
+  Vec3 velocity{0, 0, 0};
+  Vec3 force{0, 0, 0};  ///< force particles exert on the wall at this step
+};
+
+struct Checkpoint {
+  /// Particles (sorted by id), bonds, box, units, provenance. geometry.mass is always present.
+  Geometry geometry;
+  std::vector<Vec3> velocity;  ///< one per particle, same order as geometry.id
+
+  // Bond state, one entry per geometry.bonds entry.
+  std::vector<double> bond_rest_length;
+  std::vector<std::uint8_t> bond_broken;  ///< 1 once broken (broken bonds are kept so ids stay stable)
+
+  std::vector<WallState> walls;
+
+  std::int64_t step = 0;
+  double time = 0;
+  double dt = 0;
+  std::string scene_text;  ///< the scene file's text, verbatim
+
+  std::size_t size() const { return geometry.size(); }
+  /// Geometry invariants plus: one velocity per particle, one state per bond, finite values.
+  void validate(const std::filesystem::path& source) const;
+};
+
+/// Writes atomically: to "<file>.partial", then renames; the file carries the attribute
+/// /complete = 1 written last. A failure throws FormatError naming the path and leaves no file
+/// under the final name.
+void write_checkpoint(const Checkpoint& c, const std::filesystem::path& file);
+
+/// Reads and validates a checkpoint; refuses (FormatError) a file without the completion mark,
+/// of another schema, or of a newer schema version.
+Checkpoint read_checkpoint(const std::filesystem::path& file);
+
+/// True when `file` is a complete, readable checkpoint (never throws).
+bool is_complete_checkpoint(const std::filesystem::path& file);
+
+/// The complete checkpoint with the highest step in `dir` (ckpt_<step>.h5), or empty path.
+std::filesystem::path latest_complete_checkpoint(const std::filesystem::path& dir);
+
+}  // namespace basalt::io
