@@ -96,7 +96,10 @@ std::optional<std::string> Halo<Real>::migrate(Particles<Real>& p, Bonds<Real>& 
       for (const auto& b : bin) bonds.push(b.a, b.b, Real(b.r0), static_cast<std::uint8_t>(b.group));
     }
   }
-  // Keep each bond once, and only while one of its ends is owned here.
+  // Keep each bond once, and only while one of its ends is owned here. Ends may have been swapped
+  // (resolution puts the owned end first), so compare them ordered.
+  for (std::size_t k = 0; k < bonds.size(); ++k)
+    if (bonds.a[k] > bonds.b[k]) std::swap(bonds.a[k], bonds.b[k]);
   std::vector<std::int64_t> owned(p.id.begin(), p.id.begin() + static_cast<std::ptrdiff_t>(p.n_owned));
   std::sort(owned.begin(), owned.end());
   std::vector<std::uint32_t> order(bonds.size());

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <cstdlib>
 #include <numbers>
 
 #include "basalt/solver/core/errors.hpp"
@@ -270,6 +271,7 @@ void Simulation<Real>::rebuild() {
   std::copy(p_.z.begin(), p_.z.begin() + static_cast<std::ptrdiff_t>(p_.n_owned), p_.z0.begin());
   bond_broke_ = false;
   ++rebuilds_;
+  if (std::getenv("BASALT_DEBUG_REBUILD")) fmt::print(stderr, "rank {} rebuild at step {} owned {} ghosts {} bonds {} (both owned {}) pairs {}+{}\n", comm().rank(), step_, p_.n_owned, p_.n_ghost(), bonds_.size(), bonds_.n_both_owned, own_.pairs(), ghost_.pairs());
   times_.neighbor += sw.lap();
 }
 
