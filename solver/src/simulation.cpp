@@ -436,6 +436,12 @@ void Simulation<Real>::run(std::int64_t steps, FieldSink* sink) {
 }
 
 template <class Real>
+void Simulation<Real>::state_changed() {
+  energy0_ = total_energy(compute_forces<true>());
+  wall_work_in_ = 0;
+}
+
+template <class Real>
 void Simulation<Real>::force_rebuild() {
   rebuild();
   compute_forces<false>();

@@ -76,6 +76,9 @@ class Simulation {
   std::array<double, 4> energies();
   /// Collective: number of bonds.
   std::int64_t bond_count() const;
+  /// Collective: call after changing particle state from outside (e.g. initial velocities): recomputes
+  /// forces and the energy the stability guard starts from.
+  void state_changed();
   /// Collective: rebuilds the lists now (migrating particles), then recomputes forces.
   void force_rebuild();
   /// Bytes held by the solver's arrays on this rank (capacity, not RSS).
