@@ -13,15 +13,15 @@
 //   id1 id2 bondtag                (count lines)
 //   EndConnect
 // Every error names the file and line number.
+#include <fmt/format.h>
+#include <fmt/os.h>
+
 #include <charconv>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
 #include <string_view>
 #include <unordered_map>
-
-#include <fmt/format.h>
-#include <fmt/os.h>
 
 #include "basalt/io/geometry.hpp"
 
@@ -33,7 +33,11 @@ namespace {
 
 class LineReader {
  public:
-  explicit LineReader(const fs::path& file) : file_(file), in_(file) {
+  explicit LineReader(const fs::path& file) : file_(file) {
+    std::error_code ec;
+    if (!fs::exists(file, ec)) throw FormatError(file, "", "no such file");
+    if (fs::is_directory(file, ec)) throw FormatError(file, "", "is a folder, not a file");
+    in_.open(file);
     if (!in_) throw FormatError(file, "", "cannot open for reading");
   }
 
@@ -115,7 +119,8 @@ Geometry read_geo(const fs::path& file) {
     g.box_max[k] = r.number<double>(r.fields()[4 + k], "BoundingBox value");
   }
   r.expect_keyword("PeriodicBoundaries", 3);
-  for (int k = 0; k < 3; ++k) g.periodic[k] = r.number<int>(r.fields()[1 + k], "PeriodicBoundaries flag") != 0;
+  for (int k = 0; k < 3; ++k)
+    g.periodic[k] = r.number<int>(r.fields()[1 + k], "PeriodicBoundaries flag") != 0;
   r.expect_keyword("Dimension", 1);
   if (r.fields()[1] != "3D") r.fail("only 'Dimension 3D' geometries are supported");
   r.expect_keyword("BeginParticles", 0);
@@ -131,8 +136,10 @@ Geometry read_geo(const fs::path& file) {
   g.tag.reserve(n);
   for (long long i = 0; i < n; ++i) {
     auto f = r.next("a particle line 'x y z radius id tag'");
-    if (f[0] == "EndParticles") r.fail(fmt::format("particle count says {}, but only {} particles follow", n, i));
-    if (f.size() != 6) r.fail(fmt::format("particle line needs 6 fields 'x y z radius id tag', found {}", f.size()));
+    if (f[0] == "EndParticles")
+      r.fail(fmt::format("particle count says {}, but only {} particles follow", n, i));
+    if (f.size() != 6)
+      r.fail(fmt::format("particle line needs 6 fields 'x y z radius id tag', found {}", f.size()));
     Vec3 p{r.number<double>(f[0], "x"), r.number<double>(f[1], "y"), r.number<double>(f[2], "z")};
     double rad = r.number<double>(f[3], "radius");
     if (!(rad > 0)) r.fail(fmt::format("radius must be > 0, got {}", f[3]));
@@ -177,7 +184,8 @@ Geometry read_geo(const fs::path& file) {
     g.add_bond(a, c, r.number<std::int32_t>(b[2], "bond tag"));
   }
   auto ec = r.next("EndConnect");
-  if (ec[0] != "EndConnect") r.fail(fmt::format("expected 'EndConnect' after {} bonds (is the bond count too small?)", nb));
+  if (ec[0] != "EndConnect")
+    r.fail(fmt::format("expected 'EndConnect' after {} bonds (is the bond count too small?)", nb));
   if (!r.eof_after_whitespace()) r.fail("unexpected text after 'EndConnect'");
 
   g.attributes["source_format"] = "LSMGeometry 1.2";
@@ -192,13 +200,15 @@ void write_geo(const Geometry& g, const fs::path& file) {
   const fs::path tmp = file.string() + ".tmp";
   {
     std::FILE* out = std::fopen(tmp.c_str(), "w");
-    if (!out) throw FormatError(file, "", "cannot open for writing (does the folder exist and is it writable?)");
+    if (!out)
+      throw FormatError(file, "", "cannot open for writing (does the folder exist and is it writable?)");
     auto w = [&](std::string_view s) { return std::fwrite(s.data(), 1, s.size(), out) == s.size(); };
     bool ok = true;
     ok &= w("LSMGeometry 1.2\n");
-    ok &= w(fmt::format("BoundingBox {} {} {} {} {} {}\n", g.box_min[0], g.box_min[1], g.box_min[2], g.box_max[0],
-                        g.box_max[1], g.box_max[2]));
-    ok &= w(fmt::format("PeriodicBoundaries {} {} {}\n", int(g.periodic[0]), int(g.periodic[1]), int(g.periodic[2])));
+    ok &= w(fmt::format("BoundingBox {} {} {} {} {} {}\n", g.box_min[0], g.box_min[1], g.box_min[2],
+                        g.box_max[0], g.box_max[1], g.box_max[2]));
+    ok &= w(fmt::format("PeriodicBoundaries {} {} {}\n", int(g.periodic[0]), int(g.periodic[1]),
+                        int(g.periodic[2])));
     ok &= w("Dimension 3D\nBeginParticles\nSimple\n");
     ok &= w(fmt::format("{}\n", g.size()));
     fmt::memory_buffer buf;
