@@ -1,11 +1,11 @@
 #include "basalt/io/geometry.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <numeric>
 #include <unordered_set>
-
-#include <fmt/format.h>
 
 namespace basalt::io {
 

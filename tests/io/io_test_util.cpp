@@ -1,5 +1,7 @@
 #include "io_test_util.hpp"
 
+#include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <iterator>
 #include <sstream>
@@ -44,6 +46,7 @@ void expect_format_error(const std::function<void()>& f, std::initializer_list<s
     ADD_FAILURE() << "expected a FormatError mentioning '" << *fragments.begin() << "', nothing was thrown";
   } catch (const FormatError& e) {
     const std::string msg = e.what();
+    if (std::getenv("BASALT_TEST_SHOW_ERRORS")) std::printf("    error: %s\n", msg.c_str());
     for (const auto& frag : fragments)
       EXPECT_NE(msg.find(frag), std::string::npos) << "message '" << msg << "' lacks '" << frag << "'";
   }

@@ -19,7 +19,8 @@ Geometry sample_geometry();
 std::string read_bytes(const std::filesystem::path& file);
 void write_bytes(const std::filesystem::path& file, const std::string& bytes);
 
-/// Runs `f`, expects a FormatError whose message contains every fragment.
+/// Runs `f`, expects a FormatError whose message contains every fragment
+/// (BASALT_TEST_SHOW_ERRORS=1 prints each message, to review their wording).
 void expect_format_error(const std::function<void()>& f, std::initializer_list<std::string> fragments);
 
 /// Particle-by-particle equality (ids, exact positions, radii, tags, masses) and bonds.
