@@ -2,7 +2,7 @@
 // The geometry part of Basalt's HDF5 schemas (docs/formats.md), shared by "basalt-geometry" and
 // "basalt-checkpoint": root attributes for units, box and provenance; /particles, /bonds and
 // /statistics. Each schema adds its own identification and, for checkpoints, the run state.
-#include <initializer_list>
+#include <span>
 #include <string>
 #include <string_view>
 
@@ -11,7 +11,8 @@
 
 namespace basalt::io::h5 {
 
-using Names = std::initializer_list<std::string_view>;
+/// Names of root attributes a schema reserves for itself.
+using Names = std::span<const std::string_view>;
 
 /// Writes the `schema`, `schema_version` and `writer` root attributes.
 void write_schema(Writer& w, const std::string& schema, int version);

@@ -265,6 +265,12 @@ Writer::Writer(const fs::path& file, const fs::path& temp) : file_(file), temp_(
   H5Pset_fill_time(dcpl_.get(), H5D_FILL_TIME_NEVER);
   if (!fcpl.valid() || !gcpl_.valid() || !dcpl_.valid()) fail("", "cannot set up HDF5 property lists");
 
+  const fs::path folder = temp.has_parent_path() ? temp.parent_path() : fs::path(".");
+  std::error_code ec;
+  if (!fs::exists(folder, ec))
+    fail("", fmt::format("cannot create: folder '{}' does not exist", folder.string()));
+  if (!fs::is_directory(folder, ec))
+    fail("", fmt::format("cannot create: '{}' is not a folder", folder.string()));
   file_id_ = Handle(H5Fcreate(temp.c_str(), H5F_ACC_TRUNC, fcpl.get(), H5P_DEFAULT), H5Fclose);
   if (!file_id_.valid())
     fail("", fmt::format("cannot create '{}' (does the folder exist and is it writable?)", temp.string()));
