@@ -1,5 +1,6 @@
 // Geometry in HDF5 (schema "basalt-geometry" v1): round trip, byte-for-byte determinism,
 // atomic replacement, external readers (h5dump, h5py), and read_geometry's dispatch.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -168,4 +169,28 @@ TEST(ReadGeometry, MissingFileIsNamed) {
                       {(dir / "nope.geo").string(), "no such file"});
   fs::create_directories(dir / "folder.h5");
   expect_format_error([&] { read_geometry(dir / "folder.h5"); }, {"folder.h5", "is a folder"});
+}
+
+TEST(H5Geometry, SparseAndNegativeIdsAreCheckedLikeDenseOnes) {
+  const auto dir = basalt::test::scratch_dir("h5-sparse-ids");
+  for (std::int64_t far : {std::int64_t{7}, std::int64_t{1} << 62}) {  // dense bitmap, then hash set
+    Geometry g;
+    g.add_particle(-3, {0, 0, 0}, 1);
+    g.add_particle(far, {1, 0, 0}, 1);
+    g.add_particle(0, {2, 0, 0}, 1);
+    g.add_bond(far, -3);
+    write_h5(g, dir / "g.h5");
+    const auto back = read_h5(dir / "g.h5");
+    EXPECT_EQ(back.id, (std::vector<std::int64_t>{-3, 0, far}));
+    EXPECT_EQ(back.bonds[0], (Bond{-3, far, 0}));
+
+    Geometry missing = g;
+    missing.add_bond(0, far - 1);
+    expect_format_error([&] { write_h5(missing, dir / "m.h5"); },
+                        {"m.h5: bond 1", fmt::format("particle id {}, which does not exist", far - 1)});
+    Geometry duplicate = g;
+    duplicate.add_particle(far, {3, 0, 0}, 1);
+    expect_format_error([&] { write_h5(duplicate, dir / "d.h5"); },
+                        {"d.h5", fmt::format("duplicate id {}", far)});
+  }
 }
