@@ -194,3 +194,37 @@ TEST(H5Geometry, SparseAndNegativeIdsAreCheckedLikeDenseOnes) {
                         {"d.h5", fmt::format("duplicate id {}", far)});
   }
 }
+
+TEST(H5Geometry, FileWrittenWithH5pyFromTheDocsIsRead) {
+  const auto dir = basalt::test::scratch_dir("h5-from-h5py");
+  const auto file = dir / "made-by-h5py.h5";
+  const auto script = dir / "make.py";
+  // Written as a user following docs/formats.md would, with h5py's default types (int64 tags,
+  // int64 periodic flags, no /statistics group).
+  std::ofstream(script)
+      << "import h5py, numpy as np, sys\n"
+         "with h5py.File(sys.argv[1], 'w') as f:\n"
+         "    f.attrs['schema'] = 'basalt-geometry'\n"
+         "    f.attrs['schema_version'] = 1\n"
+         "    for k, v in [('length', 'mm'), ('time', 'ms'), ('force', 'N'), ('mass', '')]:\n"
+         "        f.attrs[k + '_unit'] = v\n"
+         "    f.attrs['box_min'] = [0.0, 0.0, 0.0]\n"
+         "    f.attrs['box_max'] = [3.0, 1.0, 1.0]\n"
+         "    f.attrs['periodic'] = [0, 0, 1]\n"
+         "    f.attrs['creator'] = 'a python script'\n"
+         "    f['particles/id'] = np.array([2, 5, 9])\n"
+         "    f['particles/position'] = np.array([[0.5, 0.5, 0.5], [1.5, 0.5, 0.5], [2.5, 0.5, 0.5]])\n"
+         "    f['particles/radius'] = np.full(3, 0.5)\n"
+         "    f['particles/tag'] = np.array([1, 1, 2])\n"
+         "    f['bonds/pairs'] = np.array([[2, 5], [5, 9]])\n"
+         "    f['bonds/tag'] = np.zeros(2, dtype=np.int32)\n";
+  run_and_capture("/usr/bin/python3 " + script.string() + " " + file.string(), dir / "py.txt");
+  const Geometry g = read_geometry(file);
+  EXPECT_EQ(g.id, (std::vector<std::int64_t>{2, 5, 9}));
+  EXPECT_EQ(g.position[2], (Vec3{2.5, 0.5, 0.5}));
+  EXPECT_EQ(g.tag, (std::vector<std::int32_t>{1, 1, 2}));
+  EXPECT_EQ(g.bonds[1], (Bond{5, 9, 0}));
+  EXPECT_EQ(g.periodic, (std::array<bool, 3>{false, false, true}));
+  EXPECT_EQ(g.attributes.at("creator"), "a python script");
+  EXPECT_TRUE(g.statistics.empty());
+}
