@@ -6,6 +6,7 @@
 #include <charconv>
 
 #include "basalt/io/checkpoint.hpp"
+#include "geometry_order.hpp"
 #include "h5_geometry_layout.hpp"
 #include "h5_support.hpp"
 
@@ -46,10 +47,8 @@ void write_checkpoint(const Checkpoint& c, const fs::path& file) {
   // The file stores particles sorted by id and bonds smaller id first; sort a copy if needed.
   Checkpoint storage;
   const Checkpoint* s = &c;
-  const auto order = h5::sorting_order(c.geometry.id);
-  const bool bonds_ordered =
-      std::all_of(c.geometry.bonds.begin(), c.geometry.bonds.end(), [](const Bond& b) { return b.a < b.b; });
-  if (!order.empty() || !bonds_ordered) {
+  if (!in_file_order(c.geometry)) {
+    const auto order = sorting_order(c.geometry.id);
     storage = c;
     storage.geometry.sort_by_id();  // the same stable order as `order`
     for (std::size_t k = 0; k < order.size(); ++k) storage.velocity[k] = c.velocity[order[k]];
