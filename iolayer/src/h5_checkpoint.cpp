@@ -77,7 +77,9 @@ void write_checkpoint(const Checkpoint& c, const fs::path& file) {
   w.commit();
 }
 
-Checkpoint read_checkpoint(const fs::path& file) {
+namespace {
+
+Checkpoint read_checkpoint_unguarded(const fs::path& file) {
   h5::Reader r(file);
   h5::check_schema(r, kSchema, kSchemaVersion);
   check_complete(r);
@@ -130,6 +132,12 @@ Checkpoint read_checkpoint(const fs::path& file) {
   r.close();
   c.validate(file);
   return c;
+}
+
+}  // namespace
+
+Checkpoint read_checkpoint(const fs::path& file) {
+  return h5::with_memory_guard(file, [&] { return read_checkpoint_unguarded(file); });
 }
 
 bool is_complete_checkpoint(const fs::path& file) {

@@ -12,11 +12,13 @@ constexpr int kSchemaVersion = 1;
 }  // namespace
 
 Geometry read_h5(const std::filesystem::path& file) {
-  h5::Reader r(file);
-  h5::check_schema(r, kSchema, kSchemaVersion);
-  Geometry g = h5::read_geometry_layout(r, {});
-  r.close();
-  return g;
+  return h5::with_memory_guard(file, [&] {
+    h5::Reader r(file);
+    h5::check_schema(r, kSchema, kSchemaVersion);
+    Geometry g = h5::read_geometry_layout(r, {});
+    r.close();
+    return g;
+  });
 }
 
 void write_h5(const Geometry& g, const std::filesystem::path& file) {
