@@ -8,6 +8,8 @@
 #include <fstream>
 #include <sstream>
 
+#include <fmt/format.h>
+
 #include "basalt/io/io_ranks.hpp"
 #include "test_support.hpp"
 
