@@ -134,6 +134,8 @@ int main(int argc, char** argv) {
     sub->add_option("--target-fraction", popt.target_fraction,
                     "with --exponent: solid fraction whose worth of radii is drawn")
         ->capture_default_str();
+    sub->add_flag("--fill", popt.fill_after,
+                  "with --exponent: afterwards fill the voids left as densely as possible");
     sub->add_option("--bond-tolerance", aopt.bond_tolerance,
                     "bond every pair whose gap |ci-cj|-ri-rj is <= this (length units)")
         ->capture_default_str();
@@ -206,8 +208,11 @@ int main(int argc, char** argv) {
       fmt::print("basalt-pack {}: {}\n", basalt::kVersion, volume->description());
       fmt::print("  particles            {}\n", st.particles);
       if (popt.exponent)
-        fmt::print("  radii drawn/placed   {} / {} (power law, exponent {})\n", packing.requested, st.particles,
-                   *popt.exponent);
+        fmt::print("  radii drawn/placed   {} / {} (power law, exponent {}){}\n", packing.requested,
+                   packing.requested - packing.not_placed, *popt.exponent,
+                   popt.fill_after ? fmt::format(", then {} filling voids", st.particles + packing.not_placed -
+                                                                                packing.requested)
+                                   : "");
       fmt::print("  solid fraction       {:.4f}\n", st.solid_fraction);
       fmt::print("  radii                {:.4g} .. {:.4g}\n", st.min_radius, st.max_radius);
       fmt::print("  fitted exponent      {:.3f}   (counts per log-radius bin ~ r^-alpha)\n", st.histogram.exponent);

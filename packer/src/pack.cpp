@@ -135,7 +135,7 @@ Packing pack(const Volume& volume, const PackOptions& opt) {
   }
   for (double r : out.radius) ctx.placed_solid += 4.0 / 3.0 * std::numbers::pi * r * r * r;
   detail::fill_voids(ctx);
-  if (opt.exponent) out.not_placed = out.requested - out.size();
+  out.not_placed = ctx.not_placed;
   if (opt.progress) opt.progress(1.0);
   return out;
 }

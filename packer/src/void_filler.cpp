@@ -72,12 +72,16 @@ class Filler {
         const double rho = radii[ctx_.next];
         for (;;) {
           auto it = voids_.lower_bound(Void{rho * (1 - 1e-12), 0, {}, {}});
-          if (it == voids_.end()) break;
+          if (it == voids_.end()) {
+            ++ctx_.not_placed;
+            break;
+          }
           const Void v = take(it);
           if (place(v, rho)) break;
         }
       }
-    } else {
+    }
+    if (!ctx_.radii || ctx_.options.fill_after) {
       while (!voids_.empty()) {
         const Void v = take(std::prev(voids_.end()));
         place(v, std::min(v.cap, rmax_));

@@ -4,7 +4,9 @@
 //  * dense (no exponent): GenGeo's aim, fill as densely as possible; the size distribution emerges.
 //  * power law (exponent alpha): radii follow the truncated power law N(>r) ~ r^-alpha (equivalently, the
 //    number of spheres per logarithmic radius interval ~ r^-alpha), placed largest first until the
-//    target solid fraction's worth of spheres is placed.
+//    target solid fraction's worth of spheres is placed; with fill_after, the voids left are then filled
+//    as in the dense mode (GenGeo-like assemblies: e.g. exponent 2.2 gives GenGeo's ~9,000 spheres per
+//    15 mm cube for radii 0.2-1.0).
 // Algorithm (docs/packer.md): random sequential seeding, then void filling on CGAL's regular (weighted
 // Delaunay) triangulation of the spheres and their mirror images across the boundary: each cell's void
 // gets the largest sphere tangent to its four spheres/planes, biggest voids first.
@@ -26,6 +28,8 @@ struct PackOptions {
   std::optional<double> exponent;
   /// Power-law mode: solid fraction whose worth of radii is drawn (placed largest first).
   double target_fraction = 0.55;
+  /// Power-law mode: afterwards fill the voids left as densely as possible (like the dense mode).
+  bool fill_after = false;
   /// Largest allowed overlap between two spheres, and between a sphere and the boundary.
   double overlap_tolerance = 1e-6;
   /// Solid fraction reached by random seeding before void filling starts.
