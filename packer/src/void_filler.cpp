@@ -18,6 +18,9 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <cstdio>
+#include <cstdlib>
+#include <queue>
 #include <set>
 
 #include "sphere_grid.hpp"
@@ -52,6 +55,18 @@ struct Void {
   bool operator<(const Void& o) const { return cap != o.cap ? cap < o.cap : serial < o.serial; }
 };
 
+/// Dense mode's queue entry: voids are taken slab by slab along z (the working set stays in cache), and
+/// within a slab largest first. Stale entries (their cell has died since) are skipped when taken.
+struct QueuedVoid {
+  Void v;
+  std::int32_t slab;
+  bool operator<(const QueuedVoid& o) const {  // "lower priority than"
+    if (slab != o.slab) return slab > o.slab;
+    if (v.cap != o.v.cap) return v.cap < o.v.cap;
+    return v.serial > o.v.serial;
+  }
+};
+
 Vec3 to_vec(const Point& p) { return {p.x(), p.y(), p.z()}; }
 
 class Filler {
@@ -63,6 +78,12 @@ class Filler {
         rmin_(ctx.options.rmin),
         rmax_(ctx.options.rmax),
         ghost_reach_(2 * ctx.options.rmax) {}
+
+  void report() const {
+    if (std::getenv("BASALT_PACK_DEBUG"))
+      std::fprintf(stderr, "evaluate %zu place %zu placed %zu vertices %zu cells %zu voids left %zu fail cap %zu fail three %zu\n", n_eval_,
+                   n_place_, ctx_.out.size(), rt_.number_of_vertices(), rt_.number_of_cells(), voids_.size(), n_fail_cap_, n_fail_three_);
+  }
 
   void run() {
     build();
@@ -81,7 +102,14 @@ class Filler {
         }
       }
     }
-    if (!ctx_.radii || ctx_.options.fill_after) {
+    if (!ctx_.radii) {
+      while (!queue_.empty()) {
+        const Void v = queue_.top().v;
+        queue_.pop();
+        if (v.cell->info().serial != v.serial) continue;  // the cell died
+        place(v, std::min(v.cap, rmax_));
+      }
+    } else if (ctx_.options.fill_after) {
       while (!voids_.empty()) {
         const Void v = take(std::prev(voids_.end()));
         place(v, std::min(v.cap, rmax_));
@@ -241,6 +269,7 @@ class Filler {
   }
 
   void evaluate(Cell c) {
+    ++n_eval_;
     auto& info = c->info();
     info.serial = ++serial_;
     info.cap = -1;
@@ -253,6 +282,11 @@ class Filler {
     if (!ball || ball->r < rmin_) return;
     const double cap = std::min(ball->r, vol_.signed_distance(ball->c));
     if (!(cap >= rmin_ * (1 - 1e-12))) return;
+    if (!ctx_.radii) {
+      queue_.push({Void{cap, info.serial, c, ball->c},
+                   static_cast<std::int32_t>(std::floor((ball->c[2] - zlo_) / slab_))});
+      return;
+    }
     info.cap = cap;
     voids_.insert(Void{cap, info.serial, c, ball->c});
   }
@@ -261,6 +295,7 @@ class Filler {
   /// Places a sphere of radius rho in the void: touching three of the cell's objects where it fits,
   /// else concentric with the void's ball. False when nothing fits (the void is then dropped).
   bool place(const Void& v, double rho) {
+    ++n_place_;
     CellObjects co;
     if (!objects_of(v.cell, co)) return false;
     candidates_.clear();
@@ -292,6 +327,7 @@ class Filler {
       commit(ball, v.cell);
       return true;
     }
+    ++(rho >= v.cap * (1 - 1e-12) ? n_fail_cap_ : n_fail_three_);
     return false;
   }
 
@@ -321,13 +357,17 @@ class Filler {
       ctx_.options.progress(std::min(0.99, ctx_.placed_solid / ctx_.expected_solid));
   }
 
+  std::size_t n_eval_ = 0, n_place_ = 0, n_fail_cap_ = 0, n_fail_three_ = 0;
   FillContext& ctx_;
   const Volume& vol_;
   const double tol_, rmin_, rmax_, ghost_reach_;
   Rt rt_;
   bool live_ = false;
   std::uint64_t serial_ = 0;
-  std::set<Void> voids_;
+  std::set<Void> voids_;                 // power-law mode: best fit by capacity
+  std::priority_queue<QueuedVoid> queue_;  // dense mode
+  const double zlo_ = vol_.bounds().lo[2];
+  const double slab_ = 6 * rmax_;
   std::vector<int> ghost_piece_;
   std::vector<bool> piece_flat_;
   std::vector<Cell> conflicts_, incident_;
@@ -341,6 +381,7 @@ class Filler {
 void fill_voids(FillContext& ctx) {
   Filler filler(ctx);
   filler.run();
+  filler.report();
 }
 
 }  // namespace basalt::packer::detail
