@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 #include <memory>
 #include <optional>
+#include <sys/resource.h>
 
 #include "basalt/io/geometry.hpp"
 #include "basalt/solver/core/errors.hpp"
@@ -25,6 +26,13 @@ namespace fs = std::filesystem;
 using namespace basalt::solver;
 
 namespace {
+
+/// User + system CPU seconds of this process.
+double cpu_seconds() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
 
 std::array<int, 3> parse_dims(const std::string& s) {
   std::array<int, 3> d{0, 0, 0};
@@ -114,8 +122,10 @@ int run(int argc, char** argv, MPI_Comm compute) {
 
   const double startup = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const auto t1 = std::chrono::steady_clock::now();
+  const double cpu0 = cpu_seconds();
   sim->run(scene.steps, sink.get());
   const double loop = comm.max(std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count());
+  const double cpu = comm.max(cpu_seconds() - cpu0);
 
   const auto& t = sim->times();
   const double n = std::max<double>(1, double(scene.steps));
@@ -126,6 +136,9 @@ int run(int argc, char** argv, MPI_Comm compute) {
     const double ps = double(sim->total_particles()) * double(scene.steps) / std::max(loop, 1e-12);
     fmt::print("done: {} steps in {:.3f} s ({:.1f} steps/s, {:.3f} M particle-steps/s); start-up {:.3f} s; {} rebuilds\n",
                scene.steps, loop, double(scene.steps) / std::max(loop, 1e-12), ps * 1e-6, startup, sim->rebuilds());
+    fmt::print("cpu time of the loop: {:.3f} s per rank (max), {:.0f} % of the wall time{}\n", cpu,
+               100 * cpu / std::max(loop, 1e-12),
+               cpu < 0.8 * loop ? ": the machine is shared, the wall time is inflated" : "");
     const char* names[5] = {"forces", "neighbour search", "communication", "integration", "output"};
     std::string line = "time per step:";
     for (int k = 0; k < 5; ++k)

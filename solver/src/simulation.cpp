@@ -241,7 +241,7 @@ void Simulation<Real>::resolve_bonds() {
     bonds_.ib[k] = ib;
   }
   if (comm().size() > 1) error = comm().agree_error(error);
-  if (error) throw RunError(*error);
+  if (error) stop(*error);
   // Both ends owned first, each part in memory order of its first end.
   std::vector<std::uint32_t> order(nb);
   for (std::uint32_t k = 0; k < nb; ++k) order[k] = k;
@@ -262,15 +262,15 @@ void Simulation<Real>::rebuild() {
   auto error = check_finite();
   const bool parallel = comm().size() > 1;
   if (parallel) error = comm().agree_error(error);
-  if (error) throw RunError(*error);
+  if (error) stop(*error);
   p_.drop_ghosts();
   if (parallel) {
     error = halo_->migrate(p_, bonds_);
     error = comm().agree_error(error);
-    if (error) throw RunError(*error);
+    if (error) stop(*error);
     const long long total = comm().sum(static_cast<long long>(p_.n_owned));
     if (total != n_global_)
-      throw RunError(fmt::format("step {}: {} particles on the ranks, {} expected: particles were lost", step_,
+      stop(fmt::format("step {}: {} particles on the ranks, {} expected: particles were lost", step_,
                                  total, n_global_));
   }
   times_.communication += sw.lap();
@@ -332,6 +332,7 @@ bool Simulation<Real>::energy_due(std::int64_t s) const {
 
 template <class Real>
 void Simulation<Real>::step(FieldSink* sink) {
+  sink_ = sink;
   Stopwatch sw;
   kick(p_, kick1_);
   const double moved2 = drift(p_, Real(scene_.dt));
@@ -400,12 +401,39 @@ void Simulation<Real>::save_fields(FieldSink* sink, const std::array<double, 3>&
     }
   }
   if (!any) return;
-  comm().sum_to_root(local);
+  if (comm().size() == 1) {
+    if (!sink) return;
+    std::vector<std::optional<double>> row(local.size());
+    for (std::size_t c = 0; c < local.size(); ++c)
+      if (due[c]) row[c] = local[c];
+    sink->row(step_, time_, row);
+    return;
+  }
+  finish_row(sink);
+  if (!row_sum_) row_sum_ = std::make_unique<AsyncSum>(comm());
+  row_sum_->start(std::move(local));
+  row_step_ = step_;
+  row_time_ = time_;
+  row_due_ = std::move(due);
+}
+
+template <class Real>
+void Simulation<Real>::stop(const std::string& message) {
+  // Collective (every caller has agreed on the error): deliver the row in flight, then stop.
+  finish_row(sink_);
+  if (sink_ && comm().rank() == 0) sink_->flush();
+  throw RunError(message);
+}
+
+template <class Real>
+void Simulation<Real>::finish_row(FieldSink* sink) {
+  if (!row_sum_ || !row_sum_->active()) return;
+  const auto& sums = row_sum_->finish();
   if (comm().rank() != 0 || !sink) return;
-  std::vector<std::optional<double>> row(local.size());
-  for (std::size_t c = 0; c < local.size(); ++c)
-    if (due[c]) row[c] = local[c];
-  sink->row(step_, time_, row);
+  std::vector<std::optional<double>> row(sums.size());
+  for (std::size_t c = 0; c < sums.size(); ++c)
+    if (row_due_[c]) row[c] = sums[c];
+  sink->row(row_step_, row_time_, row);
 }
 
 template <class Real>
@@ -435,7 +463,7 @@ void Simulation<Real>::guard_energy(const std::array<double, 3>& pe) {
         "{:.3g} x the critical time step {:.6g}",
         step_, e, v[0], v[1], v[2], v[3], energy0_, v[4], p_.id[bi], best, p_.vx[bi], p_.vy[bi], p_.vz[bi],
         p_.x[bi], p_.y[bi], p_.z[bi], scene_.dt, stability_.fraction, stability_.dt_critical);
-  throw RunError(comm().broadcast(msg, who));
+  stop(comm().broadcast(msg, who));
 }
 
 template <class Real>
@@ -462,6 +490,7 @@ void Simulation<Real>::run(std::int64_t steps, FieldSink* sink) {
       }
     }
   }
+  finish_row(sink);
   if (sink && comm().rank() == 0) sink->flush();
 }
 

@@ -50,8 +50,11 @@ class Simulation {
 
   /// Runs `steps` steps (scene.steps when negative), writing field rows to `sink` (rank 0 only; may be null).
   void run(std::int64_t steps = -1, FieldSink* sink = nullptr);
-  /// One step.
+  /// One step. On more than one rank a step's field row reaches the sink during the next step (its
+  /// reduction overlaps that step's work); run() and flush_fields() deliver the last one.
   void step(FieldSink* sink = nullptr);
+  /// Collective: delivers a field row still in flight to the sink.
+  void flush_fields(FieldSink* sink) { finish_row(sink); }
 
   // State and diagnostics (collective where noted).
   std::int64_t current_step() const { return step_; }
@@ -98,6 +101,10 @@ class Simulation {
   template <bool Energy>
   std::array<double, 3> compute_forces();
   void save_fields(FieldSink* sink, const std::array<double, 3>& pe);
+  /// Writes the row whose reduction is still in flight (ranks > 1), if any.
+  void finish_row(FieldSink* sink);
+  /// Collective: delivers pending output, then throws RunError(message).
+  [[noreturn]] void stop(const std::string& message);
   void guard_energy(const std::array<double, 3>& pe);
   bool energy_due(std::int64_t s) const;
 
@@ -105,6 +112,11 @@ class Simulation {
   RunOptions options_;
   std::unique_ptr<Decomposition> dec_;
   std::unique_ptr<Halo<Real>> halo_;
+  std::unique_ptr<AsyncSum> row_sum_;  ///< the last field row's reduction, finished one step later
+  std::int64_t row_step_ = 0;
+  double row_time_ = 0;
+  std::vector<char> row_due_;
+  FieldSink* sink_ = nullptr;  ///< the sink of the current step (for output delivered on errors)
   Particles<Real> p_;
   Bonds<Real> bonds_;
   IdMap ids_;
