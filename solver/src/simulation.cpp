@@ -230,6 +230,9 @@ void Simulation<Real>::resolve_bonds() {
           "step {}: the bond between particle ids {} and {} is longer than the ghost width {:.6g} (particle {} "
           "is not within reach of rank {}): bonds must not stretch beyond the longest initial bond + skin",
           step_, bonds_.a[k], bonds_.b[k], ghost_width_, ia < 0 ? bonds_.a[k] : bonds_.b[k], comm().rank());
+      if (stability_.warn)
+        *error += fmt::format(" (dt is {:.3g} x the critical time step: the run is probably unstable)",
+                              stability_.fraction);
       ia = std::max(ia, 0);
       ib = std::max(ib, 0);
     }
