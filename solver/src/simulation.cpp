@@ -310,16 +310,28 @@ void Simulation<Real>::rebuild() {
 
 template <class Real>
 template <bool Energy>
-std::array<double, 3> Simulation<Real>::compute_forces() {
+std::array<double, 3> Simulation<Real>::compute_forces(bool ghosts_in_flight) {
+  // Interactions among owned particles first: a ghost update still in flight overlaps them.
   zero_forces(p_);
   std::array<double, 3> pe{0, 0, 0};
   const std::size_t before = broken_.size();
-  if (bonds_.size() > 0) pe[0] = bond_driver_.template compute<Energy>(p_, bonds_, broken_);
-  if (!pair_driver_.empty()) pe[1] = pair_driver_.template compute<Energy>(p_, own_, ghost_);
+  const bool bonds = bonds_.size() > 0, pairs = !pair_driver_.empty();
+  if (bonds) pe[0] += bond_driver_.template compute_part<Energy, true>(p_, bonds_, broken_);
+  if (pairs) pe[1] += pair_driver_.template compute<Energy, true>(p_, own_);
   if (!wall_driver_.empty()) {
     wall_driver_.move_to(time_);
     pe[2] = wall_driver_.template compute<Energy>(p_);
   }
+  if (ghosts_in_flight) {
+    Stopwatch sw;
+    halo_->end_update_ghosts(p_);
+    ghost_wait_ += sw.lap();
+  }
+  if (bonds) {
+    pe[0] += bond_driver_.template compute_part<Energy, false>(p_, bonds_, broken_);
+    bond_driver_.commit(bonds_);
+  }
+  if (pairs) pe[1] += pair_driver_.template compute<Energy, false>(p_, ghost_);
   if (broken_.size() != before) bond_broke_ = true;  // the lists must learn the pair is now unbonded
   return pe;
 }
@@ -344,18 +356,23 @@ void Simulation<Real>::step(FieldSink* sink) {
   double need = bond_broke_ ? std::numeric_limits<double>::infinity() : moved2;
   if (parallel) need = comm().max(need);
   times_.communication += sw.lap();
+  bool in_flight = false;
   if (!(need <= rebuild_limit2_)) {
     rebuild();
     sw.lap();
   } else if (parallel) {
-    halo_->update_ghosts(p_);
+    halo_->begin_update_ghosts(p_);
+    in_flight = true;
     times_.communication += sw.lap();
   }
   ++step_;
   time_ = double(step_) * scene_.dt;
   const bool energy = energy_due(step_);
-  const auto pe = energy ? compute_forces<true>() : compute_forces<false>();
-  times_.forces += sw.lap();
+  ghost_wait_ = 0;
+  const auto pe = energy ? compute_forces<true>(in_flight) : compute_forces<false>(in_flight);
+  const double force_time = sw.lap();
+  times_.forces += force_time - ghost_wait_;
+  times_.communication += ghost_wait_;
   if (kick2_ != Real(0)) kick(p_, kick2_);
   times_.integration += sw.lap();
   if (!wall_driver_.empty()) wall_work_in_ += std::max(0.0, wall_driver_.power(time_)) * scene_.dt;

@@ -98,8 +98,10 @@ class Simulation {
   void resolve_bonds();
   void spatial_sort();
   std::optional<std::string> check_finite() const;
+  /// Forces at the current positions; ghosts_in_flight: a ghost update was begun and is completed
+  /// after the owned-only interactions.
   template <bool Energy>
-  std::array<double, 3> compute_forces();
+  std::array<double, 3> compute_forces(bool ghosts_in_flight = false);
   void save_fields(FieldSink* sink, const std::array<double, 3>& pe);
   /// Writes the row whose reduction is still in flight (ranks > 1), if any.
   void finish_row(FieldSink* sink);
@@ -141,6 +143,7 @@ class Simulation {
   double energy0_ = 0;
   double wall_work_in_ = 0;  ///< this rank's share of the positive work done by walls
   PhaseTimes times_;
+  double ghost_wait_ = 0;
   StabilityReport stability_;
 };
 
