@@ -245,14 +245,16 @@ void Simulation<Real>::resolve_bonds() {
   }
   if (comm().size() > 1) error = comm().agree_error(error);
   if (error) stop(*error);
-  // Both ends owned first, each part in memory order of its first end.
-  std::vector<std::uint32_t> order(nb);
-  for (std::uint32_t k = 0; k < nb; ++k) order[k] = k;
-  auto key = [&](std::uint32_t k) {
-    const bool ghost = static_cast<std::size_t>(bonds_.ib[k]) >= n;
-    return std::pair<int, std::int32_t>(ghost ? 1 : 0, bonds_.ia[k]);
+  // Both ends owned first, each part in memory order of its owned end (a counting sort: O(bonds)).
+  std::vector<std::uint32_t> start(2 * n + 1, 0);
+  auto key = [&](std::size_t k) {
+    return (static_cast<std::size_t>(bonds_.ib[k]) >= n ? n : 0) + static_cast<std::size_t>(bonds_.ia[k]);
   };
-  std::sort(order.begin(), order.end(), [&](std::uint32_t i, std::uint32_t j) { return key(i) < key(j); });
+  for (std::size_t k = 0; k < nb; ++k) ++start[key(k) + 1];
+  for (std::size_t c = 0; c < 2 * n; ++c) start[c + 1] += start[c];
+  std::vector<std::uint32_t> order(nb);
+  for (std::size_t k = 0; k < nb; ++k) order[start[key(k)]++] = static_cast<std::uint32_t>(k);
+  std::vector<std::uint32_t>().swap(start);
   bonds_.permute(order);
   bonds_.n_both_owned = 0;
   while (bonds_.n_both_owned < nb && static_cast<std::size_t>(bonds_.ib[bonds_.n_both_owned]) < n)
@@ -297,6 +299,7 @@ void Simulation<Real>::rebuild() {
     exclusions_.release();
   }
   grid_.release();
+  if (!wall_driver_.empty()) wall_driver_.rebuild(p_, scene_.skin);
   for (std::size_t i = 0; i < p_.n_owned; ++i) {
     p_.x0[i] = float(p_.x[i]);
     p_.y0[i] = float(p_.y[i]);
@@ -312,7 +315,8 @@ template <class Real>
 template <bool Energy>
 std::array<double, 3> Simulation<Real>::compute_forces(bool ghosts_in_flight) {
   // Interactions among owned particles first: a ghost update still in flight overlaps them.
-  zero_forces(p_);
+  if (!forces_zeroed_) zero_forces(p_);
+  forces_zeroed_ = false;
   std::array<double, 3> pe{0, 0, 0};
   const std::size_t before = broken_.size();
   const bool bonds = bonds_.size() > 0, pairs = !pair_driver_.empty();
@@ -349,11 +353,15 @@ template <class Real>
 void Simulation<Real>::step(FieldSink* sink) {
   sink_ = sink;
   Stopwatch sw;
-  kick(p_, kick1_);
-  const double moved2 = drift(p_, Real(scene_.dt));
+  // Forces are zeroed in the same pass: the non-finite check needs them only at a rebuild, and a
+  // non-finite force has already made the velocity non-finite.
+  const double moved2 = kick_zero_drift(p_, kick1_, Real(scene_.dt));
+  forces_zeroed_ = true;
   times_.integration += sw.lap();
   const bool parallel = comm().size() > 1;
-  double need = bond_broke_ ? std::numeric_limits<double>::infinity() : moved2;
+  if (!wall_driver_.empty()) wall_driver_.move_to(double(step_ + 1) * scene_.dt);
+  double need = bond_broke_ ? std::numeric_limits<double>::infinity()
+                            : std::max(moved2, wall_driver_.empty() ? 0.0 : wall_driver_.moved2_since_rebuild());
   if (parallel) need = comm().max(need);
   times_.communication += sw.lap();
   bool in_flight = false;
@@ -542,7 +550,8 @@ std::size_t Simulation<Real>::memory_bytes() const {
   add(bonds_.group);
   add(bonds_.ia);
   add(bonds_.ib);
-  b += own_.memory_bytes() + ghost_.memory_bytes() + ids_.memory_bytes() + halo_->memory_bytes();
+  b += own_.memory_bytes() + ghost_.memory_bytes() + ids_.memory_bytes() + halo_->memory_bytes() +
+       wall_driver_.memory_bytes();
   return b;
 }
 

@@ -144,6 +144,7 @@ class Simulation {
   double wall_work_in_ = 0;  ///< this rank's share of the positive work done by walls
   PhaseTimes times_;
   double ghost_wait_ = 0;
+  bool forces_zeroed_ = false;  ///< set by the fused kick-zero-drift pass
   StabilityReport stability_;
 };
 
