@@ -37,7 +37,11 @@ def basalt(a, geo, np_, steps, out):
     text = sh(cmd).stdout
     m = re.search(r"done: .* \(([0-9.]+) steps/s, ([0-9.]+) M particle-steps/s\)", text)
     phases = re.search(r"time per step: (.*)", text)
-    return float(m.group(2)) * 1e6, phases.group(1) if phases else ""
+    cpu = re.search(r"cpu time of the loop: ([0-9.]+) s per rank \(max\), ([0-9]+) %", text)
+    ph = phases.group(1) if phases else ""
+    if cpu:
+        ph += f"; cpu {cpu.group(1)} s per rank = {cpu.group(2)} % of the wall time"
+    return float(m.group(2)) * 1e6, ph
 
 
 def lammps(a, geo, np_, steps, out):
