@@ -191,8 +191,19 @@ int main(int argc, char** argv) {
     auto geometry = basalt::packer::assemble(*volume, packing, popt, aopt, st);
     const double total_seconds = bar.seconds();
 
+    // The command line without the output name (and -q), so that the same arguments give the same bytes
+    // whatever the file is called.
     std::string command = "basalt-pack";
-    for (int i = 1; i < argc; ++i) command += std::string(" ") + argv[i];
+    for (int i = 1; i < argc; ++i) {
+      const std::string arg = argv[i];
+      if (arg == "-o" || arg == "--output") {
+        ++i;
+        continue;
+      }
+      if (arg.rfind("--output=", 0) == 0 || (arg.rfind("-o", 0) == 0 && arg.size() > 2)) continue;
+      if (arg == "-q" || arg == "--quiet") continue;  // changes nothing in the file
+      command += " " + arg;
+    }
     geometry.attributes["creator"] = fmt::format("basalt-pack {}", basalt::kVersion);
     geometry.attributes["command_line"] = command;
     if (record_time) {

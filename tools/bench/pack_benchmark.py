@@ -7,7 +7,7 @@ alternating, `--repeats` times each, and reports medians and the ratio. With --l
 1 M spheres and the paper's largest assembly (150 mm cube) once each under /usr/bin/time -v (wall time,
 peak RSS). Writes a markdown table to --out (default docs/bench/packer.md).
 
-Usage: /usr/bin/python3 tools/bench/pack_benchmark.py [--basalt-pack build/packer/basalt-pack]
+Usage: /usr/bin/python3 tools/bench/pack_benchmark.py [--basalt-pack build/bin/basalt-pack]
                                                      [--repeats 5] [--large] [--out docs/bench/packer.md]
 """
 import argparse
@@ -63,7 +63,7 @@ def med(rows, key):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--basalt-pack", default=os.path.join(ROOT, "build", "packer", "basalt-pack"))
+    ap.add_argument("--basalt-pack", default=os.path.join(ROOT, "build", "bin", "basalt-pack"))
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--large", action="store_true", help="also the ~1 M and the 150 mm (~8.7 M) packs")
     ap.add_argument("--large-only", action="store_true", help="only the large packs")
@@ -75,7 +75,7 @@ def main():
     exe = os.path.abspath(a.basalt_pack)
     tmp = tempfile.mkdtemp(prefix="basalt-pack-bench-")
     cube = ["box", "--size", "15,15,15", "--rmin", "0.2", "--rmax", "1.0", "--overlap-tolerance", "1e-6",
-            "--bond-tolerance", "1e-5", "-q"]
+            "--bond-tolerance", "1e-5"]
     genlike = ["--exponent", "2.2", "--target-fraction", "0.62", "--fill"]
     have_gengeo = subprocess.run(["/usr/bin/python3", "-c", "import gengeo"], capture_output=True).returncode == 0
     gg, bp, bl = [], [], []
@@ -95,7 +95,7 @@ def main():
                 ("150 mm cube, dense", ["box", "--size", "150,150,150", "--rmin", "0.2", "--rmax", "1.0"]),
                 ("paper's largest: 150 mm cube, GenGeo-like (exponent 2.2, then fill)",
                  ["box", "--size", "150,150,150", "--rmin", "0.2", "--rmax", "1.0"] + genlike)):
-            r = basalt(exe, args + ["-q", "--seed", "1"], os.path.join(tmp, "large.geo"))
+            r = basalt(exe, args + ["--seed", "1"], os.path.join(tmp, "large.geo"))
             r["label"] = label
             large.append(r)
             print(f"{label}: {r['particles']} spheres, {r['seconds']:.1f} s, {r['rss_mib']:.0f} MiB", flush=True)
