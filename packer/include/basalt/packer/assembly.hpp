@@ -58,8 +58,8 @@ struct AssemblyStats {
   RadiusHistogram histogram;
   std::size_t bonds = 0;
   double bonds_per_particle = 0;
-  double mean_coordination = 0;   ///< touching neighbours per particle (gap <= bond tolerance)
-  double largest_overlap = 0;     ///< between two spheres
+  double mean_coordination = 0;         ///< touching neighbours per particle (gap <= bond tolerance)
+  double largest_overlap = 0;           ///< between two spheres
   double largest_boundary_overlap = 0;  ///< of a sphere beyond the boundary
   double min_radius = 0, max_radius = 0;
 };
