@@ -189,6 +189,16 @@ class Filler {
           ++count;
         }
       ghost_piece_.push_back(count == 1 ? piece : -1);
+      // Exact mirror images make many coplanar and co-orthospherical vertex sets, which send CGAL's
+      // predicates to exact arithmetic. Ghosts stand only for topology (tangency is solved against the
+      // plane itself), so a tiny deterministic nudge costs nothing and avoids that.
+      std::uint64_t h = 0x9e3779b97f4a7c15ULL * (ghost_piece_.size() + 1);
+      for (int k = 0; k < 3; ++k) {
+        h ^= h >> 31;
+        h *= 0xbf58476d1ce4e5b9ULL;
+        h ^= h >> 29;
+        g[k] += 1e-7 * rmax_ * (static_cast<double>(h >> 11) * 0x1.0p-53 - 0.5);
+      }
       auto gv = insert(g, r, -2 - static_cast<std::int32_t>(ghost_piece_.size() - 1), near);
       if (gv != Rt::Vertex_handle()) near = gv->cell();
     }
