@@ -88,20 +88,6 @@ std::vector<Pair> close_pairs(const std::vector<Vec3>& centre, const std::vector
 
 }  // namespace
 
-std::vector<std::pair<std::uint32_t, std::uint32_t>> find_touching_pairs(const std::vector<Vec3>& centre,
-                                                                         const std::vector<double>& radius,
-                                                                         double tolerance, int threads) {
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> out;
-  for (const Pair& p : close_pairs(centre, radius, tolerance, threads)) out.emplace_back(p.i, p.j);
-  return out;
-}
-
-double largest_pair_overlap(const std::vector<Vec3>& centre, const std::vector<double>& radius) {
-  double worst = 0;
-  for (const Pair& p : close_pairs(centre, radius, 0.0, 2)) worst = std::max(worst, -p.gap);
-  return worst;
-}
-
 TagLayer parse_tag_layer(const std::string& text) {
   const auto bad = [&](const std::string& why) {
     return PackError(
