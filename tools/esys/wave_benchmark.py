@@ -187,9 +187,12 @@ def launch(argv):
     env.setdefault("OMPI_ALLOW_RUN_AS_ROOT", "1")
     env.setdefault("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
     env.setdefault("OMPI_MCA_rmaps_base_oversubscribe", "1")
-    cmd = ["mpirun", "-np", str(workers + 1), "esysparticle", os.path.abspath(__file__)] + list(argv)
+    # Workers write checkpoints relative to their own working directory: start every rank in --output.
+    output = os.path.abspath(args.output)
+    child_args = list(argv) + ["--geometry", os.path.abspath(args.geometry), "--output", output]
+    cmd = ["mpirun", "-np", str(workers + 1), "esysparticle", os.path.abspath(__file__)] + child_args
     print("running:", " ".join(cmd), flush=True)
-    return subprocess.call(cmd, env=env)
+    return subprocess.call(cmd, env=env, cwd=output)
 
 
 def simulate(argv):
