@@ -3,7 +3,7 @@
 #
 #   tools/lammps/wave_benchmark.sh [--geometry FILE.geo] [--steps N] [--ranks R] [--ke]
 #                                  [--bond-model table|harmonic] [--skin S] [--output DIR]
-#                                  [--generate-side L]
+#                                  [--generate-side L] [--grid PX,PY,PZ]
 #
 # Converts the .geo with geo2data.py, runs in.wave.lmp with `mpirun -np R lmp` inside DIR and
 # prints LAMMPS's own loop time ("Loop time of ...": the stepping loop only) as particle-steps/s.
@@ -20,6 +20,7 @@ bond_model=table
 skin=0.04
 output=lammps_wave_out
 generate_side=0
+grid=""
 
 usage() { sed -n '2,12p' "$0" | sed 's/^# \{0,1\}//'; }
 need_value() { [[ $# -ge 2 && -n "$2" ]] || { echo "error: $1 needs a value" >&2; exit 2; }; }
@@ -33,12 +34,18 @@ while [[ $# -gt 0 ]]; do
     --skin) need_value "$@"; skin="$2"; shift 2 ;;
     --output) need_value "$@"; output="$2"; shift 2 ;;
     --generate-side) need_value "$@"; generate_side="$2"; shift 2 ;;
+    --grid) need_value "$@"; grid="$2"; shift 2 ;;
     -h|--help) usage; exit 0 ;;
     *) echo "error: unknown option '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
 [[ "$steps" =~ ^[1-9][0-9]*$ ]] || { echo "error: --steps must be a positive integer, got '$steps'" >&2; exit 2; }
 [[ "$ranks" =~ ^[1-9][0-9]*$ ]] || { echo "error: --ranks must be a positive integer, got '$ranks'" >&2; exit 2; }
+# default rank grid: split x only (the box is padded 50 % above the cube: z cuts unbalance the load)
+[[ -n "$grid" ]] || grid="$ranks,1,1"
+[[ "$grid" =~ ^[1-9][0-9]*,[1-9][0-9]*,[1-9][0-9]*$ ]] || { echo "error: --grid must be 'px,py,pz', got '$grid'" >&2; exit 2; }
+IFS=, read -r px py pz <<< "$grid"
+(( px * py * pz == ranks )) || { echo "error: --grid $grid does not multiply to --ranks $ranks" >&2; exit 2; }
 [[ "$bond_model" == table || "$bond_model" == harmonic ]] ||
   { echo "error: --bond-model must be table or harmonic, got '$bond_model'" >&2; exit 2; }
 
@@ -63,7 +70,7 @@ echo "conversion: $(echo "$(date +%s.%N) - $start" | bc) s"
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
 rm -f "$output/ke.dat"
 (cd "$output" && mpirun -np "$ranks" lmp -in "$here/in.wave.lmp" -log "$output/log.lammps" -echo none -screen none \
-  -var dir "$output" -var steps "$steps" -var ke "$ke" -var skin "$skin") ||
+  -var dir "$output" -var steps "$steps" -var ke "$ke" -var skin "$skin" -var px "$px" -var py "$py" -var pz "$pz") ||
   { echo "error: LAMMPS failed; see $output/log.lammps" >&2; tail -5 "$output/log.lammps" >&2; exit 1; }
 
 loop=$(grep -m1 '^Loop time of' "$output/log.lammps")
