@@ -8,11 +8,18 @@
 
 namespace basalt::io::detail {
 
+/// VTK's messages end in blank lines; keep the text only.
+inline std::string trimmed(const char* t) {
+  std::string s = t;
+  while (!s.empty() && (s.back() == '\n' || s.back() == ' ')) s.pop_back();
+  return s;
+}
+
 class VtkErrorCatcher : public vtkCommand {
  public:
   static VtkErrorCatcher* New() { return new VtkErrorCatcher; }
   void Execute(vtkObject* /*caller*/, unsigned long /*event*/, void* data) override {
-    if (message.empty() && data != nullptr) message = static_cast<const char*>(data);
+    if (message.empty() && data != nullptr) message = trimmed(static_cast<const char*>(data));
     ++count;
   }
   /// Listens for errors (and warnings: VTK's XML readers report unreadable data as warnings too).
@@ -26,6 +33,7 @@ class VtkErrorCatcher : public vtkCommand {
 
 }  // namespace basalt::io::detail
 
+#include <vtkLogger.h>
 #include <vtkOutputWindow.h>
 #include <vtkSmartPointer.h>
 
@@ -45,7 +53,7 @@ class CapturingOutputWindow : public vtkOutputWindow {
 
  private:
   void keep(const char* t) {
-    if (first.empty() && t != nullptr) first = t;
+    if (first.empty() && t != nullptr) first = trimmed(t);
   }
 };
 
@@ -54,13 +62,18 @@ class ScopedVtkMessages {
   ScopedVtkMessages()
       : previous_(vtkOutputWindow::GetInstance()), window_(vtkSmartPointer<CapturingOutputWindow>::New()) {
     vtkOutputWindow::SetInstance(window_);
+    vtkLogger::SetStderrVerbosity(vtkLogger::VERBOSITY_OFF);  // VTK also logs errors to stderr itself
   }
-  ~ScopedVtkMessages() { vtkOutputWindow::SetInstance(previous_); }
+  ~ScopedVtkMessages() {
+    vtkOutputWindow::SetInstance(previous_);
+    vtkLogger::SetStderrVerbosity(verbosity_);
+  }
   ScopedVtkMessages(const ScopedVtkMessages&) = delete;
   ScopedVtkMessages& operator=(const ScopedVtkMessages&) = delete;
   const std::string& first() const { return window_->first; }
 
  private:
+  vtkLogger::Verbosity verbosity_ = vtkLogger::GetCurrentVerbosityCutoff();
   vtkSmartPointer<vtkOutputWindow> previous_;
   vtkSmartPointer<CapturingOutputWindow> window_;
 };
