@@ -213,7 +213,12 @@ void render(const RenderOptions& o) {
   const int font = std::max(10, h / 48);
   auto bar = vtkSmartPointer<vtkScalarBarActor>::New();
   bar->SetLookupTable(lut);
-  bar->SetTitle(field_title(field, frame.info.units).c_str());
+  const std::string title = field_title(field, frame.info.units);
+  bar->SetTitle(title.c_str());
+  // The title must fit the colour bar's panel: about 0.6 font sizes per character.
+  const int panel_px = static_cast<int>(bar_width * o.size.width);
+  const int title_font = std::max(
+      7, std::min(font, static_cast<int>(0.9 * panel_px / (0.6 * static_cast<double>(title.size())))));
   bar->SetNumberOfLabels(6);
   bar->SetLabelFormat("%-#8.4g");
   bar->UnconstrainedFontSizeOn();
@@ -222,7 +227,7 @@ void render(const RenderOptions& o) {
   bar->SetBarRatio(0.3);
   bar->SetVerticalTitleSeparation(font);
   bar->SetTextPad(font / 3);
-  bar->GetTitleTextProperty()->SetFontSize(font);
+  bar->GetTitleTextProperty()->SetFontSize(title_font);
   bar->GetTitleTextProperty()->SetColor(1, 1, 1);
   bar->GetTitleTextProperty()->ItalicOff();
   bar->GetTitleTextProperty()->ShadowOff();
