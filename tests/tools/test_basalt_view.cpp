@@ -143,6 +143,29 @@ TEST(BasaltView, RendersGeometryWithCutAtRequestedSizeAndBothEndsOfTheMap) {
   EXPECT_GT(img.count(kHigh, 30, kSceneFraction), 30);
 }
 
+TEST(BasaltView, SkippingBuriedParticlesChangesAlmostNoPixel) {
+  const fs::path dir = basalt::test::scratch_dir("view-render-cull");
+  const fs::path geo = basalt::test::reference_dir() / "cube1.geo";
+  const std::string opts = "--color radius --cut z --size 480x360";
+  const Outcome fast =
+      basalt_view(fmt_args("render", geo.string(), "-o", (dir / "fast.png").string(), opts), dir);
+  const Outcome all =
+      basalt_view(fmt_args("render", geo.string(), "-o", (dir / "all.png").string(), opts + " --all"), dir);
+  ASSERT_EQ(fast.code, 0) << fast.out;
+  ASSERT_EQ(all.code, 0) << all.out;
+  EXPECT_NE(fast.out, all.out);  // fewer particles drawn
+  const Image a = read_png(dir / "fast.png"), b = read_png(dir / "all.png");
+  ASSERT_EQ(a.pixels.size(), b.pixels.size());
+  int differ = 0;
+  for (std::size_t i = 0; i < a.pixels.size(); ++i)
+    for (int c = 0; c < 3; ++c)
+      if (std::abs(a.pixels[i][c] - b.pixels[i][c]) > 2) {
+        ++differ;
+        break;
+      }
+  EXPECT_LT(differ, static_cast<int>(a.pixels.size() / 1000)) << "more than 0.1 % of the pixels differ";
+}
+
 TEST(BasaltView, RendersACheckpointFrameBySpeedWithClock) {
   const fs::path dir = basalt::test::scratch_dir("view-render-vtp");
   basalt::io::write_vtp(lattice_checkpoint(), dir / "frame.vtp");

@@ -1,11 +1,16 @@
 // basalt-view's input parsing: option values, field-series CSV, units. Pure functions, no X needed.
 #include <gtest/gtest.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkSmartPointer.h>
 
+#include <algorithm>
 #include <fstream>
 
 #include "basalt/io/geometry.hpp"
 #include "field_series.hpp"
 #include "options.hpp"
+#include "particle_selection.hpp"
 #include "test_support.hpp"
 #include "units.hpp"
 
@@ -120,4 +125,38 @@ TEST(ViewUnits, DerivedFromLengthTimeForce) {
   EXPECT_EQ(quantity_units("kinetic_energy", si), "N\u00b7m = J");
   EXPECT_EQ(quantity_units("mass", si), "kg");
   EXPECT_EQ(quantity_units("speed", si), "m/s");
+}
+
+TEST(ParticleSelection, BuriedParticlesAreDroppedAndTheSurfaceKept) {
+  // A 20^3 lattice with spacing 1 and radius 0.5; cell = 2 x radius = 1 lattice spacing.
+  auto pd = vtkSmartPointer<vtkPolyData>::New();
+  auto pts = vtkSmartPointer<vtkPoints>::New();
+  for (int k = 0; k < 20; ++k)
+    for (int j = 0; j < 20; ++j)
+      for (int i = 0; i < 20; ++i) pts->InsertNextPoint(i, j, k);
+  pd->SetPoints(pts);
+  std::vector<vtkIdType> all(8000);
+  for (vtkIdType i = 0; i < 8000; ++i) all[static_cast<std::size_t>(i)] = i;
+  const auto kept = drop_buried(*pd, all, 1.0);
+  // Kept: closer than one cell to a face (the outer layer, 20^3 - 18^3), nothing deeper.
+  EXPECT_EQ(kept.size(), 8000u - 18 * 18 * 18);
+  for (vtkIdType i : kept) {
+    const double* p = pd->GetPoint(i);
+    const double depth = std::min({p[0], p[1], p[2], 19 - p[0], 19 - p[1], 19 - p[2]});
+    EXPECT_LT(depth, 1.0);
+  }
+  // A hole (an empty cell) inside exposes its neighbours: they are kept.
+  std::vector<vtkIdType> holed;
+  const vtkIdType hole = (10 * 20 + 10) * 20 + 10;
+  for (vtkIdType i : all)
+    if (i != hole) holed.push_back(i);
+  const auto kept_holed = drop_buried(*pd, holed, 1.0);
+  EXPECT_EQ(kept_holed.size(), kept.size() + 26);
+
+  // The cut keeps the far half from the camera: seen from +x, x <= 9.5.
+  Cut cut;
+  const auto half = cut_indices(*pd, cut, parse_view("+x"));
+  EXPECT_EQ(half.size(), 4000u);
+  for (vtkIdType i : half) EXPECT_LE(pd->GetPoint(i)[0], 9.5);
+  EXPECT_EQ(select_points(*pd, half)->GetNumberOfVerts(), 4000);
 }

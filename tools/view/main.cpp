@@ -46,6 +46,11 @@ int main(int argc, char** argv) {
   render
       ->add_option("--mapper", r.mapper, "imposter (ray-cast spheres, fast) or glyph (triangulated spheres)")
       ->capture_default_str();
+  bool draw_all = false;
+  render->add_flag(
+      "--all", draw_all,
+      "draw every particle, also those buried inside the packing (slower; same picture up to a few "
+      "pixels)");
   render->add_flag("-q,--quiet", r.quiet, "print nothing on success");
 
   bv::ConvertOptions c;
@@ -88,6 +93,7 @@ int main(int argc, char** argv) {
       if (!range.empty()) r.range = bv::parse_range(range);
       if (!reference.empty()) r.reference = reference;
       r.color = color;
+      r.cull = !draw_all;
       bv::ensure_display(argc, argv);
       bv::render(r);
     } else if (convert->parsed()) {

@@ -22,6 +22,7 @@ void write_png(vtkRenderWindow& window, const fs::path& file) {
   auto writer = vtkSmartPointer<vtkPNGWriter>::New();
   writer->SetInputConnection(grab->GetOutputPort());
   writer->SetFileName(tmp.c_str());
+  writer->SetCompressionLevel(9);
   writer->Write();
   std::error_code ec;
   if (writer->GetErrorCode() != 0 || !fs::exists(tmp, ec) || fs::file_size(tmp, ec) == 0) {

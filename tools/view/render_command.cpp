@@ -29,6 +29,7 @@
 
 #include "color_field.hpp"
 #include "particle_frame.hpp"
+#include "particle_selection.hpp"
 #include "png_output.hpp"
 
 namespace basalt::view {
@@ -40,45 +41,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
-/// The particles on the camera's side of the cut are dropped, so the cut face looks at the camera.
-vtkSmartPointer<vtkPolyData> apply_cut(vtkPolyData& pd, const Cut& cut, const ViewDirection& view) {
-  double b[6];
-  pd.GetBounds(b);
-  const int axis = cut.axis;
-  const double value = cut.value.value_or(0.5 * (b[2 * axis] + b[2 * axis + 1]));
-  const bool keep_below = view.toward_camera[static_cast<std::size_t>(axis)] >= 0;
-  const vtkIdType n = pd.GetNumberOfPoints();
-  std::vector<vtkIdType> kept;
-  kept.reserve(static_cast<std::size_t>(n));
-  for (vtkIdType i = 0; i < n; ++i) {
-    const double c = pd.GetPoint(i)[axis];
-    if (keep_below ? c <= value : c >= value) kept.push_back(i);
-  }
-  auto out = vtkSmartPointer<vtkPolyData>::New();
-  auto pts = vtkSmartPointer<vtkPoints>::New();
-  pts->SetDataTypeToDouble();
-  pts->SetNumberOfPoints(static_cast<vtkIdType>(kept.size()));
-  out->GetPointData()->CopyAllocate(pd.GetPointData(), static_cast<vtkIdType>(kept.size()));
-  for (vtkIdType k = 0; k < static_cast<vtkIdType>(kept.size()); ++k) {
-    const vtkIdType i = kept[static_cast<std::size_t>(k)];
-    pts->SetPoint(k, pd.GetPoint(i));
-    out->GetPointData()->CopyData(pd.GetPointData(), i, k);
-  }
-  out->SetPoints(pts);
-  // One vertex per particle: the sphere mapper draws vertex cells.
-  const auto m = static_cast<vtkIdType>(kept.size());
-  auto offsets = vtkSmartPointer<vtkIdTypeArray>::New();
-  auto connectivity = vtkSmartPointer<vtkIdTypeArray>::New();
-  offsets->SetNumberOfTuples(m + 1);
-  connectivity->SetNumberOfTuples(m);
-  for (vtkIdType k = 0; k <= m; ++k) offsets->SetValue(k, k);
-  for (vtkIdType k = 0; k < m; ++k) connectivity->SetValue(k, k);
-  auto verts = vtkSmartPointer<vtkCellArray>::New();
-  verts->SetData(offsets, connectivity);
-  out->SetVerts(verts);
-  return out;
 }
 
 /// ParaView's "Cool to Warm": blue for low, red for high, perceptually even, readable on grey.
@@ -134,8 +96,22 @@ void render(const RenderOptions& o) {
   double full_bounds[6];
   full.GetBounds(full_bounds);
 
-  vtkSmartPointer<vtkPolyData> shown = frame.polydata;
-  if (o.cut) shown = apply_cut(full, *o.cut, o.view);
+  // Which particles to draw: the cut's half, less those buried inside the packing.
+  std::vector<vtkIdType> kept;
+  if (o.cut) {
+    kept = cut_indices(full, *o.cut, o.view);
+  } else {
+    kept.resize(static_cast<std::size_t>(total));
+    for (vtkIdType i = 0; i < total; ++i) kept[static_cast<std::size_t>(i)] = i;
+  }
+  const auto in_view = static_cast<vtkIdType>(kept.size());
+  if (o.cull) {
+    double rr[2];
+    full.GetPointData()->GetArray("radius")->GetRange(rr);
+    kept = drop_buried(full, kept, 2 * rr[1]);
+  }
+  vtkSmartPointer<vtkPolyData> shown =
+      static_cast<vtkIdType>(kept.size()) == total ? frame.polydata : select_points(full, kept);
   shown->GetPointData()->SetActiveScalars(field.c_str());
   const double read_s = seconds_since(t0);
 
@@ -240,7 +216,7 @@ void render(const RenderOptions& o) {
   auto text = vtkSmartPointer<vtkTextActor>::New();
   text->SetInput(fmt::format("{}\n{}: {} particles{}", describe_clock(frame.info, frame.kind),
                              o.input.filename().string(), total,
-                             o.cut ? fmt::format(" ({} shown, cut at {})", shown->GetNumberOfPoints(),
+                             o.cut ? fmt::format(" ({} behind the cut at {})", in_view,
                                                  std::string(1, static_cast<char>('x' + o.cut->axis)))
                                    : std::string())
                      .c_str());
@@ -281,10 +257,11 @@ void render(const RenderOptions& o) {
   const double draw_s = seconds_since(t1);
   if (!o.quiet)
     fmt::print(
-        "wrote {} ({}x{}, {} of {} particles coloured by {}, range {:.6g}..{:.6g}; read {:.2f} s, draw "
-        "{:.2f} s)\n",
-        o.output.string(), o.size.width, o.size.height, shown->GetNumberOfPoints(), total, field, range.min,
-        range.max, read_s, draw_s);
+        "wrote {} ({}x{}, {} particles, {} in view, {} drawn, coloured by {}, range {:.6g}..{:.6g}; read "
+        "{:.2f} s, "
+        "draw {:.2f} s)\n",
+        o.output.string(), o.size.width, o.size.height, total, in_view, shown->GetNumberOfPoints(), field,
+        range.min, range.max, read_s, draw_s);
 }
 
 }  // namespace basalt::view

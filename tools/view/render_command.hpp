@@ -18,6 +18,7 @@ struct RenderOptions {
   std::optional<Range> range;
   std::optional<std::filesystem::path> reference;
   std::string mapper = "imposter";  ///< "imposter" (GPU ray-cast spheres) or "glyph" (triangulated spheres)
+  bool cull = true;                 ///< skip particles buried inside the packing (hidden behind others)
   bool quiet = false;
 };
 
