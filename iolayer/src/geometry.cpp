@@ -1,11 +1,12 @@
 #include "basalt/io/geometry.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <numeric>
-#include <unordered_set>
 
-#include <fmt/format.h>
+#include "id_set.hpp"
 
 namespace basalt::io {
 
@@ -56,10 +57,15 @@ void Geometry::validate(const fs::path& source) const {
                                   position.size(), radius.size(), tag.size()));
   if (!mass.empty() && mass.size() != n)
     throw FormatError(source, "particles/mass", fmt::format("{} masses for {} particles", mass.size(), n));
-  std::unordered_set<std::int64_t> seen;
-  seen.reserve(n * 2);
+  std::int64_t lo = 0, hi = 0;
+  if (n) {
+    const auto [mn, mx] = std::minmax_element(id.begin(), id.end());
+    lo = *mn;
+    hi = *mx;
+  }
+  IdSet seen(lo, hi, n);
   for (std::size_t i = 0; i < n; ++i) {
-    if (!seen.insert(id[i]).second)
+    if (!seen.insert(id[i]))
       throw FormatError(source, fmt::format("particle {}", i), fmt::format("duplicate id {}", id[i]));
     const auto& p = position[i];
     if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
@@ -76,7 +82,7 @@ void Geometry::validate(const fs::path& source) const {
     if (b.a == b.b)
       throw FormatError(source, fmt::format("bond {}", k), fmt::format("joins particle {} to itself", b.a));
     for (auto e : {b.a, b.b})
-      if (!seen.count(e))
+      if (!seen.contains(e))
         throw FormatError(source, fmt::format("bond {}", k),
                           fmt::format("refers to particle id {}, which does not exist", e));
   }
