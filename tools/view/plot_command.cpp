@@ -99,7 +99,7 @@ void plot(const PlotOptions& o) {
   auto chart = vtkSmartPointer<vtkChartXY>::New();
   view->GetScene()->AddItem(chart);
 
-  const int font = std::max(10, o.size.height / 45);
+  const int font = std::max(10, o.size.height / 32);
   static const unsigned char palette[][3] = {{31, 119, 180}, {214, 39, 40},   {44, 160, 44},
                                              {255, 127, 14}, {148, 103, 189}, {140, 86, 75}};
   for (std::size_t k = 0; k < columns.size(); ++k) {
