@@ -166,6 +166,11 @@ def main():
              f"{a.lammps_skin} mm). Throughput = particles x steps / seconds of the stepping loop "
              "(start-up excluded), in particle-steps per second.", "",
              f"30 mm cube: {cube30_note}.", "",
+             "Reproduce: `bash tools/bench/wave_benchmark.sh [--repeats 3] [--steps 2000] [--steps30 1000]` "
+             "(add `--esys-30mm` for ESyS on the 30 mm cube: minutes per run). basalt-run also prints the CPU time "
+             "of its loop: when it is well below the wall time, other jobs had the cores, and the wall-time "
+             "throughput below understates what an idle machine gives (particles x steps / CPU seconds is then "
+             "the better estimate for 1 rank).", "",
              "## Throughput", "",
              "| case | ranks | Basalt | LAMMPS | ESyS-Particle | Basalt / LAMMPS | Basalt / ESyS | target (Basalt) |",
              "| --- | --- | --- | --- | --- | --- | --- | --- |"]
