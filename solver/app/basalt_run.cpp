@@ -183,6 +183,9 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
   }
   const double loop_local = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
   const io::OutputReport report = client.finish();
+  // An error the I/O ranks reported after the last check still fails the run (unless "continue").
+  if (!run_error && report.error && !cfg.continue_on_error)
+    run_error = fmt::format("output failed (reported at the end of the run): {}", *report.error);
   if (run_error) {
     if (root) print_report(report, layout.n_io);
     throw RunError(*run_error);
