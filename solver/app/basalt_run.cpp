@@ -116,16 +116,16 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
       info.periodic = ckpt->geometry.periodic;
       info.units = ckpt->geometry.units;
     } else {
-      const auto g = io::read_geometry(scene.geometry);
+      auto g = io::read_geometry(scene.geometry);
       if (root && (g.units.length != scene.units.length || g.units.time != scene.units.time ||
                    g.units.force != scene.units.force))
         fmt::print(stderr, "warning: the geometry declares units {}, {}, {}; the scene {}, {}, {}\n", g.units.length,
                    g.units.time, g.units.force, scene.units.length, scene.units.time, scene.units.force);
-      sim = std::make_unique<Simulation<double>>(scene, g, layout.compute, options);
       info.box_min = g.box_min;
       info.box_max = g.box_max;
       info.periodic = g.periodic;
       info.units = g.units;
+      sim = std::make_unique<Simulation<double>>(scene, std::move(g), layout.compute, options);
     }
     info.attributes = basalt::run::restart_attributes(sim->restart_layout());
     info.attributes["code_version"] = std::string(basalt::kVersion);

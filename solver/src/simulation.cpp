@@ -30,14 +30,14 @@ bool tags_match(const TagFilter& t, std::int64_t ta, std::int64_t tb) {
 }  // namespace
 
 template <class Real>
-Simulation<Real>::Simulation(const Scene& scene, const io::Geometry& g, MPI_Comm comm, const RunOptions& options)
+Simulation<Real>::Simulation(const Scene& scene, io::Geometry g, MPI_Comm comm, const RunOptions& options)
     : scene_(scene),
       options_(options),
       bond_driver_(scene.bonds),
       pair_driver_(scene.contacts),
       wall_driver_(scene.walls) {
   if (g.size() == 0) throw InputError(fmt::format("{}: the geometry has no particles", scene.geometry.string()));
-  if (scene.bonds.size() > 255) throw InputError("interactions: at most 255 bond groups");
+  if (scene.bonds.size() > 254) throw InputError("interactions: at most 254 bond groups");
   const bool se = scene.integrator == Integrator::symplectic_euler;
   kick1_ = Real(se ? scene.dt : scene.dt / 2);
   kick2_ = Real(se ? 0.0 : scene.dt / 2);
@@ -103,7 +103,7 @@ void Simulation<Real>::check_stability(const io::Geometry& g) {
 }
 
 template <class Real>
-void Simulation<Real>::distribute(const io::Geometry& g, MPI_Comm comm) {
+void Simulation<Real>::distribute(io::Geometry& g, MPI_Comm comm) {
   // The decomposition starts from the packing's bounding box; outer ranks own half-infinite regions.
   std::array<double, 3> lo{}, hi{};
   lo.fill(std::numeric_limits<double>::infinity());
@@ -122,7 +122,8 @@ void Simulation<Real>::distribute(const io::Geometry& g, MPI_Comm comm) {
   ids_.configure(g.id.front(), g.id.back(), g.size());
 
   // Which bond group takes each geometry bond (first match), and the longest bond.
-  std::vector<int> bond_group(g.bonds.size(), -1);
+  constexpr std::uint8_t kNone = 255;
+  std::vector<std::uint8_t> bond_group(g.bonds.size(), kNone);
   double longest = 0;
   std::size_t unassigned = 0;
   for (std::size_t k = 0; k < g.bonds.size(); ++k) {
@@ -132,10 +133,10 @@ void Simulation<Real>::distribute(const io::Geometry& g, MPI_Comm comm) {
       const auto& grp = scene_.bonds[gi];
       if (grp.bond_tag && *grp.bond_tag != b.tag) continue;
       if (!tags_match(grp.tags, g.tag[ia], g.tag[ib])) continue;
-      bond_group[k] = static_cast<int>(gi);
+      bond_group[k] = static_cast<std::uint8_t>(gi);
       break;
     }
-    if (bond_group[k] < 0) {
+    if (bond_group[k] == kNone) {
       ++unassigned;
       continue;
     }
@@ -155,8 +156,28 @@ void Simulation<Real>::distribute(const io::Geometry& g, MPI_Comm comm) {
   for (std::size_t i = 0; i < g.size(); ++i) {
     const auto& x = g.position[i];
     owned[i] = dec_->owns(x[0], x[1], x[2]);
-    n_mine += owned[i];
+    n_mine += static_cast<std::size_t>(owned[i]);
   }
+  // Bonds with an owned end, then particles; each part of the geometry is released once copied, so
+  // the geometry and the solver's copy never coexist in full (peak memory).
+  std::size_t n_bonds = 0;
+  for (std::size_t k = 0; k < g.bonds.size(); ++k)
+    if (bond_group[k] != kNone)
+      n_bonds += owned[static_cast<std::size_t>(g.index_of(g.bonds[k].a))] ||
+                 owned[static_cast<std::size_t>(g.index_of(g.bonds[k].b))];
+  bonds_.reserve(n_bonds);
+  for (std::size_t k = 0; k < g.bonds.size(); ++k) {
+    if (bond_group[k] == kNone) continue;
+    const auto& b = g.bonds[k];
+    const auto ia = static_cast<std::size_t>(g.index_of(b.a)), ib = static_cast<std::size_t>(g.index_of(b.b));
+    if (!owned[ia] && !owned[ib]) continue;
+    const auto& params = scene_.bonds[bond_group[k]].params;
+    const double r0 =
+        LinearBond::rest_length(params, g.radius[ia], g.radius[ib], distance(g.position[ia], g.position[ib]));
+    bonds_.push(b.a, b.b, Real(r0), bond_group[k]);
+  }
+  std::vector<io::Bond>().swap(g.bonds);
+  std::vector<std::uint8_t>().swap(bond_group);
   p_.reserve_owned(n_mine);
   for (std::size_t i = 0; i < g.size(); ++i) {
     if (!owned[i]) continue;
@@ -164,22 +185,10 @@ void Simulation<Real>::distribute(const io::Geometry& g, MPI_Comm comm) {
     p_.push_owned(g.id[i], Real(x[0]), Real(x[1]), Real(x[2]), Real(g.radius[i]), g.tag[i],
                   Real(1.0 / particle_mass(g, i, scene_.density)));
   }
-  std::size_t n_bonds = 0;
-  for (std::size_t k = 0; k < g.bonds.size(); ++k)
-    if (bond_group[k] >= 0)
-      n_bonds += owned[static_cast<std::size_t>(g.index_of(g.bonds[k].a))] ||
-                 owned[static_cast<std::size_t>(g.index_of(g.bonds[k].b))];
-  bonds_.reserve(n_bonds);
-  for (std::size_t k = 0; k < g.bonds.size(); ++k) {
-    if (bond_group[k] < 0) continue;
-    const auto& b = g.bonds[k];
-    const auto ia = static_cast<std::size_t>(g.index_of(b.a)), ib = static_cast<std::size_t>(g.index_of(b.b));
-    if (!owned[ia] && !owned[ib]) continue;
-    const auto& params = scene_.bonds[static_cast<std::size_t>(bond_group[k])].params;
-    const double r0 =
-        LinearBond::rest_length(params, g.radius[ia], g.radius[ib], distance(g.position[ia], g.position[ib]));
-    bonds_.push(b.a, b.b, Real(r0), static_cast<std::uint8_t>(bond_group[k]));
-  }
+  std::vector<io::Vec3>().swap(g.position);
+  std::vector<double>().swap(g.radius);
+  std::vector<double>().swap(g.mass);
+  std::vector<std::int32_t>().swap(g.tag);
 }
 
 template <class Real>

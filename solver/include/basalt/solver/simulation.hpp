@@ -54,9 +54,10 @@ struct RestartLayout {
 template <class Real = double>
 class Simulation {
  public:
-  /// Distributes the geometry over the ranks of `comm` and builds everything the scene needs.
-  /// Throws InputError (bad scene/geometry combination, unstable dt) on every rank alike.
-  Simulation(const Scene& scene, const io::Geometry& geometry, MPI_Comm comm, const RunOptions& options = {});
+  /// Distributes the geometry over the ranks of `comm` and builds everything the scene needs. The
+  /// geometry is taken by value and released part by part as it is copied: pass std::move(g) to keep
+  /// peak memory low. Throws InputError (bad scene/geometry combination, unstable dt) on every rank alike.
+  Simulation(const Scene& scene, io::Geometry geometry, MPI_Comm comm, const RunOptions& options = {});
 
   /// Continues a run from a checkpoint (simulation_restart.cpp): particles, velocities, masses,
   /// bonds with their rest lengths, step and time; the decomposition from `layout`. The first
@@ -116,7 +117,7 @@ class Simulation {
   std::size_t memory_bytes() const;
 
  private:
-  void distribute(const io::Geometry& g, MPI_Comm comm);
+  void distribute(io::Geometry& g, MPI_Comm comm);
   double kinetic_energy_local() const;
   double total_energy(const std::array<double, 3>& pe) const;
   void progress(std::int64_t done, std::int64_t total, double seconds) const;
