@@ -307,3 +307,74 @@ TEST(BasaltView, PlotsAValidSeriesAndNamesTheMalformedLine) {
   EXPECT_NE(r.code, 0);
   EXPECT_NE(r.out.find("available: kinetic_energy"), std::string::npos) << r.out;
 }
+
+TEST(BasaltView, RendersAnHdf5CheckpointAndAnHdf5Geometry) {
+  const fs::path dir = basalt::test::scratch_dir("view-render-h5");
+  const basalt::io::Checkpoint c = lattice_checkpoint();
+  basalt::io::write_checkpoint(c, dir / "ckpt_00003400.h5");
+  basalt::io::write_geometry(c.geometry, dir / "geometry.h5");
+
+  Outcome r = basalt_view(fmt_args("render", (dir / "ckpt_00003400.h5").string(), "-o",
+                                   (dir / "ckpt.png").string(), "--size 400x300 --view +x"),
+                          dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("coloured by speed"), std::string::npos) << r.out;
+  const Image img = read_png(dir / "ckpt.png");
+  ASSERT_EQ(img.width, 400);
+  EXPECT_GT(img.count(kLow, 30, kSceneFraction), 30);
+  EXPECT_GT(img.count(kHigh, 30, kSceneFraction), 30);
+
+  // A geometry .h5 has no velocities: radius by default; all radii equal, so one colour (the middle).
+  r = basalt_view(
+      fmt_args("render", (dir / "geometry.h5").string(), "-o", (dir / "geo.png").string(), "--size 400x300"),
+      dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("coloured by radius"), std::string::npos) << r.out;
+
+  // Displacement from a reference: the lattice moved by (0, 0, 0.25) has displacement 0.25 everywhere.
+  basalt::io::Checkpoint moved = c;
+  for (auto& p : moved.geometry.position) p[2] += 0.25;
+  basalt::io::write_checkpoint(moved, dir / "moved.h5");
+  r = basalt_view(fmt_args("convert", (dir / "moved.h5").string(), "-o", (dir / "moved.vtp").string(),
+                           "--reference", (dir / "geometry.h5").string()),
+                  dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  auto pd = read_vtp(dir / "moved.vtp");
+  vtkDataArray* d = pd->GetPointData()->GetArray("displacement");
+  ASSERT_NE(d, nullptr);
+  for (vtkIdType i = 0; i < pd->GetNumberOfPoints(); i += 97) {
+    EXPECT_EQ(d->GetComponent(i, 0), 0.0);
+    EXPECT_EQ(d->GetComponent(i, 2), (c.geometry.position[static_cast<std::size_t>(i)][2] + 0.25) -
+                                         c.geometry.position[static_cast<std::size_t>(i)][2]);
+  }
+}
+
+TEST(BasaltView, ConvertsCheckpointsToASeriesInTimeOrder) {
+  const fs::path dir = basalt::test::scratch_dir("view-convert-ckpt");
+  basalt::io::Checkpoint c = lattice_checkpoint();
+  c.step = 200;
+  c.time = 0.2;
+  basalt::io::write_checkpoint(c, dir / "ckpt_00000200.h5");
+  c.step = 100;
+  c.time = 0.1;
+  for (auto& v : c.velocity) v[0] = 0.5;
+  basalt::io::write_checkpoint(c, dir / "ckpt_00000100.h5");
+
+  const Outcome r =
+      basalt_view(fmt_args("convert", (dir / "ckpt_00000200.h5").string(),
+                           (dir / "ckpt_00000100.h5").string(), "-o", (dir / "run.pvd").string()),
+                  dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  basalt::io::PvdSeries series(dir / "run.pvd", true);
+  ASSERT_EQ(series.entries().size(), 2u);
+  EXPECT_EQ(series.entries()[0].time, 0.1);
+  EXPECT_EQ(series.entries()[0].file, "run/ckpt_00000100.vtp");
+  EXPECT_EQ(series.entries()[1].time, 0.2);
+  auto pd = read_vtp(dir / "run" / "ckpt_00000100.vtp");
+  vtkDataArray* v = pd->GetPointData()->GetArray("velocity");
+  ASSERT_NE(v, nullptr);
+  for (vtkIdType i = 0; i < pd->GetNumberOfPoints(); ++i) {
+    EXPECT_EQ(v->GetComponent(i, 0), 0.5);
+    EXPECT_EQ(v->GetComponent(i, 2), c.velocity[static_cast<std::size_t>(i)][2]);
+  }
+}

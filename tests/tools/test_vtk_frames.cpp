@@ -14,6 +14,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "basalt/io/vtk_frame_writer.hpp"
 #include "basalt/io/vtk_frames.hpp"
 #include "basalt/io/vtk_polydata.hpp"
 #include "test_support.hpp"
@@ -213,4 +214,55 @@ TEST(VtkFrames, PvdSeriesRewritesAtomicallyAndResumes) {
   } catch (const FormatError& e) {
     EXPECT_NE(std::string(e.what()).find("line 3"), std::string::npos) << e.what();
   }
+}
+
+namespace {
+FramePiece frame_piece(int source_rank, int n, std::int64_t first_id) {
+  FramePiece p;
+  p.source_rank = source_rank;
+  for (int i = 0; i < n; ++i) {
+    p.id.push_back(first_id + i);
+    p.position.push_back({0.5 * i, 1.0 / 3.0 * source_rank, 0.1 * i});
+    p.velocity.push_back({0, 0, 0.01 * i});
+    p.radius.push_back(0.25);
+    p.mass.push_back(0.1);
+    p.tag.push_back(source_rank);
+  }
+  return p;
+}
+}  // namespace
+
+TEST(VtkFrames, IoRankFrameWriterWritesPiecesPvtpAndResumableSeries) {
+  const fs::path dir = basalt::test::scratch_dir("vtk-ioranks");
+  // Two writers (I/O ranks), each serving two compute ranks; the second writer's share is empty at step 200.
+  VtkFrameWriter w0 = make_vtk_frame_writer(Units{}), w1 = make_vtk_frame_writer(Units{});
+  const std::vector<FramePiece> a{frame_piece(0, 10, 0), frame_piece(1, 5, 100)};
+  const std::vector<FramePiece> b{frame_piece(2, 7, 200), frame_piece(3, 0, 300)};
+  EXPECT_GT(w1(b, 100, 0.1, 1, 2, dir), 0u);
+  EXPECT_GT(w0(a, 100, 0.1, 0, 2, dir), 0u);
+  EXPECT_GT(w1({}, 200, 0.2, 1, 2, dir), 0u);
+  EXPECT_GT(w0(a, 200, 0.2, 0, 2, dir), 0u);
+
+  auto reader = vtkSmartPointer<vtkXMLPPolyDataReader>::New();
+  reader->SetFileName((dir / "frames" / "frame_00000100.pvtp").c_str());
+  reader->Update();
+  vtkPolyData* pd = reader->GetOutput();
+  ASSERT_EQ(pd->GetNumberOfPoints(), 22);
+  auto* id = array(pd, "id");
+  ASSERT_NE(id, nullptr);
+  EXPECT_EQ(id->GetTuple1(10), 100);  // second compute rank of writer 0
+  EXPECT_EQ(id->GetTuple1(15), 200);  // first particle of writer 1
+  EXPECT_EQ(pd->GetPoint(16)[1], 1.0 / 3.0 * 2);
+  auto step200 = read_polydata(dir / "frames" / "frame_00000200.pvtp");
+  EXPECT_EQ(step200->GetNumberOfPoints(), 15);  // writer 1 wrote an empty piece
+
+  ASSERT_EQ(PvdSeries(dir / "frames.pvd", true).entries().size(), 2u);
+  EXPECT_EQ(PvdSeries(dir / "frames.pvd", true).entries()[1].file, "frames/frame_00000200.pvtp");
+  // A restart at step 200 (a new writer) replaces the frame at t = 0.2 rather than listing it twice.
+  VtkFrameWriter restarted = make_vtk_frame_writer(Units{});
+  restarted(a, 200, 0.2, 0, 1, dir);
+  const PvdSeries after(dir / "frames.pvd", true);
+  ASSERT_EQ(after.entries().size(), 2u);
+  EXPECT_EQ(after.entries()[0].time, 0.1);
+  EXPECT_EQ(after.entries()[1].time, 0.2);
 }

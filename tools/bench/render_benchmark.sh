@@ -12,7 +12,7 @@ here="$(cd "$(dirname "$0")" && pwd)"
 root="$(cd "$here/../.." && pwd)"
 build="${1:-$root/build}"
 repeats="${2:-3}"
-view="$build/tools/view/basalt-view"
+view="$build/bin/basalt-view"
 tile="$build/tools/bench/basalt-tile-frame"
 geo="${BASALT_REFERENCE_DIR:-$root/../shared/reference}/cube1.geo"
 work="$(mktemp -d)"
@@ -24,19 +24,23 @@ trap 'rm -rf "$work"' EXIT
 median() { sort -g | awk '{a[NR]=$1} END {print (NR%2) ? a[(NR+1)/2] : (a[NR/2]+a[NR/2+1])/2}'; }
 
 run_all() {
-  printf "%-10s %-9s %10s %10s %10s  %s\n" frame mapper "wall [s]" "read [s]" "draw [s]" "(median of $repeats)"
+  printf "%-7s %-15s %9s %9s %9s %9s  %s\n" frame mode drawn "wall [s]" "read [s]" "draw [s]" "(median of $repeats)"
   for frame in tile1 tile5; do
-    for mapper in imposter glyph; do
+    for mode in imposter imposter-all glyph glyph-all; do
+      mapper="${mode%-all}"
+      extra=""
+      [ "$mode" != "$mapper" ] && extra="--all"
       walls=() ; reads=() ; draws=()
       for ((r = 0; r < repeats; r++)); do
         start=$(date +%s.%N)
-        line=$("$view" render "$work/$frame.vtp" -o "$work/$frame-$mapper.png" --color speed --cut x --mapper "$mapper")
+        line=$("$view" render "$work/$frame.vtp" -o "$work/$frame-$mode.png" --color speed --cut x --mapper "$mapper" $extra)
         end=$(date +%s.%N)
         walls+=("$(echo "$end - $start" | bc -l)")
         reads+=("$(echo "$line" | sed -E 's/.*read ([0-9.]+) s.*/\1/')")
         draws+=("$(echo "$line" | sed -E 's/.*draw ([0-9.]+) s.*/\1/')")
       done
-      printf "%-10s %-9s %10.2f %10.2f %10.2f\n" "$frame" "$mapper" \
+      drawn=$(echo "$line" | sed -E 's/.* ([0-9]+) drawn.*/\1/')
+      printf "%-7s %-15s %9s %9.2f %9.2f %9.2f\n" "$frame" "$mode" "$drawn" \
         "$(printf '%s\n' "${walls[@]}" | median)" "$(printf '%s\n' "${reads[@]}" | median)" \
         "$(printf '%s\n' "${draws[@]}" | median)"
     done

@@ -91,7 +91,7 @@ std::string field_units(const std::string& field, const io::Units& units) {
 
 std::string field_title(const std::string& field, const io::Units& units) {
   const std::string u = field_units(field, units);
-  return u.empty() ? field : fmt::format("{} [{}]", field, u);
+  return u.empty() ? field : fmt::format("{} ({})", field, u);
 }
 
 }  // namespace basalt::view

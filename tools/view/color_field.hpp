@@ -21,7 +21,7 @@ vtkSmartPointer<vtkDoubleArray> color_values(vtkPolyData& pd, const std::string&
 
 /// Units of a field from the frame's units: radius -> "mm", speed -> "mm/ms", id -> "" ...
 std::string field_units(const std::string& field, const io::Units& units);
-/// "speed [mm/ms]", or "id" when the field has no unit.
+/// "speed (mm/ms)", or "id" when the field has no unit.
 std::string field_title(const std::string& field, const io::Units& units);
 
 }  // namespace basalt::view

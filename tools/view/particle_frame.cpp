@@ -28,7 +28,6 @@ ParticleSet from_geometry(io::Geometry g) {
   return s;
 }
 
-#if BASALT_VIEW_HAVE_CHECKPOINT
 ParticleSet from_checkpoint(io::Checkpoint c) {
   ParticleSet s;
   s.info = io::info_of(c);
@@ -37,7 +36,6 @@ ParticleSet from_checkpoint(io::Checkpoint c) {
   s.kind = "checkpoint";
   return s;
 }
-#endif
 
 ParticleSet read_any(const fs::path& file) {
   std::error_code ec;
@@ -47,7 +45,6 @@ ParticleSet read_any(const fs::path& file) {
       throw io::FormatError(file, "", "unknown file type (expected .h5, .hdf5, .geo, .vtp or .pvtp)");
     return from_geometry(io::read_geometry(file));
   }
-#if BASALT_VIEW_HAVE_CHECKPOINT
   // A checkpoint extends the geometry schema: try it first, then a plain geometry.
   try {
     return from_checkpoint(io::read_checkpoint(file));
@@ -61,9 +58,6 @@ ParticleSet read_any(const fs::path& file) {
                       as_checkpoint.what(), as_geometry.what()));
     }
   }
-#else
-  return from_geometry(io::read_geometry(file));
-#endif
 }
 
 }  // namespace

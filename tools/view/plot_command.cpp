@@ -60,7 +60,7 @@ std::string pretty(std::string name) {
 
 std::string labelled(const std::string& column, const io::Units& u) {
   const std::string unit = quantity_units(column, u);
-  return unit.empty() ? pretty(column) : fmt::format("{} [{}]", pretty(column), unit);
+  return unit.empty() ? pretty(column) : fmt::format("{} ({})", pretty(column), unit);
 }
 
 }  // namespace
@@ -99,7 +99,7 @@ void plot(const PlotOptions& o) {
   auto chart = vtkSmartPointer<vtkChartXY>::New();
   view->GetScene()->AddItem(chart);
 
-  const int font = std::max(10, o.size.height / 45);
+  const int font = std::max(10, o.size.height / 32);
   static const unsigned char palette[][3] = {{31, 119, 180}, {214, 39, 40},   {44, 160, 44},
                                              {255, 127, 14}, {148, 103, 189}, {140, 86, 75}};
   for (std::size_t k = 0; k < columns.size(); ++k) {
@@ -119,12 +119,12 @@ void plot(const PlotOptions& o) {
       const std::string u0 = quantity_units(columns[0], units);
       const bool same = std::all_of(columns.begin(), columns.end(),
                                     [&](const std::string& c) { return quantity_units(c, units) == u0; });
-      ylabel = same && !u0.empty() ? fmt::format("value [{}]", u0) : "value";
+      ylabel = same && !u0.empty() ? fmt::format("value ({})", u0) : "value";
     }
   }
   vtkAxis* x = chart->GetAxis(vtkAxis::BOTTOM);
   vtkAxis* y = chart->GetAxis(vtkAxis::LEFT);
-  x->SetTitle(fmt::format("time [{}]", units.time));
+  x->SetTitle(fmt::format("time ({})", units.time));
   y->SetTitle(ylabel);
   for (vtkAxis* a : {x, y}) {
     a->GetTitleProperties()->SetFontSize(font);

@@ -80,6 +80,8 @@ void render(const RenderOptions& o) {
   require_writable(o.output.string());
   if (o.output.extension() != ".png")
     throw std::invalid_argument(fmt::format("output {}: render writes PNG images (.png)", o.output.string()));
+  if (o.mapper != "imposter" && o.mapper != "glyph")
+    throw std::invalid_argument(fmt::format("--mapper \"{}\": expected imposter or glyph", o.mapper));
   auto t0 = Clock::now();
   Frame frame = read_frame(o.input, o.reference);
   vtkPolyData& full = *frame.polydata;
@@ -91,8 +93,11 @@ void render(const RenderOptions& o) {
   std::string field = o.color;
   if (field.empty()) field = full.GetPointData()->GetArray("speed") ? "speed" : "radius";
   // Colour values are taken before the cut so that the range describes the whole frame.
-  full.GetPointData()->AddArray(color_values(full, field));
-  full.GetPointData()->SetActiveScalars(field.c_str());
+  const std::string color_array = "basalt-view colour: " + field;
+  auto values = color_values(full, field);
+  values->SetName(color_array.c_str());
+  full.GetPointData()->AddArray(values);
+  full.GetPointData()->SetActiveScalars(color_array.c_str());
   double full_bounds[6];
   full.GetBounds(full_bounds);
 
@@ -105,6 +110,12 @@ void render(const RenderOptions& o) {
     for (vtkIdType i = 0; i < total; ++i) kept[static_cast<std::size_t>(i)] = i;
   }
   const auto in_view = static_cast<vtkIdType>(kept.size());
+  if (in_view == 0) {
+    const int a = o.cut->axis;
+    throw std::invalid_argument(fmt::format("--cut: no particles left (the particles' {} runs from {} to {})",
+                                            static_cast<char>('x' + a), full_bounds[2 * a],
+                                            full_bounds[2 * a + 1]));
+  }
   if (o.cull) {
     double rr[2];
     full.GetPointData()->GetArray("radius")->GetRange(rr);
@@ -112,7 +123,7 @@ void render(const RenderOptions& o) {
   }
   vtkSmartPointer<vtkPolyData> shown =
       static_cast<vtkIdType>(kept.size()) == total ? frame.polydata : select_points(full, kept);
-  shown->GetPointData()->SetActiveScalars(field.c_str());
+  shown->GetPointData()->SetActiveScalars(color_array.c_str());
   const double read_s = seconds_since(t0);
 
   Range range;
@@ -120,7 +131,7 @@ void render(const RenderOptions& o) {
     range = *o.range;
   } else {
     double r[2];
-    full.GetPointData()->GetArray(field.c_str())->GetRange(r);
+    values->GetRange(r);
     range = {r[0], r[1]};
     if (!(range.min < range.max)) {  // a constant field: centre it in the map
       const double pad = range.min == 0 ? 1.0 : 0.05 * std::abs(range.min);
@@ -142,8 +153,6 @@ void render(const RenderOptions& o) {
     auto spheres = vtkSmartPointer<vtkOpenGLSphereMapper>::New();
     spheres->SetScaleArray("radius_float32");
     mapper = spheres;
-  } else if (o.mapper != "glyph") {
-    throw std::invalid_argument(fmt::format("--mapper \"{}\": expected imposter or glyph", o.mapper));
   }
   vtkSmartPointer<vtkMapper> any_mapper;
   if (mapper) {

@@ -75,6 +75,11 @@ void PvdSeries::truncate_after(double t) {
   rewrite();
 }
 
+void PvdSeries::truncate_before_or_at(double t) {
+  std::erase_if(entries_, [t](const Entry& e) { return e.time >= t; });
+  rewrite();
+}
+
 void PvdSeries::rewrite() const {
   std::string xml =
       "<?xml version=\"1.0\"?>\n"

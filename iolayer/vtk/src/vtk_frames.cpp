@@ -67,15 +67,19 @@ std::vector<Vec3> displacement_from(const Geometry& current, const Geometry& ref
   return d;
 }
 
-std::vector<ArrayLayout> layout_of(const ParticleArrays& a) {
+std::vector<ArrayLayout> frame_layout(bool mass, bool velocity, bool displacement) {
   std::vector<ArrayLayout> l{{"id", "Int64", 1}, {"radius", "Float64", 1}, {"tag", "Int32", 1}};
-  if (!a.mass.empty()) l.push_back({"mass", "Float64", 1});
-  if (!a.velocity.empty()) {
+  if (mass) l.push_back({"mass", "Float64", 1});
+  if (velocity) {
     l.push_back({"velocity", "Float64", 3});
     l.push_back({"speed", "Float64", 1});
   }
-  if (!a.displacement.empty()) l.push_back({"displacement", "Float64", 3});
+  if (displacement) l.push_back({"displacement", "Float64", 3});
   return l;
+}
+
+std::vector<ArrayLayout> layout_of(const ParticleArrays& a) {
+  return frame_layout(!a.mass.empty(), !a.velocity.empty(), !a.displacement.empty());
 }
 
 void write_vtp(const ParticleArrays& a, const FrameInfo& info, const fs::path& file,

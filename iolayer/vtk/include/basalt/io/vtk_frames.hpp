@@ -58,6 +58,8 @@ struct ArrayLayout {
 };
 /// The point-data arrays a piece made from `a` holds, in order (same on every piece of a frame).
 std::vector<ArrayLayout> layout_of(const ParticleArrays& a);
+/// The same, from which optional arrays are present.
+std::vector<ArrayLayout> frame_layout(bool mass, bool velocity, bool displacement);
 
 /// Writes one .vtp (atomically: temporary name, then rename). Throws FormatError naming the file.
 /// With `layout`, the file holds exactly those arrays (see write_piece).
@@ -91,6 +93,8 @@ class PvdSeries {
   void add(double time, const std::filesystem::path& file);
   /// Drops entries with time > t (a restart from an earlier checkpoint) and rewrites the file.
   void truncate_after(double t);
+  /// Drops entries with time >= t (before a restart writes the frame at t again); rewrites the file.
+  void truncate_before_or_at(double t);
 
   struct Entry {
     double time;
