@@ -29,7 +29,7 @@ STAGES = {
 
 def run(a, q, extra, out):
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
-               OMPI_MCA_rmaps_base_oversubscribe="1", OMPI_MCA_mpi_yield_when_idle="1")
+               OMPI_MCA_rmaps_base_oversubscribe="1", OMPI_MCA_mpi_yield_when_idle="0")  # compute ranks should not yield; the I/O rank sleeps by itself
     shutil.rmtree(out, ignore_errors=True)
     cmd = ["mpirun", "-np", str(1 + q), a.basalt_run, str(ROOT / "scenes/wave.toml"), "--geometry", a.geometry,
            "--steps", str(a.steps), "--quiet", "--frames-every", "0", "--io-ranks", str(q), "--output", str(out)] + extra
