@@ -24,6 +24,8 @@ STAGES = {
     "fields every step": ["--fields-every", "1", "--checkpoint-every", "0"],
     "checkpoint every 100": ["--fields-every", "0", "--checkpoint-every", "100"],
     "both": ["--fields-every", "1", "--checkpoint-every", "100"],
+    "checkpoint every 100, --no-exact-restart": ["--fields-every", "0", "--checkpoint-every", "100",
+                                                 "--no-exact-restart"],
 }
 
 
@@ -38,7 +40,8 @@ def run(a, q, extra, out):
         sys.exit(f"failed: {' '.join(cmd)}\n{p.stdout}\n{p.stderr}")
     loop = float(re.search(r"done: \d+ steps in ([0-9.]+) s", p.stdout).group(1))
     wait = float(re.search(r"compute ranks waited ([0-9.]+) s", p.stdout).group(1))
-    return loop, wait
+    cpu = float(re.search(r"loop CPU time: ([0-9.]+) s", p.stdout).group(1))
+    return loop, wait, cpu
 
 
 def main():
@@ -49,44 +52,43 @@ def main():
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--throttle", default="", help="MB/s values for the slow-storage table (0 = unthrottled)")
     ap.add_argument("--throttle-checkpoint-every", type=int, default=100)
+    ap.add_argument("--stages", default="", help="';'-separated subset of the stages (default: all)")
+    ap.add_argument("--output-root", default=None, help="where the runs write (default: the system's temp folder; "
+                    "/dev/shm takes the disk out of the measurement)")
     a = ap.parse_args()
-    tmp = Path(tempfile.mkdtemp(prefix="basalt-output-bench-"))
-    print(f"geometry {a.geometry}, {a.steps} steps, median of {a.repeats} (interleaved), loop seconds\n")
-    if not a.throttle:
-        times = {(s, q): [] for s in STAGES for q in (0, 1)}
-        waits = {(s, q): [] for s in STAGES for q in (0, 1)}
+    tmp = Path(tempfile.mkdtemp(prefix="basalt-output-bench-", dir=a.output_root))
+    print(f"geometry {a.geometry}, {a.steps} steps, median of {a.repeats} (interleaved), loop seconds, "
+          f"output under {tmp.parent}\n")
+    if a.stages:
+        for s in list(STAGES):
+            if s not in a.stages.split(";") and s != "none":
+                del STAGES[s]
+    def table(cases, label, extra_of, base_case):
+        res = {(c, q): [] for c in cases for q in (0, 1)}
         for _ in range(a.repeats):  # interleave so that load changes hit every case alike
-            for s, extra in STAGES.items():
+            for c in cases:
                 for q in (0, 1):
-                    t, w = run(a, q, extra, tmp / "out")
-                    times[(s, q)].append(t)
-                    waits[(s, q)].append(w)
-        print("| stage | Q = 0: loop s | vs none | Q = 1: loop s | vs none | Q = 1 compute wait s |")
-        print("| --- | --- | --- | --- | --- | --- |")
-        base = {q: statistics.median(times[("none", q)]) for q in (0, 1)}
-        for s in STAGES:
-            m0, m1 = statistics.median(times[(s, 0)]), statistics.median(times[(s, 1)])
-            print(f"| {s} | {m0:.3f} | {100 * (m0 / base[0] - 1):+.1f} % | {m1:.3f} | {100 * (m1 / base[1] - 1):+.1f} % "
-                  f"| {statistics.median(waits[(s, 1)]):.4f} |")
+                    res[(c, q)].append(run(a, q, extra_of(c), tmp / "out"))
+        med = {k: [statistics.median(x[i] for x in v) for i in range(3)] for k, v in res.items()}
+        print(f"| {label} | Q = 0: loop s | vs {base_case} | CPU s | vs {base_case} | Q = 1: loop s | vs {base_case} "
+              f"| CPU s | vs {base_case} | Q = 1 compute wait s |")
+        print("| --- " * 10 + "|")
+        for c in cases:
+            row = f"| {c} "
+            for q in (0, 1):
+                t, w, cpu = med[(c, q)]
+                bt, _, bcpu = med[(base_case, q)]
+                row += f"| {t:.3f} | {100 * (t / bt - 1):+.1f} % | {cpu:.3f} | {100 * (cpu / bcpu - 1):+.1f} % "
+            print(row + f"| {med[(c, 1)][1]:.4f} |")
+
+    if not a.throttle:
+        table(list(STAGES), "stage", lambda c: STAGES[c], "none")
     else:
         rates = [float(x) for x in a.throttle.split(",")]
-        extra = ["--fields-every", "0", "--checkpoint-every", str(a.throttle_checkpoint_every)]
-        times = {(r, q): [] for r in rates for q in (0, 1)}
-        waits = {(r, q): [] for r in rates for q in (0, 1)}
-        for _ in range(a.repeats):
-            for r in rates:
-                for q in (0, 1):
-                    t, w = run(a, q, extra + ["--throttle-io-mbps", str(r)], tmp / "out")
-                    times[(r, q)].append(t)
-                    waits[(r, q)].append(w)
-        print(f"checkpoint every {a.throttle_checkpoint_every} steps, storage throttled to R MB/s (0 = not throttled)\n")
-        print("| R MB/s | Q = 0: loop s | vs unthrottled | Q = 1: loop s | vs unthrottled | Q = 1 compute wait s |")
-        print("| --- | --- | --- | --- | --- | --- |")
-        base = {q: statistics.median(times[(rates[0], q)]) for q in (0, 1)}
-        for r in rates:
-            m0, m1 = statistics.median(times[(r, 0)]), statistics.median(times[(r, 1)])
-            print(f"| {r:g} | {m0:.3f} | {m0 / base[0]:.2f}x | {m1:.3f} | {m1 / base[1]:.2f}x | "
-                  f"{statistics.median(waits[(r, 1)]):.4f} |")
+        every = str(a.throttle_checkpoint_every)
+        print(f"checkpoint every {every} steps, storage throttled to R MB/s (0 = not throttled)\n")
+        table(rates, "R MB/s", lambda r: ["--fields-every", "0", "--checkpoint-every", every,
+                                          "--throttle-io-mbps", str(r)], rates[0])
     shutil.rmtree(tmp, ignore_errors=True)
 
 
