@@ -31,7 +31,10 @@ STAGES = {
 
 def run(a, q, extra, out):
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
-               OMPI_MCA_rmaps_base_oversubscribe="1", OMPI_MCA_mpi_yield_when_idle="0")  # compute ranks should not yield; the I/O rank sleeps by itself
+               OMPI_MCA_rmaps_base_oversubscribe="1", OMPI_MCA_mpi_yield_when_idle="0",
+               HWLOC_COMPONENTS="-gl")
+    # Compute ranks should not yield (the I/O rank sleeps by itself); hwloc's GL probe would connect to an
+    # X server on :0 if another session runs one, and die when it goes away.
     shutil.rmtree(out, ignore_errors=True)
     cmd = ["mpirun", "-np", str(1 + q), a.basalt_run, str(ROOT / "scenes/wave.toml"), "--geometry", a.geometry,
            "--steps", str(a.steps), "--quiet", "--frames-every", "0", "--io-ranks", str(q), "--output", str(out)] + extra

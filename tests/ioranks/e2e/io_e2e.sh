@@ -7,6 +7,8 @@ case_name=$1
 W=$WORK/$case_name
 rm -rf "$W"
 mkdir -p "$W"
+# hwloc's GL probe would connect to an X server on :0 if one runs (and die with it): not wanted.
+export HWLOC_COMPONENTS=-gl
 CHECK="/usr/bin/python3 $(dirname "$0")/output_checks.py"
 fail() { echo "FAIL ($case_name): $*"; exit 1; }
 
@@ -114,6 +116,25 @@ case $case_name in
     step=$(basename "$last" .h5 | sed 's/ckpt_0*//')
     grep -q "continuing from step $step ($last)" "$W/last.log" || { cat "$W/last.log"; fail "did not restart from $last"; }
     must_fail "ckpt_999999.h5" 2 --io-ranks 1 --steps 20 --output "$W/out2" --restart "$W/out/ckpt_999999.h5"
+    ;;
+  folder_removed)
+    # The output folder disappears mid-run: the next checkpoint fails naming its path, the run stops
+    # cleanly (exit 1, I/O rank released); a checkpoint completed elsewhere before stays restartable.
+    "$MPIEXEC" -np 2 "$BASALT_RUN" "$SCENE" --geometry "$GEOMETRY" --quiet --io-ranks 1 --steps 3000 \
+      --checkpoint-every 20 --throttle-io-mbps 8 --output "$W/out" >"$W/last.log" 2>&1 &
+    mpirun_pid=$!
+    for _ in $(seq 1 600); do
+      [ -e "$W/out/ckpt_000020.h5" ] && break
+      sleep 0.1
+    done
+    mkdir -p "$W/kept" && cp "$W/out/ckpt_000020.h5" "$W/kept/"
+    rm -rf "$W/out"
+    wait "$mpirun_pid"
+    code=$?
+    cat "$W/last.log"
+    [ $code -ne 0 ] || fail "the run succeeded although its output folder was removed"
+    grep -Eq "error: output failed.*$W/out/ckpt_0[0-9]+\.h5" "$W/last.log" || fail "the error does not name the file"
+    must_run 1 --steps 10 --output "$W/again" --restart "$W/kept"
     ;;
   other_scene)
     must_run 1 --steps 20 --checkpoint-every 20 --output "$W/out"
