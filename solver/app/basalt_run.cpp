@@ -16,7 +16,6 @@
 #include <fstream>
 #include <memory>
 #include <optional>
-
 #include <sys/resource.h>
 
 #include "basalt/io/checkpoint.hpp"
@@ -46,6 +45,12 @@ struct Cli {
   double throttle_mbps = 0;
   int frames_in_flight = 0;
 };
+/// User + system CPU seconds of this process.
+double cpu_seconds() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
 
 std::array<int, 3> parse_dims(const std::string& s) {
   std::array<int, 3> d{0, 0, 0};
@@ -78,14 +83,6 @@ void prepare_output_folder(const fs::path& dir) {
     }
   }
   if (auto e = Comm(MPI_COMM_WORLD).agree_error(error)) throw InputError(*e);
-}
-
-/// CPU time of the calling thread: on a shared machine the loop's wall time depends on what else
-/// runs; its CPU time shows what the run itself did.
-double thread_cpu_seconds() {
-  rusage u{};
-  getrusage(RUSAGE_THREAD, &u);
-  return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
 }
 
 std::string mb(std::uint64_t bytes) { return fmt::format("{:.2f} MB", double(bytes) * 1e-6); }
@@ -181,7 +178,7 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
   sim->set_canonical_every(scene.exact_restart ? cfg.checkpoint_every : 0);
   const double startup = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const auto t1 = std::chrono::steady_clock::now();
-  const double cpu1 = thread_cpu_seconds();
+  const double cpu0 = cpu_seconds();
   std::optional<std::string> run_error;
   if (client.error() && !cfg.continue_on_error) {
     run_error = *client.error();
@@ -193,7 +190,7 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
     }
   }
   const double loop_local = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
-  const double loop_cpu_local = thread_cpu_seconds() - cpu1;
+  const double cpu_local = cpu_seconds() - cpu0;
   const io::OutputReport report = client.finish();
   // An error the I/O ranks reported after the last check still fails the run (unless "continue").
   if (!run_error && report.error && !cfg.continue_on_error)
@@ -203,7 +200,7 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
     throw RunError(*run_error);
   }
   const double loop = comm.max(loop_local);
-  const double loop_cpu = comm.max(loop_cpu_local);
+  const double cpu = comm.max(cpu_local);
 
   const auto& t = sim->times();
   const double n = std::max<double>(1, double(steps));
@@ -214,14 +211,15 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
     const double ps = double(sim->total_particles()) * double(steps) / std::max(loop, 1e-12);
     fmt::print("done: {} steps in {:.3f} s ({:.1f} steps/s, {:.3f} M particle-steps/s); start-up {:.3f} s; {} rebuilds\n",
                steps, loop, double(steps) / std::max(loop, 1e-12), ps * 1e-6, startup, sim->rebuilds());
+    fmt::print("cpu time of the loop: {:.3f} s per rank (max), {:.0f} % of the wall time{}\n", cpu,
+               100 * cpu / std::max(loop, 1e-12),
+               cpu < 0.8 * loop ? ": the machine is shared, the wall time is inflated" : "");
     const char* names[5] = {"forces", "neighbour search", "communication", "integration", "output"};
     std::string line = "time per step:";
     for (int k = 0; k < 5; ++k)
       line += fmt::format(" {} {:.4f} ms ({:.1f} %){}", names[k], 1e3 * parts[k] / n,
                           100 * parts[k] / std::max(loop, 1e-12), k < 4 ? "," : "");
     fmt::print("{}\n", line);
-    fmt::print("loop CPU time: {:.3f} s (max over compute ranks; {:.0f} % of the loop's wall time)\n", loop_cpu,
-               100 * loop_cpu / std::max(loop, 1e-12));
     fmt::print("solver arrays: {:.1f} MB ({:.0f} bytes per particle)\n", mem / 1e6,
                mem / double(sim->total_particles()));
     print_report(report, layout.n_io);

@@ -72,4 +72,23 @@ std::optional<std::string> Comm::agree_error(const std::optional<std::string>& l
 
 void Comm::barrier() const { MPI_Barrier(comm_); }
 
+AsyncSum::~AsyncSum() {
+  if (active_) MPI_Wait(&request_, MPI_STATUS_IGNORE);
+}
+
+void AsyncSum::start(std::vector<double> values) {
+  if (active_) finish();
+  send_ = std::move(values);
+  recv_.assign(send_.size(), 0.0);
+  MPI_Ireduce(send_.data(), recv_.data(), static_cast<int>(send_.size()), MPI_DOUBLE, MPI_SUM, 0, comm_.raw(),
+              &request_);
+  active_ = true;
+}
+
+const std::vector<double>& AsyncSum::finish() {
+  if (active_) MPI_Wait(&request_, MPI_STATUS_IGNORE);
+  active_ = false;
+  return recv_;
+}
+
 }  // namespace basalt::solver

@@ -163,36 +163,67 @@ void Halo<Real>::build_ghosts(Particles<Real>& p, double width) {
 }
 
 template <class Real>
-void Halo<Real>::update_ghosts(Particles<Real>& p) {
+void Halo<Real>::begin_update_ghosts(Particles<Real>& p) {
   const MPI_Comm comm = dec_.comm().raw();
   const MPI_Datatype type = sizeof(Real) == sizeof(double) ? MPI_DOUBLE : MPI_FLOAT;
-  for (int d = 0; d < 3; ++d) {
+  int last = -1;
+  for (int d = 0; d < 3; ++d)
+    if (dec_.dims()[d] > 1) last = d;
+  async_axis_ = last;
+  for (int d = 0; d <= last; ++d) {
     if (dec_.dims()[d] == 1) continue;
     for (int side = 0; side < 2; ++side) {
       const auto& list = send_[d][side];
-      sbuf_.resize(3 * list.size());
+      auto& sbuf = d == last ? async_send_[side] : sbuf_;
+      auto& rbuf = d == last ? async_recv_[side] : rbuf_;
+      sbuf.resize(3 * list.size());
       for (std::size_t k = 0; k < list.size(); ++k) {
         const auto i = list[k];
-        sbuf_[3 * k] = p.x[i];
-        sbuf_[3 * k + 1] = p.y[i];
-        sbuf_[3 * k + 2] = p.z[i];
+        sbuf[3 * k] = p.x[i];
+        sbuf[3 * k + 1] = p.y[i];
+        sbuf[3 * k + 2] = p.z[i];
       }
       const std::size_t nin = recv_count_[d][1 - side], begin = recv_begin_[d][1 - side];
-      rbuf_.resize(3 * nin);
-      MPI_Sendrecv(sbuf_.data(), static_cast<int>(sbuf_.size()), type, dec_.neighbor(d, side), 21, rbuf_.data(),
-                   static_cast<int>(rbuf_.size()), type, dec_.neighbor(d, 1 - side), 21, comm, MPI_STATUS_IGNORE);
+      rbuf.resize(3 * nin);
+      const int dest = dec_.neighbor(d, side), src = dec_.neighbor(d, 1 - side);
+      if (d == last) {
+        MPI_Irecv(rbuf.data(), static_cast<int>(rbuf.size()), type, src, 21 + side, comm, &requests_[2 * side]);
+        MPI_Isend(sbuf.data(), static_cast<int>(sbuf.size()), type, dest, 21 + side, comm, &requests_[2 * side + 1]);
+        continue;
+      }
+      MPI_Sendrecv(sbuf.data(), static_cast<int>(sbuf.size()), type, dest, 21, rbuf.data(),
+                   static_cast<int>(rbuf.size()), type, src, 21, comm, MPI_STATUS_IGNORE);
       for (std::size_t k = 0; k < nin; ++k) {
-        p.x[begin + k] = rbuf_[3 * k];
-        p.y[begin + k] = rbuf_[3 * k + 1];
-        p.z[begin + k] = rbuf_[3 * k + 2];
+        p.x[begin + k] = rbuf[3 * k];
+        p.y[begin + k] = rbuf[3 * k + 1];
+        p.z[begin + k] = rbuf[3 * k + 2];
       }
     }
   }
 }
 
 template <class Real>
+void Halo<Real>::end_update_ghosts(Particles<Real>& p) {
+  const int d = async_axis_;
+  if (d < 0) return;
+  MPI_Waitall(4, requests_.data(), MPI_STATUSES_IGNORE);
+  for (int side = 0; side < 2; ++side) {
+    const std::size_t nin = recv_count_[d][1 - side], begin = recv_begin_[d][1 - side];
+    const auto& rbuf = async_recv_[side];
+    for (std::size_t k = 0; k < nin; ++k) {
+      p.x[begin + k] = rbuf[3 * k];
+      p.y[begin + k] = rbuf[3 * k + 1];
+      p.z[begin + k] = rbuf[3 * k + 2];
+    }
+  }
+  async_axis_ = -1;
+}
+
+template <class Real>
 std::size_t Halo<Real>::memory_bytes() const {
   std::size_t b = (sbuf_.capacity() + rbuf_.capacity()) * sizeof(Real);
+  for (int side = 0; side < 2; ++side)
+    b += (async_send_[side].capacity() + async_recv_[side].capacity()) * sizeof(Real);
   for (const auto& a : send_)
     for (const auto& s : a) b += s.capacity() * sizeof(std::int32_t);
   return b;

@@ -230,6 +230,9 @@ void Simulation<Real>::resolve_bonds() {
           "step {}: the bond between particle ids {} and {} is longer than the ghost width {:.6g} (particle {} "
           "is not within reach of rank {}): bonds must not stretch beyond the longest initial bond + skin",
           step_, bonds_.a[k], bonds_.b[k], ghost_width_, ia < 0 ? bonds_.a[k] : bonds_.b[k], comm().rank());
+      if (stability_.warn)
+        *error += fmt::format(" (dt is {:.3g} x the critical time step: the run is probably unstable)",
+                              stability_.fraction);
       ia = std::max(ia, 0);
       ib = std::max(ib, 0);
     }
@@ -241,15 +244,17 @@ void Simulation<Real>::resolve_bonds() {
     bonds_.ib[k] = ib;
   }
   if (comm().size() > 1) error = comm().agree_error(error);
-  if (error) throw RunError(*error);
-  // Both ends owned first, each part in memory order of its first end.
-  std::vector<std::uint32_t> order(nb);
-  for (std::uint32_t k = 0; k < nb; ++k) order[k] = k;
-  auto key = [&](std::uint32_t k) {
-    const bool ghost = static_cast<std::size_t>(bonds_.ib[k]) >= n;
-    return std::pair<int, std::int32_t>(ghost ? 1 : 0, bonds_.ia[k]);
+  if (error) stop(*error);
+  // Both ends owned first, each part in memory order of its owned end (a counting sort: O(bonds)).
+  std::vector<std::uint32_t> start(2 * n + 1, 0);
+  auto key = [&](std::size_t k) {
+    return (static_cast<std::size_t>(bonds_.ib[k]) >= n ? n : 0) + static_cast<std::size_t>(bonds_.ia[k]);
   };
-  std::sort(order.begin(), order.end(), [&](std::uint32_t i, std::uint32_t j) { return key(i) < key(j); });
+  for (std::size_t k = 0; k < nb; ++k) ++start[key(k) + 1];
+  for (std::size_t c = 0; c < 2 * n; ++c) start[c + 1] += start[c];
+  std::vector<std::uint32_t> order(nb);
+  for (std::size_t k = 0; k < nb; ++k) order[start[key(k)]++] = static_cast<std::uint32_t>(k);
+  std::vector<std::uint32_t>().swap(start);
   bonds_.permute(order);
   bonds_.n_both_owned = 0;
   while (bonds_.n_both_owned < nb && static_cast<std::size_t>(bonds_.ib[bonds_.n_both_owned]) < n)
@@ -262,15 +267,15 @@ void Simulation<Real>::rebuild() {
   auto error = check_finite();
   const bool parallel = comm().size() > 1;
   if (parallel) error = comm().agree_error(error);
-  if (error) throw RunError(*error);
+  if (error) stop(*error);
   p_.drop_ghosts();
   if (parallel) {
     error = halo_->migrate(p_, bonds_);
     error = comm().agree_error(error);
-    if (error) throw RunError(*error);
+    if (error) stop(*error);
     const long long total = comm().sum(static_cast<long long>(p_.n_owned));
     if (total != n_global_)
-      throw RunError(fmt::format("step {}: {} particles on the ranks, {} expected: particles were lost", step_,
+      stop(fmt::format("step {}: {} particles on the ranks, {} expected: particles were lost", step_,
                                  total, n_global_));
   }
   times_.communication += sw.lap();
@@ -296,6 +301,7 @@ void Simulation<Real>::rebuild() {
     exclusions_.release();
   }
   grid_.release();
+  if (!wall_driver_.empty()) wall_driver_.rebuild(p_, scene_.skin);
   for (std::size_t i = 0; i < p_.n_owned; ++i) {
     p_.x0[i] = float(p_.x[i]);
     p_.y0[i] = float(p_.y[i]);
@@ -309,16 +315,29 @@ void Simulation<Real>::rebuild() {
 
 template <class Real>
 template <bool Energy>
-std::array<double, 3> Simulation<Real>::compute_forces() {
-  zero_forces(p_);
+std::array<double, 3> Simulation<Real>::compute_forces(bool ghosts_in_flight) {
+  // Interactions among owned particles first: a ghost update still in flight overlaps them.
+  if (!forces_zeroed_) zero_forces(p_);
+  forces_zeroed_ = false;
   std::array<double, 3> pe{0, 0, 0};
   const std::size_t before = broken_.size();
-  if (bonds_.size() > 0) pe[0] = bond_driver_.template compute<Energy>(p_, bonds_, broken_);
-  if (!pair_driver_.empty()) pe[1] = pair_driver_.template compute<Energy>(p_, own_, ghost_);
+  const bool bonds = bonds_.size() > 0, pairs = !pair_driver_.empty();
+  if (bonds) pe[0] += bond_driver_.template compute_part<Energy, true>(p_, bonds_, broken_);
+  if (pairs) pe[1] += pair_driver_.template compute<Energy, true>(p_, own_);
   if (!wall_driver_.empty()) {
     wall_driver_.move_to(time_);
     pe[2] = wall_driver_.template compute<Energy>(p_);
   }
+  if (ghosts_in_flight) {
+    Stopwatch sw;
+    halo_->end_update_ghosts(p_);
+    ghost_wait_ += sw.lap();
+  }
+  if (bonds) {
+    pe[0] += bond_driver_.template compute_part<Energy, false>(p_, bonds_, broken_);
+    bond_driver_.commit(bonds_);
+  }
+  if (pairs) pe[1] += pair_driver_.template compute<Energy, false>(p_, ghost_);
   if (broken_.size() != before) bond_broke_ = true;  // the lists must learn the pair is now unbonded
   return pe;
 }
@@ -334,27 +353,37 @@ bool Simulation<Real>::energy_due(std::int64_t s) const {
 
 template <class Real>
 void Simulation<Real>::step(FieldSink* sink) {
+  sink_ = sink;
   Stopwatch sw;
-  kick(p_, kick1_);
-  const double moved2 = drift(p_, Real(scene_.dt));
+  // Forces are zeroed in the same pass: the non-finite check needs them only at a rebuild, and a
+  // non-finite force has already made the velocity non-finite.
+  const double moved2 = kick_zero_drift(p_, kick1_, Real(scene_.dt));
+  forces_zeroed_ = true;
   times_.integration += sw.lap();
   const bool parallel = comm().size() > 1;
-  double need = bond_broke_ ? std::numeric_limits<double>::infinity() : moved2;
+  if (!wall_driver_.empty()) wall_driver_.move_to(double(step_ + 1) * scene_.dt);
+  double need = bond_broke_ ? std::numeric_limits<double>::infinity()
+                            : std::max(moved2, wall_driver_.empty() ? 0.0 : wall_driver_.moved2_since_rebuild());
   if (parallel) need = comm().max(need);
   times_.communication += sw.lap();
+  bool in_flight = false;
   canonical_ = canonical_due(step_ + 1);  // a restart point: rebuild in canonical order
   if (!(need <= rebuild_limit2_) || canonical_) {
     rebuild();
     sw.lap();
   } else if (parallel) {
-    halo_->update_ghosts(p_);
+    halo_->begin_update_ghosts(p_);
+    in_flight = true;
     times_.communication += sw.lap();
   }
   ++step_;
   time_ = double(step_) * scene_.dt;
   const bool energy = energy_due(step_);
-  const auto pe = energy ? compute_forces<true>() : compute_forces<false>();
-  times_.forces += sw.lap();
+  ghost_wait_ = 0;
+  const auto pe = energy ? compute_forces<true>(in_flight) : compute_forces<false>(in_flight);
+  const double force_time = sw.lap();
+  times_.forces += force_time - ghost_wait_;
+  times_.communication += ghost_wait_;
   if (kick2_ != Real(0)) kick(p_, kick2_);
   times_.integration += sw.lap();
   if (!wall_driver_.empty()) wall_work_in_ += std::max(0.0, wall_driver_.power(time_)) * scene_.dt;
@@ -370,12 +399,39 @@ void Simulation<Real>::save_fields(FieldSink* sink, const std::array<double, 3>&
   std::vector<char> due;
   const bool any = field_partials(pe, local, due);
   if (!any) return;
-  comm().sum_to_root(local);
+  if (comm().size() == 1) {
+    if (!sink) return;
+    std::vector<std::optional<double>> row(local.size());
+    for (std::size_t c = 0; c < local.size(); ++c)
+      if (due[c]) row[c] = local[c];
+    sink->row(step_, time_, row);
+    return;
+  }
+  finish_row(sink);
+  if (!row_sum_) row_sum_ = std::make_unique<AsyncSum>(comm());
+  row_sum_->start(std::move(local));
+  row_step_ = step_;
+  row_time_ = time_;
+  row_due_ = std::move(due);
+}
+
+template <class Real>
+void Simulation<Real>::stop(const std::string& message) {
+  // Collective (every caller has agreed on the error): deliver the row in flight, then stop.
+  finish_row(sink_);
+  if (sink_ && comm().rank() == 0) sink_->flush();
+  throw RunError(message);
+}
+
+template <class Real>
+void Simulation<Real>::finish_row(FieldSink* sink) {
+  if (!row_sum_ || !row_sum_->active()) return;
+  const auto& sums = row_sum_->finish();
   if (comm().rank() != 0 || !sink) return;
-  std::vector<std::optional<double>> row(local.size());
-  for (std::size_t c = 0; c < local.size(); ++c)
-    if (due[c]) row[c] = local[c];
-  sink->row(step_, time_, row);
+  std::vector<std::optional<double>> row(sums.size());
+  for (std::size_t c = 0; c < sums.size(); ++c)
+    if (row_due_[c]) row[c] = sums[c];
+  sink->row(row_step_, row_time_, row);
 }
 
 template <class Real>
@@ -405,7 +461,7 @@ void Simulation<Real>::guard_energy(const std::array<double, 3>& pe) {
         "{:.3g} x the critical time step {:.6g}",
         step_, e, v[0], v[1], v[2], v[3], energy0_, v[4], p_.id[bi], best, p_.vx[bi], p_.vy[bi], p_.vz[bi],
         p_.x[bi], p_.y[bi], p_.z[bi], scene_.dt, stability_.fraction, stability_.dt_critical);
-  throw RunError(comm().broadcast(msg, who));
+  stop(comm().broadcast(msg, who));
 }
 
 template <class Real>
@@ -432,6 +488,7 @@ void Simulation<Real>::run(std::int64_t steps, FieldSink* sink) {
       }
     }
   }
+  finish_row(sink);
   if (sink && comm().rank() == 0) sink->flush();
 }
 
@@ -463,7 +520,8 @@ std::size_t Simulation<Real>::memory_bytes() const {
   add(bonds_.group);
   add(bonds_.ia);
   add(bonds_.ib);
-  b += own_.memory_bytes() + ghost_.memory_bytes() + ids_.memory_bytes() + halo_->memory_bytes();
+  b += own_.memory_bytes() + ghost_.memory_bytes() + ids_.memory_bytes() + halo_->memory_bytes() +
+       wall_driver_.memory_bytes();
   return b;
 }
 

@@ -20,7 +20,7 @@ Simulation<Real>::Simulation(const Scene& scene, const io::Checkpoint& c, const 
       pair_driver_(scene.contacts),
       wall_driver_(scene.walls) {
   if (c.size() == 0) throw InputError("the checkpoint has no particles");
-  if (scene.bonds.size() > 255) throw InputError("interactions: at most 255 bond groups");
+  if (scene.bonds.size() > 254) throw InputError("interactions: at most 254 bond groups");
   if (c.dt != scene.dt)
     throw InputError(fmt::format("the checkpoint was written with dt = {}, the scene has run.dt = {}", c.dt, scene.dt));
   const bool se = scene.integrator == Integrator::symplectic_euler;
@@ -29,6 +29,8 @@ Simulation<Real>::Simulation(const Scene& scene, const io::Checkpoint& c, const 
   rebuild_limit2_ = 0.25 * scene.skin * scene.skin;
   check_stability(c.geometry);
   distribute_checkpoint(c, layout, comm);
+  // Walls where the uninterrupted run had them at this step's rebuild (step() moves them first).
+  if (!wall_driver_.empty()) wall_driver_.move_to(double(step_) * scene.dt);
   canonical_ = true;
   rebuild();
   const auto pe = compute_forces<true>();

@@ -43,7 +43,7 @@ def run(a, q, extra, out):
         sys.exit(f"failed: {' '.join(cmd)}\n{p.stdout}\n{p.stderr}")
     loop = float(re.search(r"done: \d+ steps in ([0-9.]+) s", p.stdout).group(1))
     wait = float(re.search(r"compute ranks waited ([0-9.]+) s", p.stdout).group(1))
-    cpu = float(re.search(r"loop CPU time: ([0-9.]+) s", p.stdout).group(1))
+    cpu = float(re.search(r"cpu time of the loop: ([0-9.]+) s", p.stdout).group(1))
     return loop, wait, cpu
 
 

@@ -81,8 +81,11 @@ class Simulation {
 
   /// Runs `steps` steps (scene.steps when negative), writing field rows to `sink` (rank 0 only; may be null).
   void run(std::int64_t steps = -1, FieldSink* sink = nullptr);
-  /// One step.
+  /// One step. On more than one rank a step's field row reaches the sink during the next step (its
+  /// reduction overlaps that step's work); run() and flush_fields() deliver the last one.
   void step(FieldSink* sink = nullptr);
+  /// Collective: delivers a field row still in flight to the sink.
+  void flush_fields(FieldSink* sink) { finish_row(sink); }
 
   // State and diagnostics (collective where noted).
   std::int64_t current_step() const { return step_; }
@@ -126,14 +129,20 @@ class Simulation {
   void resolve_bonds();
   void spatial_sort();
   std::optional<std::string> check_finite() const;
+  /// Forces at the current positions; ghosts_in_flight: a ghost update was begun and is completed
+  /// after the owned-only interactions.
   template <bool Energy>
-  std::array<double, 3> compute_forces();
+  std::array<double, 3> compute_forces(bool ghosts_in_flight = false);
   void save_fields(FieldSink* sink, const std::array<double, 3>& pe);
   bool field_partials(const std::array<double, 3>& pe, std::vector<double>& local, std::vector<char>& due) const;
   void output_fields(const std::array<double, 3>& pe);
   void distribute_checkpoint(const io::Checkpoint& c, const RestartLayout& layout, MPI_Comm comm);
   void canonical_order();
   bool canonical_due(std::int64_t s) const { return canonical_every_ > 0 && s % canonical_every_ == 0; }
+  /// Writes the row whose reduction is still in flight (ranks > 1), if any.
+  void finish_row(FieldSink* sink);
+  /// Collective: delivers pending output, then throws RunError(message).
+  [[noreturn]] void stop(const std::string& message);
   void guard_energy(const std::array<double, 3>& pe);
   bool energy_due(std::int64_t s) const;
 
@@ -141,6 +150,11 @@ class Simulation {
   RunOptions options_;
   std::unique_ptr<Decomposition> dec_;
   std::unique_ptr<Halo<Real>> halo_;
+  std::unique_ptr<AsyncSum> row_sum_;  ///< the last field row's reduction, finished one step later
+  std::int64_t row_step_ = 0;
+  double row_time_ = 0;
+  std::vector<char> row_due_;
+  FieldSink* sink_ = nullptr;  ///< the sink of the current step (for output delivered on errors)
   Particles<Real> p_;
   Bonds<Real> bonds_;
   IdMap ids_;
@@ -165,6 +179,8 @@ class Simulation {
   double energy0_ = 0;
   double wall_work_in_ = 0;  ///< this rank's share of the positive work done by walls
   PhaseTimes times_;
+  double ghost_wait_ = 0;
+  bool forces_zeroed_ = false;  ///< set by the fused kick-zero-drift pass
   StabilityReport stability_;
   OutputSink* output_ = nullptr;        ///< set during run(steps, OutputSink&)
   std::int64_t canonical_every_ = 0;    ///< canonical rebuild at these steps (restart points)

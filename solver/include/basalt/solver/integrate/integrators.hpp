@@ -56,6 +56,47 @@ double drift(Particles<Real>& p, Real h) {
   return double(m);
 }
 
+/// kick(h), zero the forces (the next force computation accumulates from zero), drift(dt), in one
+/// pass over memory. Returns what drift() returns.
+template <class Real>
+double kick_zero_drift(Particles<Real>& p, Real h, Real dt) {
+  const std::size_t n = p.n_owned;
+  Real* __restrict x = p.x.data();
+  Real* __restrict y = p.y.data();
+  Real* __restrict z = p.z.data();
+  Real* __restrict vx = p.vx.data();
+  Real* __restrict vy = p.vy.data();
+  Real* __restrict vz = p.vz.data();
+  Real* __restrict fx = p.fx.data();
+  Real* __restrict fy = p.fy.data();
+  Real* __restrict fz = p.fz.data();
+  const Real* __restrict im = p.inv_mass.data();
+  const float* __restrict x0 = p.x0.data();
+  const float* __restrict y0 = p.y0.data();
+  const float* __restrict z0 = p.z0.data();
+  Real m = 0;
+  Real sum = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Real s = h * im[i];
+    const Real ux = vx[i] + s * fx[i], uy = vy[i] + s * fy[i], uz = vz[i] + s * fz[i];
+    vx[i] = ux;
+    vy[i] = uy;
+    vz[i] = uz;
+    fx[i] = 0;
+    fy[i] = 0;
+    fz[i] = 0;
+    x[i] += dt * ux;
+    y[i] += dt * uy;
+    z[i] += dt * uz;
+    const Real dx = x[i] - x0[i], dy = y[i] - y0[i], dz = z[i] - z0[i];
+    const Real d2 = dx * dx + dy * dy + dz * dz;
+    m = d2 > m ? d2 : m;
+    sum += d2;
+  }
+  if (!std::isfinite(sum)) return std::numeric_limits<double>::infinity();
+  return double(m);
+}
+
 template <class Real>
 void zero_forces(Particles<Real>& p) {
   std::fill(p.fx.begin(), p.fx.end(), Real(0));

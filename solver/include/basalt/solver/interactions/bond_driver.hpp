@@ -34,16 +34,25 @@ class BondDriver {
   /// that broke (they are removed at once).
   template <bool Energy>
   double compute(Particles<Real>& p, Bonds<Real>& bonds, std::vector<BrokenBond>& broken) {
-    gone_.clear();
-    double energy = 0;
-    if (K_.size() == 1 && !breakable_)
-      energy = loops<Energy, true, false>(p, bonds, broken);
-    else if (K_.size() == 1)
-      energy = loops<Energy, true, true>(p, bonds, broken);
-    else
-      energy = loops<Energy, false, true>(p, bonds, broken);
+    const double e = compute_part<Energy, true>(p, bonds, broken) + compute_part<Energy, false>(p, bonds, broken);
+    commit(bonds);
+    return e;
+  }
+
+  /// Bonds with both ends owned (BothOwned) or with a ghost end; call commit() after both parts.
+  template <bool Energy, bool BothOwned>
+  double compute_part(Particles<Real>& p, const Bonds<Real>& bonds, std::vector<BrokenBond>& broken) {
+    if (BothOwned) gone_.clear();
+    const std::size_t b = BothOwned ? 0 : bonds.n_both_owned, e = BothOwned ? bonds.n_both_owned : bonds.size();
+    if (K_.size() == 1 && !breakable_) return loop<Energy, true, false, BothOwned>(p, bonds, broken, b, e);
+    if (K_.size() == 1) return loop<Energy, true, true, BothOwned>(p, bonds, broken, b, e);
+    return loop<Energy, false, true, BothOwned>(p, bonds, broken, b, e);
+  }
+
+  /// Removes the bonds that broke in this step's compute_part() calls.
+  void commit(Bonds<Real>& bonds) {
     if (!gone_.empty()) remove(bonds, gone_);
-    return energy;
+    gone_.clear();
   }
 
   /// Bonds counted once across ranks.
@@ -61,13 +70,6 @@ class BondDriver {
   }
 
  private:
-  template <bool Energy, bool Uniform, bool Breakable>
-  double loops(Particles<Real>& p, Bonds<Real>& bonds, std::vector<BrokenBond>& broken) {
-    // Both ends owned: Newton's third law. Then one end a ghost: force on the owned end only.
-    return loop<Energy, Uniform, Breakable, true>(p, bonds, broken, 0, bonds.n_both_owned) +
-           loop<Energy, Uniform, Breakable, false>(p, bonds, broken, bonds.n_both_owned, bonds.size());
-  }
-
   template <bool Energy, bool Uniform, bool Breakable, bool BothOwned>
   double loop(Particles<Real>& p, const Bonds<Real>& bonds, std::vector<BrokenBond>& broken, std::size_t begin,
               std::size_t end) {

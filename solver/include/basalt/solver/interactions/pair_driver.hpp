@@ -33,10 +33,15 @@ class PairDriver {
     return -1;
   }
 
+  /// Owned-owned pairs (Newton's third law) when Newton, owned-ghost pairs (owned end only) otherwise.
+  template <bool Energy, bool Newton>
+  double compute(Particles<Real>& p, const PairList& list) const {
+    if (uniform_) return loop<Energy, true, Newton>(p, list);
+    return loop<Energy, false, Newton>(p, list);
+  }
   template <bool Energy>
   double compute(Particles<Real>& p, const PairList& own, const PairList& ghost) const {
-    if (uniform_) return loop<Energy, true>(p, own, ghost);
-    return loop<Energy, false>(p, own, ghost);
+    return compute<Energy, true>(p, own) + compute<Energy, false>(p, ghost);
   }
 
   Real max_stiffness() const {
@@ -46,47 +51,43 @@ class PairDriver {
   }
 
  private:
-  template <bool Energy, bool Uniform>
-  double loop(Particles<Real>& p, const PairList& own, const PairList& ghost) const {
+  template <bool Energy, bool Uniform, bool Newton>
+  double loop(Particles<Real>& p, const PairList& list) const {
     double energy = 0;
     const std::size_t n = p.n_owned;
-    const Real* x = p.x.data();
-    const Real* y = p.y.data();
-    const Real* z = p.z.data();
-    const Real* rad = p.radius.data();
-    Real* fx = p.fx.data();
-    Real* fy = p.fy.data();
-    Real* fz = p.fz.data();
+    const Real* __restrict x = p.x.data();
+    const Real* __restrict y = p.y.data();
+    const Real* __restrict z = p.z.data();
+    const Real* __restrict rad = p.radius.data();
+    Real* __restrict fx = p.fx.data();
+    Real* __restrict fy = p.fy.data();
+    Real* __restrict fz = p.fz.data();
+    const std::uint32_t* __restrict off = list.offset.data();
+    const std::int32_t* __restrict nb = list.neigh.data();
     const Real K0 = K_.empty() ? Real(0) : K_[0];
     for (std::size_t i = 0; i < n; ++i) {
       const Real xi = x[i], yi = y[i], zi = z[i], ri = rad[i];
       Real fxi = 0, fyi = 0, fzi = 0;
-      for (int pass = 0; pass < 2; ++pass) {
-        const PairList& list = pass == 0 ? own : ghost;
-        for (auto k = list.offset[i]; k < list.offset[i + 1]; ++k) {
-          const auto j = static_cast<std::size_t>(list.neigh[k]);
-          const Real dx = xi - x[j], dy = yi - y[j], dz = zi - z[j];
-          const Real r2 = dx * dx + dy * dy + dz * dz;
-          const Real rsum = ri + rad[j];
-          if (!Model::touching(r2, rsum)) continue;
-          Real K = K0;
-          if constexpr (!Uniform) {
-            const int g = group_of(p.tag[i], p.tag[j]);
-            K = K_[static_cast<std::size_t>(g)];
-          }
-          const Real r = std::sqrt(r2);
-          const Real s = Model::force(K, rsum, r) / r;
-          fxi += s * dx;
-          fyi += s * dy;
-          fzi += s * dz;
-          if (pass == 0) {
-            fx[j] -= s * dx;
-            fy[j] -= s * dy;
-            fz[j] -= s * dz;
-          }
-          if constexpr (Energy)
-            if (pass == 0 || p.id[i] < p.id[j]) energy += double(Model::energy(K, rsum, r));
+      for (auto k = off[i]; k < off[i + 1]; ++k) {
+        const auto j = static_cast<std::size_t>(nb[k]);
+        const Real dx = xi - x[j], dy = yi - y[j], dz = zi - z[j];
+        const Real r2 = dx * dx + dy * dy + dz * dz;
+        const Real rsum = ri + rad[j];
+        if (!Model::touching(r2, rsum)) continue;
+        Real K = K0;
+        if constexpr (!Uniform) K = K_[static_cast<std::size_t>(group_of(p.tag[i], p.tag[j]))];
+        const Real r = std::sqrt(r2);
+        const Real s = Model::force(K, rsum, r) / r;
+        fxi += s * dx;
+        fyi += s * dy;
+        fzi += s * dz;
+        if constexpr (Newton) {
+          fx[j] -= s * dx;
+          fy[j] -= s * dy;
+          fz[j] -= s * dz;
         }
+        if constexpr (Energy)
+          if (Newton || p.id[i] < p.id[j]) energy += double(Model::energy(K, rsum, r));
       }
       fx[i] += fxi;
       fy[i] += fyi;

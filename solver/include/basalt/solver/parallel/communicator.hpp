@@ -39,4 +39,23 @@ class Comm {
   int size_ = 1;
 };
 
+/// A non-blocking element-wise sum to rank 0: start() posts it, finish() waits and returns the sums
+/// (meaningful on rank 0). Lets field-saver reductions overlap the next step's work.
+class AsyncSum {
+ public:
+  explicit AsyncSum(const Comm& comm) : comm_(comm) {}
+  ~AsyncSum();
+  AsyncSum(const AsyncSum&) = delete;
+  AsyncSum& operator=(const AsyncSum&) = delete;
+  bool active() const { return active_; }
+  void start(std::vector<double> values);
+  const std::vector<double>& finish();
+
+ private:
+  const Comm& comm_;
+  std::vector<double> send_, recv_;
+  MPI_Request request_ = MPI_REQUEST_NULL;
+  bool active_ = false;
+};
+
 }  // namespace basalt::solver

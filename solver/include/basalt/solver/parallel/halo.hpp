@@ -1,6 +1,7 @@
 #pragma once
 // Ghost exchange and migration over the six faces of a rank's region, one axis after the other
 // (ghosts received along x are forwarded along y and z, which fills edges and corners).
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -27,7 +28,15 @@ class Halo {
   void build_ghosts(Particles<Real>& p, double width);
 
   /// Refreshes ghost positions along the lists of the last build_ghosts().
-  void update_ghosts(Particles<Real>& p);
+  void update_ghosts(Particles<Real>& p) {
+    begin_update_ghosts(p);
+    end_update_ghosts(p);
+  }
+  /// Starts the refresh: the exchanges along every active axis but the last complete here (later axes
+  /// forward what earlier ones received); the last one is posted non-blocking, so work on owned
+  /// particles can overlap it. end_update_ghosts() completes it.
+  void begin_update_ghosts(Particles<Real>& p);
+  void end_update_ghosts(Particles<Real>& p);
 
   /// Bytes held by the send lists and buffers.
   std::size_t memory_bytes() const;
@@ -38,6 +47,9 @@ class Halo {
   std::array<std::array<std::size_t, 2>, 3> recv_begin_{};         ///< where ghosts from [axis][from side] start
   std::array<std::array<std::size_t, 2>, 3> recv_count_{};
   std::vector<Real> sbuf_, rbuf_;
+  std::array<std::vector<Real>, 2> async_send_, async_recv_;
+  std::array<MPI_Request, 4> requests_{MPI_REQUEST_NULL, MPI_REQUEST_NULL, MPI_REQUEST_NULL, MPI_REQUEST_NULL};
+  int async_axis_ = -1;
 };
 
 }  // namespace basalt::solver
