@@ -63,6 +63,14 @@ case $case_name in
     [ "$(grep -c '<DataSet' "$W/out/frames.pvd")" -eq 4 ] || fail "expected 4 frames in frames.pvd"
     $CHECK pvd "$W/out" || fail "VTK frames disagree with the checkpoints"
     grep -Eq "frames +4 files" "$W/last.log" || fail "the report does not count 4 frames"
+    # A restart from step 50 in the same folder: the series drops the frames after it and continues;
+    # fields.csv keeps its rows up to step 50 and appends, with no step twice.
+    must_run 3 --io-ranks 1 --steps 50 --checkpoint-every 50 --frames-every 25 --output "$W/out" \
+      --restart "$W/out/ckpt_000050.h5"
+    [ "$(grep -c '<DataSet' "$W/out/frames.pvd")" -eq 4 ] || fail "frames.pvd after the restart: expected 4 frames"
+    [ -z "$(cut -d, -f1 "$W/out/fields.csv" | sort | uniq -d)" ] || fail "fields.csv has a step twice"
+    [ "$(wc -l <"$W/out/fields.csv")" -eq 101 ] || fail "fields.csv: expected a header and 100 rows"
+    $CHECK pvd "$W/out" || fail "VTK frames disagree with the checkpoints after the restart"
     ;;
   unwritable_output)
     touch "$W/a_file"
