@@ -5,18 +5,18 @@
 // The only code that touches MPI_COMM_WORLD: it creates the output folder (world rank 0, a failure
 // stops every rank before anything starts) and splits the world into compute and I/O ranks. Compute
 // rank 0 prints progress, a summary of the time per step and the output report (docs/io-ranks.md).
+#include <fmt/format.h>
 #include <mpi.h>
+#include <sys/resource.h>
 
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
-#include <fmt/format.h>
 #include <fstream>
 #include <memory>
 #include <optional>
-#include <sys/resource.h>
 
 #include "basalt/io/checkpoint.hpp"
 #include "basalt/io/geometry.hpp"
@@ -49,7 +49,8 @@ struct Cli {
 double cpu_seconds() {
   rusage u{};
   getrusage(RUSAGE_SELF, &u);
-  return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+  return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
 }
 
 std::array<int, 3> parse_dims(const std::string& s) {
@@ -57,8 +58,8 @@ std::array<int, 3> parse_dims(const std::string& s) {
   if (s.empty()) return d;
   char c1 = 0, c2 = 0;
   int n = 0;
-  if (std::sscanf(s.c_str(), "%d%c%d%c%d%n", &d[0], &c1, &d[1], &c2, &d[2], &n) != 5 || c1 != ',' || c2 != ',' ||
-      static_cast<std::size_t>(n) != s.size() || d[0] < 1 || d[1] < 1 || d[2] < 1)
+  if (std::sscanf(s.c_str(), "%d%c%d%c%d%n", &d[0], &c1, &d[1], &c2, &d[2], &n) != 5 || c1 != ',' ||
+      c2 != ',' || static_cast<std::size_t>(n) != s.size() || d[0] < 1 || d[1] < 1 || d[2] < 1)
     throw InputError(fmt::format("--dims {}: expected three positive integers, e.g. --dims 2,1,1", s));
   return d;
 }
@@ -89,10 +90,11 @@ std::string mb(std::uint64_t bytes) { return fmt::format("{:.2f} MB", double(byt
 
 void print_report(const io::OutputReport& r, int n_io) {
   auto kind = [](const char* name, const io::OutputKindReport& k) {
-    return fmt::format("  {:<12} {:>5} files {:>12}  write {:8.3f} s\n", name, k.files, mb(k.bytes), k.write_seconds);
+    return fmt::format("  {:<12} {:>5} files {:>12}  write {:8.3f} s\n", name, k.files, mb(k.bytes),
+                       k.write_seconds);
   };
   std::string text = fmt::format("output ({}):\n", n_io > 0 ? fmt::format("{} I/O rank(s)", n_io)
-                                                               : std::string("written by the compute ranks"));
+                                                            : std::string("written by the compute ranks"));
   text += kind("checkpoints", r.checkpoints) + kind("frames", r.frames) + kind("fields", r.fields);
   text += fmt::format("  compute ranks waited {:.4f} s for output", r.compute_wait_seconds);
   if (n_io > 0)
@@ -116,8 +118,8 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
   std::optional<std::string> setup_error;
   try {
     if (ckpt) {
-      sim = std::make_unique<Simulation<double>>(scene, *ckpt, basalt::run::restart_layout_of(*ckpt, ckpt_file),
-                                                 layout.compute, options);
+      sim = std::make_unique<Simulation<double>>(
+          scene, *ckpt, basalt::run::restart_layout_of(*ckpt, ckpt_file), layout.compute, options);
       info.box_min = ckpt->geometry.box_min;
       info.box_max = ckpt->geometry.box_max;
       info.periodic = ckpt->geometry.periodic;
@@ -126,8 +128,9 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
       auto g = io::read_geometry(scene.geometry);
       if (root && (g.units.length != scene.units.length || g.units.time != scene.units.time ||
                    g.units.force != scene.units.force))
-        fmt::print(stderr, "warning: the geometry declares units {}, {}, {}; the scene {}, {}, {}\n", g.units.length,
-                   g.units.time, g.units.force, scene.units.length, scene.units.time, scene.units.force);
+        fmt::print(stderr, "warning: the geometry declares units {}, {}, {}; the scene {}, {}, {}\n",
+                   g.units.length, g.units.time, g.units.force, scene.units.length, scene.units.time,
+                   scene.units.force);
       info.box_min = g.box_min;
       info.box_max = g.box_max;
       info.periodic = g.periodic;
@@ -152,19 +155,23 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
   if (ckpt) steps = cli.steps >= 0 ? cli.steps : std::max<std::int64_t>(0, scene.steps - ckpt->step);
   const auto& st = sim->stability();
   if (root) {
-    fmt::print("basalt-run {}: {} particles, {} bonds on {} compute rank(s) ({}x{}x{}) + {} I/O rank(s), {} steps of "
-               "dt = {} {}{}\n",
-               basalt::kVersion, sim->total_particles(), sim->bond_count(), comm.size(), sim->decomposition().dims()[0],
-               sim->decomposition().dims()[1], sim->decomposition().dims()[2], layout.n_io, steps, scene.dt,
-               scene.units.time,
-               ckpt ? fmt::format(", continuing from step {} ({})", ckpt->step, ckpt_file.string()) : std::string());
+    fmt::print(
+        "basalt-run {}: {} particles, {} bonds on {} compute rank(s) ({}x{}x{}) + {} I/O rank(s), {} steps "
+        "of "
+        "dt = {} {}{}\n",
+        basalt::kVersion, sim->total_particles(), sim->bond_count(), comm.size(),
+        sim->decomposition().dims()[0], sim->decomposition().dims()[1], sim->decomposition().dims()[2],
+        layout.n_io, steps, scene.dt, scene.units.time,
+        ckpt ? fmt::format(", continuing from step {} ({})", ckpt->step, ckpt_file.string()) : std::string());
     if (st.dt_critical > 0)
-      fmt::print("time step: dt = {:.3g} x critical step {:.4g} (2 sqrt(m_min/k_max), m_min = {:.4g}, k_max = {:.4g}); "
-                 "safe fraction {}\n",
-                 st.fraction, st.dt_critical, st.m_min, st.k_max, scene.dt_safety);
+      fmt::print(
+          "time step: dt = {:.3g} x critical step {:.4g} (2 sqrt(m_min/k_max), m_min = {:.4g}, k_max = "
+          "{:.4g}); "
+          "safe fraction {}\n",
+          st.fraction, st.dt_critical, st.m_min, st.k_max, scene.dt_safety);
     if (st.warn)
-      fmt::print(stderr, "warning: dt = {} is {:.3g} x the critical time step, above the safe fraction {}\n", scene.dt,
-                 st.fraction, scene.dt_safety);
+      fmt::print(stderr, "warning: dt = {} is {:.3g} x the critical time step, above the safe fraction {}\n",
+                 scene.dt, st.fraction, scene.dt_safety);
     if (sim->unassigned_bonds() > 0)
       fmt::print(stderr, "warning: {} bonds of the geometry match no bond interaction and exert no force\n",
                  sim->unassigned_bonds());
@@ -209,8 +216,10 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
   const double mem = comm.sum(double(sim->memory_bytes()));
   if (root) {
     const double ps = double(sim->total_particles()) * double(steps) / std::max(loop, 1e-12);
-    fmt::print("done: {} steps in {:.3f} s ({:.1f} steps/s, {:.3f} M particle-steps/s); start-up {:.3f} s; {} rebuilds\n",
-               steps, loop, double(steps) / std::max(loop, 1e-12), ps * 1e-6, startup, sim->rebuilds());
+    fmt::print(
+        "done: {} steps in {:.3f} s ({:.1f} steps/s, {:.3f} M particle-steps/s); start-up {:.3f} s; {} "
+        "rebuilds\n",
+        steps, loop, double(steps) / std::max(loop, 1e-12), ps * 1e-6, startup, sim->rebuilds());
     fmt::print("cpu time of the loop: {:.3f} s per rank (max), {:.0f} % of the wall time{}\n", cpu,
                100 * cpu / std::max(loop, 1e-12),
                cpu < 0.8 * loop ? ": the machine is shared, the wall time is inflated" : "");
@@ -237,22 +246,27 @@ int run_world(int argc, char** argv) {
   Cli cli;
   CLI::App app{"basalt-run: parallel DEM solver (Basalt)"};
   app.add_option("scene", cli.scene_file, "scene file (TOML, docs/scenes.md)")->required();
-  app.add_option("--geometry", cli.geometry, "geometry file (.h5 or .geo); overrides the scene's geometry.file");
+  app.add_option("--geometry", cli.geometry,
+                 "geometry file (.h5 or .geo); overrides the scene's geometry.file");
   app.add_option("--steps", cli.steps, "number of steps; overrides run.steps (with --restart: steps to add)")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--output", cli.output, "output folder; overrides output.directory");
   app.add_option("--dims", cli.dims_text, "compute-rank grid x,y,z (default: MPI_Dims_create)");
-  app.add_option("--io-ranks", cli.io_ranks, "dedicated I/O ranks among the mpirun ranks (0: compute ranks write)")
+  app.add_option("--io-ranks", cli.io_ranks,
+                 "dedicated I/O ranks among the mpirun ranks (0: compute ranks write)")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--checkpoint-every", cli.checkpoint_every, "HDF5 checkpoint every N steps (0 = off)")
       ->check(CLI::NonNegativeNumber);
-  app.add_option("--frames-every", cli.frames_every, "VTK frame every N steps (0 = off)")->check(CLI::NonNegativeNumber);
+  app.add_option("--frames-every", cli.frames_every, "VTK frame every N steps (0 = off)")
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--fields-every", cli.fields_every, "every field saver every N steps (0 = off)")
       ->check(CLI::NonNegativeNumber);
-  app.add_option("--restart", cli.restart, "continue from a checkpoint, or from the latest complete one in a folder");
+  app.add_option("--restart", cli.restart,
+                 "continue from a checkpoint, or from the latest complete one in a folder");
   app.add_option("--frames-in-flight", cli.frames_in_flight, "frames a compute rank may have posted (bound)")
       ->check(CLI::PositiveNumber);
-  app.add_option("--throttle-io-mbps", cli.throttle_mbps, "benchmark only: make output storage this slow (MB/s)")
+  app.add_option("--throttle-io-mbps", cli.throttle_mbps,
+                 "benchmark only: make output storage this slow (MB/s)")
       ->check(CLI::NonNegativeNumber);
   app.add_flag("--no-exact-restart", cli.no_exact_restart,
                "checkpoint steps are not bit-for-bit restart points (saves one list rebuild per checkpoint)");
@@ -291,12 +305,14 @@ int run_world(int argc, char** argv) {
     basalt::run::check_same_scene(*ckpt, ckpt_file, scene);
     (void)basalt::run::restart_layout_of(*ckpt, ckpt_file);
   } else if (!fs::exists(scene.geometry)) {
-    throw InputError(fmt::format("{}: geometry file {} does not exist{}", cli.scene_file, scene.geometry.string(),
-                                 cli.geometry.empty() ? " (geometry.file; --geometry overrides it)" : " (--geometry)"));
+    throw InputError(
+        fmt::format("{}: geometry file {} does not exist{}", cli.scene_file, scene.geometry.string(),
+                    cli.geometry.empty() ? " (geometry.file; --geometry overrides it)" : " (--geometry)"));
   }
 
   prepare_output_folder(scene.output_dir);
-  if (ckpt && world_root && !scene.fields.empty()) basalt::run::truncate_fields(scene.output_dir / "fields.csv", ckpt->step);
+  if (ckpt && world_root && !scene.fields.empty())
+    basalt::run::truncate_fields(scene.output_dir / "fields.csv", ckpt->step);
 
   io::OutputConfig cfg;
   cfg.dir = scene.output_dir;
@@ -308,9 +324,9 @@ int run_world(int argc, char** argv) {
   cfg.continue_on_error = scene.output_continue_on_error;
   cfg.throttle_mb_per_s = cli.throttle_mbps;
   cfg.append_fields = ckpt.has_value();
-  const auto vtk = basalt::run::make_vtk_frame_writer(io::Units{scene.units.length, scene.units.time,
-                                                                scene.units.force, io::Units{}.mass},
-                                                      ckpt ? ckpt->time : -1.0);
+  const auto vtk = basalt::run::make_vtk_frame_writer(
+      io::Units{scene.units.length, scene.units.time, scene.units.force, io::Units{}.mass},
+      ckpt ? ckpt->time : -1.0);
 
   io::RankLayout layout;
   try {

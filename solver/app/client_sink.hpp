@@ -8,7 +8,8 @@ namespace basalt::run {
 
 class ClientSink final : public solver::OutputSink {
  public:
-  ClientSink(io::OutputClient& client, bool continue_on_error) : client_(client), continue_(continue_on_error) {}
+  ClientSink(io::OutputClient& client, bool continue_on_error)
+      : client_(client), continue_(continue_on_error) {}
   void begin(const std::vector<std::string>&) override {}  // the client knows the columns (OutputConfig)
   void fields(std::int64_t step, double time, std::span<const double> partials) override {
     client_.submit_fields(step, time, partials);

@@ -17,7 +17,8 @@ fs::path resolve_restart(const fs::path& p) {
   if (fs::is_directory(p)) {
     const auto latest = io::latest_complete_checkpoint(p);
     if (latest.empty())
-      throw InputError(fmt::format("--restart {}: no complete checkpoint (ckpt_<step>.h5) in this folder", p.string()));
+      throw InputError(
+          fmt::format("--restart {}: no complete checkpoint (ckpt_<step>.h5) in this folder", p.string()));
     return latest;
   }
   if (!fs::exists(p)) throw InputError(fmt::format("--restart {}: no such file or folder", p.string()));
@@ -25,14 +26,17 @@ fs::path resolve_restart(const fs::path& p) {
 }
 
 namespace {
-std::string vec_text(const std::array<double, 3>& v) { return fmt::format("{:.17g},{:.17g},{:.17g}", v[0], v[1], v[2]); }
+std::string vec_text(const std::array<double, 3>& v) {
+  return fmt::format("{:.17g},{:.17g},{:.17g}", v[0], v[1], v[2]);
+}
 
 const std::string& attribute(const io::Checkpoint& c, const fs::path& file, const std::string& key) {
   const auto it = c.geometry.attributes.find(key);
   if (it == c.geometry.attributes.end())
-    throw InputError(fmt::format("{}: attribute '{}' is missing: a restart needs the decomposition the run used "
-                                 "(checkpoints written by basalt-run carry it)",
-                                 file.string(), key));
+    throw InputError(
+        fmt::format("{}: attribute '{}' is missing: a restart needs the decomposition the run used "
+                    "(checkpoints written by basalt-run carry it)",
+                    file.string(), key));
   return it->second;
 }
 
@@ -53,7 +57,8 @@ std::array<double, 3> vec(const io::Checkpoint& c, const fs::path& file, const s
     char* end = nullptr;
     v[d] = std::strtod(s, &end);
     if (end == s || (d < 2 && *end != ',') || (d == 2 && *end != '\0'))
-      throw InputError(fmt::format("{}: attribute '{}' = \"{}\" is not three numbers", file.string(), key, t));
+      throw InputError(
+          fmt::format("{}: attribute '{}' = \"{}\" is not three numbers", file.string(), key, t));
     s = end + 1;
   }
   return v;
@@ -78,10 +83,11 @@ solver::RestartLayout restart_layout_of(const io::Checkpoint& c, const fs::path&
 
 void check_same_scene(const io::Checkpoint& c, const fs::path& file, const solver::Scene& scene) {
   if (c.scene_text != scene.text)
-    throw InputError(fmt::format(
-        "{}: this checkpoint was written by another scene ({} particles; its stored scene text differs from {}): "
-        "restart it with the scene file that wrote it",
-        file.string(), c.size(), scene.file.string()));
+    throw InputError(
+        fmt::format("{}: this checkpoint was written by another scene ({} particles; its stored scene text "
+                    "differs from {}): "
+                    "restart it with the scene file that wrote it",
+                    file.string(), c.size(), scene.file.string()));
 }
 
 void truncate_fields(const fs::path& csv, std::int64_t step) {

@@ -42,8 +42,8 @@ io::VtkFrameWriter make_vtk_frame_writer(const io::Units& units, double resume_a
     std::vector<std::int32_t> tag;
   };
   auto state = std::make_shared<State>();
-  return [state, units, resume_after_time](const std::vector<io::FramePiece>& pieces, std::int64_t step, double time,
-                                           int piece_index, int n_pieces,
+  return [state, units, resume_after_time](const std::vector<io::FramePiece>& pieces, std::int64_t step,
+                                           double time, int piece_index, int n_pieces,
                                            const std::filesystem::path& dir) -> std::uint64_t {
     auto& s = *state;
     s.id.clear();

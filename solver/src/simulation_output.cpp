@@ -121,7 +121,10 @@ void Simulation<Real>::pack_frame(io::FramePiece& piece, std::uint32_t kinds) co
       for (std::size_t w = 0; w < wall_driver_.size(); ++w) {
         const auto& s = wall_driver_.spec(w);
         const auto v = s.motion.velocity_at(time_);
-        piece.walls.push_back({s.name, wall_driver_.point(w), s.normal, {v[0], v[1], v[2]},
+        piece.walls.push_back({s.name,
+                               wall_driver_.point(w),
+                               s.normal,
+                               {v[0], v[1], v[2]},
                                {f[3 * w], f[3 * w + 1], f[3 * w + 2]}});
       }
   }
@@ -144,7 +147,8 @@ void Simulation<Real>::canonical_order() {
   const std::size_t n = p_.n_owned;
   std::vector<std::uint32_t> order(n);
   std::iota(order.begin(), order.end(), 0u);
-  std::sort(order.begin(), order.end(), [&](std::uint32_t i, std::uint32_t j) { return p_.id[i] < p_.id[j]; });
+  std::sort(order.begin(), order.end(),
+            [&](std::uint32_t i, std::uint32_t j) { return p_.id[i] < p_.id[j]; });
   p_.permute_owned(order);
   const std::size_t nb = bonds_.size();
   for (std::size_t k = 0; k < nb; ++k)
@@ -190,10 +194,13 @@ void Simulation<Real>::run(std::int64_t steps, OutputSink& out) {
       auto error = out.poll();
       if (parallel) error = comm().agree_error(error);
       if (error && !reported) {
-        if (!out.continue_on_error()) throw RunError(fmt::format("output failed at step {}: {}", step_, *error));
+        if (!out.continue_on_error())
+          throw RunError(fmt::format("output failed at step {}: {}", step_, *error));
         if (comm().rank() == 0)
-          fmt::print(stderr, "basalt-run: warning: output failed at step {} (on_error = \"continue\"; the run goes "
-                             "on without it): {}\n", step_, *error);
+          fmt::print(stderr,
+                     "basalt-run: warning: output failed at step {} (on_error = \"continue\"; the run goes "
+                     "on without it): {}\n",
+                     step_, *error);
         reported = true;
       }
     }
@@ -209,13 +216,13 @@ void Simulation<Real>::run(std::int64_t steps, OutputSink& out) {
   out.flush();
 }
 
-#define BASALT_INSTANTIATE(R)                                                                                   \
-  template bool Simulation<R>::field_partials(const std::array<double, 3>&, std::vector<double>&,              \
-                                              std::vector<char>&) const;                                         \
-  template void Simulation<R>::output_fields(const std::array<double, 3>&);                                    \
-  template void Simulation<R>::pack_frame(io::FramePiece&, std::uint32_t) const;                               \
-  template RestartLayout Simulation<R>::restart_layout() const;                                                \
-  template void Simulation<R>::canonical_order();                                                              \
+#define BASALT_INSTANTIATE(R)                                                                     \
+  template bool Simulation<R>::field_partials(const std::array<double, 3>&, std::vector<double>&, \
+                                              std::vector<char>&) const;                          \
+  template void Simulation<R>::output_fields(const std::array<double, 3>&);                       \
+  template void Simulation<R>::pack_frame(io::FramePiece&, std::uint32_t) const;                  \
+  template RestartLayout Simulation<R>::restart_layout() const;                                   \
+  template void Simulation<R>::canonical_order();                                                 \
   template void Simulation<R>::run(std::int64_t, OutputSink&);
 BASALT_INSTANTIATE(double)
 BASALT_INSTANTIATE(float)

@@ -22,7 +22,8 @@ Simulation<Real>::Simulation(const Scene& scene, const io::Checkpoint& c, const 
   if (c.size() == 0) throw InputError("the checkpoint has no particles");
   if (scene.bonds.size() > 254) throw InputError("interactions: at most 254 bond groups");
   if (c.dt != scene.dt)
-    throw InputError(fmt::format("the checkpoint was written with dt = {}, the scene has run.dt = {}", c.dt, scene.dt));
+    throw InputError(
+        fmt::format("the checkpoint was written with dt = {}, the scene has run.dt = {}", c.dt, scene.dt));
   const bool se = scene.integrator == Integrator::symplectic_euler;
   kick1_ = Real(se ? scene.dt : scene.dt / 2);
   kick2_ = Real(se ? 0.0 : scene.dt / 2);
@@ -38,7 +39,8 @@ Simulation<Real>::Simulation(const Scene& scene, const io::Checkpoint& c, const 
 }
 
 template <class Real>
-void Simulation<Real>::distribute_checkpoint(const io::Checkpoint& c, const RestartLayout& layout, MPI_Comm comm) {
+void Simulation<Real>::distribute_checkpoint(const io::Checkpoint& c, const RestartLayout& layout,
+                                             MPI_Comm comm) {
   const auto& g = c.geometry;
   dec_ = std::make_unique<Decomposition>(Comm(comm), options_.dims, layout.box_min, layout.box_max);
   halo_ = std::make_unique<Halo<Real>>(*dec_);
@@ -58,8 +60,8 @@ void Simulation<Real>::distribute_checkpoint(const io::Checkpoint& c, const Rest
     owned[i] = 1;
     const double im = c.inv_mass.empty() ? 1.0 / g.mass[i] : c.inv_mass[i];
     const auto& v = c.velocity[i];
-    p_.push_owned(g.id[i], Real(x[0]), Real(x[1]), Real(x[2]), Real(g.radius[i]), g.tag[i], Real(im), Real(v[0]),
-                  Real(v[1]), Real(v[2]));
+    p_.push_owned(g.id[i], Real(x[0]), Real(x[1]), Real(x[2]), Real(g.radius[i]), g.tag[i], Real(im),
+                  Real(v[0]), Real(v[1]), Real(v[2]));
   }
   for (std::size_t k = 0; k < g.bonds.size(); ++k) {
     const auto& b = g.bonds[k];
@@ -78,18 +80,19 @@ void Simulation<Real>::distribute_checkpoint(const io::Checkpoint& c, const Rest
     }
     if (!owned[ia] && !owned[ib]) continue;
     if (b.tag < 0 || static_cast<std::size_t>(b.tag) >= scene_.bonds.size())
-      throw InputError(fmt::format("the checkpoint's bond {}-{} belongs to interaction group {}, but the scene has "
-                                   "{} bond group(s)",
-                                   b.a, b.b, b.tag, scene_.bonds.size()));
+      throw InputError(
+          fmt::format("the checkpoint's bond {}-{} belongs to interaction group {}, but the scene has "
+                      "{} bond group(s)",
+                      b.a, b.b, b.tag, scene_.bonds.size()));
     bonds_.push(b.a, b.b, Real(c.bond_rest_length[k]), static_cast<std::uint8_t>(b.tag));
   }
   step_ = c.step;
   time_ = c.time;
 }
 
-#define BASALT_INSTANTIATE(R)                                                                                   \
-  template Simulation<R>::Simulation(const Scene&, const io::Checkpoint&, const RestartLayout&, MPI_Comm,       \
-                                     const RunOptions&);                                                         \
+#define BASALT_INSTANTIATE(R)                                                                             \
+  template Simulation<R>::Simulation(const Scene&, const io::Checkpoint&, const RestartLayout&, MPI_Comm, \
+                                     const RunOptions&);                                                  \
   template void Simulation<R>::distribute_checkpoint(const io::Checkpoint&, const RestartLayout&, MPI_Comm);
 BASALT_INSTANTIATE(double)
 BASALT_INSTANTIATE(float)
