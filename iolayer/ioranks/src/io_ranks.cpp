@@ -219,7 +219,9 @@ struct OutputClient::Impl {
       int done = 0;
       if (block) {
         const double t0 = MPI_Wtime();
-        MPI_Wait(&q.front().request, MPI_STATUS_IGNORE);
+        // A compute rank blocked on a full queue sleeps too: on a shared node its core is what the
+        // I/O rank may need to drain the queue.
+        wait_without_spinning(q.front().request);
         local.compute_wait_seconds += MPI_Wtime() - t0;
         done = 1;
       } else {
