@@ -129,7 +129,7 @@ TEST(Pack, NonConvexMeshVolume) {
                         (c[0] <= 2 - r || c[1] <= 2 - r || std::hypot(c[0] - 2, c[1] - 2) >= r);
     EXPECT_TRUE((arm1 || arm2 || corner) && c[2] >= r && c[2] <= 3 - r) << "sphere " << i << " pokes out";
   }
-  EXPECT_GT(chk::solid_fraction(*mesh, p), 0.55);
+  EXPECT_GT(chk::solid_fraction(*mesh, p), 0.5);  // 3 high with rmax 0.6: mostly wall layer
 }
 
 TEST(Pack, BadMeshesAreRefusedWithTheReason) {
