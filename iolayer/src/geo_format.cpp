@@ -17,15 +17,18 @@
 #include <fmt/os.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 #include <string_view>
 #include <unordered_map>
 
 #include "basalt/io/geometry.hpp"
+#include "geometry_order.hpp"
 
 namespace basalt::io {
 
@@ -200,13 +203,21 @@ Geometry read_geo(const fs::path& file) {
   return g;
 }
 
-void write_geo(const Geometry& g, const fs::path& file) {
-  g.validate(file);
+void write_geo(const Geometry& unordered, const fs::path& file) {
+  unordered.validate(file);
+  Geometry storage;
+  const Geometry& g = in_file_order(unordered, storage);
   const fs::path tmp = file.string() + ".tmp";
+  const fs::path folder = file.has_parent_path() ? file.parent_path() : fs::path(".");
+  std::error_code exists_ec;
+  if (!fs::exists(folder, exists_ec))
+    throw FormatError(file, "", fmt::format("cannot create: folder '{}' does not exist", folder.string()));
+  if (!fs::is_directory(folder, exists_ec))
+    throw FormatError(file, "", fmt::format("cannot create: '{}' is not a folder", folder.string()));
   {
     std::FILE* out = std::fopen(tmp.c_str(), "w");
     if (!out)
-      throw FormatError(file, "", "cannot open for writing (does the folder exist and is it writable?)");
+      throw FormatError(file, "", fmt::format("cannot create '{}': {}", tmp.string(), std::strerror(errno)));
     auto w = [&](std::string_view s) { return std::fwrite(s.data(), 1, s.size(), out) == s.size(); };
     bool ok = true;
     ok &= w("LSMGeometry 1.2\n");

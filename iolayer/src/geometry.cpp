@@ -6,6 +6,7 @@
 #include <cmath>
 #include <numeric>
 
+#include "geometry_order.hpp"
 #include "id_set.hpp"
 
 namespace basalt::io {
@@ -106,6 +107,26 @@ void write_geometry(const Geometry& g, const fs::path& file) {
   if (ext == ".h5" || ext == ".hdf5") return write_h5(g, file);
   if (ext == ".geo") return write_geo(g, file);
   throw FormatError(file, "", "unknown geometry format (expected .h5, .hdf5 or .geo)");
+}
+
+std::vector<std::size_t> sorting_order(const std::vector<std::int64_t>& id) {
+  if (std::is_sorted(id.begin(), id.end())) return {};
+  std::vector<std::size_t> order(id.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t i, std::size_t j) { return id[i] < id[j]; });
+  return order;
+}
+
+bool in_file_order(const Geometry& g) {
+  return std::is_sorted(g.id.begin(), g.id.end()) &&
+         std::all_of(g.bonds.begin(), g.bonds.end(), [](const Bond& b) { return b.a < b.b; });
+}
+
+const Geometry& in_file_order(const Geometry& g, Geometry& storage) {
+  if (in_file_order(g)) return g;
+  storage = g;
+  storage.sort_by_id();
+  return storage;
 }
 
 }  // namespace basalt::io

@@ -4,10 +4,9 @@
 
 #include <algorithm>
 #include <charconv>
-#include <cmath>
-#include <set>
 
 #include "basalt/io/checkpoint.hpp"
+#include "geometry_order.hpp"
 #include "h5_geometry_layout.hpp"
 #include "h5_support.hpp"
 
@@ -22,8 +21,6 @@ constexpr int kSchemaVersion = 1;
 // Root attributes of this schema besides the geometry's; "complete" is written last.
 constexpr std::string_view kRunAttributes[] = {"step", "time", "dt", "scene_text", "complete"};
 constexpr const char* kWallVectors[] = {"position", "normal", "velocity", "force"};
-
-bool finite(const Vec3& v) { return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]); }
 
 Vec3& wall_vector(WallState& w, int k) {
   Vec3* v[] = {&w.position, &w.normal, &w.velocity, &w.force};
@@ -45,62 +42,13 @@ void check_complete(const h5::Reader& r) {
 
 }  // namespace
 
-void Checkpoint::validate(const fs::path& source) const {
-  geometry.validate(source);
-  const std::size_t n = size();
-  const std::size_t m = geometry.bonds.size();
-  if (geometry.mass.size() != n)
-    throw FormatError(
-        source, "/particles/mass",
-        fmt::format("a checkpoint stores every mass: {} masses for {} particles", geometry.mass.size(), n));
-  if (velocity.size() != n)
-    throw FormatError(source, "/particles/velocity",
-                      fmt::format("{} velocities for {} particles", velocity.size(), n));
-  for (std::size_t i = 0; i < n; ++i)
-    if (!finite(velocity[i]))
-      throw FormatError(source, "/particles/velocity",
-                        fmt::format("particle id {}: velocity is not finite", geometry.id[i]));
-  if (bond_rest_length.size() != m)
-    throw FormatError(source, "/bonds/rest_length",
-                      fmt::format("{} values for {} bonds", bond_rest_length.size(), m));
-  if (bond_broken.size() != m)
-    throw FormatError(source, "/bonds/broken", fmt::format("{} values for {} bonds", bond_broken.size(), m));
-  for (std::size_t k = 0; k < m; ++k) {
-    if (!std::isfinite(bond_rest_length[k]) || bond_rest_length[k] < 0)
-      throw FormatError(
-          source, "/bonds/rest_length",
-          fmt::format("bond {}: rest length must be finite and >= 0, got {}", k, bond_rest_length[k]));
-    if (bond_broken[k] > 1)
-      throw FormatError(source, "/bonds/broken",
-                        fmt::format("bond {}: flag must be 0 or 1, got {}", k, bond_broken[k]));
-  }
-  std::set<std::string> names;
-  for (const auto& w : walls) {
-    const auto where = "/walls/" + w.name;
-    if (w.name.empty() || w.name == "." || w.name.find('/') != std::string::npos)
-      throw FormatError(source, where, "a wall name must be non-empty, not '.', and without '/'");
-    if (!names.insert(w.name).second) throw FormatError(source, where, "two walls have this name");
-    for (int k = 0; k < 4; ++k)
-      if (!finite(wall_vector(w, k)))
-        throw FormatError(source, where, fmt::format("{} is not finite", kWallVectors[k]));
-    const auto& nv = w.normal;
-    if (nv[0] == 0 && nv[1] == 0 && nv[2] == 0) throw FormatError(source, where, "normal is the zero vector");
-  }
-  if (step < 0) throw FormatError(source, root_attribute("step"), fmt::format("must be >= 0, got {}", step));
-  if (!std::isfinite(time)) throw FormatError(source, root_attribute("time"), "is not finite");
-  if (!std::isfinite(dt) || dt < 0)
-    throw FormatError(source, root_attribute("dt"), fmt::format("must be finite and >= 0, got {}", dt));
-}
-
 void write_checkpoint(const Checkpoint& c, const fs::path& file) {
   c.validate(file);
   // The file stores particles sorted by id and bonds smaller id first; sort a copy if needed.
   Checkpoint storage;
   const Checkpoint* s = &c;
-  const auto order = h5::sorting_order(c.geometry.id);
-  const bool bonds_ordered =
-      std::all_of(c.geometry.bonds.begin(), c.geometry.bonds.end(), [](const Bond& b) { return b.a < b.b; });
-  if (!order.empty() || !bonds_ordered) {
+  if (!in_file_order(c.geometry)) {
+    const auto order = sorting_order(c.geometry.id);
     storage = c;
     storage.geometry.sort_by_id();  // the same stable order as `order`
     for (std::size_t k = 0; k < order.size(); ++k) storage.velocity[k] = c.velocity[order[k]];
@@ -129,7 +77,9 @@ void write_checkpoint(const Checkpoint& c, const fs::path& file) {
   w.commit();
 }
 
-Checkpoint read_checkpoint(const fs::path& file) {
+namespace {
+
+Checkpoint read_checkpoint_unguarded(const fs::path& file) {
   h5::Reader r(file);
   h5::check_schema(r, kSchema, kSchemaVersion);
   check_complete(r);
@@ -182,6 +132,12 @@ Checkpoint read_checkpoint(const fs::path& file) {
   r.close();
   c.validate(file);
   return c;
+}
+
+}  // namespace
+
+Checkpoint read_checkpoint(const fs::path& file) {
+  return h5::with_memory_guard(file, [&] { return read_checkpoint_unguarded(file); });
 }
 
 bool is_complete_checkpoint(const fs::path& file) {

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numeric>
 
 #include "basalt/version.hpp"
 #include "id_set.hpp"
@@ -204,23 +203,6 @@ Geometry read_geometry_layout(const Reader& r, Names extra_reserved) {
 
   // Every invariant of Geometry::validate() has been checked above, naming the dataset.
   return g;
-}
-
-std::vector<std::size_t> sorting_order(const std::vector<std::int64_t>& id) {
-  if (std::is_sorted(id.begin(), id.end())) return {};
-  std::vector<std::size_t> order(id.size());
-  std::iota(order.begin(), order.end(), std::size_t{0});
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t i, std::size_t j) { return id[i] < id[j]; });
-  return order;
-}
-
-const Geometry& sorted(const Geometry& g, Geometry& storage) {
-  const bool bonds_ordered =
-      std::all_of(g.bonds.begin(), g.bonds.end(), [](const Bond& b) { return b.a < b.b; });
-  if (bonds_ordered && std::is_sorted(g.id.begin(), g.id.end())) return g;
-  storage = g;
-  storage.sort_by_id();
-  return storage;
 }
 
 }  // namespace basalt::io::h5

@@ -29,10 +29,4 @@ void write_geometry_layout(Writer& w, const Geometry& g, Names extra_reserved);
 /// Root string attributes that are neither the geometry's nor in `extra_reserved` become provenance.
 Geometry read_geometry_layout(const Reader& r, Names extra_reserved);
 
-/// Indices that sort `id` ascending (stable), or empty when it is already sorted.
-std::vector<std::size_t> sorting_order(const std::vector<std::int64_t>& id);
-
-/// `g` if it is sorted with every bond stored a < b, else a sorted copy kept in `storage`.
-const Geometry& sorted(const Geometry& g, Geometry& storage);
-
 }  // namespace basalt::io::h5

@@ -12,6 +12,8 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <new>
+#include <stdexcept>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -223,5 +225,18 @@ class Writer {
   Handle dcpl_;  // dataset creation: no timestamps, never write fill values
   bool committed_ = false;
 };
+
+/// Runs `read`, turning an allocation failure (a file declaring more values than memory holds or
+/// than a vector can address) into a FormatError naming the file.
+template <class F>
+auto with_memory_guard(const fs::path& file, F&& read) -> decltype(read()) {
+  try {
+    return read();
+  } catch (const std::bad_alloc&) {
+    throw FormatError(file, "", "not enough memory to hold the file's datasets");
+  } catch (const std::length_error&) {
+    throw FormatError(file, "", "a dataset declares more values than this machine can address");
+  }
+}
 
 }  // namespace basalt::io::h5

@@ -260,3 +260,13 @@ TEST(Checkpoint, UnwritableDestinationNamesThePath) {
   expect_format_error([&] { write_checkpoint(sample_checkpoint(), missing); },
                       {missing.string(), "cannot create: folder", "does not exist"});
 }
+
+TEST(Checkpoint, EmptyStateRoundTrips) {
+  const auto dir = basalt::test::scratch_dir("ckpt-empty");
+  Checkpoint c;  // no particles, bonds or walls: e.g. a rank-less test scene at step 0
+  c.scene_text = "";
+  write_checkpoint(c, dir / "ckpt_0.h5");
+  EXPECT_TRUE(is_complete_checkpoint(dir / "ckpt_0.h5"));
+  expect_same(read_checkpoint(dir / "ckpt_0.h5"), c);
+  EXPECT_EQ(latest_complete_checkpoint(dir), dir / "ckpt_0.h5");
+}

@@ -222,3 +222,22 @@ TEST_F(H5BadInput, BadRootAttributes) {
   edit_file(file_, [](hid_t f) { set_int_attribute(f, "my_note", 3); });
   expect_error({"cube.h5: attribute 'my_note' of /: provenance attributes must be strings"});
 }
+
+TEST_F(H5BadInput, DatasetLargerThanMemory) {
+  // A chunked dataset may declare 2^60 values without storing them: the reader must refuse it
+  // with an error naming the file instead of dying in the allocator.
+  edit_file(file_, [](hid_t f) {
+    check(H5Ldelete(f, "/particles/id", H5P_DEFAULT), "delete");
+    const hsize_t dims[1] = {hsize_t{1} << 60};
+    const hsize_t chunk[1] = {1024};
+    const hid_t space = H5Screate_simple(1, dims, nullptr);
+    const hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
+    H5Pset_chunk(dcpl, 1, chunk);
+    const hid_t ds = H5Dcreate2(f, "/particles/id", H5T_STD_I64LE, space, H5P_DEFAULT, dcpl, H5P_DEFAULT);
+    ASSERT_GE(ds, 0);
+    H5Dclose(ds);
+    H5Pclose(dcpl);
+    H5Sclose(space);
+  });
+  expect_error({"cube.h5", "more values than this machine can address"});
+}

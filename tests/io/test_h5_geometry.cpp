@@ -114,8 +114,11 @@ TEST(H5Geometry, UnwritableDestinationNamesThePath) {
   basalt::io::test::write_bytes(dir / "plain-file", "x");
   const auto target = dir / "plain-file" / "g.h5";  // parent is a regular file: even root cannot write
   expect_format_error([&] { write_h5(sample_geometry(), target); }, {target.string(), "cannot create"});
-  expect_format_error([&] { write_geometry(sample_geometry(), dir / "missing-folder" / "g.geo"); },
-                      {(dir / "missing-folder" / "g.geo").string(), "cannot open for writing"});
+  expect_format_error(
+      [&] { write_geometry(sample_geometry(), dir / "missing-folder" / "g.geo"); },
+      {(dir / "missing-folder" / "g.geo").string(), "cannot create: folder", "does not exist"});
+  expect_format_error([&] { write_geometry(sample_geometry(), dir / "plain-file" / "g.geo"); },
+                      {(dir / "plain-file" / "g.geo").string(), "is not a folder"});
 }
 
 TEST(H5Geometry, ReadableWithH5dumpAndH5py) {
@@ -150,6 +153,17 @@ TEST(ReadGeometry, DispatchesOnExtension) {
   EXPECT_EQ(read_geometry(dir / "g.H5").id, read_geometry(dir / "g.geo").id);
   EXPECT_EQ(read_bytes(dir / "g.H5").substr(1, 3), "HDF");
   EXPECT_EQ(read_bytes(dir / "g.geo").substr(0, 15), "LSMGeometry 1.2");
+}
+
+TEST(GeoFormat, WritesParticlesInIdOrderAndBondsSmallerIdFirst) {
+  const auto dir = basalt::test::scratch_dir("geo-order");
+  write_geo(sample_geometry(), dir / "g.geo");  // ids 40, 3, 17, 8, 99, 5 in memory
+  const auto text = read_bytes(dir / "g.geo");
+  EXPECT_NE(text.find("Simple\n6\n0.1 0.2 0.30000000000000004 0.25 3 2\n-1 1e-300 6.02214076e+23 0.3 5 -4\n"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("BeginConnect\n4\n3 8 1\n17 40 2\n5 99 0\n8 40 7\nEndConnect\n"), std::string::npos)
+      << text;
 }
 
 TEST(ReadGeometry, UnknownExtensionIsNamed) {
