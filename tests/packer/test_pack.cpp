@@ -325,6 +325,9 @@ TEST(Pack, ImpossibleRequestsAreRefused) {
   chk::write_text(dir / "tet.off",
                   "OFF\n4 4 0\n0 0 0\n4 0 0\n0 4 0\n0 0 4\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n");
   expect_error(*load_mesh(dir / "tet.off"), options(0.9, 1.0), "too small for one sphere");
+  auto few = options(0.2, 1.0);
+  few.seed_fraction = 0.0;
+  expect_error(*box, few, "seed fraction must be in");
   auto pl = options(0.2, 1.0);
   pl.exponent = -1;
   expect_error(*box, pl, "exponent must be > 0");
