@@ -153,7 +153,7 @@ def write_cube(w, gg, bp, bl):
     w("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
     if gg:
         w(f"| GenGeo (python3-gengeo, InsertGenerator3D) | {med(gg, 'particles'):.0f} | "
-          f"{med(gg, 'solid_fraction'):.4f} | | {med(gg, 'bonds'):.0f} | "
+          f"{med(gg, 'solid_fraction'):.4f} | {med(gg, 'exponent'):.2f} | {med(gg, 'bonds'):.0f} | "
           f"{2 * med(gg, 'bonds') / med(gg, 'particles'):.2f} | {med(gg, 'seconds'):.2f} | {med(gg, 'rss_mib'):.0f} |")
     for name, rows in (("basalt-pack, dense (default)", bp),
                        ("basalt-pack, GenGeo-like: `--exponent 2.2 --target-fraction 0.62 --fill`", bl)):
