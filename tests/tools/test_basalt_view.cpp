@@ -265,6 +265,21 @@ TEST(BasaltView, ConvertsManyInputsToAPvdSeries) {
   for (vtkIdType i = 0; i < 20; ++i)
     EXPECT_EQ(pd->GetPoint(i)[2], b_read.position[static_cast<std::size_t>(i)][2]);
 
+  // A missing input is found before anything is written.
+  r = basalt_view(fmt_args("convert", (dir / "a.geo").string(), (dir / "nope.geo").string(), "-o",
+                           (dir / "other.pvd").string()),
+                  dir);
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.out.find("nope.geo: no such file"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(dir / "other"));
+  EXPECT_FALSE(fs::exists(dir / "other.pvd"));
+
+  // An output folder that does not exist.
+  r = basalt_view(fmt_args("convert", (dir / "a.geo").string(), "-o", (dir / "missing" / "a.vtp").string()),
+                  dir);
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.out.find("does not exist"), std::string::npos) << r.out;
+
   // Several inputs cannot go to one .vtp.
   r = basalt_view(fmt_args("convert", (dir / "a.geo").string(), (dir / "b.geo").string(), "-o",
                            (dir / "one.vtp").string()),
