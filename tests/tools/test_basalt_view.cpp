@@ -393,3 +393,44 @@ TEST(BasaltView, ConvertsCheckpointsToASeriesInTimeOrder) {
     EXPECT_EQ(v->GetComponent(i, 2), c.velocity[static_cast<std::size_t>(i)][2]);
   }
 }
+
+TEST(BasaltView, RendersAParallelFrameAndReportsItsFields) {
+  const fs::path dir = basalt::test::scratch_dir("view-pvtp");
+  // The lattice split in two pieces, as two I/O ranks write it.
+  const basalt::io::Checkpoint c = lattice_checkpoint();
+  const auto all = basalt::io::arrays_of(c);
+  const std::size_t half = c.size() / 2;
+  basalt::io::ParticleArrays lo = all, hi = all;
+  lo.id = all.id.subspan(0, half);
+  lo.position = all.position.subspan(0, half);
+  lo.radius = all.radius.subspan(0, half);
+  lo.tag = all.tag.subspan(0, half);
+  lo.velocity = all.velocity.subspan(0, half);
+  lo.mass = all.mass.subspan(0, half);
+  hi.id = all.id.subspan(half);
+  hi.position = all.position.subspan(half);
+  hi.radius = all.radius.subspan(half);
+  hi.tag = all.tag.subspan(half);
+  hi.velocity = all.velocity.subspan(half);
+  hi.mass = all.mass.subspan(half);
+  const auto layout = basalt::io::layout_of(all);
+  basalt::io::write_piece(dir, c.step, 0, 2, lo, basalt::io::info_of(c), layout);
+  basalt::io::write_piece(dir, c.step, 1, 2, hi, basalt::io::info_of(c), layout);
+  const fs::path pvtp = basalt::io::write_pvtp(dir, c.step, 2, layout);
+
+  Outcome r = basalt_view(fmt_args("info", pvtp.string()), dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("1728 particles"), std::string::npos) << r.out;
+  EXPECT_NE(
+      r.out.find("colour fields: id, radius, tag, mass, velocity, velocity_x, velocity_y, velocity_z, speed"),
+      std::string::npos)
+      << r.out;
+
+  r = basalt_view(fmt_args("render", pvtp.string(), "-o", (dir / "p.png").string(),
+                           "--size 400x300 --view -y --color velocity_z"),
+                  dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  const Image img = read_png(dir / "p.png");
+  EXPECT_GT(img.count(kLow, 30, kSceneFraction), 30);   // bottom half (piece 0) at rest
+  EXPECT_GT(img.count(kHigh, 30, kSceneFraction), 30);  // top half (piece 1) fastest
+}
