@@ -1,5 +1,6 @@
 // basalt-view end to end: the command run as a user would, without DISPLAY (it starts its own
 // virtual X server), its outputs checked through VTK's readers: PNG size and content, VTK frames.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <vtkDataArray.h>
@@ -43,9 +44,10 @@ struct Outcome {
   std::string out;  ///< stdout and stderr together
 };
 
-Outcome basalt_view(const std::string& args, const fs::path& dir) {
+Outcome basalt_view(const std::string& args, const fs::path& dir, const std::string& env = "") {
   const fs::path log = dir / "basalt-view.log";
-  const std::string cmd = "env -u DISPLAY " BASALT_VIEW_EXE " " + args + " > '" + log.string() + "' 2>&1";
+  const std::string cmd =
+      fmt::format("env -u DISPLAY {} {} {} > '{}' 2>&1", env, BASALT_VIEW_EXE, args, log.string());
   const int status = std::system(cmd.c_str());
   Outcome r;
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128;
@@ -433,4 +435,27 @@ TEST(BasaltView, RendersAParallelFrameAndReportsItsFields) {
   const Image img = read_png(dir / "p.png");
   EXPECT_GT(img.count(kLow, 30, kSceneFraction), 30);   // bottom half (piece 0) at rest
   EXPECT_GT(img.count(kHigh, 30, kSceneFraction), 30);  // top half (piece 1) fastest
+}
+
+TEST(BasaltView, StartsItsOwnXServerAlsoForConcurrentCommands) {
+  const fs::path dir = basalt::test::scratch_dir("view-xvfb");
+  const fs::path geo = basalt::test::reference_dir() / "cube1.geo";
+  // Three renders at once, each starting its own Xvfb: the servers pick distinct free displays.
+  std::string cmd = "env -u DISPLAY sh -c '";
+  for (int i = 0; i < 3; ++i)
+    cmd += fmt::format("\"{}\" render \"{}\" -o \"{}\" --size 200x150 -q & ", BASALT_VIEW_EXE, geo.string(),
+                       (dir / fmt::format("c{}.png", i)).string());
+  cmd += "wait'";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+  for (int i = 0; i < 3; ++i) {
+    const Image img = read_png(dir / fmt::format("c{}.png", i));
+    EXPECT_EQ(img.width, 200) << i;
+    EXPECT_EQ(img.height, 150) << i;
+  }
+
+  // Without Xvfb on the PATH, a clear error instead of VTK's.
+  const Outcome r =
+      basalt_view(fmt_args("render", geo.string(), "-o", (dir / "x.png").string()), dir, "PATH=/nonexistent");
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.out.find("Xvfb is not installed"), std::string::npos) << r.out;
 }
