@@ -74,12 +74,12 @@ int run(int argc, char** argv, MPI_Comm compute) {
   const auto t0 = std::chrono::steady_clock::now();
   std::unique_ptr<Simulation<double>> sim;
   {
-    const auto g = basalt::io::read_geometry(scene.geometry);
+    auto g = basalt::io::read_geometry(scene.geometry);
     if (root && (g.units.length != scene.units.length || g.units.time != scene.units.time ||
                  g.units.force != scene.units.force))
       fmt::print(stderr, "warning: the geometry declares units {}, {}, {}; the scene {}, {}, {}\n", g.units.length,
                  g.units.time, g.units.force, scene.units.length, scene.units.time, scene.units.force);
-    sim = std::make_unique<Simulation<double>>(scene, g, compute, options);
+    sim = std::make_unique<Simulation<double>>(scene, std::move(g), compute, options);
   }
   const auto& st = sim->stability();
   if (root) {

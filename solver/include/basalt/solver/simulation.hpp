@@ -43,9 +43,10 @@ struct StabilityReport {
 template <class Real = double>
 class Simulation {
  public:
-  /// Distributes the geometry over the ranks of `comm` and builds everything the scene needs.
-  /// Throws InputError (bad scene/geometry combination, unstable dt) on every rank alike.
-  Simulation(const Scene& scene, const io::Geometry& geometry, MPI_Comm comm, const RunOptions& options = {});
+  /// Distributes the geometry over the ranks of `comm` and builds everything the scene needs. The
+  /// geometry is taken by value and released part by part as it is copied: pass std::move(g) to keep
+  /// peak memory low. Throws InputError (bad scene/geometry combination, unstable dt) on every rank alike.
+  Simulation(const Scene& scene, io::Geometry geometry, MPI_Comm comm, const RunOptions& options = {});
 
   /// Runs `steps` steps (scene.steps when negative), writing field rows to `sink` (rank 0 only; may be null).
   void run(std::int64_t steps = -1, FieldSink* sink = nullptr);
@@ -85,7 +86,7 @@ class Simulation {
   std::size_t memory_bytes() const;
 
  private:
-  void distribute(const io::Geometry& g, MPI_Comm comm);
+  void distribute(io::Geometry& g, MPI_Comm comm);
   double kinetic_energy_local() const;
   double total_energy(const std::array<double, 3>& pe) const;
   void progress(std::int64_t done, std::int64_t total, double seconds) const;
