@@ -342,3 +342,16 @@ TEST(Pack, ASmallVolumeHoldsAtLeastOneSphere) {
   const auto p = pack(*box, o);
   expect_valid(*box, p, o);
 }
+
+TEST(Pack, ProgressIsReportedAndEndsAtOne) {
+  auto box = make_box({0, 0, 0}, {15, 15, 15});  // ~5,000 spheres: progress every 4,096 placements
+  auto o = options(0.2, 1.0, 6);
+  std::vector<double> seen;
+  o.progress = [&](double f) { seen.push_back(f); };
+  const auto p = pack(*box, o);
+  ASSERT_GE(seen.size(), 2u) << p.size() << " spheres";
+  EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
+  EXPECT_GT(seen.front(), 0.0);
+  EXPECT_LT(seen[seen.size() - 2], 1.0);
+  EXPECT_EQ(seen.back(), 1.0);
+}
