@@ -72,6 +72,15 @@ case $case_name in
     [ "$(wc -l <"$W/out/fields.csv")" -eq 101 ] || fail "fields.csv: expected a header and 100 rows"
     $CHECK pvd "$W/out" || fail "VTK frames disagree with the checkpoints after the restart"
     ;;
+  two_io_ranks)
+    # 2 compute + 2 I/O ranks: one checkpoint file per step (I/O rank 0 gathers), one VTK piece per I/O
+    # rank; the checkpoints equal those of 2 compute ranks writing themselves.
+    must_run 4 --io-ranks 2 --steps 100 --checkpoint-every 50 --frames-every 50 --output "$W/q2"
+    must_run 2 --io-ranks 0 --steps 100 --checkpoint-every 50 --output "$W/q0"
+    [ -e "$W/q2/frame_00000100/piece_0001.vtp" ] || fail "no VTK piece from the second I/O rank"
+    $CHECK same "$W/q2/ckpt_000100.h5" "$W/q0/ckpt_000100.h5" || fail "checkpoints differ between Q = 2 and Q = 0"
+    $CHECK pvd "$W/q2" || fail "VTK frames disagree with the checkpoints"
+    ;;
   unwritable_output)
     touch "$W/a_file"
     must_fail "$W/a_file/out: cannot create the output folder" 3 --io-ranks 1 --steps 10 --output "$W/a_file/out"
