@@ -1,0 +1,311 @@
+#!/usr/bin/python3
+"""The seed paper's scaling study at this machine's scale (docs/paper-study.md).
+
+Steps (each can be skipped; results go to --data, default docs/data/paper_study):
+  table     partition_study table: Table 2 (1x1x1 .. 10x10x10 subdomains of 15 mm) -> table2.csv, table2.md
+  pingpong  mpirun -np 2 partition_study pingpong -> pingpong.csv (latency, bandwidth, allreduce)
+  runs      basalt-run scenes/wave.toml on the 15 mm cube (cube1.geo and basalt-pack's seed-7 cube) at 1 and
+            2 compute ranks, output stages none / field saver, --repeats each -> runs.csv (every repeat, with
+            the timing summary per step), stages.csv (Figure 5 input, see figure5.py)
+  model     weak-scaling projection to 1000 ranks from the measured costs -> model.csv, model.md,
+            docs/img/weak_scaling.png
+Run from the worktree root with the build in build/:
+  source scripts/mpi-env.sh && /usr/bin/python3 tools/bench/paper_study.py --steps 3000 --repeats 3
+"""
+import argparse
+import csv
+import math
+import os
+import re
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+# The paper (Weatherley et al. 2010; /work/shared/BENCHMARK.md): SGI cluster, Xeon L5520, 10,000 steps.
+PAPER_STEPS = 10000
+PAPER_POINTS = {27: 1104.5, 1000: 1617.5}  # workers -> seconds, no output
+PAPER_PARTICLES = {27: 241540, 1000: 8700121}
+# Assumed interconnect of a 2010 cluster (InfiniBand QDR class); not measured, stated in the docs.
+CLUSTER_LATENCY_S = 3e-6
+CLUSTER_BANDWIDTH_BPS = 2.5e9
+
+DONE_RE = re.compile(r"done: (\d+) steps in ([0-9.]+) s .*?start-up ([0-9.]+) s; (\d+) rebuilds")
+PART_RE = re.compile(r"(forces|neighbour search|communication|integration|output) ([0-9.]+) ms")
+HEAD_RE = re.compile(r"basalt-run \S+: (\d+) particles, (\d+) bonds on (\d+) rank")
+
+
+def sh(cmd, **kw):
+    print("+", " ".join(cmd), flush=True)
+    return subprocess.run(cmd, check=True, text=True, capture_output=True, **kw)
+
+
+def mpirun(np):
+    return ["mpirun", "-np", str(np)]
+
+
+# ---------------------------------------------------------------------------------------------- table
+def step_table(a):
+    out = sh([a.bin("partition_study"), "table", "--geometry", a.cube1, "--max-n", str(a.max_n), "--pack",
+              str(a.pack), "--csv", os.path.join(a.data, "table2.csv")])
+    with open(os.path.join(a.data, "table2.md"), "w") as f:
+        f.write(out.stdout)
+    print(out.stdout)
+
+
+def step_pingpong(a):
+    out = sh(mpirun(2) + [a.bin("partition_study"), "pingpong", "--csv", os.path.join(a.data, "pingpong.csv")])
+    print(out.stdout)
+
+
+def read_pingpong(a):
+    with open(os.path.join(a.data, "pingpong.csv")) as f:
+        for line in f:
+            if line.startswith("#"):
+                kv = dict(x.split("=") for x in line[1:].split())
+                return float(kv["latency_s"]), float(kv["bandwidth_Bps"]), float(kv["allreduce_s"])
+    raise SystemExit("pingpong.csv has no summary line")
+
+
+# ----------------------------------------------------------------------------------------------- runs
+def scene_variant(src, dst, geometry, fields):
+    """The wave scene with an absolute geometry path, with or without its [[output.fields]] blocks."""
+    with open(src) as f:
+        text = f.read()
+    text = re.sub(r'(?m)^file = ".*"$', f'file = "{geometry}"', text, count=1)
+    if not fields:
+        text = re.sub(r"(?ms)^\[\[output\.fields\]\].*?(?=^\[|\Z)", "", text)
+    with open(dst, "w") as f:
+        f.write(text)
+
+
+def parse_run(stdout):
+    d = DONE_RE.search(stdout)
+    h = HEAD_RE.search(stdout)
+    if not d or not h:
+        raise SystemExit("cannot read basalt-run's summary:\n" + stdout)
+    parts = {k: float(v) for k, v in PART_RE.findall(stdout)}
+    return {"particles": int(h.group(1)), "bonds": int(h.group(2)), "ranks": int(h.group(3)),
+            "steps": int(d.group(1)), "loop_s": float(d.group(2)), "startup_s": float(d.group(3)),
+            "rebuilds": int(d.group(4)), "forces_ms": parts["forces"], "neighbour_ms": parts["neighbour search"],
+            "comm_ms": parts["communication"], "integration_ms": parts["integration"], "output_ms": parts["output"]}
+
+
+def ensure_packed(a):
+    if not os.path.exists(a.packed):
+        os.makedirs(os.path.dirname(a.packed), exist_ok=True)
+        sh([a.bin("basalt-pack"), "box", "--size", "15,15,15", "--rmin", "0.2", "--rmax", "1.0", "--seed", "7",
+            "-o", a.packed, "--quiet"])
+
+
+def step_runs(a):
+    ensure_packed(a)
+    tmp = tempfile.mkdtemp(prefix="paper-study-")
+    rows = []
+    geoms = [("cube1.geo", a.cube1), ("basalt-pack seed 7", a.packed)]
+    try:
+        # Interleave configurations within each repeat so that machine noise spreads over all of them.
+        for rep in range(a.repeats):
+            for gname, gpath in geoms:
+                for stage in ("none", "fields"):
+                    scene = os.path.join(tmp, f"wave-{stage}.toml")
+                    scene_variant(os.path.join(ROOT, "scenes", "wave.toml"), scene, os.path.abspath(gpath),
+                                  stage == "fields")
+                    for p in (1, 2):
+                        out = sh(mpirun(p) + [a.bin("basalt-run"), scene, "--steps", str(a.steps), "--output",
+                                              os.path.join(tmp, "out"), "--quiet"])
+                        r = parse_run(out.stdout)
+                        r.update({"geometry": gname, "stage": stage, "io_ranks": 0, "repeat": rep})
+                        print(f"  {gname:20s} {stage:6s} P={p} loop {r['loop_s']:.3f} s  comm {r['comm_ms']:.4f} "
+                              f"ms/step", flush=True)
+                        rows.append(r)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    keys = ["geometry", "stage", "ranks", "io_ranks", "repeat", "particles", "bonds", "steps", "loop_s",
+            "startup_s", "rebuilds", "forces_ms", "neighbour_ms", "comm_ms", "integration_ms", "output_ms"]
+    with open(os.path.join(a.data, "runs.csv"), "w", newline="") as f:
+        w = csv.DictWriter(f, keys)
+        w.writeheader()
+        w.writerows(rows)
+    # Figure 5 input: one row per run, time scaled to the paper's 10,000 steps.
+    with open(os.path.join(a.data, "stages.csv"), "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["geometry", "compute_ranks", "io_ranks", "stage", "repeat", "particles", "steps",
+                    "loop_seconds", "seconds_per_10000_steps"])
+        for r in rows:
+            w.writerow([r["geometry"], r["ranks"], r["io_ranks"], r["stage"], r["repeat"], r["particles"],
+                        r["steps"], r["loop_s"], r["loop_s"] * PAPER_STEPS / r["steps"]])
+
+
+def read_csv(path):
+    with open(path) as f:
+        return list(csv.DictReader(f))
+
+
+# ---------------------------------------------------------------------------------------------- model
+def median_of(rows, key, **match):
+    v = [float(r[key]) for r in rows if all(str(r[k]) == str(x) for k, x in match.items())]
+    if not v:
+        raise SystemExit(f"no runs match {match}")
+    return statistics.median(v)
+
+
+def ghosts_at_np2(a):
+    """Mean owned and largest ghost count per rank at 2 ranks on cube1.geo (2x1x1, as MPI_Dims_create
+    chooses), from partition_study's replay of the decomposition."""
+    out = sh([a.bin("partition_study"), "grid", "--geometry", a.cube1, "--dims", "2,1,1"])
+    rows = list(csv.DictReader(out.stdout.splitlines()))
+    return statistics.mean(float(r["owned"]) for r in rows), max(float(r["ghosts"]) for r in rows)
+
+
+def step_model(a):
+    runs = read_csv(os.path.join(a.data, "runs.csv"))
+    table = read_csv(os.path.join(a.data, "table2.csv"))
+    lat, bw, ar2 = read_pingpong(a)
+    g = "cube1.geo"
+    n1 = int(median_of(runs, "particles", geometry=g, ranks=1, stage="none"))
+    comp = lambda p: sum(median_of(runs, k, geometry=g, ranks=p, stage="none")
+                         for k in ("forces_ms", "neighbour_ms", "integration_ms")) * 1e-3
+    t1 = comp(1)                       # s per step, all particles on one rank
+    c_p = t1 / n1                      # s per particle-step
+    owned2, ghosts2 = ghosts_at_np2(a)
+    t2 = comp(2)                       # s per step per rank (max over ranks) at 2 ranks
+    # compute(2) = c_p * (owned + gamma * ghosts): the work ghosts add (pairs and bonds with a ghost end).
+    gamma = max(0.0, (t2 / c_p - owned2) / ghosts2)
+    comm2 = median_of(runs, "comm_ms", geometry=g, ranks=2, stage="none") * 1e-3
+    fields_cost = (median_of(runs, "output_ms", geometry=g, ranks=1, stage="fields")) * 1e-3
+    measured = {"particles_1rank": n1, "compute_s_per_step_1rank": t1, "c_p_s": c_p, "owned_2rank": owned2,
+                "ghosts_2rank_max": ghosts2, "compute_s_per_step_2rank": t2, "gamma": gamma,
+                "comm_s_per_step_2rank": comm2, "latency_s": lat, "bandwidth_Bps": bw, "allreduce2_s": ar2,
+                "fieldsaver_s_per_step_1rank": fields_cost}
+
+    def project(row, L, B, compute_per_particle):
+        P = int(row["subdomains"])
+        owned = float(row["owned_max"])
+        ghosts = float(row["ghosts_max"])
+        compute = compute_per_particle * (owned + gamma * ghosts)
+        msgs = float(row["messages_max"])
+        # Each of the (up to) 6 phases is a blocking sendrecv: the bytes of the largest rank cross the link.
+        comm = msgs * L + float(row["bytes_step_max"]) / B
+        # Two reductions per step (max displacement; field saver's sum when on): a tree of log2 P rounds.
+        reduce_ = 2 * math.ceil(math.log2(P)) * L if P > 1 else 0.0
+        return compute, comm, reduce_
+
+    rows = []
+    for row in table:
+        P = int(row["subdomains"])
+        c_here, m_here, r_here = project(row, lat, bw, c_p)
+        c_cl, m_cl, r_cl = project(row, CLUSTER_LATENCY_S, CLUSTER_BANDWIDTH_BPS, c_p)
+        # The paper's own compute speed: 110.45 ms per step for 8,946 particles per worker at 27 workers.
+        c_paper = PAPER_POINTS[27] / PAPER_STEPS / (PAPER_PARTICLES[27] / 27)
+        c_pp, m_pp, r_pp = project(row, CLUSTER_LATENCY_S, CLUSTER_BANDWIDTH_BPS, c_paper)
+        rows.append({"n": int(row["n"]), "ranks": P, "particles": int(row["particles"]),
+                     "owned_max": float(row["owned_max"]), "ghosts_max": float(row["ghosts_max"]),
+                     "bytes_step_max": float(row["bytes_step_max"]), "messages_max": int(float(row["messages_max"])),
+                     "here_compute_s": c_here, "here_comm_s": m_here, "here_reduce_s": r_here,
+                     "here_T10k_s": (c_here + m_here + r_here) * PAPER_STEPS,
+                     "cluster_compute_s": c_cl, "cluster_comm_s": m_cl, "cluster_reduce_s": r_cl,
+                     "cluster_T10k_s": (c_cl + m_cl + r_cl) * PAPER_STEPS,
+                     "paperspeed_T10k_s": (c_pp + m_pp + r_pp) * PAPER_STEPS})
+    with open(os.path.join(a.data, "model.csv"), "w", newline="") as f:
+        w = csv.DictWriter(f, list(rows[0].keys()))
+        w.writeheader()
+        w.writerows(rows)
+    with open(os.path.join(a.data, "model_inputs.csv"), "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["quantity", "value"])
+        for k, v in measured.items():
+            w.writerow([k, f"{v:.6g}"])
+        w.writerow(["cluster_latency_s (assumed)", CLUSTER_LATENCY_S])
+        w.writerow(["cluster_bandwidth_Bps (assumed)", CLUSTER_BANDWIDTH_BPS])
+    by = {r["ranks"]: r for r in rows}
+    lines = ["| ranks | particles | max owned | max ghosts | bytes/step (max rank) | T per 10,000 steps, this "
+             "machine's L, B (s) | same, cluster L, B (s) | paper's compute speed + cluster L, B (s) |",
+             "| --- | --- | --- | --- | --- | --- | --- | --- |"]
+    for r in rows:
+        lines.append(f"| {r['ranks']} | {r['particles']:,} | {r['owned_max']:.0f} | {r['ghosts_max']:.0f} | "
+                     f"{r['bytes_step_max']:.0f} | {r['here_T10k_s']:.2f} | {r['cluster_T10k_s']:.2f} | "
+                     f"{r['paperspeed_T10k_s']:.1f} |")
+    growth = {k: by[1000][k] / by[27][k] - 1 for k in ("here_T10k_s", "cluster_T10k_s", "paperspeed_T10k_s")}
+    lines.append("")
+    lines.append("Growth 27 -> 1000 ranks: this machine's L, B {:+.1%}; cluster L, B {:+.1%}; paper's compute "
+                 "speed with cluster L, B {:+.1%}; the paper measured {:+.1%}.".format(
+                     growth["here_T10k_s"], growth["cluster_T10k_s"], growth["paperspeed_T10k_s"],
+                     PAPER_POINTS[1000] / PAPER_POINTS[27] - 1))
+    lines.append("")
+    lines.append("Measured inputs: " + ", ".join(f"{k} = {v:.4g}" for k, v in measured.items()))
+    md = "\n".join(lines) + "\n"
+    with open(os.path.join(a.data, "model.md"), "w") as f:
+        f.write(md)
+    print(md)
+    plot_model(a, rows)
+
+
+def plot_model(a, rows):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    P = [r["ranks"] for r in rows]
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 4.8))
+    here = [r["here_T10k_s"] for r in rows]
+    ax1.stackplot(P, [r["here_compute_s"] * PAPER_STEPS for r in rows],
+                  [r["here_comm_s"] * PAPER_STEPS for r in rows], [r["here_reduce_s"] * PAPER_STEPS for r in rows],
+                  labels=["compute (measured cost per particle-step)", "ghost exchange (L, B of this machine)",
+                          "reductions (2 x log2 P x L)"], alpha=0.8)
+    ax1.plot(P, [r["cluster_T10k_s"] for r in rows], "k--", label="total with the assumed cluster L, B")
+    ax1.set_xscale("log")
+    ax1.set_xlabel("compute ranks (one 15 mm subdomain each)")
+    ax1.set_ylabel("projected seconds per 10,000 steps")
+    ax1.set_title("Basalt: projected weak scaling (Table 2 partitions)")
+    ax1.set_ylim(0, max(here) * 1.3)
+    ax1.legend(loc="upper left", fontsize=8)
+    base = {k: next(r[k] for r in rows if r["ranks"] == 27) for k in ("here_T10k_s", "cluster_T10k_s",
+                                                                      "paperspeed_T10k_s")}
+    ax2.plot(P, [r["here_T10k_s"] / base["here_T10k_s"] for r in rows], "o-", label="Basalt, this machine's L, B")
+    ax2.plot(P, [r["cluster_T10k_s"] / base["cluster_T10k_s"] for r in rows], "s--",
+             label="Basalt, assumed cluster L, B")
+    ax2.plot(P, [r["paperspeed_T10k_s"] / base["paperspeed_T10k_s"] for r in rows], "^:",
+             label="paper's compute speed, same model")
+    ax2.plot(list(PAPER_POINTS), [PAPER_POINTS[k] / PAPER_POINTS[27] for k in PAPER_POINTS], "r*", ms=14,
+             label="ESyS-Particle, paper (measured)")
+    ax2.set_xscale("log")
+    ax2.axhline(1.0, color="grey", lw=0.5)
+    ax2.set_xlabel("compute ranks")
+    ax2.set_ylabel("time relative to 27 ranks")
+    ax2.set_title("Weak-scaling growth")
+    ax2.legend(fontsize=8)
+    fig.tight_layout()
+    os.makedirs(os.path.dirname(a.plot), exist_ok=True)
+    fig.savefig(a.plot, dpi=110)
+    print("wrote", a.plot)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("steps_to_run", nargs="*", default=["table", "pingpong", "runs", "model"],
+                    choices=["table", "pingpong", "runs", "model"])
+    ap.add_argument("--build", default=os.path.join(ROOT, "build"))
+    ap.add_argument("--data", default=os.path.join(ROOT, "docs", "data", "paper_study"))
+    ap.add_argument("--plot", default=os.path.join(ROOT, "docs", "img", "weak_scaling.png"))
+    ap.add_argument("--cube1", default=os.environ.get("BASALT_REFERENCE_DIR", "/work/shared/reference") +
+                    "/cube1.geo")
+    ap.add_argument("--packed", default=os.path.join(ROOT, "out", "paper_study", "cube15_seed7.h5"))
+    ap.add_argument("--max-n", type=int, default=10)
+    ap.add_argument("--pack", type=int, default=0, help="pack cubes n <= this instead of tiling cube1.geo")
+    ap.add_argument("--steps", type=int, default=3000)
+    ap.add_argument("--repeats", type=int, default=3)
+    a = ap.parse_args()
+    a.bin = lambda name: os.path.join(a.build, "bin", name)
+    os.makedirs(a.data, exist_ok=True)
+    t0 = time.time()
+    for s in a.steps_to_run:
+        {"table": step_table, "pingpong": step_pingpong, "runs": step_runs, "model": step_model}[s](a)
+    print(f"paper_study: done in {time.time() - t0:.0f} s")
+
+
+if __name__ == "__main__":
+    main()
