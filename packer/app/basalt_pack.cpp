@@ -1,8 +1,10 @@
 // basalt-pack: fill a box, cylinder, sphere or closed triangle mesh with bonded spheres.
 //   basalt-pack box --size 15,15,15 --rmin 0.2 --rmax 1.0 --seed 7 -o cube.h5
 // docs/packer.md describes every option and statistic.
+#include <fmt/format.h>
 #include <unistd.h>
 
+#include <CLI/CLI.hpp>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -13,9 +15,6 @@
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <CLI/CLI.hpp>
-#include <fmt/format.h>
 
 #include "basalt/io/geometry.hpp"
 #include "basalt/packer/assembly.hpp"
@@ -36,7 +35,8 @@ Vec3 parse_vec3(const std::string& text, const char* option) {
   for (int k = 0; k < 3; ++k) {
     const auto end = text.find(',', pos);
     if ((k < 2) == (end == std::string::npos))
-      throw PackError(fmt::format("{} '{}': expected three comma-separated numbers, e.g. 15,15,15", option, text));
+      throw PackError(
+          fmt::format("{} '{}': expected three comma-separated numbers, e.g. 15,15,15", option, text));
     const std::string part = text.substr(pos, end == std::string::npos ? std::string::npos : end - pos);
     try {
       std::size_t used = 0;
@@ -59,11 +59,13 @@ void check_output(const fs::path& out) {
                                 out.string(), ext));
   const fs::path dir = out.parent_path().empty() ? fs::path(".") : out.parent_path();
   if (!fs::is_directory(dir))
-    throw PackError(fmt::format("{}: cannot write the output: folder '{}' does not exist", out.string(), dir.string()));
-  if (fs::is_directory(out)) throw PackError(fmt::format("{}: cannot write the output: it is a folder", out.string()));
+    throw PackError(
+        fmt::format("{}: cannot write the output: folder '{}' does not exist", out.string(), dir.string()));
+  if (fs::is_directory(out))
+    throw PackError(fmt::format("{}: cannot write the output: it is a folder", out.string()));
   if (access(dir.c_str(), W_OK) != 0)
-    throw PackError(fmt::format("{}: cannot write the output: folder '{}' is not writable", out.string(),
-                                dir.string()));
+    throw PackError(
+        fmt::format("{}: cannot write the output: folder '{}' is not writable", out.string(), dir.string()));
 }
 
 class ProgressBar {
@@ -98,8 +100,10 @@ class ProgressBar {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"basalt-pack: fills a volume with bonded spheres whose radii follow a power law "
-               "(Basalt " + std::string(basalt::kVersion) + ")"};
+  CLI::App app{
+      "basalt-pack: fills a volume with bonded spheres whose radii follow a power law "
+      "(Basalt " +
+      std::string(basalt::kVersion) + ")"};
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string(basalt::kVersion));
 
@@ -127,7 +131,8 @@ int main(int argc, char** argv) {
   for (auto* sub : {box, cyl, sph, mesh}) {
     sub->add_option("--rmin", popt.rmin, "smallest radius")->required();
     sub->add_option("--rmax", popt.rmax, "largest radius")->required();
-    sub->add_option("-o,--output", output, "output geometry: .h5 (Basalt) or .geo (ESyS-Particle)")->required();
+    sub->add_option("-o,--output", output, "output geometry: .h5 (Basalt) or .geo (ESyS-Particle)")
+        ->required();
     sub->add_option("--seed", popt.seed, "random seed (same seed, same file)")->capture_default_str();
     sub->add_option("--exponent", exponent,
                     "follow the power law N(>r) ~ r^-EXPONENT instead of filling as densely as possible");
@@ -147,7 +152,8 @@ int main(int argc, char** argv) {
     sub->add_option("--tag-layer", tag_texts,
                     "FACE:THICKNESS:TAG: particles within THICKNESS of FACE get TAG (repeatable; faces: "
                     "xmin..zmax for a box, side/bottom/top for a cylinder, surface for any volume)");
-    sub->add_option("--seed-fraction", popt.seed_fraction, "solid fraction placed at random before void filling")
+    sub->add_option("--seed-fraction", popt.seed_fraction,
+                    "solid fraction placed at random before void filling")
         ->capture_default_str();
     sub->add_option("--bins", aopt.histogram_bins, "radius histogram bins")->capture_default_str();
     sub->add_option("--threads", aopt.threads, "threads for bonding and statistics")->capture_default_str();
@@ -191,8 +197,19 @@ int main(int argc, char** argv) {
     auto geometry = basalt::packer::assemble(*volume, packing, popt, aopt, st);
     const double total_seconds = bar.seconds();
 
+    // The command line without the output name (and -q), so that the same arguments give the same bytes
+    // whatever the file is called.
     std::string command = "basalt-pack";
-    for (int i = 1; i < argc; ++i) command += std::string(" ") + argv[i];
+    for (int i = 1; i < argc; ++i) {
+      const std::string arg = argv[i];
+      if (arg == "-o" || arg == "--output") {
+        ++i;
+        continue;
+      }
+      if (arg.rfind("--output=", 0) == 0 || (arg.rfind("-o", 0) == 0 && arg.size() > 2)) continue;
+      if (arg == "-q" || arg == "--quiet") continue;  // changes nothing in the file
+      command += " " + arg;
+    }
     geometry.attributes["creator"] = fmt::format("basalt-pack {}", basalt::kVersion);
     geometry.attributes["command_line"] = command;
     if (record_time) {
@@ -210,22 +227,24 @@ int main(int argc, char** argv) {
       if (popt.exponent)
         fmt::print("  radii drawn/placed   {} / {} (power law, exponent {}){}\n", packing.requested,
                    packing.requested - packing.not_placed, *popt.exponent,
-                   popt.fill_after ? fmt::format(", then {} filling voids", st.particles + packing.not_placed -
-                                                                                packing.requested)
+                   popt.fill_after ? fmt::format(", then {} filling voids",
+                                                 st.particles + packing.not_placed - packing.requested)
                                    : "");
       fmt::print("  solid fraction       {:.4f}\n", st.solid_fraction);
       fmt::print("  radii                {:.4g} .. {:.4g}\n", st.min_radius, st.max_radius);
-      fmt::print("  fitted exponent      {:.3f}   (counts per log-radius bin ~ r^-alpha)\n", st.histogram.exponent);
+      fmt::print("  fitted exponent      {:.3f}   (counts per log-radius bin ~ r^-alpha)\n",
+                 st.histogram.exponent);
       fmt::print("  radius histogram     ");
       for (std::size_t k = 0; k < st.histogram.counts.size(); ++k)
-        fmt::print("{}[{:.3g},{:.3g}): {:.0f}", k ? ", " : "", st.histogram.edges[k], st.histogram.edges[k + 1],
-                   st.histogram.counts[k]);
+        fmt::print("{}[{:.3g},{:.3g}): {:.0f}", k ? ", " : "", st.histogram.edges[k],
+                   st.histogram.edges[k + 1], st.histogram.counts[k]);
       fmt::print("\n");
       fmt::print("  bonds                {}{}\n", st.bonds, aopt.bonds ? "" : " (bonds off)");
       fmt::print("  bonds per particle   {:.3f}\n", st.bonds_per_particle);
-      fmt::print("  mean coordination    {:.3f}   (neighbours within the bond tolerance)\n", st.mean_coordination);
-      fmt::print("  largest overlap      {:.3g} between spheres, {:.3g} with the boundary\n", st.largest_overlap,
-                 std::max(0.0, st.largest_boundary_overlap));
+      fmt::print("  mean coordination    {:.3f}   (neighbours within the bond tolerance)\n",
+                 st.mean_coordination);
+      fmt::print("  largest overlap      {:.3g} between spheres, {:.3g} with the boundary\n",
+                 st.largest_overlap, std::max(0.0, st.largest_boundary_overlap));
       fmt::print("  time                 {:.3f} s ({:.3f} s packing)\n", total_seconds, pack_seconds);
       fmt::print("  written              {}\n", output);
     }

@@ -1,14 +1,14 @@
 // Bonds, region tags, statistics, and the geometry handed to the I/O layer.
 #include "basalt/packer/assembly.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <limits>
 #include <numbers>
 #include <thread>
-
-#include <fmt/format.h>
 
 #include "basalt/packer/error.hpp"
 
@@ -23,8 +23,8 @@ struct Pair {
 
 /// Every pair (i < j) with gap <= max_gap, in order of i then j. Cell lists in CSR form; the index range
 /// is split between threads and the pieces are joined in order, so the result does not depend on them.
-std::vector<Pair> close_pairs(const std::vector<Vec3>& centre, const std::vector<double>& radius, double max_gap,
-                              int threads) {
+std::vector<Pair> close_pairs(const std::vector<Vec3>& centre, const std::vector<double>& radius,
+                              double max_gap, int threads) {
   const std::size_t n = centre.size();
   std::vector<Pair> result;
   if (n < 2) return result;
@@ -88,23 +88,10 @@ std::vector<Pair> close_pairs(const std::vector<Vec3>& centre, const std::vector
 
 }  // namespace
 
-std::vector<std::pair<std::uint32_t, std::uint32_t>> find_touching_pairs(const std::vector<Vec3>& centre,
-                                                                         const std::vector<double>& radius,
-                                                                         double tolerance, int threads) {
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> out;
-  for (const Pair& p : close_pairs(centre, radius, tolerance, threads)) out.emplace_back(p.i, p.j);
-  return out;
-}
-
-double largest_pair_overlap(const std::vector<Vec3>& centre, const std::vector<double>& radius) {
-  double worst = 0;
-  for (const Pair& p : close_pairs(centre, radius, 0.0, 2)) worst = std::max(worst, -p.gap);
-  return worst;
-}
-
 TagLayer parse_tag_layer(const std::string& text) {
   const auto bad = [&](const std::string& why) {
-    return PackError(fmt::format("--tag-layer '{}': {} (expected FACE:THICKNESS:TAG, e.g. zmin:0.5:2)", text, why));
+    return PackError(
+        fmt::format("--tag-layer '{}': {} (expected FACE:THICKNESS:TAG, e.g. zmin:0.5:2)", text, why));
   };
   const auto a = text.find(':');
   const auto b = a == std::string::npos ? a : text.find(':', a + 1);
@@ -116,13 +103,15 @@ TagLayer parse_tag_layer(const std::string& text) {
   if (e1 != std::errc() || p1 != thick.data() + thick.size() || !(layer.thickness >= 0))
     throw bad(fmt::format("thickness '{}' is not a number >= 0", thick));
   auto [p2, e2] = std::from_chars(tag.data(), tag.data() + tag.size(), layer.tag);
-  if (e2 != std::errc() || p2 != tag.data() + tag.size()) throw bad(fmt::format("tag '{}' is not an integer", tag));
+  if (e2 != std::errc() || p2 != tag.data() + tag.size())
+    throw bad(fmt::format("tag '{}' is not an integer", tag));
   if (layer.face.empty()) throw bad("no face");
   return layer;
 }
 
 std::vector<std::int32_t> region_tags(const Volume& volume, const std::vector<Vec3>& centre,
-                                      const std::vector<double>& radius, const std::vector<TagLayer>& layers) {
+                                      const std::vector<double>& radius,
+                                      const std::vector<TagLayer>& layers) {
   std::vector<std::int32_t> tags(centre.size(), 0);
   const auto names = volume.piece_names();
   std::vector<BoundaryPiece> pieces;
@@ -131,8 +120,8 @@ std::vector<std::int32_t> region_tags(const Volume& volume, const std::vector<Ve
     if (layer.face != "surface") {
       auto it = std::find(names.begin(), names.end(), layer.face);
       if (it == names.end())
-        throw PackError(fmt::format("--tag-layer: the volume has no face '{}' (it has: surface, {})", layer.face,
-                                    fmt::join(names, ", ")));
+        throw PackError(fmt::format("--tag-layer: the volume has no face '{}' (it has: surface, {})",
+                                    layer.face, fmt::join(names, ", ")));
       id = static_cast<int>(it - names.begin());
     }
     for (std::size_t i = 0; i < centre.size(); ++i) {
@@ -206,7 +195,8 @@ basalt::io::Geometry assemble(const Volume& volume, const Packing& packing, cons
   for (std::size_t i = 0; i < n; ++i) {
     const double r = packing.radius[i];
     solid += 4.0 / 3.0 * std::numbers::pi * r * r * r;
-    st.largest_boundary_overlap = std::max(st.largest_boundary_overlap, r - volume.signed_distance(packing.centre[i]));
+    st.largest_boundary_overlap =
+        std::max(st.largest_boundary_overlap, r - volume.signed_distance(packing.centre[i]));
     st.min_radius = std::min(st.min_radius, r);
     st.max_radius = std::max(st.max_radius, r);
   }

@@ -12,11 +12,10 @@
 #include <CGAL/Polygon_mesh_processing/triangulate_faces.h>
 #include <CGAL/Side_of_triangle_mesh.h>
 #include <CGAL/Surface_mesh.h>
+#include <fmt/format.h>
 
 #include <algorithm>
 #include <cmath>
-
-#include <fmt/format.h>
 
 #include "basalt/packer/error.hpp"
 #include "basalt/packer/volume.hpp"
@@ -92,21 +91,24 @@ std::unique_ptr<Volume> load_mesh(const std::filesystem::path& file) {
   std::string ext = file.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
   if (ext != ".off" && ext != ".stl" && ext != ".obj" && ext != ".ply")
-    throw PackError(fmt::format("{}: unknown mesh format '{}' (expected .off, .stl, .obj or .ply)", name, ext));
+    throw PackError(
+        fmt::format("{}: unknown mesh format '{}' (expected .off, .stl, .obj or .ply)", name, ext));
   Mesh mesh;
   if (!PMP::IO::read_polygon_mesh(name, mesh) || mesh.number_of_faces() == 0)
-    throw PackError(fmt::format("{}: cannot read a polygon mesh from it (malformed, empty or non-manifold)", name));
+    throw PackError(
+        fmt::format("{}: cannot read a polygon mesh from it (malformed, empty or non-manifold)", name));
   if (!CGAL::is_triangle_mesh(mesh)) PMP::triangulate_faces(mesh);
   if (!CGAL::is_closed(mesh)) {
     std::size_t border = 0;
     for (auto h : mesh.halfedges())
       if (mesh.is_border(h)) ++border;
     throw PackError(fmt::format(
-        "{}: the mesh is open ({} border edges): a volume needs a closed surface (a watertight mesh)", name, border));
+        "{}: the mesh is open ({} border edges): a volume needs a closed surface (a watertight mesh)", name,
+        border));
   }
   if (PMP::does_self_intersect(mesh))
-    throw PackError(fmt::format("{}: the mesh intersects itself: a volume needs a surface without self-intersections",
-                                name));
+    throw PackError(fmt::format(
+        "{}: the mesh intersects itself: a volume needs a surface without self-intersections", name));
   if (!PMP::is_outward_oriented(mesh)) PMP::reverse_face_orientations(mesh);
   if (!(CGAL::to_double(PMP::volume(mesh)) > 0))
     throw PackError(fmt::format("{}: the mesh encloses no volume", name));

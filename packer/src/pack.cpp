@@ -1,11 +1,11 @@
 // Packing driver: option checks, the power-law radii, random seeding; then the void filler.
 #include "basalt/packer/pack.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
-
-#include <fmt/format.h>
 
 #include "basalt/packer/error.hpp"
 #include "basalt/packer/random.hpp"
@@ -57,7 +57,8 @@ std::size_t seed_randomly(const Volume& volume, const PackOptions& opt, double f
 
 void check_options(const PackOptions& o) {
   if (!std::isfinite(o.rmin) || !std::isfinite(o.rmax))
-    throw PackError(fmt::format("rmin and rmax must be finite numbers (got rmin {}, rmax {})", o.rmin, o.rmax));
+    throw PackError(
+        fmt::format("rmin and rmax must be finite numbers (got rmin {}, rmax {})", o.rmin, o.rmax));
   if (!(o.rmin > 0)) throw PackError(fmt::format("rmin must be > 0, got {}", o.rmin));
   if (o.rmin > o.rmax)
     throw PackError(fmt::format("rmin must not exceed rmax (got rmin {} > rmax {})", o.rmin, o.rmax));
@@ -110,21 +111,25 @@ Packing pack(const Volume& volume, const PackOptions& opt) {
   std::vector<double> radii;
   detail::FillContext ctx{volume, opt, grid, out};
   if (opt.exponent) {
-    radii = power_law_radii(opt.rmin, opt.rmax, *opt.exponent, opt.target_fraction * volume.measure(), opt.seed);
+    radii =
+        power_law_radii(opt.rmin, opt.rmax, *opt.exponent, opt.target_fraction * volume.measure(), opt.seed);
     out.requested = radii.size();
     ctx.radii = &radii;
-    out.seeds = seed_randomly(volume, opt, opt.seed_fraction, [&](std::size_t i) { return radii[i]; },
-                              radii.size(), grid, out, rng);
+    out.seeds = seed_randomly(
+        volume, opt, opt.seed_fraction, [&](std::size_t i) { return radii[i]; }, radii.size(), grid, out,
+        rng);
     ctx.next = out.seeds;
     ctx.expected_solid = opt.target_fraction * volume.measure();
   } else {
-    out.seeds = seed_randomly(volume, opt, opt.seed_fraction, [&](std::size_t) { return opt.rmax; },
-                              static_cast<std::size_t>(-1), grid, out, rng);
+    out.seeds = seed_randomly(
+        volume, opt, opt.seed_fraction, [&](std::size_t) { return opt.rmax; }, static_cast<std::size_t>(-1),
+        grid, out, rng);
     ctx.expected_solid = 0.7 * volume.measure();
   }
   if (out.seeds == 0) {
     // Nothing of the first size fits: is there room for even one sphere of radius rmin?
-    out.seeds = seed_randomly(volume, opt, 1.0, [&](std::size_t) { return opt.rmin; }, 1, grid, out, rng);
+    out.seeds = seed_randomly(
+        volume, opt, 1.0, [&](std::size_t) { return opt.rmin; }, 1, grid, out, rng);
     if (out.seeds == 0)
       throw PackError(fmt::format("the volume ({}) is too small for one sphere of radius rmin = {}",
                                   volume.description(), opt.rmin));

@@ -77,7 +77,7 @@ struct FillContext {
   std::size_t next = 0;                        ///< first radius of `radii` not yet placed
   double expected_solid = 1;                   ///< for progress: solid volume expected at the end
   double placed_solid = 0;
-  std::size_t not_placed = 0;                  ///< power-law mode: radii for which no void was left
+  std::size_t not_placed = 0;  ///< power-law mode: radii for which no void was left
 };
 
 /// Places spheres into the voids left between out's spheres until none of radius >= rmin is left

@@ -29,8 +29,10 @@ int quadratic(double a, double h, double k, double t[2]) {
   }
   double disc = h * h - a * k;
   if (disc < 0) {
-    if (disc > -1e-14 * (h * h + std::abs(a * k))) disc = 0;
-    else return 0;
+    if (disc > -1e-14 * (h * h + std::abs(a * k)))
+      disc = 0;
+    else
+      return 0;
   }
   const double s = std::sqrt(disc);
   const double q = -(h + std::copysign(s, h));  // q = -(h + sign(h) s)

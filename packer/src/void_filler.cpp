@@ -17,9 +17,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 #include <cstdio>
 #include <cstdlib>
+#include <numbers>
 #include <queue>
 #include <set>
 
@@ -35,7 +35,8 @@ struct CellInfo {
   std::uint64_t serial = 0;
   double cap = -1;  ///< capacity while the cell's void is in the set, else -1
 };
-using Vb = CGAL::Triangulation_vertex_base_with_info_3<std::int32_t, K, CGAL::Regular_triangulation_vertex_base_3<K>>;
+using Vb = CGAL::Triangulation_vertex_base_with_info_3<std::int32_t, K,
+                                                       CGAL::Regular_triangulation_vertex_base_3<K>>;
 using RCb = CGAL::Regular_triangulation_cell_base_3<K, CGAL::Triangulation_cell_base_3<K>,
                                                     CGAL::Discard_hidden_points>;
 using Cb = CGAL::Triangulation_cell_base_with_info_3<CellInfo, K, RCb>;
@@ -81,8 +82,11 @@ class Filler {
 
   void report() const {
     if (std::getenv("BASALT_PACK_DEBUG"))
-      std::fprintf(stderr, "evaluate %zu place %zu placed %zu vertices %zu cells %zu voids left %zu fail cap %zu fail three %zu\n", n_eval_,
-                   n_place_, ctx_.out.size(), rt_.number_of_vertices(), rt_.number_of_cells(), voids_.size(), n_fail_cap_, n_fail_three_);
+      std::fprintf(stderr,
+                   "evaluate %zu place %zu placed %zu vertices %zu cells %zu voids left %zu fail cap %zu "
+                   "fail three %zu\n",
+                   n_eval_, n_place_, ctx_.out.size(), rt_.number_of_vertices(), rt_.number_of_cells(),
+                   voids_.size(), n_fail_cap_, n_fail_three_);
   }
 
   void run() {
@@ -154,7 +158,8 @@ class Filler {
     rt_.find_conflicts(wp, start, std::back_inserter(boundary_), std::back_inserter(conflicts_));
     if (conflicts_.empty()) return {};  // hidden (cannot happen for non-overlapping spheres)
     for (Cell k : conflicts_) kill(k);
-    auto v = rt_.insert_in_hole(wp, conflicts_.begin(), conflicts_.end(), boundary_[0].first, boundary_[0].second);
+    auto v =
+        rt_.insert_in_hole(wp, conflicts_.begin(), conflicts_.end(), boundary_[0].first, boundary_[0].second);
     v->info() = info;
     incident_.clear();
     rt_.incident_cells(v, std::back_inserter(incident_));
@@ -184,6 +189,16 @@ class Filler {
           ++count;
         }
       ghost_piece_.push_back(count == 1 ? piece : -1);
+      // Exact mirror images make many coplanar and co-orthospherical vertex sets, which send CGAL's
+      // predicates to exact arithmetic. Ghosts stand only for topology (tangency is solved against the
+      // plane itself), so a tiny deterministic nudge costs nothing and avoids that.
+      std::uint64_t h = 0x9e3779b97f4a7c15ULL * (ghost_piece_.size() + 1);
+      for (int k = 0; k < 3; ++k) {
+        h ^= h >> 31;
+        h *= 0xbf58476d1ce4e5b9ULL;
+        h ^= h >> 29;
+        g[k] += 1e-7 * rmax_ * (static_cast<double>(h >> 11) * 0x1.0p-53 - 0.5);
+      }
       auto gv = insert(g, r, -2 - static_cast<std::int32_t>(ghost_piece_.size() - 1), near);
       if (gv != Rt::Vertex_handle()) near = gv->cell();
     }
@@ -316,9 +331,8 @@ class Filler {
           candidates_.push_back(ball);
         }
       }
-      std::sort(candidates_.begin(), candidates_.end(), [&](const Ball& a, const Ball& b) {
-        return norm2(a.c - v.centre) < norm2(b.c - v.centre);
-      });
+      std::sort(candidates_.begin(), candidates_.end(),
+                [&](const Ball& a, const Ball& b) { return norm2(a.c - v.centre) < norm2(b.c - v.centre); });
       candidates_.push_back({v.centre, rho});
     }
     for (const Ball& ball : candidates_) {
@@ -364,7 +378,7 @@ class Filler {
   Rt rt_;
   bool live_ = false;
   std::uint64_t serial_ = 0;
-  std::set<Void> voids_;                 // power-law mode: best fit by capacity
+  std::set<Void> voids_;                   // power-law mode: best fit by capacity
   std::priority_queue<QueuedVoid> queue_;  // dense mode
   const double zlo_ = vol_.bounds().lo[2];
   const double slab_ = 6 * rmax_;

@@ -1,9 +1,9 @@
 // Analytic volumes: box, cylinder (along z), sphere.
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
-
-#include <fmt/format.h>
 
 #include "basalt/packer/error.hpp"
 #include "basalt/packer/volume.hpp"
@@ -27,8 +27,8 @@ class BoxVolume final : public Volume {
     }
   }
   std::string description() const override {
-    return fmt::format("box {} x {} x {} from ({}, {}, {})", hi_[0] - lo_[0], hi_[1] - lo_[1], hi_[2] - lo_[2],
-                       lo_[0], lo_[1], lo_[2]);
+    return fmt::format("box {} x {} x {} from ({}, {}, {})", hi_[0] - lo_[0], hi_[1] - lo_[1],
+                       hi_[2] - lo_[2], lo_[0], lo_[1], lo_[2]);
   }
   Bounds bounds() const override { return {lo_, hi_}; }
   double measure() const override { return (hi_[0] - lo_[0]) * (hi_[1] - lo_[1]) * (hi_[2] - lo_[2]); }
@@ -42,7 +42,9 @@ class BoxVolume final : public Volume {
       if (planes_[k].distance(x) <= reach) out.push_back({k, true, planes_[k]});
   }
   Plane tangent_plane(int id, const Vec3&) const override { return planes_[id]; }
-  std::vector<std::string> piece_names() const override { return {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"}; }
+  std::vector<std::string> piece_names() const override {
+    return {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"};
+  }
 
  private:
   Vec3 lo_, hi_;
@@ -58,8 +60,8 @@ class CylinderVolume final : public Volume {
     top_.d = -(base[2] + height);
   }
   std::string description() const override {
-    return fmt::format("cylinder radius {} height {} along z, base centre ({}, {}, {})", r_, h_, base_[0], base_[1],
-                       base_[2]);
+    return fmt::format("cylinder radius {} height {} along z, base centre ({}, {}, {})", r_, h_, base_[0],
+                       base_[1], base_[2]);
   }
   Bounds bounds() const override {
     return {{base_[0] - r_, base_[1] - r_, base_[2]}, {base_[0] + r_, base_[1] + r_, base_[2] + h_}};
@@ -99,7 +101,9 @@ class SphereVolume final : public Volume {
   std::string description() const override {
     return fmt::format("sphere radius {} centred at ({}, {}, {})", r_, c_[0], c_[1], c_[2]);
   }
-  Bounds bounds() const override { return {{c_[0] - r_, c_[1] - r_, c_[2] - r_}, {c_[0] + r_, c_[1] + r_, c_[2] + r_}}; }
+  Bounds bounds() const override {
+    return {{c_[0] - r_, c_[1] - r_, c_[2] - r_}, {c_[0] + r_, c_[1] + r_, c_[2] + r_}};
+  }
   double measure() const override { return 4.0 / 3.0 * std::numbers::pi * r_ * r_ * r_; }
   double signed_distance(const Vec3& x) const override { return r_ - norm(x - c_); }
   void pieces_near(const Vec3& x, double reach, std::vector<BoundaryPiece>& out) const override {
@@ -129,8 +133,8 @@ void require(bool ok, const std::string& what) {
 std::unique_ptr<Volume> make_box(const Vec3& lo, const Vec3& hi) {
   require(finite(lo) && finite(hi), "box: corners must be finite numbers");
   for (int k = 0; k < 3; ++k)
-    require(hi[k] > lo[k], fmt::format("box: size must be > 0 in every direction, got {} along {}", hi[k] - lo[k],
-                                       "xyz"[k]));
+    require(hi[k] > lo[k], fmt::format("box: size must be > 0 in every direction, got {} along {}",
+                                       hi[k] - lo[k], "xyz"[k]));
   return std::make_unique<BoxVolume>(lo, hi);
 }
 

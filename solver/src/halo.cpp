@@ -13,7 +13,7 @@ struct Migrant {
   std::int64_t id;
   std::int32_t tag;
   std::int32_t pad;
-  double x, y, z, vx, vy, vz, r, m;
+  double x, y, z, vx, vy, vz, r, inv_mass;
 };
 
 struct BondRecord {
@@ -63,7 +63,7 @@ std::optional<std::string> Halo<Real>::migrate(Particles<Real>& p, Bonds<Real>& 
       if (side < 0) continue;
       out[side].push_back(Migrant{p.id[i], p.tag[i], 0, double(p.x[i]), double(p.y[i]), double(p.z[i]),
                                   double(p.vx[i]), double(p.vy[i]), double(p.vz[i]), double(p.radius[i]),
-                                  double(p.mass[i])});
+                                  double(p.inv_mass[i])});
       leaving_ids[side].push_back(p.id[i]);
       leaving.push_back(i);
     }
@@ -90,7 +90,7 @@ std::optional<std::string> Halo<Real>::migrate(Particles<Real>& p, Bonds<Real>& 
               "particle id {} at ({}, {}, {}) moved more than one rank's region between two neighbour-list "
               "rebuilds (arrived at rank {} owning [{}, {}) along axis {})",
               m.id, m.x, m.y, m.z, dec_.comm().rank(), dec_.lo(d), dec_.hi(d), "xyz"[d]);
-        p.push_owned(m.id, Real(m.x), Real(m.y), Real(m.z), Real(m.r), m.tag, Real(m.m), Real(m.vx), Real(m.vy),
+        p.push_owned(m.id, Real(m.x), Real(m.y), Real(m.z), Real(m.r), m.tag, Real(m.inv_mass), Real(m.vx), Real(m.vy),
                      Real(m.vz));
       }
       for (const auto& b : bin) bonds.push(b.a, b.b, Real(b.r0), static_cast<std::uint8_t>(b.group));

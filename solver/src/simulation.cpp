@@ -30,14 +30,14 @@ bool tags_match(const TagFilter& t, std::int64_t ta, std::int64_t tb) {
 }  // namespace
 
 template <class Real>
-Simulation<Real>::Simulation(const Scene& scene, const io::Geometry& g, MPI_Comm comm, const RunOptions& options)
+Simulation<Real>::Simulation(const Scene& scene, io::Geometry g, MPI_Comm comm, const RunOptions& options)
     : scene_(scene),
       options_(options),
       bond_driver_(scene.bonds),
       pair_driver_(scene.contacts),
       wall_driver_(scene.walls) {
   if (g.size() == 0) throw InputError(fmt::format("{}: the geometry has no particles", scene.geometry.string()));
-  if (scene.bonds.size() > 255) throw InputError("interactions: at most 255 bond groups");
+  if (scene.bonds.size() > 254) throw InputError("interactions: at most 254 bond groups");
   const bool se = scene.integrator == Integrator::symplectic_euler;
   kick1_ = Real(se ? scene.dt : scene.dt / 2);
   kick2_ = Real(se ? 0.0 : scene.dt / 2);
@@ -103,7 +103,7 @@ void Simulation<Real>::check_stability(const io::Geometry& g) {
 }
 
 template <class Real>
-void Simulation<Real>::distribute(const io::Geometry& g, MPI_Comm comm) {
+void Simulation<Real>::distribute(io::Geometry& g, MPI_Comm comm) {
   // The decomposition starts from the packing's bounding box; outer ranks own half-infinite regions.
   std::array<double, 3> lo{}, hi{};
   lo.fill(std::numeric_limits<double>::infinity());
@@ -122,7 +122,8 @@ void Simulation<Real>::distribute(const io::Geometry& g, MPI_Comm comm) {
   ids_.configure(g.id.front(), g.id.back(), g.size());
 
   // Which bond group takes each geometry bond (first match), and the longest bond.
-  std::vector<int> bond_group(g.bonds.size(), -1);
+  constexpr std::uint8_t kNone = 255;
+  std::vector<std::uint8_t> bond_group(g.bonds.size(), kNone);
   double longest = 0;
   std::size_t unassigned = 0;
   for (std::size_t k = 0; k < g.bonds.size(); ++k) {
@@ -132,10 +133,10 @@ void Simulation<Real>::distribute(const io::Geometry& g, MPI_Comm comm) {
       const auto& grp = scene_.bonds[gi];
       if (grp.bond_tag && *grp.bond_tag != b.tag) continue;
       if (!tags_match(grp.tags, g.tag[ia], g.tag[ib])) continue;
-      bond_group[k] = static_cast<int>(gi);
+      bond_group[k] = static_cast<std::uint8_t>(gi);
       break;
     }
-    if (bond_group[k] < 0) {
+    if (bond_group[k] == kNone) {
       ++unassigned;
       continue;
     }
@@ -151,23 +152,43 @@ void Simulation<Real>::distribute(const io::Geometry& g, MPI_Comm comm) {
         dec_->min_interior_width(), ghost_width_, dec_->dims()[0], dec_->dims()[1], dec_->dims()[2]));
 
   std::vector<char> owned(g.size(), 0);
+  std::size_t n_mine = 0;
   for (std::size_t i = 0; i < g.size(); ++i) {
     const auto& x = g.position[i];
-    if (!dec_->owns(x[0], x[1], x[2])) continue;
-    owned[i] = 1;
-    p_.push_owned(g.id[i], Real(x[0]), Real(x[1]), Real(x[2]), Real(g.radius[i]), g.tag[i],
-                  Real(particle_mass(g, i, scene_.density)));
+    owned[i] = dec_->owns(x[0], x[1], x[2]);
+    n_mine += static_cast<std::size_t>(owned[i]);
   }
+  // Bonds with an owned end, then particles; each part of the geometry is released once copied, so
+  // the geometry and the solver's copy never coexist in full (peak memory).
+  std::size_t n_bonds = 0;
+  for (std::size_t k = 0; k < g.bonds.size(); ++k)
+    if (bond_group[k] != kNone)
+      n_bonds += owned[static_cast<std::size_t>(g.index_of(g.bonds[k].a))] ||
+                 owned[static_cast<std::size_t>(g.index_of(g.bonds[k].b))];
+  bonds_.reserve(n_bonds);
   for (std::size_t k = 0; k < g.bonds.size(); ++k) {
-    if (bond_group[k] < 0) continue;
+    if (bond_group[k] == kNone) continue;
     const auto& b = g.bonds[k];
     const auto ia = static_cast<std::size_t>(g.index_of(b.a)), ib = static_cast<std::size_t>(g.index_of(b.b));
     if (!owned[ia] && !owned[ib]) continue;
-    const auto& params = scene_.bonds[static_cast<std::size_t>(bond_group[k])].params;
+    const auto& params = scene_.bonds[bond_group[k]].params;
     const double r0 =
         LinearBond::rest_length(params, g.radius[ia], g.radius[ib], distance(g.position[ia], g.position[ib]));
-    bonds_.push(b.a, b.b, Real(r0), static_cast<std::uint8_t>(bond_group[k]));
+    bonds_.push(b.a, b.b, Real(r0), bond_group[k]);
   }
+  std::vector<io::Bond>().swap(g.bonds);
+  std::vector<std::uint8_t>().swap(bond_group);
+  p_.reserve_owned(n_mine);
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    if (!owned[i]) continue;
+    const auto& x = g.position[i];
+    p_.push_owned(g.id[i], Real(x[0]), Real(x[1]), Real(x[2]), Real(g.radius[i]), g.tag[i],
+                  Real(1.0 / particle_mass(g, i, scene_.density)));
+  }
+  std::vector<io::Vec3>().swap(g.position);
+  std::vector<double>().swap(g.radius);
+  std::vector<double>().swap(g.mass);
+  std::vector<std::int32_t>().swap(g.tag);
 }
 
 template <class Real>
@@ -253,6 +274,8 @@ void Simulation<Real>::rebuild() {
                                  total, n_global_));
   }
   times_.communication += sw.lap();
+  if (canonical_) canonical_order();
+  canonical_ = false;
   spatial_sort();
   times_.neighbor += sw.lap();
   if (parallel) halo_->build_ghosts(p_, ghost_width_);
@@ -261,14 +284,23 @@ void Simulation<Real>::rebuild() {
   if (!pair_driver_.empty()) {
     grid_.build(p_.x, p_.y, p_.z, p_.size(), contact_cutoff_);
     exclusions_.build(bonds_.ia, bonds_.ib, p_.size());
-    auto accept = [this](std::size_t i, std::size_t j) { return pair_driver_.group_of(p_.tag[i], p_.tag[j]) >= 0; };
-    build_pair_lists(p_, grid_, scene_.skin, exclusions_, accept, own_, ghost_);
+    if (pair_driver_.takes_all()) {
+      build_pair_lists(p_, grid_, scene_.skin, exclusions_, [](std::size_t, std::size_t) { return true; }, own_,
+                       ghost_);
+    } else {
+      auto accept = [this](std::size_t i, std::size_t j) {
+        return pair_driver_.group_of(p_.tag[i], p_.tag[j]) >= 0;
+      };
+      build_pair_lists(p_, grid_, scene_.skin, exclusions_, accept, own_, ghost_);
+    }
     exclusions_.release();
   }
   grid_.release();
-  std::copy(p_.x.begin(), p_.x.begin() + static_cast<std::ptrdiff_t>(p_.n_owned), p_.x0.begin());
-  std::copy(p_.y.begin(), p_.y.begin() + static_cast<std::ptrdiff_t>(p_.n_owned), p_.y0.begin());
-  std::copy(p_.z.begin(), p_.z.begin() + static_cast<std::ptrdiff_t>(p_.n_owned), p_.z0.begin());
+  for (std::size_t i = 0; i < p_.n_owned; ++i) {
+    p_.x0[i] = float(p_.x[i]);
+    p_.y0[i] = float(p_.y[i]);
+    p_.z0[i] = float(p_.z[i]);
+  }
   bond_broke_ = false;
   ++rebuilds_;
   if (std::getenv("BASALT_DEBUG_REBUILD")) fmt::print(stderr, "rank {} rebuild at step {} owned {} ghosts {} bonds {} (both owned {}) pairs {}+{}\n", comm().rank(), step_, p_.n_owned, p_.n_ghost(), bonds_.size(), bonds_.n_both_owned, own_.pairs(), ghost_.pairs());
@@ -310,7 +342,8 @@ void Simulation<Real>::step(FieldSink* sink) {
   double need = bond_broke_ ? std::numeric_limits<double>::infinity() : moved2;
   if (parallel) need = comm().max(need);
   times_.communication += sw.lap();
-  if (!(need <= rebuild_limit2_)) {
+  canonical_ = canonical_due(step_ + 1);  // a restart point: rebuild in canonical order
+  if (!(need <= rebuild_limit2_) || canonical_) {
     rebuild();
     sw.lap();
   } else if (parallel) {
@@ -332,43 +365,10 @@ void Simulation<Real>::step(FieldSink* sink) {
 
 template <class Real>
 void Simulation<Real>::save_fields(FieldSink* sink, const std::array<double, 3>& pe) {
+  if (output_) return output_fields(pe);
   std::vector<double> local;
   std::vector<char> due;
-  bool any = false;
-  for (const auto& f : scene_.fields) {
-    const bool d = step_ % f.every == 0;
-    any = any || d;
-    const std::size_t width = f.type == FieldSpec::Type::wall_force ? 3 : 1;
-    for (std::size_t c = 0; c < width; ++c) due.push_back(d);
-    if (!d) {
-      local.insert(local.end(), width, 0.0);
-      continue;
-    }
-    switch (f.type) {
-      case FieldSpec::Type::kinetic_energy:
-        local.push_back(kinetic_energy_local());
-        break;
-      case FieldSpec::Type::bond_potential_energy:
-        local.push_back(pe[0]);
-        break;
-      case FieldSpec::Type::contact_potential_energy:
-        local.push_back(pe[1]);
-        break;
-      case FieldSpec::Type::wall_potential_energy:
-        local.push_back(pe[2]);
-        break;
-      case FieldSpec::Type::bond_count:
-        local.push_back(double(BondDriver<Real, LinearBond>::count(p_, bonds_)));
-        break;
-      case FieldSpec::Type::wall_force: {
-        std::size_t w = 0;
-        while (wall_driver_.spec(w).name != f.wall) ++w;
-        const auto& fw = wall_driver_.force(w);
-        local.insert(local.end(), fw.begin(), fw.end());
-        break;
-      }
-    }
-  }
+  const bool any = field_partials(pe, local, due);
   if (!any) return;
   comm().sum_to_root(local);
   if (comm().rank() != 0 || !sink) return;
@@ -389,7 +389,7 @@ void Simulation<Real>::guard_energy(const std::array<double, 3>& pe) {
   double best = -1;
   std::size_t bi = 0;
   for (std::size_t i = 0; i < p_.n_owned; ++i) {
-    const double ke = 0.5 * double(p_.mass[i]) * double(p_.vx[i] * p_.vx[i] + p_.vy[i] * p_.vy[i] + p_.vz[i] * p_.vz[i]);
+    const double ke = 0.5 * double(p_.mass(i)) * double(p_.vx[i] * p_.vx[i] + p_.vy[i] * p_.vy[i] + p_.vz[i] * p_.vz[i]);
     if (!(ke <= best)) {
       best = ke;
       bi = i;
@@ -451,9 +451,10 @@ template <class Real>
 std::size_t Simulation<Real>::memory_bytes() const {
   std::size_t b = 0;
   auto add = [&](const auto& v) { b += v.capacity() * sizeof(typename std::decay_t<decltype(v)>::value_type); };
-  for (const auto* v : {&p_.x, &p_.y, &p_.z, &p_.radius, &p_.vx, &p_.vy, &p_.vz, &p_.fx, &p_.fy, &p_.fz, &p_.mass,
-                        &p_.inv_mass, &p_.x0, &p_.y0, &p_.z0})
+  for (const auto* v : {&p_.x, &p_.y, &p_.z, &p_.radius, &p_.vx, &p_.vy, &p_.vz, &p_.fx, &p_.fy, &p_.fz,
+                        &p_.inv_mass})
     add(*v);
+  for (const auto* v : {&p_.x0, &p_.y0, &p_.z0}) add(*v);
   add(p_.id);
   add(p_.tag);
   add(bonds_.a);

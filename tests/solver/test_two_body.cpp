@@ -159,7 +159,7 @@ K = 1000.0
   p.vx[a] = 1.0;
   p.vx[b] = -0.5;
   sim.state_changed();
-  const double ma = p.mass[a], mb = p.mass[b];
+  const double ma = p.mass(a), mb = p.mass(b);
   const double px0 = ma * p.vx[a] + mb * p.vx[b];
   const double ke0 = sim.kinetic_energy();
   // Normal relative velocity at contact, along the line of centres at impact: measure it from the

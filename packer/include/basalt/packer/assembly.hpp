@@ -10,15 +10,6 @@
 
 namespace basalt::packer {
 
-/// Pairs (i < j, by index) whose gap |ci - cj| - ri - rj is <= tolerance (an absolute length, as in
-/// GenGeo's generateBonds), sorted. Uses `threads` threads; the result does not depend on it.
-std::vector<std::pair<std::uint32_t, std::uint32_t>> find_touching_pairs(const std::vector<Vec3>& centre,
-                                                                         const std::vector<double>& radius,
-                                                                         double tolerance, int threads = 1);
-
-/// Largest overlap -(|ci - cj| - ri - rj) over all pairs (0 when none overlap).
-double largest_pair_overlap(const std::vector<Vec3>& centre, const std::vector<double>& radius);
-
 /// "Tag particles near a face": every particle whose distance to the face (its surface's, i.e. the
 /// centre's distance minus the radius) is <= thickness gets `tag`. Face: a piece name of the volume
 /// ("xmin" ... "zmax" for a box, "side"/"bottom"/"top" for a cylinder) or "surface" for every piece.
@@ -58,8 +49,8 @@ struct AssemblyStats {
   RadiusHistogram histogram;
   std::size_t bonds = 0;
   double bonds_per_particle = 0;
-  double mean_coordination = 0;   ///< touching neighbours per particle (gap <= bond tolerance)
-  double largest_overlap = 0;     ///< between two spheres
+  double mean_coordination = 0;         ///< touching neighbours per particle (gap <= bond tolerance)
+  double largest_overlap = 0;           ///< between two spheres
   double largest_boundary_overlap = 0;  ///< of a sphere beyond the boundary
   double min_radius = 0, max_radius = 0;
 };

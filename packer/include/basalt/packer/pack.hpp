@@ -41,9 +41,9 @@ struct PackOptions {
 struct Packing {
   std::vector<Vec3> centre;
   std::vector<double> radius;
-  std::size_t seeds = 0;         ///< spheres placed by random seeding
-  std::size_t requested = 0;     ///< power-law mode: radii drawn
-  std::size_t not_placed = 0;    ///< power-law mode: drawn radii for which no void was left
+  std::size_t seeds = 0;       ///< spheres placed by random seeding
+  std::size_t requested = 0;   ///< power-law mode: radii drawn
+  std::size_t not_placed = 0;  ///< power-law mode: drawn radii for which no void was left
   std::size_t size() const { return radius.size(); }
 };
 

@@ -21,9 +21,9 @@ struct Plane {
 
 /// One face or curved surface of a volume, as seen from a point: its tangent plane there.
 struct BoundaryPiece {
-  int id = 0;         ///< stable id of the face / surface within the volume
-  bool flat = true;   ///< flat pieces have one plane everywhere
-  Plane plane;        ///< exact plane (flat) or tangent plane at the point closest to the query
+  int id = 0;        ///< stable id of the face / surface within the volume
+  bool flat = true;  ///< flat pieces have one plane everywhere
+  Plane plane;       ///< exact plane (flat) or tangent plane at the point closest to the query
 };
 
 struct Bounds {

@@ -19,6 +19,13 @@ struct Bonds {
 
   std::size_t size() const { return a.size(); }
 
+  void reserve(std::size_t n) {
+    a.reserve(n);
+    b.reserve(n);
+    r0.reserve(n);
+    group.reserve(n);
+  }
+
   void push(std::int64_t ga, std::int64_t gb, Real rest, std::uint8_t g) {
     a.push_back(ga);
     b.push_back(gb);

@@ -20,9 +20,11 @@ struct Particles {
   // Owned only (ghosts need no velocity, force or mass):
   std::vector<Real> vx, vy, vz;
   std::vector<Real> fx, fy, fz;
-  std::vector<Real> mass;
-  std::vector<Real> inv_mass;
-  std::vector<Real> x0, y0, z0;  ///< positions at the last neighbour-list rebuild
+  std::vector<Real> inv_mass;    ///< 1 / mass (the mass itself is mass(i))
+  std::vector<float> x0, y0, z0;  ///< positions at the last neighbour-list rebuild (float: only
+                                  ///< compared with half the skin)
+
+  Real mass(std::size_t i) const { return Real(1) / inv_mass[i]; }
 
   std::size_t size() const { return x.size(); }
   std::size_t n_ghost() const { return x.size() - n_owned; }
@@ -36,15 +38,23 @@ struct Particles {
     id.resize(n);
     tag.resize(n);
   }
+  /// Capacity for n owned particles (exact: no growth slack).
+  void reserve_owned(std::size_t n) {
+    for (auto* v : {&x, &y, &z, &radius, &vx, &vy, &vz, &fx, &fy, &fz, &inv_mass}) v->reserve(n);
+    for (auto* v : {&x0, &y0, &z0}) v->reserve(n);
+    id.reserve(n);
+    tag.reserve(n);
+  }
   /// Resizes the owned-only arrays.
   void resize_owned(std::size_t n) {
-    for (auto* v : {&vx, &vy, &vz, &fx, &fy, &fz, &mass, &inv_mass, &x0, &y0, &z0}) v->resize(n);
+    for (auto* v : {&vx, &vy, &vz, &fx, &fy, &fz, &inv_mass}) v->resize(n);
+    for (auto* v : {&x0, &y0, &z0}) v->resize(n);
   }
   /// Drops ghosts, keeps owned particles.
   void drop_ghosts() { resize_all(n_owned); }
 
-  /// Appends an owned particle; requires that there are no ghosts.
-  void push_owned(std::int64_t gid, Real px, Real py, Real pz, Real r, std::int32_t t, Real m, Real pvx = 0,
+  /// Appends an owned particle (im = 1 / mass); requires that there are no ghosts.
+  void push_owned(std::int64_t gid, Real px, Real py, Real pz, Real r, std::int32_t t, Real im, Real pvx = 0,
                   Real pvy = 0, Real pvz = 0) {
     x.push_back(px);
     y.push_back(py);
@@ -58,11 +68,10 @@ struct Particles {
     fx.push_back(0);
     fy.push_back(0);
     fz.push_back(0);
-    mass.push_back(m);
-    inv_mass.push_back(Real(1) / m);
-    x0.push_back(px);
-    y0.push_back(py);
-    z0.push_back(pz);
+    inv_mass.push_back(im);
+    x0.push_back(float(px));
+    y0.push_back(float(py));
+    z0.push_back(float(pz));
     ++n_owned;
   }
 
@@ -72,8 +81,8 @@ struct Particles {
       auto copy = v;
       for (std::size_t k = 0; k < order.size(); ++k) v[k] = copy[order[k]];
     };
-    for (auto* v : {&x, &y, &z, &radius, &vx, &vy, &vz, &fx, &fy, &fz, &mass, &inv_mass, &x0, &y0, &z0})
-      apply(*v);
+    for (auto* v : {&x, &y, &z, &radius, &vx, &vy, &vz, &fx, &fy, &fz, &inv_mass}) apply(*v);
+    for (auto* v : {&x0, &y0, &z0}) apply(*v);
     apply(id);
     apply(tag);
   }
@@ -85,7 +94,8 @@ struct Particles {
       v[i] = v[last];
       v.pop_back();
     };
-    for (auto* v : {&x, &y, &z, &radius, &vx, &vy, &vz, &fx, &fy, &fz, &mass, &inv_mass, &x0, &y0, &z0}) mv(*v);
+    for (auto* v : {&x, &y, &z, &radius, &vx, &vy, &vz, &fx, &fy, &fz, &inv_mass}) mv(*v);
+    for (auto* v : {&x0, &y0, &z0}) mv(*v);
     mv(id);
     mv(tag);
     --n_owned;

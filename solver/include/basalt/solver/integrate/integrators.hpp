@@ -38,9 +38,9 @@ double drift(Particles<Real>& p, Real h) {
   const Real* __restrict vx = p.vx.data();
   const Real* __restrict vy = p.vy.data();
   const Real* __restrict vz = p.vz.data();
-  const Real* __restrict x0 = p.x0.data();
-  const Real* __restrict y0 = p.y0.data();
-  const Real* __restrict z0 = p.z0.data();
+  const float* __restrict x0 = p.x0.data();
+  const float* __restrict y0 = p.y0.data();
+  const float* __restrict z0 = p.z0.data();
   Real m = 0;
   Real sum = 0;  // non-finite positions make the sum non-finite
   for (std::size_t i = 0; i < n; ++i) {
@@ -67,7 +67,7 @@ template <class Real>
 double kinetic_energy(const Particles<Real>& p) {
   double e = 0;
   for (std::size_t i = 0; i < p.n_owned; ++i)
-    e += 0.5 * double(p.mass[i]) *
+    e += 0.5 / double(p.inv_mass[i]) *
          double(p.vx[i] * p.vx[i] + p.vy[i] * p.vy[i] + p.vz[i] * p.vz[i]);
   return e;
 }

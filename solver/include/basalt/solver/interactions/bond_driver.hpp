@@ -26,6 +26,7 @@ class BondDriver {
       K_.push_back(Real(g.params.K));
       eps_.push_back(std::isfinite(g.params.break_strain) ? Real(g.params.break_strain)
                                                           : std::numeric_limits<Real>::infinity());
+      breakable_ = breakable_ || std::isfinite(g.params.break_strain);
     }
   }
 
@@ -33,40 +34,15 @@ class BondDriver {
   /// that broke (they are removed at once).
   template <bool Energy>
   double compute(Particles<Real>& p, Bonds<Real>& bonds, std::vector<BrokenBond>& broken) {
+    gone_.clear();
     double energy = 0;
-    const std::size_t nb = bonds.size(), n2 = bonds.n_both_owned;
-    const Real* x = p.x.data();
-    const Real* y = p.y.data();
-    const Real* z = p.z.data();
-    Real* fx = p.fx.data();
-    Real* fy = p.fy.data();
-    Real* fz = p.fz.data();
-    const bool uniform = K_.size() == 1;
-    std::vector<std::size_t> gone;
-    for (std::size_t k = 0; k < nb; ++k) {
-      const auto i = static_cast<std::size_t>(bonds.ia[k]), j = static_cast<std::size_t>(bonds.ib[k]);
-      const Real dx = x[i] - x[j], dy = y[i] - y[j], dz = z[i] - z[j];
-      const Real r = std::sqrt(dx * dx + dy * dy + dz * dz);
-      const std::size_t g = uniform ? 0 : bonds.group[k];
-      const Real r0 = bonds.r0[k];
-      if (Model::broken(eps_[g], r0, r)) [[unlikely]] {
-        gone.push_back(k);
-        if (k < n2 || p.id[i] < p.id[j]) broken.push_back({bonds.a[k], bonds.b[k], double(r), double(r0)});
-        continue;
-      }
-      const Real s = Model::force(K_[g], r0, r) / r;
-      fx[i] += s * dx;
-      fy[i] += s * dy;
-      fz[i] += s * dz;
-      if (k < n2) {
-        fx[j] -= s * dx;
-        fy[j] -= s * dy;
-        fz[j] -= s * dz;
-      }
-      if constexpr (Energy)
-        if (k < n2 || p.id[i] < p.id[j]) energy += double(Model::energy(K_[g], r0, r));
-    }
-    if (!gone.empty()) remove(bonds, gone);
+    if (K_.size() == 1 && !breakable_)
+      energy = loops<Energy, true, false>(p, bonds, broken);
+    else if (K_.size() == 1)
+      energy = loops<Energy, true, true>(p, bonds, broken);
+    else
+      energy = loops<Energy, false, true>(p, bonds, broken);
+    if (!gone_.empty()) remove(bonds, gone_);
     return energy;
   }
 
@@ -85,6 +61,56 @@ class BondDriver {
   }
 
  private:
+  template <bool Energy, bool Uniform, bool Breakable>
+  double loops(Particles<Real>& p, Bonds<Real>& bonds, std::vector<BrokenBond>& broken) {
+    // Both ends owned: Newton's third law. Then one end a ghost: force on the owned end only.
+    return loop<Energy, Uniform, Breakable, true>(p, bonds, broken, 0, bonds.n_both_owned) +
+           loop<Energy, Uniform, Breakable, false>(p, bonds, broken, bonds.n_both_owned, bonds.size());
+  }
+
+  template <bool Energy, bool Uniform, bool Breakable, bool BothOwned>
+  double loop(Particles<Real>& p, const Bonds<Real>& bonds, std::vector<BrokenBond>& broken, std::size_t begin,
+              std::size_t end) {
+    double energy = 0;
+    const Real* __restrict x = p.x.data();
+    const Real* __restrict y = p.y.data();
+    const Real* __restrict z = p.z.data();
+    Real* __restrict fx = p.fx.data();
+    Real* __restrict fy = p.fy.data();
+    Real* __restrict fz = p.fz.data();
+    const std::int32_t* __restrict ia = bonds.ia.data();
+    const std::int32_t* __restrict ib = bonds.ib.data();
+    const Real* __restrict r0s = bonds.r0.data();
+    const Real K0 = K_[0], eps0 = eps_[0];
+    for (std::size_t k = begin; k < end; ++k) {
+      const auto i = static_cast<std::size_t>(ia[k]), j = static_cast<std::size_t>(ib[k]);
+      const Real dx = x[i] - x[j], dy = y[i] - y[j], dz = z[i] - z[j];
+      const Real r = std::sqrt(dx * dx + dy * dy + dz * dz);
+      const Real r0 = r0s[k];
+      const std::size_t g = Uniform ? 0 : bonds.group[k];
+      const Real K = Uniform ? K0 : K_[g];
+      if constexpr (Breakable) {
+        if (Model::broken(Uniform ? eps0 : eps_[g], r0, r)) [[unlikely]] {
+          gone_.push_back(k);
+          if (BothOwned || p.id[i] < p.id[j]) broken.push_back({bonds.a[k], bonds.b[k], double(r), double(r0)});
+          continue;
+        }
+      }
+      const Real s = Model::force(K, r0, r) / r;
+      fx[i] += s * dx;
+      fy[i] += s * dy;
+      fz[i] += s * dz;
+      if constexpr (BothOwned) {
+        fx[j] -= s * dx;
+        fy[j] -= s * dy;
+        fz[j] -= s * dz;
+      }
+      if constexpr (Energy)
+        if (BothOwned || p.id[i] < p.id[j]) energy += double(Model::energy(K, r0, r));
+    }
+    return energy;
+  }
+
   static void remove(Bonds<Real>& bonds, const std::vector<std::size_t>& gone) {
     std::vector<std::uint32_t> keep;
     keep.reserve(bonds.size() - gone.size());
@@ -102,6 +128,8 @@ class BondDriver {
   }
 
   std::vector<Real> K_, eps_;
+  bool breakable_ = false;
+  std::vector<std::size_t> gone_;
 };
 
 }  // namespace basalt::solver

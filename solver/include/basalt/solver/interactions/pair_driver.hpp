@@ -21,6 +21,8 @@ class PairDriver {
   }
 
   bool empty() const { return groups_.empty(); }
+  /// One group for every pair of tags.
+  bool takes_all() const { return uniform_; }
 
   /// Group index taking a pair of particles with these tags, or -1.
   int group_of(std::int64_t ti, std::int64_t tj) const {

@@ -3,6 +3,7 @@
 // particles appears once (i < j, Newton's third law applies); a pair of an owned particle and a ghost
 // appears in the ghost list of the owned one (the owning rank of the ghost lists it too; each rank
 // applies the force to its own particle only). Bonded pairs are excluded (they interact by their bond).
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -69,10 +70,12 @@ void build_pair_lists(const Particles<Real>& p, const CellGrid& grid, double ski
       for (std::int64_t y = std::max<std::int64_t>(cy - 1, 0); y <= std::min(cy + 1, dims[1] - 1); ++y)
         for (std::int64_t x = std::max<std::int64_t>(cx - 1, 0); x <= std::min(cx + 1, dims[0] - 1); ++x) {
           const std::int64_t cell = (z * dims[1] + y) * dims[0] + x;
-          for (auto k = start[static_cast<std::size_t>(cell)]; k < start[static_cast<std::size_t>(cell) + 1];
-               ++k) {
-            const std::uint32_t j = order[k];
-            if (j <= i) continue;  // owned-owned pairs once; ghosts all have j >= n > i
+          // A cell lists its particles in increasing index: skip to the first j > i (owned-owned pairs
+          // once; ghosts all have j >= n > i) without a per-candidate branch.
+          const auto* first = order.data() + start[static_cast<std::size_t>(cell)];
+          const auto* last = order.data() + start[static_cast<std::size_t>(cell) + 1];
+          for (const auto* it = std::upper_bound(first, last, static_cast<std::uint32_t>(i)); it != last; ++it) {
+            const std::uint32_t j = *it;
             const Real dx = xi - p.x[j], dy = yi - p.y[j], dz = zi - p.z[j];
             const Real cut = ri + p.radius[j];
             if (dx * dx + dy * dy + dz * dz >= cut * cut) continue;

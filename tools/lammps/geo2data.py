@@ -1,0 +1,130 @@
+#!/usr/bin/python3
+"""Converts an ESyS-Particle .geo packing into LAMMPS input for the wave benchmark.
+
+    /usr/bin/python3 tools/lammps/geo2data.py cube1.geo OUTDIR [--bond-model table|harmonic]
+
+Writes into OUTDIR:
+  data.lmp          atom_style hybrid sphere bond: "id type x y z diameter density molecule",
+                    LAMMPS id = .geo id + 1, density 1 (LAMMPS mass = 4/3 pi r^3, as in ESyS),
+                    a box padded like the ESyS run (2 r_max at the sides and below, +50 % above),
+                    one bond type per distinct rest length r0 = r1 + r2 (ESyS's convention).
+  bond_style.in, bond_coeffs.in  the bond_style and bond_coeff commands (included by the input
+                    template; table paths are relative to OUTDIR, where LAMMPS must run).
+  bond_tables/*.table  (table model) tension-only linear springs, 3-point tables.
+  bottom_group.in   a group of the particles that can touch the base wall during the run.
+Bond models:
+  table     F = K (r - r0) for r > r0 and 0 for r < r0: compression is carried by the granular contact
+            (pair gran/hooke, kn = K, cutoff r1 + r2 = r0), which LAMMPS applies to bonded pairs too. The
+            sum is ESyS's NRotBond + NRotElastic-with-exclusion exactly (piecewise linear, kink at a node).
+  harmonic  bond_style harmonic K/2, r0: simpler, but a compressed bonded pair then feels 2 K (bond +
+            contact), unlike ESyS. Kept for timing comparisons only.
+"""
+
+import argparse
+import math
+import os
+import sys
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, "..", "esys"))
+
+from geofile import GeoError, read_geo  # noqa: E402
+
+TABLES_PER_FILE = 100  # LAMMPS scans a table file from its start for every bond_coeff
+
+
+def convert(geo, outdir, stiffness, bond_model, pad_top, table_span, bottom_band):
+    box_lo, box_hi, particles, bonds = read_geo(geo)
+    radius = {p[0]: p[4] for p in particles}
+    rmax = max(radius.values())
+    lo = [min(box_lo[i], min(p[i + 1] - p[4] for p in particles)) for i in range(3)]
+    hi = [max(box_hi[i], max(p[i + 1] + p[4] for p in particles)) for i in range(3)]
+    pad = 2.0 * rmax
+    dom_lo = [lo[0] - pad, lo[1] - pad, lo[2] - pad]
+    dom_hi = [hi[0] + pad, hi[1] + pad, hi[2] + pad_top * (hi[2] - lo[2])]
+
+    # one bond type per distinct rest length (printed with 12 significant digits)
+    type_of_r0 = {}
+    bond_types = []
+    for a, b, _ in bonds:
+        key = f"{radius[a] + radius[b]:.12g}"
+        if key not in type_of_r0:
+            type_of_r0[key] = len(type_of_r0) + 1
+        bond_types.append(type_of_r0[key])
+
+    os.makedirs(outdir, exist_ok=True)
+    tmp = os.path.join(outdir, "data.lmp.tmp")
+    with open(tmp, "w") as f:
+        f.write(f"LAMMPS data file from {os.path.abspath(geo)} (tools/lammps/geo2data.py)\n\n")
+        f.write(f"{len(particles)} atoms\n{len(bonds)} bonds\n1 atom types\n{len(type_of_r0)} bond types\n\n")
+        for i, axis in enumerate("xyz"):
+            f.write(f"{dom_lo[i]:.10g} {dom_hi[i]:.10g} {axis}lo {axis}hi\n")
+        f.write("\nAtoms # hybrid sphere bond\n\n")
+        for pid, x, y, z, r, tag in particles:
+            f.write(f"{pid + 1} 1 {x:.10g} {y:.10g} {z:.10g} {2.0 * r:.12g} 1 1\n")
+        f.write("\nBonds\n\n")
+        for i, ((a, b, _), t) in enumerate(zip(bonds, bond_types)):
+            f.write(f"{i + 1} {t} {a + 1} {b + 1}\n")
+    os.replace(tmp, os.path.join(outdir, "data.lmp"))
+
+    with open(os.path.join(outdir, "bond_style.in"), "w") as f:
+        f.write("bond_style harmonic\n" if bond_model == "harmonic" else "bond_style table linear 3\n")
+    with open(os.path.join(outdir, "bond_coeffs.in"), "w") as f:
+        if bond_model == "harmonic":
+            for key, t in type_of_r0.items():
+                f.write(f"bond_coeff {t} {0.5 * stiffness:.12g} {key}\n")
+        else:
+            tdir = os.path.join(outdir, "bond_tables")
+            os.makedirs(tdir, exist_ok=True)
+            files = {}
+            for key, t in type_of_r0.items():
+                r0 = float(key)
+                name = os.path.join(tdir, f"b{(t - 1) // TABLES_PER_FILE:05d}.table")
+                if name not in files:
+                    files[name] = open(name, "w")
+                    files[name].write("# tension-only linear springs: f = -K (r - r0) for r > r0, else 0\n\n")
+                lo_r, hi_r = r0 * (1.0 - table_span), r0 * (1.0 + table_span)
+                e_hi = 0.5 * stiffness * (hi_r - r0) ** 2
+                f_hi = -stiffness * (hi_r - r0)
+                files[name].write(f"T{t}\nN 3\n\n1 {lo_r:.17g} 0 0\n2 {r0:.17g} 0 0\n3 {hi_r:.17g} {e_hi:.17g} "
+                                  f"{f_hi:.17g}\n\n")
+                f.write(f"bond_coeff {t} {os.path.relpath(name, outdir)} T{t}\n")
+            for fh in files.values():
+                fh.close()
+
+    bottom = [p[0] + 1 for p in particles if p[3] - p[4] - lo[2] < bottom_band]
+    with open(os.path.join(outdir, "bottom_group.in"), "w") as f:
+        for i in range(0, len(bottom), 50):
+            f.write("group bottom id " + " ".join(str(v) for v in bottom[i:i + 50]) + "\n")
+    return {"particles": len(particles), "bonds": len(bonds), "bond_types": len(type_of_r0),
+            "bottom": len(bottom), "rmax": rmax, "lo": lo, "hi": hi}
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument("geometry", help=".geo file")
+    p.add_argument("outdir")
+    p.add_argument("--stiffness", type=float, default=1000.0, help="bond K, N/mm")
+    p.add_argument("--bond-model", choices=("table", "harmonic"), default="table")
+    p.add_argument("--pad-top", type=float, default=0.5, help="box padding above, fraction of the height")
+    p.add_argument("--table-span", type=float, default=0.2,
+                   help="bond tables cover r0 (1 +- span); LAMMPS stops if a bond leaves it")
+    p.add_argument("--bottom-band", type=float, default=0.1,
+                   help="particles whose lowest point is within this of the base may touch the wall, mm")
+    args = p.parse_args()
+    try:
+        info = convert(args.geometry, args.outdir, args.stiffness, args.bond_model, args.pad_top, args.table_span,
+                       args.bottom_band)
+    except GeoError as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
+    except OSError as e:
+        print(f"error: cannot write into {args.outdir}: {e}", file=sys.stderr)
+        return 2
+    print(f"{args.outdir}: {info['particles']} atoms, {info['bonds']} bonds in {info['bond_types']} bond types "
+          f"({args.bond_model}), {info['bottom']} atoms in group bottom")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
