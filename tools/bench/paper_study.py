@@ -7,9 +7,10 @@ Steps (each can be skipped; results go to --data, default docs/data/paper_study)
   packed    (not by default) the same for n <= --pack with cubes packed whole by basalt::packer
             -> table2_packed.csv, table2_packed.md
   pingpong  mpirun -np 2 partition_study pingpong -> pingpong.csv (latency, bandwidth, allreduce)
-  runs      basalt-run scenes/wave.toml on the 15 mm cube (cube1.geo and basalt-pack's seed-7 cube) at 1 and
-            2 compute ranks, output stages none / field saver, --repeats each -> runs.csv (every repeat, with
-            the timing summary per step), stages.csv (Figure 5 input, see figure5.py)
+  runs      basalt-run scenes/wave.toml on the 15 mm cube cube1.geo at P = 1, 2 compute ranks and Q = 0, 1 I/O
+            ranks for the four output stages (none, field saver, checkpoint every 100 steps, both), and on
+            basalt-pack's seed-7 cube (no output, Q = 0); --repeats each, interleaved -> runs.csv (every run
+            with basalt-run's timing summary and CPU time), stages.csv (Figure 5 input, see figure5.py)
   model     weak-scaling projection to 1000 ranks from the measured costs -> model.csv, model.md,
             docs/img/weak_scaling.png
 Run from the worktree root with the build in build/:
@@ -39,7 +40,7 @@ CLUSTER_BANDWIDTH_BPS = 2.5e9
 
 DONE_RE = re.compile(r"done: (\d+) steps in ([0-9.]+) s .*?start-up ([0-9.]+) s; (\d+) rebuilds")
 PART_RE = re.compile(r"(forces|neighbour search|communication|integration|output) ([0-9.]+) ms")
-HEAD_RE = re.compile(r"basalt-run \S+: (\d+) particles, (\d+) bonds on (\d+) rank")
+HEAD_RE = re.compile(r"basalt-run \S+: (\d+) particles, (\d+) bonds on (\d+) (?:compute )?rank")
 
 
 def sh(cmd, **kw):
@@ -85,17 +86,6 @@ def read_pingpong(a):
 
 
 # ----------------------------------------------------------------------------------------------- runs
-def scene_variant(src, dst, geometry, fields):
-    """The wave scene with an absolute geometry path, with or without its [[output.fields]] blocks."""
-    with open(src) as f:
-        text = f.read()
-    text = re.sub(r'(?m)^file = ".*"$', f'file = "{geometry}"', text, count=1)
-    if not fields:
-        text = re.sub(r"(?ms)^\[\[output\.fields\]\].*?(?=^\[|\Z)", "", text)
-    with open(dst, "w") as f:
-        f.write(text)
-
-
 def parse_run(stdout):
     d = DONE_RE.search(stdout)
     h = HEAD_RE.search(stdout)
@@ -115,37 +105,48 @@ def ensure_packed(a):
             "-o", a.packed, "--quiet"])
 
 
+# The paper's four output stages as basalt-run options (the scene's own field saver, kinetic energy, is
+# switched by --fields-every; checkpoints are HDF5 files written by the compute ranks (Q = 0) or by the
+# I/O rank (Q = 1); no VTK frames).
+STAGE_ARGS = {
+    "none": ["--fields-every", "0", "--checkpoint-every", "0"],
+    "fields": ["--fields-every", "1", "--checkpoint-every", "0"],
+    "checkpoint": ["--fields-every", "0", "--checkpoint-every", "100"],
+    "both": ["--fields-every", "1", "--checkpoint-every", "100"],
+}
+
+
 def step_runs(a):
     ensure_packed(a)
     tmp = tempfile.mkdtemp(prefix="paper-study-")
     rows = []
-    geoms = [("cube1.geo", a.cube1), ("basalt-pack seed 7", a.packed)]
+    configs = [("cube1.geo", a.cube1, stage, p, q) for stage in STAGE_ARGS for p in (1, 2) for q in (0, 1)]
+    configs += [("basalt-pack seed 7", a.packed, "none", p, 0) for p in (1, 2)]
+    scene = os.path.join(ROOT, "scenes", "wave.toml")
     try:
-        # Interleave configurations within each repeat so that machine noise spreads over all of them.
+        # Interleave the configurations within each repeat so that machine noise spreads over all of them.
         for rep in range(a.repeats):
-            for gname, gpath in geoms:
-                for stage in ("none", "fields"):
-                    scene = os.path.join(tmp, f"wave-{stage}.toml")
-                    scene_variant(os.path.join(ROOT, "scenes", "wave.toml"), scene, os.path.abspath(gpath),
-                                  stage == "fields")
-                    for p in (1, 2):
-                        out = sh(["/usr/bin/time", "-f", "CPU %U %S"] + mpirun(p) +
-                                 [a.bin("basalt-run"), scene, "--steps", str(a.steps), "--output",
-                                  os.path.join(tmp, "out"), "--quiet"])
-                        r = parse_run(out.stdout)
-                        cpu = re.search(r"CPU ([0-9.]+) ([0-9.]+)", out.stderr)
-                        r["cpu_user_s"], r["cpu_sys_s"] = float(cpu.group(1)), float(cpu.group(2))
-                        r.update({"geometry": gname, "stage": stage, "io_ranks": 0, "repeat": rep})
-                        print(f"  {gname:20s} {stage:6s} P={p} loop {r['loop_s']:.3f} s  comm {r['comm_ms']:.4f} "
-                              f"ms/step  cpu {r['cpu_user_s']:.2f}+{r['cpu_sys_s']:.2f} s", flush=True)
-                        rows.append(r)
+            for gname, gpath, stage, p, q in configs:
+                out_dir = os.path.join(tmp, "out")
+                shutil.rmtree(out_dir, ignore_errors=True)
+                out = sh(["/usr/bin/time", "-f", "CPU %U %S"] + mpirun(p + q) +
+                         [a.bin("basalt-run"), scene, "--geometry", os.path.abspath(gpath), "--steps", str(a.steps),
+                          "--output", out_dir, "--quiet", "--frames-every", "0", "--io-ranks", str(q)] +
+                         STAGE_ARGS[stage])
+                r = parse_run(out.stdout)
+                cpu = re.search(r"CPU ([0-9.]+) ([0-9.]+)", out.stderr)
+                r["cpu_user_s"], r["cpu_sys_s"] = float(cpu.group(1)), float(cpu.group(2))
+                r.update({"geometry": gname, "stage": stage, "io_ranks": q, "repeat": rep})
+                print(f"  {gname:20s} {stage:10s} P={p} Q={q} loop {r['loop_s']:.3f} s  comm {r['comm_ms']:.4f} "
+                      f"ms/step  cpu {r['cpu_user_s']:.2f}+{r['cpu_sys_s']:.2f} s", flush=True)
+                rows.append(r)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
     keys = ["geometry", "stage", "ranks", "io_ranks", "repeat", "particles", "bonds", "steps", "loop_s",
             "startup_s", "rebuilds", "forces_ms", "neighbour_ms", "comm_ms", "integration_ms", "output_ms", "cpu_user_s",
             "cpu_sys_s"]
     with open(os.path.join(a.data, "runs.csv"), "w", newline="") as f:
-        w = csv.DictWriter(f, keys)
+        w = csv.DictWriter(f, keys, extrasaction="ignore")
         w.writeheader()
         w.writerows(rows)
     # Figure 5 input: one row per run, time scaled to the paper's 10,000 steps.
@@ -187,7 +188,8 @@ def step_model(a):
     table = read_csv(os.path.join(a.data, "table2.csv"))
     lat, bw, ar2 = read_pingpong(a)
     g = "cube1.geo"
-    sel = [r for r in runs if r["geometry"] == g and r["ranks"] == "1" and r["stage"] == "none"]
+    sel = [r for r in runs if r["geometry"] == g and r["ranks"] == "1" and r["stage"] == "none" and
+           r["io_ranks"] == "0"]
     n1 = int(sel[0]["particles"])
     steps = int(sel[0]["steps"])
     # Compute cost per particle-step on a core of its own: CPU seconds of the 1-rank run (user + sys), the
@@ -196,13 +198,13 @@ def step_model(a):
     cpu_loop = [(float(r["cpu_user_s"]) + float(r["cpu_sys_s"])) * float(r["loop_s"]) /
                 (float(r["loop_s"]) + float(r["startup_s"])) for r in sel]
     c_p = statistics.median(cpu_loop) / (n1 * steps)
-    wall_compute = sum(median_of(runs, k, geometry=g, ranks=1, stage="none")
+    wall_compute = sum(median_of(runs, k, geometry=g, ranks=1, stage="none", io_ranks=0)
                        for k in ("forces_ms", "neighbour_ms", "integration_ms")) * 1e-3
     owned2, ghosts2 = ghosts_at_np2(a)
-    comm2 = median_of(runs, "comm_ms", geometry=g, ranks=2, stage="none") * 1e-3
-    rebuild_rate = median_of(runs, "rebuilds", geometry=g, ranks=1, stage="none") / steps
-    fields1 = median_of(runs, "output_ms", geometry=g, ranks=1, stage="fields") * 1e-3
-    fields2 = median_of(runs, "output_ms", geometry=g, ranks=2, stage="fields") * 1e-3
+    comm2 = median_of(runs, "comm_ms", geometry=g, ranks=2, stage="none", io_ranks=0) * 1e-3
+    rebuild_rate = median_of(runs, "rebuilds", geometry=g, ranks=1, stage="none", io_ranks=0) / steps
+    fields1 = median_of(runs, "output_ms", geometry=g, ranks=1, stage="fields", io_ranks=0) * 1e-3
+    fields2 = median_of(runs, "output_ms", geometry=g, ranks=2, stage="fields", io_ranks=0) * 1e-3
     measured = {"particles_1rank": n1, "cpu_s_per_particle_step": c_p,
                 "wall_compute_s_per_step_1rank_contended": wall_compute,
                 "wall_s_per_particle_step_1rank_contended": wall_compute / n1, "owned_2rank": owned2,
