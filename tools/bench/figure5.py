@@ -59,7 +59,7 @@ def main():
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, (ax, ax2) = plt.subplots(1, 2, figsize=(12, 4.8))
+    fig, (ax, ax2) = plt.subplots(1, 2, figsize=(12, 5.6))
     ranks = sorted({p for (_, _, p) in med})
     for stage, label, color in STAGES:
         for q, style, marker in ((0, "-", "o"), (1, "--", "s")):
@@ -77,17 +77,16 @@ def main():
     ax.set_xticks(ranks)
     ax.set_ylim(bottom=0)
     ax.set_title(a.title, fontsize=10)
-    ax.legend(fontsize=8)
     ax2.axhline(0, color="grey", lw=0.5)
     ax2.set_xticks(ranks)
     ax2.set_xlabel("compute ranks P")
     ax2.set_ylabel("% over no output (same P and Q)")
     ax2.set_title("cost of output", fontsize=10)
-    if ax2.lines[1:]:
-        ax2.legend(fontsize=8)
+    handles, labels = ax.get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=4, fontsize=8)
     n = min(count.values())
-    fig.text(0.01, 0.01, f"median of >= {n} runs per point; Q = I/O ranks (0: compute ranks write)", fontsize=8)
-    fig.tight_layout(rect=(0, 0.03, 1, 1))
+    fig.text(0.01, 0.125, f"median of >= {n} runs per point; Q = I/O ranks (0: compute ranks write)", fontsize=8)
+    fig.tight_layout(rect=(0, 0.14, 1, 1))
     fig.savefig(a.output, dpi=110)
     print("wrote", a.output)
 
