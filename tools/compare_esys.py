@@ -34,7 +34,7 @@ def main():
         ROOT, "docs", "data", "esys_cube1_ekin.csv" if a.steps <= 2000 else "esys_cube1_ekin_10000.csv")
     if not os.path.exists(a.geometry):
         sys.exit(f"compare_esys: geometry {a.geometry} not found (--geometry)")
-    exe = os.path.join(a.build, "solver", "basalt-run")
+    exe = os.path.join(a.build, "bin", "basalt-run")
     if not os.access(exe, os.X_OK):
         sys.exit(f"compare_esys: {exe} not built (cmake --build {a.build} --target basalt-run)")
     with tempfile.TemporaryDirectory() as out:

@@ -30,7 +30,7 @@ def sh(cmd, **kw):
 
 
 def basalt(a, geo, np_, steps, out):
-    cmd = [os.path.join(a.build, "solver", "basalt-run"), os.path.join(a.root, "scenes", "wave.toml"),
+    cmd = [os.path.join(a.build, "bin", "basalt-run"), os.path.join(a.root, "scenes", "wave.toml"),
            "--geometry", geo, "--steps", str(steps), "--output", out, "--quiet"]
     if np_ > 1:
         cmd = ["mpirun", "-np", str(np_)] + cmd
@@ -55,7 +55,7 @@ def esys(a, geo, np_, steps, out):
 
 
 def peak_rss_kb(a, geo, steps, out):
-    cmd = ["/usr/bin/time", "-v", os.path.join(a.build, "solver", "basalt-run"),
+    cmd = ["/usr/bin/time", "-v", os.path.join(a.build, "bin", "basalt-run"),
            os.path.join(a.root, "scenes", "wave.toml"), "--geometry", geo, "--steps", str(steps), "--output", out,
            "--quiet"]
     r = subprocess.run(cmd, check=True, capture_output=True, text=True)
