@@ -270,7 +270,7 @@ int main(int argc, char** argv) {
       ->required()
       ->expected(3)
       ->delimiter(',')
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::Range(1, 64));
   grd->add_option("--skin", skin, "the scene's run.skin (mm)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
