@@ -11,6 +11,8 @@ Steps (each can be skipped; results go to --data, default docs/data/paper_study)
             ranks for the four output stages (none, field saver, checkpoint every 100 steps, both), and on
             basalt-pack's seed-7 cube (no output, Q = 0); --repeats each, interleaved -> runs.csv (every run
             with basalt-run's timing summary and CPU time), stages.csv (Figure 5 input, see figure5.py)
+  weak      (not by default) Figure 5 with one 15 mm cube per compute rank: cube1.geo twice side by side at
+            P = 2, the four stages, Q = 0, 1 -> stages_weak.csv (needs stages.csv from runs)
   model     weak-scaling projection to 1000 ranks from the measured costs -> model.csv, model.md,
             docs/img/weak_scaling.png
 Run from the worktree root with the build in build/:
@@ -158,8 +160,8 @@ def step_runs(a):
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
     keys = ["geometry", "stage", "ranks", "io_ranks", "repeat", "particles", "bonds", "steps", "loop_s",
-            "startup_s", "rebuilds", "forces_ms", "neighbour_ms", "comm_ms", "integration_ms", "output_ms", "cpu_user_s",
-            "cpu_sys_s"]
+            "startup_s", "rebuilds", "forces_ms", "neighbour_ms", "comm_ms", "integration_ms", "output_ms",
+            "cpu_user_s", "cpu_sys_s"]
     with open(os.path.join(a.data, "runs.csv"), "w", newline="") as f:
         w = csv.DictWriter(f, keys, extrasaction="ignore")
         w.writeheader()
@@ -172,6 +174,85 @@ def step_runs(a):
         for r in rows:
             w.writerow([r["geometry"], r["ranks"], r["io_ranks"], r["stage"], r["repeat"], r["particles"],
                         r["steps"], r["loop_s"], r["loop_s"] * PAPER_STEPS / r["steps"]])
+
+
+def tile_geo(src, dims, dst):
+    """Copies of a .geo packing side by side (dims = copies along x, y, z; ids offset per copy; bonds only
+    within copies): weak scaling, one 15 mm cube per compute rank."""
+    with open(src) as f:
+        lines = f.read().split("\n")
+    box = [float(v) for v in lines[1].split()[1:7]]
+    side = [box[3] - box[0], box[4] - box[1], box[5] - box[2]]
+    i = lines.index("BeginParticles")
+    parts = [l.split() for l in lines[i + 3:i + 3 + int(lines[i + 2])]]
+    j = lines.index("BeginConnect", i)
+    bonds = [l.split() for l in lines[j + 2:j + 2 + int(lines[j + 1])]]
+    stride = max(int(p[4]) for p in parts) + 1
+    out_p, out_b = [], []
+    k = 0
+    for ix in range(dims[0]):
+        for iy in range(dims[1]):
+            for iz in range(dims[2]):
+                off = k * stride
+                for x, y, z, r, pid, tag in parts:
+                    out_p.append(f"{float(x) + ix * side[0]!r} {float(y) + iy * side[1]!r} "
+                                 f"{float(z) + iz * side[2]!r} {r} {int(pid) + off} {tag}")
+                for a_, b_, t in bonds:
+                    out_b.append(f"{int(a_) + off} {int(b_) + off} {t}")
+                k += 1
+    hi = [box[d] + dims[d] * side[d] for d in range(3)]
+    with open(dst, "w") as f:
+        f.write("LSMGeometry 1.2\n")
+        f.write(f"BoundingBox {box[0]} {box[1]} {box[2]} {hi[0]} {hi[1]} {hi[2]}\n")
+        f.write("PeriodicBoundaries 0 0 0\nDimension 3D\nBeginParticles\nSimple\n")
+        f.write(f"{len(out_p)}\n" + "\n".join(out_p) + "\nEndParticles\nBeginConnect\n")
+        f.write(f"{len(out_b)}\n" + "\n".join(out_b) + "\nEndConnect\n")
+
+
+def step_weak(a):
+    """Figure 5 as the paper drew it: one 15 mm cube per compute rank. P = 2 runs cube1.geo twice side by side
+    (2 x 1 x 1, 17,896 particles) with the four stages and Q = 0, 1 -> stages_weak.csv (with the P = 1 rows of
+    stages.csv: the same cube1 on 1 rank)."""
+    geo = os.path.join(os.path.dirname(a.packed), "cube1_2x1x1.geo")
+    os.makedirs(os.path.dirname(geo), exist_ok=True)
+    tile_geo(a.cube1, (2, 1, 1), geo)
+    tmp = tempfile.mkdtemp(prefix="paper-study-")
+    rows = [r for r in read_csv(os.path.join(a.data, "stages.csv"))
+            if r["geometry"] == "cube1.geo" and r["compute_ranks"] == "1"]
+    for r in rows:
+        r["geometry"] = "15 mm cube per compute rank"
+    scene = os.path.join(ROOT, "scenes", "wave.toml")
+    try:
+        for rep in range(a.repeats):
+            for stage in STAGE_ARGS:
+                for q in (0, 1):
+                    out_dir = os.path.join(tmp, "out")
+                    shutil.rmtree(out_dir, ignore_errors=True)
+                    cmd = (mpirun(2 + q) + [a.bin("basalt-run"), scene, "--geometry", geo, "--steps", str(a.steps),
+                                            "--output", out_dir, "--quiet", "--frames-every", "0", "--io-ranks",
+                                            str(q), "--dims", "2,1,1"] + STAGE_ARGS[stage])
+                    for attempt in range(3):
+                        print("+", " ".join(cmd), flush=True)
+                        out = subprocess.run(cmd, text=True, capture_output=True)
+                        if out.returncode == 0:
+                            break
+                        with open(os.path.join(a.data, "failures.log"), "a") as f:
+                            f.write(f"$ {' '.join(cmd)}\nexit {out.returncode}\n{out.stdout}\n{out.stderr}\n\n")
+                    else:
+                        raise SystemExit("basalt-run failed 3 times: " + " ".join(cmd))
+                    r = parse_run(out.stdout)
+                    print(f"  2x cube1 {stage:10s} P=2 Q={q} loop {r['loop_s']:.3f} s", flush=True)
+                    rows.append({"geometry": "15 mm cube per compute rank", "compute_ranks": 2, "io_ranks": q,
+                                 "stage": stage, "repeat": rep, "particles": r["particles"], "steps": r["steps"],
+                                 "loop_seconds": r["loop_s"],
+                                 "seconds_per_10000_steps": r["loop_s"] * PAPER_STEPS / r["steps"]})
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    with open(os.path.join(a.data, "stages_weak.csv"), "w", newline="") as f:
+        w = csv.DictWriter(f, ["geometry", "compute_ranks", "io_ranks", "stage", "repeat", "particles", "steps",
+                               "loop_seconds", "seconds_per_10000_steps"])
+        w.writeheader()
+        w.writerows(rows)
 
 
 def read_csv(path):
@@ -364,7 +445,7 @@ def plot_model(a, rows):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("steps_to_run", nargs="*", default=["table", "pingpong", "runs", "model"],
-                    choices=["table", "packed", "pingpong", "runs", "model"])
+                    choices=["table", "packed", "pingpong", "runs", "model", "weak"])
     ap.add_argument("--build", default=os.path.join(ROOT, "build"))
     ap.add_argument("--data", default=os.path.join(ROOT, "docs", "data", "paper_study"))
     ap.add_argument("--plot", default=os.path.join(ROOT, "docs", "img", "weak_scaling.png"))
@@ -383,7 +464,9 @@ def main():
     os.makedirs(a.data, exist_ok=True)
     t0 = time.time()
     for s in a.steps_to_run:
-        {"table": step_table, "packed": step_packed, "pingpong": step_pingpong, "runs": step_runs, "model": step_model}[s](a)
+        steps = {"table": step_table, "packed": step_packed, "pingpong": step_pingpong, "runs": step_runs,
+                 "model": step_model, "weak": step_weak}
+        steps[s](a)
     print(f"paper_study: done in {time.time() - t0:.0f} s")
 
 
