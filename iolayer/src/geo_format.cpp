@@ -13,17 +13,22 @@
 //   id1 id2 bondtag                (count lines)
 //   EndConnect
 // Every error names the file and line number.
+#include <fmt/format.h>
+#include <fmt/os.h>
+
+#include <algorithm>
+#include <cerrno>
 #include <charconv>
+#include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 #include <string_view>
 #include <unordered_map>
 
-#include <fmt/format.h>
-#include <fmt/os.h>
-
 #include "basalt/io/geometry.hpp"
+#include "geometry_order.hpp"
 
 namespace basalt::io {
 
@@ -33,7 +38,11 @@ namespace {
 
 class LineReader {
  public:
-  explicit LineReader(const fs::path& file) : file_(file), in_(file) {
+  explicit LineReader(const fs::path& file) : file_(file) {
+    std::error_code ec;
+    if (!fs::exists(file, ec)) throw FormatError(file, "", "no such file");
+    if (fs::is_directory(file, ec)) throw FormatError(file, "", "is a folder, not a file");
+    in_.open(file);
     if (!in_) throw FormatError(file, "", "cannot open for reading");
   }
 
@@ -68,16 +77,19 @@ class LineReader {
     return v;
   }
 
+  /// True when only blank lines remain; otherwise the next non-blank line becomes fields().
   bool eof_after_whitespace() {
-    std::string rest;
-    while (std::getline(in_, rest)) {
+    while (std::getline(in_, line_)) {
       ++line_no_;
-      if (rest.find_first_not_of(" \t\r") != std::string::npos) return false;
+      if (!line_.empty() && line_.back() == '\r') line_.pop_back();
+      split();
+      if (!fields_.empty()) return false;
     }
     return true;
   }
 
   const std::vector<std::string_view>& fields() const { return fields_; }
+  std::size_t line() const { return line_no_; }
 
  private:
   void split() {
@@ -107,7 +119,8 @@ Geometry read_geo(const fs::path& file) {
   auto head = r.next("LSMGeometry header");
   if (head[0] != "LSMGeometry") r.fail("not an ESyS-Particle geometry: first line must be 'LSMGeometry 1.2'");
   if (head.size() < 2 || (head[1] != "1.2" && head[1] != "1.1"))
-    r.fail("unsupported LSMGeometry version (expected 1.2)");
+    r.fail(fmt::format("unsupported LSMGeometry version '{}' (Basalt reads 1.1 and 1.2)",
+                       head.size() < 2 ? "" : std::string(head[1])));
 
   r.expect_keyword("BoundingBox", 6);
   for (int k = 0; k < 3; ++k) {
@@ -115,7 +128,8 @@ Geometry read_geo(const fs::path& file) {
     g.box_max[k] = r.number<double>(r.fields()[4 + k], "BoundingBox value");
   }
   r.expect_keyword("PeriodicBoundaries", 3);
-  for (int k = 0; k < 3; ++k) g.periodic[k] = r.number<int>(r.fields()[1 + k], "PeriodicBoundaries flag") != 0;
+  for (int k = 0; k < 3; ++k)
+    g.periodic[k] = r.number<int>(r.fields()[1 + k], "PeriodicBoundaries flag") != 0;
   r.expect_keyword("Dimension", 1);
   if (r.fields()[1] != "3D") r.fail("only 'Dimension 3D' geometries are supported");
   r.expect_keyword("BeginParticles", 0);
@@ -125,46 +139,49 @@ Geometry read_geo(const fs::path& file) {
   if (count_line.size() != 1) r.fail("expected the particle count alone on the line");
   const auto n = r.number<long long>(count_line[0], "particle count");
   if (n < 0) r.fail("particle count is negative");
-  g.id.reserve(n);
-  g.position.reserve(n);
-  g.radius.reserve(n);
-  g.tag.reserve(n);
+  // The count comes from the file: reserve no more than a sane amount up front.
+  const auto expect = static_cast<std::size_t>(std::min<long long>(n, 1 << 24));
+  g.id.reserve(expect);
+  g.position.reserve(expect);
+  g.radius.reserve(expect);
+  g.tag.reserve(expect);
+  std::unordered_map<std::int64_t, std::size_t> line_of_id;  // id -> line, to name both lines of a duplicate
+  line_of_id.reserve(expect * 2);
   for (long long i = 0; i < n; ++i) {
     auto f = r.next("a particle line 'x y z radius id tag'");
-    if (f[0] == "EndParticles") r.fail(fmt::format("particle count says {}, but only {} particles follow", n, i));
-    if (f.size() != 6) r.fail(fmt::format("particle line needs 6 fields 'x y z radius id tag', found {}", f.size()));
+    if (f[0] == "EndParticles")
+      r.fail(fmt::format("particle count says {}, but only {} particles follow", n, i));
+    if (f.size() != 6)
+      r.fail(fmt::format("particle line needs 6 fields 'x y z radius id tag', found {}", f.size()));
     Vec3 p{r.number<double>(f[0], "x"), r.number<double>(f[1], "y"), r.number<double>(f[2], "z")};
+    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
+      r.fail("position must be finite");
     double rad = r.number<double>(f[3], "radius");
-    if (!(rad > 0)) r.fail(fmt::format("radius must be > 0, got {}", f[3]));
-    g.add_particle(r.number<std::int64_t>(f[4], "id"), p, rad, r.number<std::int32_t>(f[5], "tag"));
+    if (!(rad > 0) || !std::isfinite(rad)) r.fail(fmt::format("radius must be finite and > 0, got {}", f[3]));
+    const auto pid = r.number<std::int64_t>(f[4], "id");
+    if (auto [it, fresh] = line_of_id.emplace(pid, r.line()); !fresh)
+      r.fail(fmt::format("duplicate particle id {} (first on line {})", pid, it->second));
+    g.add_particle(pid, p, rad, r.number<std::int32_t>(f[5], "tag"));
   }
   auto end_p = r.next("EndParticles");
   if (end_p[0] != "EndParticles")
     r.fail(fmt::format("expected 'EndParticles' after {} particles (is the particle count too small?)", n));
 
   // Bonds are optional in files written without connections.
-  std::vector<std::string_view> f;
-  try {
-    f = r.next("BeginConnect");
-  } catch (const FormatError&) {
+  g.attributes["source_format"] = "LSMGeometry 1.2";
+  g.attributes["source_file"] = file.filename().string();
+  if (r.eof_after_whitespace()) {
     g.sort_by_id();
     g.validate(file);
     return g;
   }
+  auto f = r.fields();
   if (f[0] != "BeginConnect") r.fail("expected 'BeginConnect'");
   auto bc = r.next("bond count");
   if (bc.size() != 1) r.fail("expected the bond count alone on the line");
   const auto nb = r.number<long long>(bc[0], "bond count");
   if (nb < 0) r.fail("bond count is negative");
-  g.bonds.reserve(nb);
-  std::unordered_map<std::int64_t, char> ids;
-  ids.reserve(g.id.size() * 2);
-  for (auto pid : g.id) {
-    if (!ids.emplace(pid, 0).second) {
-      // Name the line later in validate(); here we only know the id.
-      throw FormatError(file, "particles", fmt::format("duplicate particle id {}", pid));
-    }
-  }
+  g.bonds.reserve(static_cast<std::size_t>(std::min<long long>(nb, 1 << 24)));
   for (long long k = 0; k < nb; ++k) {
     auto b = r.next("a bond line 'id1 id2 tag'");
     if (b[0] == "EndConnect") r.fail(fmt::format("bond count says {}, but only {} bonds follow", nb, k));
@@ -172,33 +189,42 @@ Geometry read_geo(const fs::path& file) {
     auto a = r.number<std::int64_t>(b[0], "bond id1");
     auto c = r.number<std::int64_t>(b[1], "bond id2");
     for (auto e : {a, c})
-      if (!ids.count(e)) r.fail(fmt::format("bond refers to particle id {}, which does not exist", e));
+      if (!line_of_id.count(e)) r.fail(fmt::format("bond refers to particle id {}, which does not exist", e));
     if (a == c) r.fail(fmt::format("bond joins particle {} to itself", a));
     g.add_bond(a, c, r.number<std::int32_t>(b[2], "bond tag"));
   }
   auto ec = r.next("EndConnect");
-  if (ec[0] != "EndConnect") r.fail(fmt::format("expected 'EndConnect' after {} bonds (is the bond count too small?)", nb));
+  if (ec[0] != "EndConnect")
+    r.fail(fmt::format("expected 'EndConnect' after {} bonds (is the bond count too small?)", nb));
   if (!r.eof_after_whitespace()) r.fail("unexpected text after 'EndConnect'");
 
-  g.attributes["source_format"] = "LSMGeometry 1.2";
-  g.attributes["source_file"] = file.filename().string();
   g.sort_by_id();
   g.validate(file);
   return g;
 }
 
-void write_geo(const Geometry& g, const fs::path& file) {
-  g.validate(file);
+void write_geo(const Geometry& unordered, const fs::path& file) {
+  unordered.validate(file);
+  Geometry storage;
+  const Geometry& g = in_file_order(unordered, storage);
   const fs::path tmp = file.string() + ".tmp";
+  const fs::path folder = file.has_parent_path() ? file.parent_path() : fs::path(".");
+  std::error_code exists_ec;
+  if (!fs::exists(folder, exists_ec))
+    throw FormatError(file, "", fmt::format("cannot create: folder '{}' does not exist", folder.string()));
+  if (!fs::is_directory(folder, exists_ec))
+    throw FormatError(file, "", fmt::format("cannot create: '{}' is not a folder", folder.string()));
   {
     std::FILE* out = std::fopen(tmp.c_str(), "w");
-    if (!out) throw FormatError(file, "", "cannot open for writing (does the folder exist and is it writable?)");
+    if (!out)
+      throw FormatError(file, "", fmt::format("cannot create '{}': {}", tmp.string(), std::strerror(errno)));
     auto w = [&](std::string_view s) { return std::fwrite(s.data(), 1, s.size(), out) == s.size(); };
     bool ok = true;
     ok &= w("LSMGeometry 1.2\n");
-    ok &= w(fmt::format("BoundingBox {} {} {} {} {} {}\n", g.box_min[0], g.box_min[1], g.box_min[2], g.box_max[0],
-                        g.box_max[1], g.box_max[2]));
-    ok &= w(fmt::format("PeriodicBoundaries {} {} {}\n", int(g.periodic[0]), int(g.periodic[1]), int(g.periodic[2])));
+    ok &= w(fmt::format("BoundingBox {} {} {} {} {} {}\n", g.box_min[0], g.box_min[1], g.box_min[2],
+                        g.box_max[0], g.box_max[1], g.box_max[2]));
+    ok &= w(fmt::format("PeriodicBoundaries {} {} {}\n", int(g.periodic[0]), int(g.periodic[1]),
+                        int(g.periodic[2])));
     ok &= w("Dimension 3D\nBeginParticles\nSimple\n");
     ok &= w(fmt::format("{}\n", g.size()));
     fmt::memory_buffer buf;

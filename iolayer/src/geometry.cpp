@@ -1,11 +1,13 @@
 #include "basalt/io/geometry.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <numeric>
-#include <unordered_set>
 
-#include <fmt/format.h>
+#include "geometry_order.hpp"
+#include "id_set.hpp"
 
 namespace basalt::io {
 
@@ -56,10 +58,15 @@ void Geometry::validate(const fs::path& source) const {
                                   position.size(), radius.size(), tag.size()));
   if (!mass.empty() && mass.size() != n)
     throw FormatError(source, "particles/mass", fmt::format("{} masses for {} particles", mass.size(), n));
-  std::unordered_set<std::int64_t> seen;
-  seen.reserve(n * 2);
+  std::int64_t lo = 0, hi = 0;
+  if (n) {
+    const auto [mn, mx] = std::minmax_element(id.begin(), id.end());
+    lo = *mn;
+    hi = *mx;
+  }
+  IdSet seen(lo, hi, n);
   for (std::size_t i = 0; i < n; ++i) {
-    if (!seen.insert(id[i]).second)
+    if (!seen.insert(id[i]))
       throw FormatError(source, fmt::format("particle {}", i), fmt::format("duplicate id {}", id[i]));
     const auto& p = position[i];
     if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
@@ -76,7 +83,7 @@ void Geometry::validate(const fs::path& source) const {
     if (b.a == b.b)
       throw FormatError(source, fmt::format("bond {}", k), fmt::format("joins particle {} to itself", b.a));
     for (auto e : {b.a, b.b})
-      if (!seen.count(e))
+      if (!seen.contains(e))
         throw FormatError(source, fmt::format("bond {}", k),
                           fmt::format("refers to particle id {}, which does not exist", e));
   }
@@ -100,6 +107,26 @@ void write_geometry(const Geometry& g, const fs::path& file) {
   if (ext == ".h5" || ext == ".hdf5") return write_h5(g, file);
   if (ext == ".geo") return write_geo(g, file);
   throw FormatError(file, "", "unknown geometry format (expected .h5, .hdf5 or .geo)");
+}
+
+std::vector<std::size_t> sorting_order(const std::vector<std::int64_t>& id) {
+  if (std::is_sorted(id.begin(), id.end())) return {};
+  std::vector<std::size_t> order(id.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t i, std::size_t j) { return id[i] < id[j]; });
+  return order;
+}
+
+bool in_file_order(const Geometry& g) {
+  return std::is_sorted(g.id.begin(), g.id.end()) &&
+         std::all_of(g.bonds.begin(), g.bonds.end(), [](const Bond& b) { return b.a < b.b; });
+}
+
+const Geometry& in_file_order(const Geometry& g, Geometry& storage) {
+  if (in_file_order(g)) return g;
+  storage = g;
+  storage.sort_by_id();
+  return storage;
 }
 
 }  // namespace basalt::io

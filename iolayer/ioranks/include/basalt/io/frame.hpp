@@ -1,0 +1,73 @@
+#pragma once
+// One compute rank's share of a run's state at one output step ("frame piece"), and its flat
+// wire format. Compute ranks fill a FramePiece with their owned particles; the I/O side
+// assembles the pieces of all ranks into a Checkpoint (sorted by id) or writes them as VTK.
+#include <cstddef>
+#include <array>
+#include <cstdint>
+#include <map>
+#include <string>
+#include <span>
+#include <vector>
+
+#include "basalt/io/checkpoint.hpp"
+
+namespace basalt::io {
+
+enum FrameKind : std::uint32_t {
+  kFrameCheckpoint = 1u << 0,  ///< write an HDF5 checkpoint of this step
+  kFrameVtk = 1u << 1,         ///< write a VTK frame of this step
+};
+
+struct FramePiece {
+  std::uint32_t kinds = 0;  ///< FrameKind bits
+  std::int64_t step = 0;
+  double time = 0;
+  double dt = 0;
+  std::int32_t source_rank = 0;  ///< compute rank that packed it
+
+  // Owned particles of the source rank (any order).
+  std::vector<std::int64_t> id;
+  std::vector<Vec3> position;
+  std::vector<Vec3> velocity;
+  std::vector<double> radius;
+  std::vector<double> mass;
+  std::vector<std::int32_t> tag;
+
+  // Bonds this rank is responsible for (each bond in exactly one piece), with their state.
+  std::vector<Bond> bonds;
+  std::vector<double> bond_rest_length;
+  std::vector<std::uint8_t> bond_broken;
+
+  // Global, identical on every rank; only the piece of compute rank 0 needs to carry them.
+  std::vector<WallState> walls;
+
+  std::size_t size() const { return id.size(); }
+  void clear();  ///< empties the arrays, keeping their capacity
+};
+
+/// Flat bytes for MPI: a fixed header, then each array. Round-trips exactly.
+void serialize(const FramePiece& piece, std::vector<std::byte>& out);
+/// Throws std::runtime_error on a malformed buffer (bad magic, sizes that overrun the buffer).
+FramePiece deserialize(std::span<const std::byte> bytes);
+
+/// What a checkpoint needs besides the per-rank pieces: fixed for the whole run.
+struct RunInfo {
+  Vec3 box_min{0, 0, 0};
+  Vec3 box_max{0, 0, 0};
+  std::array<bool, 3> periodic{false, false, false};
+  Units units;
+  std::map<std::string, std::string> attributes;  ///< provenance (code version, command line ...)
+  std::string scene_text;
+};
+
+/// Joins the pieces of one step into a checkpoint: particles sorted by id, bonds sorted by
+/// (a, b), walls from whichever piece carries them. Throws std::runtime_error if pieces
+/// disagree on the step or a particle id appears twice.
+Checkpoint assemble(std::vector<FramePiece>& pieces, const RunInfo& run);
+
+/// RunInfo as a flat buffer (sent once from compute rank 0 to every I/O rank at start).
+void serialize(const RunInfo& info, std::vector<std::byte>& out);
+RunInfo deserialize_run_info(std::span<const std::byte> bytes);
+
+}  // namespace basalt::io

@@ -1,0 +1,71 @@
+// Checkpoint invariants (checkpoint.hpp), independent of the file format.
+#include "basalt/io/checkpoint.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <set>
+#include <string>
+#include <utility>
+
+namespace basalt::io {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string root_attribute(const char* name) { return fmt::format("attribute '{}' of /", name); }
+
+bool finite(const Vec3& v) { return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]); }
+
+}  // namespace
+
+void Checkpoint::validate(const fs::path& source) const {
+  geometry.validate(source);
+  const std::size_t n = size();
+  const std::size_t m = geometry.bonds.size();
+  if (geometry.mass.size() != n)
+    throw FormatError(
+        source, "/particles/mass",
+        fmt::format("a checkpoint stores every mass: {} masses for {} particles", geometry.mass.size(), n));
+  if (velocity.size() != n)
+    throw FormatError(source, "/particles/velocity",
+                      fmt::format("{} velocities for {} particles", velocity.size(), n));
+  for (std::size_t i = 0; i < n; ++i)
+    if (!finite(velocity[i]))
+      throw FormatError(source, "/particles/velocity",
+                        fmt::format("particle id {}: velocity is not finite", geometry.id[i]));
+  if (bond_rest_length.size() != m)
+    throw FormatError(source, "/bonds/rest_length",
+                      fmt::format("{} values for {} bonds", bond_rest_length.size(), m));
+  if (bond_broken.size() != m)
+    throw FormatError(source, "/bonds/broken", fmt::format("{} values for {} bonds", bond_broken.size(), m));
+  for (std::size_t k = 0; k < m; ++k) {
+    if (!std::isfinite(bond_rest_length[k]) || bond_rest_length[k] < 0)
+      throw FormatError(
+          source, "/bonds/rest_length",
+          fmt::format("bond {}: rest length must be finite and >= 0, got {}", k, bond_rest_length[k]));
+    if (bond_broken[k] > 1)
+      throw FormatError(source, "/bonds/broken",
+                        fmt::format("bond {}: flag must be 0 or 1, got {}", k, bond_broken[k]));
+  }
+  std::set<std::string> names;
+  for (const auto& w : walls) {
+    const auto where = "/walls/" + w.name;
+    if (w.name.empty() || w.name == "." || w.name.find('/') != std::string::npos)
+      throw FormatError(source, where, "a wall name must be non-empty, not '.', and without '/'");
+    if (!names.insert(w.name).second) throw FormatError(source, where, "two walls have this name");
+    const std::pair<const char*, const Vec3*> vectors[] = {
+        {"position", &w.position}, {"normal", &w.normal}, {"velocity", &w.velocity}, {"force", &w.force}};
+    for (const auto& [what, v] : vectors)
+      if (!finite(*v)) throw FormatError(source, where, fmt::format("{} is not finite", what));
+    const auto& nv = w.normal;
+    if (nv[0] == 0 && nv[1] == 0 && nv[2] == 0) throw FormatError(source, where, "normal is the zero vector");
+  }
+  if (step < 0) throw FormatError(source, root_attribute("step"), fmt::format("must be >= 0, got {}", step));
+  if (!std::isfinite(time)) throw FormatError(source, root_attribute("time"), "is not finite");
+  if (!std::isfinite(dt) || dt < 0)
+    throw FormatError(source, root_attribute("dt"), fmt::format("must be finite and >= 0, got {}", dt));
+}
+
+}  // namespace basalt::io

@@ -1,0 +1,183 @@
+// Checkpoints in HDF5, schema "basalt-checkpoint" version 1 (docs/formats.md): the geometry
+// layout plus velocities, bond state, walls and the run's clock, marked complete when written.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <charconv>
+
+#include "basalt/io/checkpoint.hpp"
+#include "geometry_order.hpp"
+#include "h5_geometry_layout.hpp"
+#include "h5_support.hpp"
+
+namespace basalt::io {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr const char* kSchema = "basalt-checkpoint";
+constexpr int kSchemaVersion = 1;
+// Root attributes of this schema besides the geometry's; "complete" is written last.
+constexpr std::string_view kRunAttributes[] = {"step", "time", "dt", "scene_text", "complete"};
+constexpr const char* kWallVectors[] = {"position", "normal", "velocity", "force"};
+
+Vec3& wall_vector(WallState& w, int k) {
+  Vec3* v[] = {&w.position, &w.normal, &w.velocity, &w.force};
+  return *v[k];
+}
+const Vec3& wall_vector(const WallState& w, int k) { return wall_vector(const_cast<WallState&>(w), k); }
+
+std::string root_attribute(const std::string& name) { return fmt::format("attribute '{}' of /", name); }
+
+/// Checks the completion mark: present and equal to 1.
+void check_complete(const h5::Reader& r) {
+  if (!r.has_attribute("/", "complete"))
+    r.fail(root_attribute("complete"),
+           "missing: the checkpoint was not completely written (did the run stop while writing it?)");
+  const auto mark = r.scalar_attribute<std::int64_t>("/", "complete");
+  if (mark != 1)
+    r.fail(root_attribute("complete"), fmt::format("is {}, expected 1: the checkpoint is incomplete", mark));
+}
+
+}  // namespace
+
+void write_checkpoint(const Checkpoint& c, const fs::path& file) {
+  c.validate(file);
+  // The file stores particles sorted by id and bonds smaller id first; sort a copy if needed.
+  Checkpoint storage;
+  const Checkpoint* s = &c;
+  if (!in_file_order(c.geometry)) {
+    const auto order = sorting_order(c.geometry.id);
+    storage = c;
+    storage.geometry.sort_by_id();  // the same stable order as `order`
+    for (std::size_t k = 0; k < order.size(); ++k) storage.velocity[k] = c.velocity[order[k]];
+    s = &storage;
+  }
+
+  h5::Writer w(file, file.string() + ".partial");
+  h5::write_schema(w, kSchema, kSchemaVersion);
+  h5::write_geometry_layout(w, s->geometry, kRunAttributes);
+  w.dataset("/particles/velocity", reinterpret_cast<const double*>(s->velocity.data()), s->size(), 3);
+  w.dataset("/bonds/rest_length", s->bond_rest_length);
+  w.dataset("/bonds/broken", s->bond_broken);
+  w.group("/walls");
+  for (std::size_t i = 0; i < s->walls.size(); ++i) {
+    const auto& wall = s->walls[i];
+    const auto g = "/walls/" + wall.name;
+    w.group(g);
+    w.scalar_attribute<std::int64_t>(g, "index", static_cast<std::int64_t>(i));
+    for (int k = 0; k < 4; ++k) w.dataset(g + "/" + kWallVectors[k], wall_vector(wall, k).data(), 3);
+  }
+  w.scalar_attribute<std::int64_t>("/", "step", s->step);
+  w.scalar_attribute<double>("/", "time", s->time);
+  w.scalar_attribute<double>("/", "dt", s->dt);
+  w.attribute("/", "scene_text", s->scene_text);
+  w.scalar_attribute<std::uint8_t>("/", "complete", 1);  // last: its presence means everything above is there
+  w.commit();
+}
+
+namespace {
+
+Checkpoint read_checkpoint_unguarded(const fs::path& file) {
+  h5::Reader r(file);
+  h5::check_schema(r, kSchema, kSchemaVersion);
+  check_complete(r);
+
+  Checkpoint c;
+  c.geometry = h5::read_geometry_layout(r, kRunAttributes);
+  const std::size_t n = c.size();
+  const std::size_t m = c.geometry.bonds.size();
+  if (!c.geometry.has_mass() && n > 0)
+    r.fail("/particles/mass", "missing dataset (a checkpoint stores every particle's mass)");
+
+  const auto vrows = r.rows<double>("/particles/velocity", 3);
+  if (vrows != n) r.fail("/particles/velocity", fmt::format("{} rows for {} particles", vrows, n));
+  c.velocity.resize(n);
+  if (n) r.read_into("/particles/velocity", reinterpret_cast<double*>(c.velocity.data()));
+
+  const auto lrows = r.rows<double>("/bonds/rest_length");
+  if (lrows != m) r.fail("/bonds/rest_length", fmt::format("{} values for {} bonds", lrows, m));
+  c.bond_rest_length = r.read<double>("/bonds/rest_length");
+  const auto brows = r.rows<std::uint8_t>("/bonds/broken");
+  if (brows != m) r.fail("/bonds/broken", fmt::format("{} values for {} bonds", brows, m));
+  c.bond_broken = r.read<std::uint8_t>("/bonds/broken");
+
+  const auto names = r.members("/walls");
+  c.walls.resize(names.size());
+  std::vector<bool> seen(names.size(), false);
+  for (const auto& name : names) {
+    const auto g = "/walls/" + name;
+    r.require_group(g);
+    const auto index = r.scalar_attribute<std::int64_t>(g, "index");
+    if (index < 0 || index >= static_cast<std::int64_t>(names.size()) ||
+        seen[static_cast<std::size_t>(index)])
+      r.fail(fmt::format("attribute 'index' of {}", g),
+             fmt::format("{} is not a free position among {} walls", index, names.size()));
+    seen[static_cast<std::size_t>(index)] = true;
+    WallState& wall = c.walls[static_cast<std::size_t>(index)];
+    wall.name = name;
+    for (int k = 0; k < 4; ++k) {
+      const auto ds = g + "/" + kWallVectors[k];
+      const auto rows = r.rows<double>(ds);
+      if (rows != 3) r.fail(ds, fmt::format("expected 3 values, found {}", rows));
+      r.read_into(ds, wall_vector(wall, k).data());
+    }
+  }
+
+  c.step = r.scalar_attribute<std::int64_t>("/", "step");
+  c.time = r.scalar_attribute<double>("/", "time");
+  c.dt = r.scalar_attribute<double>("/", "dt");
+  c.scene_text = r.string_attribute("/", "scene_text");
+  r.close();
+  c.validate(file);
+  return c;
+}
+
+}  // namespace
+
+Checkpoint read_checkpoint(const fs::path& file) {
+  return h5::with_memory_guard(file, [&] { return read_checkpoint_unguarded(file); });
+}
+
+bool is_complete_checkpoint(const fs::path& file) {
+  try {
+    // Opening checks the file is as long as its superblock says (a cut-off file fails here);
+    // then the schema, the completion mark, and that every dataset is there with the right shape.
+    h5::Reader r(file);
+    h5::check_schema(r, kSchema, kSchemaVersion);
+    check_complete(r);
+    const auto n = r.rows<std::int64_t>("/particles/id");
+    const auto m = r.rows<std::int64_t>("/bonds/pairs", 2);
+    return r.rows<double>("/particles/position", 3) == n && r.rows<double>("/particles/velocity", 3) == n &&
+           r.rows<double>("/particles/radius") == n &&
+           ((n == 0 && !r.exists("/particles/mass")) || r.rows<double>("/particles/mass") == n) &&
+           r.rows<std::int32_t>("/particles/tag") == n && r.rows<double>("/bonds/rest_length") == m &&
+           r.rows<std::uint8_t>("/bonds/broken") == m && r.rows<std::int32_t>("/bonds/tag") == m;
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
+fs::path latest_complete_checkpoint(const fs::path& dir) {
+  std::error_code ec;
+  std::vector<std::pair<std::int64_t, fs::path>> candidates;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const auto name = it->path().filename().string();
+    if (name.size() <= 8 || name.rfind("ckpt_", 0) != 0 || name.substr(name.size() - 3) != ".h5") continue;
+    const auto digits = std::string_view(name).substr(5, name.size() - 8);
+    if (!std::all_of(digits.begin(), digits.end(), [](char ch) { return ch >= '0' && ch <= '9'; })) continue;
+    std::int64_t step = 0;
+    auto [p, e] = std::from_chars(digits.data(), digits.data() + digits.size(), step);
+    if (e != std::errc() || p != digits.data() + digits.size()) continue;
+    candidates.emplace_back(step, it->path());
+  }
+  std::sort(candidates.begin(), candidates.end(), [](const auto& a, const auto& b) {
+    return a.first != b.first ? a.first > b.first : a.second > b.second;
+  });
+  for (const auto& [step, path] : candidates)
+    if (is_complete_checkpoint(path)) return path;
+  return {};
+}
+
+}  // namespace basalt::io

@@ -1,0 +1,32 @@
+#pragma once
+// The geometry part of Basalt's HDF5 schemas (docs/formats.md), shared by "basalt-geometry" and
+// "basalt-checkpoint": root attributes for units, box and provenance; /particles, /bonds and
+// /statistics. Each schema adds its own identification and, for checkpoints, the run state.
+#include <span>
+#include <string>
+#include <string_view>
+
+#include "basalt/io/geometry.hpp"
+#include "h5_support.hpp"
+
+namespace basalt::io::h5 {
+
+/// Names of root attributes a schema reserves for itself.
+using Names = std::span<const std::string_view>;
+
+/// Writes the `schema`, `schema_version` and `writer` root attributes.
+void write_schema(Writer& w, const std::string& schema, int version);
+/// Refuses a file whose `schema` differs or whose `schema_version` is newer than `version`
+/// (or not a positive integer); `other_hint` is appended when the schema is another Basalt one.
+void check_schema(const Reader& r, const std::string& schema, int version);
+
+/// Writes the geometry's root attributes (units, box, periodic, provenance) and the groups
+/// /particles, /bonds, /statistics. `g` must be validated, sorted by id, bonds stored a < b.
+/// `extra_reserved`: root attributes the calling schema writes itself (provenance may not use them).
+void write_geometry_layout(Writer& w, const Geometry& g, Names extra_reserved);
+
+/// Reads and checks what write_geometry_layout wrote; every error names the dataset or attribute.
+/// Root string attributes that are neither the geometry's nor in `extra_reserved` become provenance.
+Geometry read_geometry_layout(const Reader& r, Names extra_reserved);
+
+}  // namespace basalt::io::h5

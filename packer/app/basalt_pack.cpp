@@ -1,0 +1,256 @@
+// basalt-pack: fill a box, cylinder, sphere or closed triangle mesh with bonded spheres.
+//   basalt-pack box --size 15,15,15 --rmin 0.2 --rmax 1.0 --seed 7 -o cube.h5
+// docs/packer.md describes every option and statistic.
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "basalt/io/geometry.hpp"
+#include "basalt/packer/assembly.hpp"
+#include "basalt/packer/error.hpp"
+#include "basalt/packer/pack.hpp"
+#include "basalt/packer/volume.hpp"
+#include "basalt/version.hpp"
+
+namespace fs = std::filesystem;
+using basalt::packer::PackError;
+using basalt::packer::Vec3;
+
+namespace {
+
+Vec3 parse_vec3(const std::string& text, const char* option) {
+  Vec3 v{};
+  std::size_t pos = 0;
+  for (int k = 0; k < 3; ++k) {
+    const auto end = text.find(',', pos);
+    if ((k < 2) == (end == std::string::npos))
+      throw PackError(
+          fmt::format("{} '{}': expected three comma-separated numbers, e.g. 15,15,15", option, text));
+    const std::string part = text.substr(pos, end == std::string::npos ? std::string::npos : end - pos);
+    try {
+      std::size_t used = 0;
+      v[k] = std::stod(part, &used);
+      if (used != part.size()) throw std::invalid_argument(part);
+    } catch (const std::exception&) {
+      throw PackError(fmt::format("{} '{}': '{}' is not a number", option, text, part));
+    }
+    pos = end + 1;
+  }
+  return v;
+}
+
+/// Fails early, before any packing, when the output cannot be written.
+void check_output(const fs::path& out) {
+  std::string ext = out.extension().string();
+  for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (ext != ".h5" && ext != ".hdf5" && ext != ".geo")
+    throw PackError(fmt::format("{}: unknown output format '{}' (use .h5 for Basalt, .geo for ESyS-Particle)",
+                                out.string(), ext));
+  const fs::path dir = out.parent_path().empty() ? fs::path(".") : out.parent_path();
+  if (!fs::is_directory(dir))
+    throw PackError(
+        fmt::format("{}: cannot write the output: folder '{}' does not exist", out.string(), dir.string()));
+  if (fs::is_directory(out))
+    throw PackError(fmt::format("{}: cannot write the output: it is a folder", out.string()));
+  if (access(dir.c_str(), W_OK) != 0)
+    throw PackError(
+        fmt::format("{}: cannot write the output: folder '{}' is not writable", out.string(), dir.string()));
+}
+
+class ProgressBar {
+ public:
+  explicit ProgressBar(bool enabled) : enabled_(enabled && isatty(fileno(stderr))) {}
+  void update(double f) {
+    if (!enabled_) return;
+    const double t = seconds();
+    if (t < 2.0 || t - last_ < 0.2) return;
+    last_ = t;
+    shown_ = true;
+    const int width = 40, fill = static_cast<int>(std::lround(f * width));
+    const double eta = f > 0.02 ? t * (1 - f) / f : 0;
+    std::fprintf(stderr, "\r[%s%s] %3.0f%%  %.0f s, ~%.0f s left ", std::string(fill, '#').c_str(),
+                 std::string(width - fill, '.').c_str(), 100 * f, t, eta);
+    std::fflush(stderr);
+  }
+  void finish() {
+    if (shown_) std::fprintf(stderr, "\n");
+  }
+  double seconds() const {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  }
+
+ private:
+  bool enabled_;
+  bool shown_ = false;
+  double last_ = 0;
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "basalt-pack: fills a volume with bonded spheres whose radii follow a power law "
+      "(Basalt " +
+      std::string(basalt::kVersion) + ")"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", std::string(basalt::kVersion));
+
+  std::string size, origin = "0,0,0", centre = "0,0,0", mesh_file, output;
+  double radius = 0, height = 0;
+  basalt::packer::PackOptions popt;
+  basalt::packer::AssemblyOptions aopt;
+  std::optional<double> exponent;
+  std::vector<std::string> tag_texts;
+  bool no_bonds = false, record_time = false, quiet = false;
+
+  auto* box = app.add_subcommand("box", "an axis-aligned box from --origin to --origin + --size");
+  box->add_option("--size", size, "edge lengths X,Y,Z")->required();
+  box->add_option("--origin", origin, "lowest corner X,Y,Z")->capture_default_str();
+  auto* cyl = app.add_subcommand("cylinder", "a cylinder along z, base centre at --origin");
+  cyl->add_option("--radius", radius, "cylinder radius")->required();
+  cyl->add_option("--height", height, "cylinder height")->required();
+  cyl->add_option("--origin", origin, "centre of the base X,Y,Z")->capture_default_str();
+  auto* sph = app.add_subcommand("sphere", "a ball");
+  sph->add_option("--radius", radius, "ball radius")->required();
+  sph->add_option("--centre,--center", centre, "centre X,Y,Z")->capture_default_str();
+  auto* mesh = app.add_subcommand("mesh", "the inside of a closed triangle mesh (OFF, STL, OBJ, PLY)");
+  mesh->add_option("file", mesh_file, "mesh file")->required();
+
+  for (auto* sub : {box, cyl, sph, mesh}) {
+    sub->add_option("--rmin", popt.rmin, "smallest radius")->required();
+    sub->add_option("--rmax", popt.rmax, "largest radius")->required();
+    sub->add_option("-o,--output", output, "output geometry: .h5 (Basalt) or .geo (ESyS-Particle)")
+        ->required();
+    sub->add_option("--seed", popt.seed, "random seed (same seed, same file)")->capture_default_str();
+    sub->add_option("--exponent", exponent,
+                    "follow the power law N(>r) ~ r^-EXPONENT instead of filling as densely as possible");
+    sub->add_option("--target-fraction", popt.target_fraction,
+                    "with --exponent: solid fraction whose worth of radii is drawn")
+        ->capture_default_str();
+    sub->add_flag("--fill", popt.fill_after,
+                  "with --exponent: afterwards fill the voids left as densely as possible");
+    sub->add_option("--bond-tolerance", aopt.bond_tolerance,
+                    "bond every pair whose gap |ci-cj|-ri-rj is <= this (length units)")
+        ->capture_default_str();
+    sub->add_flag("--no-bonds", no_bonds, "write no bonds");
+    sub->add_option("--bond-tag", aopt.bond_tag, "tag of the bonds")->capture_default_str();
+    sub->add_option("--overlap-tolerance", popt.overlap_tolerance,
+                    "largest overlap allowed between spheres and with the boundary")
+        ->capture_default_str();
+    sub->add_option("--tag-layer", tag_texts,
+                    "FACE:THICKNESS:TAG: particles within THICKNESS of FACE get TAG (repeatable; faces: "
+                    "xmin..zmax for a box, side/bottom/top for a cylinder, surface for any volume)");
+    sub->add_option("--seed-fraction", popt.seed_fraction,
+                    "solid fraction placed at random before void filling")
+        ->capture_default_str();
+    sub->add_option("--bins", aopt.histogram_bins, "radius histogram bins")->capture_default_str();
+    sub->add_option("--threads", aopt.threads, "threads for bonding and statistics")->capture_default_str();
+    sub->add_flag("--record-time", record_time,
+                  "also store the pack time and date in the file (then the file differs from run to run)");
+    sub->add_flag("-q,--quiet", quiet, "print nothing but errors");
+  }
+  CLI11_PARSE(app, argc, argv);
+
+  try {
+    popt.exponent = exponent;
+    aopt.bonds = !no_bonds;
+    if (!(aopt.bond_tolerance >= 0) || !std::isfinite(aopt.bond_tolerance))
+      throw PackError(fmt::format("--bond-tolerance must be >= 0, got {}", aopt.bond_tolerance));
+    if (aopt.histogram_bins < 1) throw PackError("--bins must be >= 1");
+    if (aopt.threads < 1) throw PackError("--threads must be >= 1");
+    basalt::packer::check_options(popt);
+    for (const auto& t : tag_texts) aopt.tags.push_back(basalt::packer::parse_tag_layer(t));
+    check_output(output);
+
+    std::unique_ptr<basalt::packer::Volume> volume;
+    if (*box) {
+      const Vec3 lo = parse_vec3(origin, "--origin"), ext = parse_vec3(size, "--size");
+      volume = basalt::packer::make_box(lo, {lo[0] + ext[0], lo[1] + ext[1], lo[2] + ext[2]});
+    } else if (*cyl) {
+      volume = basalt::packer::make_cylinder(parse_vec3(origin, "--origin"), radius, height);
+    } else if (*sph) {
+      volume = basalt::packer::make_sphere(parse_vec3(centre, "--centre"), radius);
+    } else {
+      volume = basalt::packer::load_mesh(mesh_file);
+    }
+    // Unknown tag faces fail now, not after packing.
+    (void)basalt::packer::region_tags(*volume, {}, {}, aopt.tags);
+
+    ProgressBar bar(!quiet);
+    popt.progress = [&](double f) { bar.update(f); };
+    const auto packing = basalt::packer::pack(*volume, popt);
+    bar.finish();
+    const double pack_seconds = bar.seconds();
+    basalt::packer::AssemblyStats st;
+    auto geometry = basalt::packer::assemble(*volume, packing, popt, aopt, st);
+    const double total_seconds = bar.seconds();
+
+    // The command line without the output name (and -q), so that the same arguments give the same bytes
+    // whatever the file is called.
+    std::string command = "basalt-pack";
+    for (int i = 1; i < argc; ++i) {
+      const std::string arg = argv[i];
+      if (arg == "-o" || arg == "--output") {
+        ++i;
+        continue;
+      }
+      if (arg.rfind("--output=", 0) == 0 || (arg.rfind("-o", 0) == 0 && arg.size() > 2)) continue;
+      if (arg == "-q" || arg == "--quiet") continue;  // changes nothing in the file
+      command += " " + arg;
+    }
+    geometry.attributes["creator"] = fmt::format("basalt-pack {}", basalt::kVersion);
+    geometry.attributes["command_line"] = command;
+    if (record_time) {
+      geometry.statistics["pack_seconds"] = {total_seconds};
+      std::time_t now = std::time(nullptr);
+      char date[64];
+      std::strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
+      geometry.attributes["created"] = date;
+    }
+    basalt::io::write_geometry(geometry, output);
+
+    if (!quiet) {
+      fmt::print("basalt-pack {}: {}\n", basalt::kVersion, volume->description());
+      fmt::print("  particles            {}\n", st.particles);
+      if (popt.exponent)
+        fmt::print("  radii drawn/placed   {} / {} (power law, exponent {}){}\n", packing.requested,
+                   packing.requested - packing.not_placed, *popt.exponent,
+                   popt.fill_after ? fmt::format(", then {} filling voids",
+                                                 st.particles + packing.not_placed - packing.requested)
+                                   : "");
+      fmt::print("  solid fraction       {:.4f}\n", st.solid_fraction);
+      fmt::print("  radii                {:.4g} .. {:.4g}\n", st.min_radius, st.max_radius);
+      fmt::print("  fitted exponent      {:.3f}   (counts per log-radius bin ~ r^-alpha)\n",
+                 st.histogram.exponent);
+      fmt::print("  radius histogram     ");
+      for (std::size_t k = 0; k < st.histogram.counts.size(); ++k)
+        fmt::print("{}[{:.3g},{:.3g}): {:.0f}", k ? ", " : "", st.histogram.edges[k],
+                   st.histogram.edges[k + 1], st.histogram.counts[k]);
+      fmt::print("\n");
+      fmt::print("  bonds                {}{}\n", st.bonds, aopt.bonds ? "" : " (bonds off)");
+      fmt::print("  bonds per particle   {:.3f}\n", st.bonds_per_particle);
+      fmt::print("  mean coordination    {:.3f}   (neighbours within the bond tolerance)\n",
+                 st.mean_coordination);
+      fmt::print("  largest overlap      {:.3g} between spheres, {:.3g} with the boundary\n",
+                 st.largest_overlap, std::max(0.0, st.largest_boundary_overlap));
+      fmt::print("  time                 {:.3f} s ({:.3f} s packing)\n", total_seconds, pack_seconds);
+      fmt::print("  written              {}\n", output);
+    }
+    return 0;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "basalt-pack: error: %s\n", e.what());
+    return 1;
+  }
+}

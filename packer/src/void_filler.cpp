@@ -1,0 +1,401 @@
+// Void filling on CGAL's regular (weighted Delaunay) triangulation: the only file of the packer that
+// includes CGAL's triangulation headers (they are heavy to compile).
+//
+// Vertices are the placed spheres (weight r^2), their mirror images across nearby boundary pieces
+// ("ghosts", which make a void next to a wall a cell like any other) and eight far "frame" points that
+// keep the triangulation three-dimensional. Each finite cell whose vertices stand for four distinct
+// objects (spheres, or boundary planes through their ghosts) gets the ball tangent to those four; its
+// radius, clipped to the distance to the boundary, is the cell's capacity. Voids are kept in an ordered
+// set by (capacity, serial); inserting a sphere removes the cells in conflict and evaluates the new ones.
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Regular_triangulation_3.h>
+#include <CGAL/Regular_triangulation_cell_base_3.h>
+#include <CGAL/Regular_triangulation_vertex_base_3.h>
+#include <CGAL/Triangulation_cell_base_with_info_3.h>
+#include <CGAL/Triangulation_data_structure_3.h>
+#include <CGAL/Triangulation_vertex_base_with_info_3.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <numbers>
+#include <queue>
+#include <set>
+
+#include "sphere_grid.hpp"
+#include "tangent.hpp"
+
+namespace basalt::packer::detail {
+
+namespace {
+
+using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+struct CellInfo {
+  std::uint64_t serial = 0;
+  double cap = -1;  ///< capacity while the cell's void is in the set, else -1
+};
+using Vb = CGAL::Triangulation_vertex_base_with_info_3<std::int32_t, K,
+                                                       CGAL::Regular_triangulation_vertex_base_3<K>>;
+using RCb = CGAL::Regular_triangulation_cell_base_3<K, CGAL::Triangulation_cell_base_3<K>,
+                                                    CGAL::Discard_hidden_points>;
+using Cb = CGAL::Triangulation_cell_base_with_info_3<CellInfo, K, RCb>;
+using Tds = CGAL::Triangulation_data_structure_3<Vb, Cb, CGAL::Sequential_tag>;
+using Rt = CGAL::Regular_triangulation_3<K, Tds>;
+using WPoint = K::Weighted_point_3;
+using Point = K::Point_3;
+using Cell = Rt::Cell_handle;
+
+constexpr std::int32_t kFrame = -1;  // vertex info: >= 0 sphere index, -1 frame, <= -2 ghost -(2 + g)
+
+struct Void {
+  double cap;
+  std::uint64_t serial;
+  Cell cell;
+  Vec3 centre;
+  bool operator<(const Void& o) const { return cap != o.cap ? cap < o.cap : serial < o.serial; }
+};
+
+/// Dense mode's queue entry: voids are taken slab by slab along z (the working set stays in cache), and
+/// within a slab largest first. Stale entries (their cell has died since) are skipped when taken.
+struct QueuedVoid {
+  Void v;
+  std::int32_t slab;
+  bool operator<(const QueuedVoid& o) const {  // "lower priority than"
+    if (slab != o.slab) return slab > o.slab;
+    if (v.cap != o.v.cap) return v.cap < o.v.cap;
+    return v.serial > o.v.serial;
+  }
+};
+
+Vec3 to_vec(const Point& p) { return {p.x(), p.y(), p.z()}; }
+
+class Filler {
+ public:
+  explicit Filler(FillContext& ctx)
+      : ctx_(ctx),
+        vol_(ctx.volume),
+        tol_(ctx.options.overlap_tolerance),
+        rmin_(ctx.options.rmin),
+        rmax_(ctx.options.rmax),
+        ghost_reach_(2 * ctx.options.rmax) {}
+
+  void report() const {
+    if (std::getenv("BASALT_PACK_DEBUG"))
+      std::fprintf(stderr,
+                   "evaluate %zu place %zu placed %zu vertices %zu cells %zu voids left %zu fail cap %zu "
+                   "fail three %zu\n",
+                   n_eval_, n_place_, ctx_.out.size(), rt_.number_of_vertices(), rt_.number_of_cells(),
+                   voids_.size(), n_fail_cap_, n_fail_three_);
+  }
+
+  void run() {
+    build();
+    if (ctx_.radii) {
+      const auto& radii = *ctx_.radii;
+      for (; ctx_.next < radii.size(); ++ctx_.next) {
+        const double rho = radii[ctx_.next];
+        for (;;) {
+          auto it = voids_.lower_bound(Void{rho * (1 - 1e-12), 0, {}, {}});
+          if (it == voids_.end()) {
+            ++ctx_.not_placed;
+            break;
+          }
+          const Void v = take(it);
+          if (place(v, rho)) break;
+        }
+      }
+    }
+    if (!ctx_.radii) {
+      while (!queue_.empty()) {
+        const Void v = queue_.top().v;
+        queue_.pop();
+        if (v.cell->info().serial != v.serial) continue;  // the cell died
+        place(v, std::min(v.cap, rmax_));
+      }
+    } else if (ctx_.options.fill_after) {
+      while (!voids_.empty()) {
+        const Void v = take(std::prev(voids_.end()));
+        place(v, std::min(v.cap, rmax_));
+      }
+    }
+  }
+
+ private:
+  // ---- triangulation upkeep -------------------------------------------------------------------
+  void build() {
+    const Bounds b = vol_.bounds();
+    double extent = 0;
+    for (int k = 0; k < 3; ++k) extent = std::max(extent, b.hi[k] - b.lo[k]);
+    const double far = 2 * extent + 10 * rmax_;
+    Cell hint;
+    for (int corner = 0; corner < 8; ++corner) {
+      Point p(corner & 1 ? b.hi[0] + far : b.lo[0] - far, corner & 2 ? b.hi[1] + far : b.lo[1] - far,
+              corner & 4 ? b.hi[2] + far : b.lo[2] - far);
+      auto v = rt_.insert(WPoint(p, 0.0), hint);
+      v->info() = kFrame;
+      hint = v->cell();
+    }
+    for (std::size_t i = 0; i < ctx_.out.size(); ++i) add_vertices(i, Cell());
+    for (auto c = rt_.finite_cells_begin(); c != rt_.finite_cells_end(); ++c) evaluate(c);
+    live_ = true;
+  }
+
+  /// Inserts one weighted point; while live, keeps the void set in step with the cells.
+  Rt::Vertex_handle insert(const Vec3& c, double r, std::int32_t info, Cell hint) {
+    const WPoint wp(Point(c[0], c[1], c[2]), r * r);
+    if (!live_) {
+      auto v = rt_.insert(wp, hint);
+      if (v != Rt::Vertex_handle()) v->info() = info;
+      return v;
+    }
+    Rt::Locate_type lt;
+    int li, lj;
+    Cell start = rt_.locate(wp, lt, li, lj, hint);
+    if (lt == Rt::VERTEX) return {};
+    conflicts_.clear();
+    boundary_.clear();
+    rt_.find_conflicts(wp, start, std::back_inserter(boundary_), std::back_inserter(conflicts_));
+    if (conflicts_.empty()) return {};  // hidden (cannot happen for non-overlapping spheres)
+    for (Cell k : conflicts_) kill(k);
+    auto v =
+        rt_.insert_in_hole(wp, conflicts_.begin(), conflicts_.end(), boundary_[0].first, boundary_[0].second);
+    v->info() = info;
+    incident_.clear();
+    rt_.incident_cells(v, std::back_inserter(incident_));
+    for (Cell n : incident_) evaluate(n);
+    return v;
+  }
+
+  /// The sphere's vertex and its mirror images across the boundary pieces within reach.
+  void add_vertices(std::size_t i, Cell hint) {
+    const Vec3 c = ctx_.out.centre[i];
+    const double r = ctx_.out.radius[i];
+    auto v = insert(c, r, static_cast<std::int32_t>(i), hint);
+    Cell near = v != Rt::Vertex_handle() ? v->cell() : hint;
+    pieces_.clear();
+    vol_.pieces_near(c, r + ghost_reach_, pieces_);
+    const int m = std::min<int>(static_cast<int>(pieces_.size()), 3);
+    for (int mask = 1; mask < (1 << m); ++mask) {
+      Vec3 g = c;
+      int piece = -1;
+      int count = 0;
+      for (int k = 0; k < m; ++k)
+        if (mask & (1 << k)) {
+          g = pieces_[k].plane.mirror(g);
+          piece = pieces_[k].id;
+          if (piece_flat_.size() <= static_cast<std::size_t>(piece)) piece_flat_.resize(piece + 1, true);
+          piece_flat_[piece] = pieces_[k].flat;
+          ++count;
+        }
+      ghost_piece_.push_back(count == 1 ? piece : -1);
+      // Exact mirror images make many coplanar and co-orthospherical vertex sets, which send CGAL's
+      // predicates to exact arithmetic. Ghosts stand only for topology (tangency is solved against the
+      // plane itself), so a tiny deterministic nudge costs nothing and avoids that.
+      std::uint64_t h = 0x9e3779b97f4a7c15ULL * (ghost_piece_.size() + 1);
+      for (int k = 0; k < 3; ++k) {
+        h ^= h >> 31;
+        h *= 0xbf58476d1ce4e5b9ULL;
+        h ^= h >> 29;
+        g[k] += 1e-7 * rmax_ * (static_cast<double>(h >> 11) * 0x1.0p-53 - 0.5);
+      }
+      auto gv = insert(g, r, -2 - static_cast<std::int32_t>(ghost_piece_.size() - 1), near);
+      if (gv != Rt::Vertex_handle()) near = gv->cell();
+    }
+  }
+
+  void kill(Cell c) {
+    auto& info = c->info();
+    if (info.cap >= 0) voids_.erase(Void{info.cap, info.serial, {}, {}});
+    info.cap = -1;
+    info.serial = 0;
+  }
+
+  Void take(std::set<Void>::iterator it) {
+    Void v = *it;
+    voids_.erase(it);
+    v.cell->info().cap = -1;
+    return v;
+  }
+
+  // ---- geometry of one cell ----------------------------------------------------------------------
+  struct CellObjects {
+    std::array<Object, 4> o;
+    int piece[4] = {-1, -1, -1, -1};  ///< curved boundary piece behind a plane object, else -1
+    bool curved = false;
+  };
+
+  /// The four distinct objects a cell stands for; false when they are not four (or a frame point).
+  bool objects_of(Cell c, CellObjects& co) const {
+    int n = 0;
+    int seen[4];
+    int nseen = 0;
+    for (int i = 0; i < 4; ++i) {
+      const std::int32_t info = c->vertex(i)->info();
+      if (info >= 0) {
+        co.o[n].is_plane = false;
+        co.o[n].c = ctx_.out.centre[info];
+        co.o[n].r = ctx_.out.radius[info];
+        co.piece[n] = -1;
+        ++n;
+        continue;
+      }
+      if (info == kFrame) return false;
+      const int piece = ghost_piece_[-2 - info];
+      if (piece < 0) return false;
+      if (std::find(seen, seen + nseen, piece) != seen + nseen) continue;
+      seen[nseen++] = piece;
+      co.o[n].is_plane = true;
+      co.piece[n] = piece;
+      ++n;
+    }
+    if (n != 4) return false;
+    co.curved = false;
+    for (int i = 0; i < 4; ++i)
+      if (co.o[i].is_plane) {
+        const int piece = co.piece[i];
+        co.o[i].plane = vol_.tangent_plane(piece, Vec3{0, 0, 0});
+        if (piece_flat_[piece]) {
+          co.piece[i] = -1;  // flat: one plane everywhere, nothing to relinearise
+        } else {
+          co.curved = true;
+        }
+      }
+    return true;
+  }
+
+  void relinearise(CellObjects& co, const Vec3& at) const {
+    for (int i = 0; i < 4; ++i)
+      if (co.o[i].is_plane && co.piece[i] >= 0) co.o[i].plane = vol_.tangent_plane(co.piece[i], at);
+  }
+
+  std::optional<Ball> capacity_ball(CellObjects& co, const Vec3& near) const {
+    if (co.curved) relinearise(co, near);
+    auto ball = tangent_ball(co.o, near);
+    for (int it = 0; co.curved && ball && it < 8; ++it) {
+      relinearise(co, ball->c);
+      auto next = tangent_ball(co.o, ball->c);
+      if (!next) return std::nullopt;
+      const bool done = norm(next->c - ball->c) < 1e-12 * (1 + norm(ball->c));
+      ball = next;
+      if (done) break;
+    }
+    return ball;
+  }
+
+  void evaluate(Cell c) {
+    ++n_eval_;
+    auto& info = c->info();
+    info.serial = ++serial_;
+    info.cap = -1;
+    if (rt_.is_infinite(c)) return;
+    CellObjects co;
+    if (!objects_of(c, co)) return;
+    Vec3 near{0, 0, 0};
+    for (int i = 0; i < 4; ++i) near = near + 0.25 * to_vec(c->vertex(i)->point().point());
+    auto ball = capacity_ball(co, near);
+    if (!ball || ball->r < rmin_) return;
+    const double cap = std::min(ball->r, vol_.signed_distance(ball->c));
+    if (!(cap >= rmin_ * (1 - 1e-12))) return;
+    if (!ctx_.radii) {
+      queue_.push({Void{cap, info.serial, c, ball->c},
+                   static_cast<std::int32_t>(std::floor((ball->c[2] - zlo_) / slab_))});
+      return;
+    }
+    info.cap = cap;
+    voids_.insert(Void{cap, info.serial, c, ball->c});
+  }
+
+  // ---- placement ----------------------------------------------------------------------------------
+  /// Places a sphere of radius rho in the void: touching three of the cell's objects where it fits,
+  /// else concentric with the void's ball. False when nothing fits (the void is then dropped).
+  bool place(const Void& v, double rho) {
+    ++n_place_;
+    CellObjects co;
+    if (!objects_of(v.cell, co)) return false;
+    candidates_.clear();
+    if (rho >= v.cap * (1 - 1e-12)) {
+      candidates_.push_back({v.centre, v.cap});
+    } else {
+      if (co.curved) relinearise(co, v.centre);
+      for (int drop = 0; drop < 4; ++drop) {
+        int t[3], n = 0;
+        for (int i = 0; i < 4; ++i)
+          if (i != drop) t[n++] = i;
+        Ball sol[2];
+        const int ns = tangent_balls(co.o[t[0]], co.o[t[1]], co.o[t[2]], rho, sol);
+        for (int s = 0; s < ns; ++s) {
+          Ball ball = sol[s];
+          if (co.curved && !refine(co, t, rho, ball)) continue;
+          if (gap(ball, co.o[drop]) < -tol_) continue;
+          candidates_.push_back(ball);
+        }
+      }
+      std::sort(candidates_.begin(), candidates_.end(),
+                [&](const Ball& a, const Ball& b) { return norm2(a.c - v.centre) < norm2(b.c - v.centre); });
+      candidates_.push_back({v.centre, rho});
+    }
+    for (const Ball& ball : candidates_) {
+      if (vol_.signed_distance(ball.c) < ball.r - tol_) continue;
+      if (ctx_.grid.overlaps(ball.c, ball.r, tol_)) continue;
+      commit(ball, v.cell);
+      return true;
+    }
+    ++(rho >= v.cap * (1 - 1e-12) ? n_fail_cap_ : n_fail_three_);
+    return false;
+  }
+
+  /// Tangency to a curved piece: re-solve with the tangent plane at the current centre until it settles.
+  bool refine(CellObjects co, const int t[3], double rho, Ball& ball) const {
+    for (int it = 0; it < 8; ++it) {
+      relinearise(co, ball.c);
+      Ball sol[2];
+      const int ns = tangent_balls(co.o[t[0]], co.o[t[1]], co.o[t[2]], rho, sol);
+      if (ns == 0) return false;
+      const Ball& best = ns == 2 && norm2(sol[1].c - ball.c) < norm2(sol[0].c - ball.c) ? sol[1] : sol[0];
+      const bool done = norm(best.c - ball.c) < 1e-12 * (1 + norm(ball.c));
+      ball = best;
+      if (done) break;
+    }
+    return true;
+  }
+
+  void commit(const Ball& ball, Cell hint) {
+    const std::size_t i = ctx_.out.size();
+    ctx_.out.centre.push_back(ball.c);
+    ctx_.out.radius.push_back(ball.r);
+    ctx_.grid.add(ball.c, ball.r);
+    ctx_.placed_solid += 4.0 / 3.0 * std::numbers::pi * ball.r * ball.r * ball.r;
+    add_vertices(i, hint);
+    if (ctx_.options.progress && (i & 4095) == 0)
+      ctx_.options.progress(std::min(0.99, ctx_.placed_solid / ctx_.expected_solid));
+  }
+
+  std::size_t n_eval_ = 0, n_place_ = 0, n_fail_cap_ = 0, n_fail_three_ = 0;
+  FillContext& ctx_;
+  const Volume& vol_;
+  const double tol_, rmin_, rmax_, ghost_reach_;
+  Rt rt_;
+  bool live_ = false;
+  std::uint64_t serial_ = 0;
+  std::set<Void> voids_;                   // power-law mode: best fit by capacity
+  std::priority_queue<QueuedVoid> queue_;  // dense mode
+  const double zlo_ = vol_.bounds().lo[2];
+  const double slab_ = 6 * rmax_;
+  std::vector<int> ghost_piece_;
+  std::vector<bool> piece_flat_;
+  std::vector<Cell> conflicts_, incident_;
+  std::vector<Rt::Facet> boundary_;
+  std::vector<BoundaryPiece> pieces_;
+  std::vector<Ball> candidates_;
+};
+
+}  // namespace
+
+void fill_voids(FillContext& ctx) {
+  Filler filler(ctx);
+  filler.run();
+  filler.report();
+}
+
+}  // namespace basalt::packer::detail

@@ -1,0 +1,49 @@
+#pragma once
+// 3-D Cartesian decomposition of space over the compute ranks. The cut planes along each axis split
+// the geometry's bounding box evenly; ranks on the outer faces of the grid own half-infinite regions,
+// so the domain follows particles that leave the initial box (open boundaries).
+#include <mpi.h>
+
+#include <array>
+#include <limits>
+
+#include "basalt/solver/parallel/communicator.hpp"
+
+namespace basalt::solver {
+
+class Decomposition {
+ public:
+  /// dims: {0,0,0} lets MPI_Dims_create choose; else the product must equal the number of ranks.
+  /// Throws InputError when dims do not fit.
+  Decomposition(const Comm& comm, std::array<int, 3> dims, const std::array<double, 3>& box_min,
+                const std::array<double, 3>& box_max);
+  ~Decomposition();
+  Decomposition(const Decomposition&) = delete;
+  Decomposition& operator=(const Decomposition&) = delete;
+
+  const Comm& comm() const { return cart_; }
+  const std::array<int, 3>& dims() const { return dims_; }
+  const std::array<int, 3>& coords() const { return coords_; }
+  /// Neighbouring rank along axis d on side 0 (low) or 1 (high); MPI_PROC_NULL on an open face.
+  int neighbor(int d, int side) const { return nb_[d][side]; }
+  double lo(int d) const { return lo_[d]; }
+  double hi(int d) const { return hi_[d]; }
+  /// Grid coordinate along d of the rank owning coordinate v.
+  int coord_of(int d, double v) const;
+  bool owns(double x, double y, double z) const {
+    return x >= lo_[0] && x < hi_[0] && y >= lo_[1] && y < hi_[1] && z >= lo_[2] && z < hi_[2];
+  }
+  /// Smallest width of an interior (finite) region, infinity when there is none.
+  double min_interior_width() const;
+
+ private:
+  MPI_Comm cart_raw_ = MPI_COMM_NULL;
+  Comm cart_;
+  std::array<int, 3> dims_{1, 1, 1};
+  std::array<int, 3> coords_{0, 0, 0};
+  std::array<std::array<int, 2>, 3> nb_{};
+  std::array<double, 3> box_min_{}, box_max_{};
+  std::array<double, 3> lo_{}, hi_{};
+};
+
+}  // namespace basalt::solver

@@ -1,0 +1,43 @@
+#pragma once
+// Ghost exchange and migration over the six faces of a rank's region, one axis after the other
+// (ghosts received along x are forwarded along y and z, which fills edges and corners).
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "basalt/solver/core/bonds.hpp"
+#include "basalt/solver/core/particles.hpp"
+#include "basalt/solver/parallel/decomposition.hpp"
+
+namespace basalt::solver {
+
+template <class Real>
+class Halo {
+ public:
+  explicit Halo(const Decomposition& dec) : dec_(dec) {}
+
+  /// Sends owned particles that left this rank's region (with every bond touching them) to the
+  /// neighbour in that direction. Requires no ghosts. Returns an error message (not thrown: the caller
+  /// agrees on errors across ranks) when a particle arrives outside its new owner's region.
+  std::optional<std::string> migrate(Particles<Real>& p, Bonds<Real>& bonds);
+
+  /// Appends as ghosts copies of the neighbours' particles within `width` of this rank's faces and
+  /// remembers the lists for update_ghosts(). Requires no ghosts.
+  void build_ghosts(Particles<Real>& p, double width);
+
+  /// Refreshes ghost positions along the lists of the last build_ghosts().
+  void update_ghosts(Particles<Real>& p);
+
+  /// Bytes held by the send lists and buffers.
+  std::size_t memory_bytes() const;
+
+ private:
+  const Decomposition& dec_;
+  std::array<std::array<std::vector<std::int32_t>, 2>, 3> send_;  ///< [axis][side] local indices
+  std::array<std::array<std::size_t, 2>, 3> recv_begin_{};         ///< where ghosts from [axis][from side] start
+  std::array<std::array<std::size_t, 2>, 3> recv_count_{};
+  std::vector<Real> sbuf_, rbuf_;
+};
+
+}  // namespace basalt::solver

@@ -1,0 +1,80 @@
+#pragma once
+// A run as the scene file (TOML, docs/scenes.md) describes it. parse_scene() checks every key:
+// an unknown or misspelled key, a wrong type, a missing file or an impossible value is an InputError
+// naming the file, line and key.
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "basalt/solver/interactions/elastic_wall.hpp"
+#include "basalt/solver/interactions/linear_bond.hpp"
+#include "basalt/solver/interactions/linear_elastic.hpp"
+#include "basalt/solver/scene/wall_motion.hpp"
+
+namespace basalt::solver {
+
+/// Particle-tag filter of an interaction group: empty = every particle; for pairs {a, b} = pairs
+/// with one end tagged a and the other b (either order).
+using TagFilter = std::vector<std::int64_t>;
+
+template <class Model>
+struct Group {
+  std::string name;
+  typename Model::Params params;
+  TagFilter tags;
+  std::optional<std::int64_t> bond_tag;  ///< bonds only: the geometry's bond tag this group takes
+};
+
+struct WallSpec {
+  std::string name;
+  std::array<double, 3> point{0, 0, 0};
+  std::array<double, 3> normal{0, 0, 1};  ///< unit length after parsing
+  ElasticWall::Params params;
+  TagFilter tags;  ///< particle tags the wall touches (empty: all)
+  WallMotion motion;
+};
+
+struct FieldSpec {
+  enum class Type { kinetic_energy, bond_potential_energy, contact_potential_energy, wall_potential_energy,
+                    bond_count, wall_force };
+  Type type = Type::kinetic_energy;
+  std::int64_t every = 1;
+  std::string wall;  ///< wall_force only
+};
+
+enum class Integrator { velocity_verlet, symplectic_euler };
+
+struct Scene {
+  std::filesystem::path file;  ///< the scene file ("" when parsed from text)
+  std::string text;            ///< its content (provenance)
+  struct {
+    std::string length = "mm", time = "ms", force = "N";
+  } units;
+  std::filesystem::path geometry;  ///< resolved against the scene file's folder
+  double density = 1;
+  double dt = 0;
+  std::int64_t steps = 0;
+  double skin = 0;
+  Integrator integrator = Integrator::velocity_verlet;
+  bool force_dt = false;
+  double dt_safety = 0.2;                ///< warn when dt > dt_safety * critical step
+  std::int64_t energy_check_every = 100;  ///< 0: no energy-growth guard
+  std::vector<Group<LinearBond>> bonds;
+  std::vector<Group<LinearElastic>> contacts;
+  std::vector<WallSpec> walls;
+  std::filesystem::path output_dir = "out";
+  std::vector<FieldSpec> fields;
+};
+
+/// Reads and checks a scene file. Throws InputError naming file, line and key.
+Scene parse_scene(const std::filesystem::path& file);
+/// Same from text; `label` names the source in errors, relative paths resolve against `base_dir`.
+Scene parse_scene_text(const std::string& text, const std::string& label, const std::filesystem::path& base_dir);
+
+/// Column names of fields.csv for these savers (after "step" and "time").
+std::vector<std::string> field_columns(const Scene& scene);
+
+}  // namespace basalt::solver

@@ -1,0 +1,75 @@
+#include "basalt/solver/parallel/communicator.hpp"
+
+namespace basalt::solver {
+
+Comm::Comm(MPI_Comm comm) : comm_(comm) {
+  MPI_Comm_rank(comm_, &rank_);
+  MPI_Comm_size(comm_, &size_);
+}
+
+double Comm::max(double v) const {
+  double out = v;
+  MPI_Allreduce(&v, &out, 1, MPI_DOUBLE, MPI_MAX, comm_);
+  return out;
+}
+
+double Comm::min(double v) const {
+  double out = v;
+  MPI_Allreduce(&v, &out, 1, MPI_DOUBLE, MPI_MIN, comm_);
+  return out;
+}
+
+double Comm::sum(double v) const {
+  double out = v;
+  MPI_Allreduce(&v, &out, 1, MPI_DOUBLE, MPI_SUM, comm_);
+  return out;
+}
+
+long long Comm::sum(long long v) const {
+  long long out = v;
+  MPI_Allreduce(&v, &out, 1, MPI_LONG_LONG, MPI_SUM, comm_);
+  return out;
+}
+
+void Comm::sum_to_root(std::vector<double>& v) const {
+  if (size_ == 1 || v.empty()) return;
+  if (rank_ == 0)
+    MPI_Reduce(MPI_IN_PLACE, v.data(), static_cast<int>(v.size()), MPI_DOUBLE, MPI_SUM, 0, comm_);
+  else
+    MPI_Reduce(v.data(), nullptr, static_cast<int>(v.size()), MPI_DOUBLE, MPI_SUM, 0, comm_);
+}
+
+void Comm::sum_all(std::vector<double>& v) const {
+  if (size_ == 1 || v.empty()) return;
+  MPI_Allreduce(MPI_IN_PLACE, v.data(), static_cast<int>(v.size()), MPI_DOUBLE, MPI_SUM, comm_);
+}
+
+std::pair<double, int> Comm::max_loc(double v) const {
+  struct {
+    double v;
+    int r;
+  } in{v, rank_}, out{v, rank_};
+  MPI_Allreduce(&in, &out, 1, MPI_DOUBLE_INT, MPI_MAXLOC, comm_);
+  return {out.v, out.r};
+}
+
+std::string Comm::broadcast(const std::string& s, int root) const {
+  if (size_ == 1) return s;
+  int n = static_cast<int>(s.size());
+  MPI_Bcast(&n, 1, MPI_INT, root, comm_);
+  std::string out = rank_ == root ? s : std::string(static_cast<std::size_t>(n), '\0');
+  MPI_Bcast(out.data(), n, MPI_CHAR, root, comm_);
+  return out;
+}
+
+std::optional<std::string> Comm::agree_error(const std::optional<std::string>& local) const {
+  int mine = local ? rank_ : size_;
+  int first = mine;
+  MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, comm_);
+  if (first == size_) return std::nullopt;
+  return broadcast(local ? *local : std::string(), first);
+}
+
+void Comm::barrier() const { MPI_Barrier(comm_); }
+
+}  // namespace basalt::solver

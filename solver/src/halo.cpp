@@ -1,0 +1,204 @@
+#include "basalt/solver/parallel/halo.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cstring>
+
+namespace basalt::solver {
+
+namespace {
+
+struct Migrant {
+  std::int64_t id;
+  std::int32_t tag;
+  std::int32_t pad;
+  double x, y, z, vx, vy, vz, r, inv_mass;
+};
+
+struct BondRecord {
+  std::int64_t a, b;
+  double r0;
+  std::int32_t group;
+  std::int32_t pad;
+};
+
+struct GhostRecord {
+  std::int64_t id;
+  std::int32_t tag;
+  std::int32_t pad;
+  double x, y, z, r;
+};
+
+/// Sends `out` to dest and receives from src (either may be MPI_PROC_NULL).
+template <class T>
+std::vector<T> sendrecv(MPI_Comm comm, const std::vector<T>& out, int dest, int src) {
+  long long n_out = static_cast<long long>(out.size()), n_in = 0;
+  MPI_Sendrecv(&n_out, 1, MPI_LONG_LONG, dest, 11, &n_in, 1, MPI_LONG_LONG, src, 11, comm, MPI_STATUS_IGNORE);
+  std::vector<T> in(static_cast<std::size_t>(n_in));
+  MPI_Sendrecv(out.data(), static_cast<int>(out.size() * sizeof(T)), MPI_BYTE, dest, 12, in.data(),
+               static_cast<int>(in.size() * sizeof(T)), MPI_BYTE, src, 12, comm, MPI_STATUS_IGNORE);
+  return in;
+}
+
+template <class Real>
+const std::vector<Real>& axis(const Particles<Real>& p, int d) {
+  return d == 0 ? p.x : (d == 1 ? p.y : p.z);
+}
+
+}  // namespace
+
+template <class Real>
+std::optional<std::string> Halo<Real>::migrate(Particles<Real>& p, Bonds<Real>& bonds) {
+  const MPI_Comm comm = dec_.comm().raw();
+  std::optional<std::string> error;
+  for (int d = 0; d < 3; ++d) {
+    if (dec_.dims()[d] == 1) continue;
+    const auto& c = axis(p, d);
+    std::array<std::vector<Migrant>, 2> out;
+    std::array<std::vector<std::int64_t>, 2> leaving_ids;
+    std::vector<std::size_t> leaving;
+    for (std::size_t i = 0; i < p.n_owned; ++i) {
+      const int side = c[i] < dec_.lo(d) ? 0 : (c[i] >= dec_.hi(d) ? 1 : -1);
+      if (side < 0) continue;
+      out[side].push_back(Migrant{p.id[i], p.tag[i], 0, double(p.x[i]), double(p.y[i]), double(p.z[i]),
+                                  double(p.vx[i]), double(p.vy[i]), double(p.vz[i]), double(p.radius[i]),
+                                  double(p.inv_mass[i])});
+      leaving_ids[side].push_back(p.id[i]);
+      leaving.push_back(i);
+    }
+    std::array<std::vector<BondRecord>, 2> bout;
+    for (int side = 0; side < 2; ++side) {
+      auto& ids = leaving_ids[side];
+      if (ids.empty()) continue;
+      std::sort(ids.begin(), ids.end());
+      for (std::size_t k = 0; k < bonds.size(); ++k)
+        if (std::binary_search(ids.begin(), ids.end(), bonds.a[k]) ||
+            std::binary_search(ids.begin(), ids.end(), bonds.b[k]))
+          bout[side].push_back(BondRecord{bonds.a[k], bonds.b[k], double(bonds.r0[k]), bonds.group[k], 0});
+    }
+    for (auto it = leaving.rbegin(); it != leaving.rend(); ++it) p.swap_remove_owned(*it);
+
+    for (int side = 0; side < 2; ++side) {
+      const int dest = dec_.neighbor(d, side), src = dec_.neighbor(d, 1 - side);
+      const auto in = sendrecv(comm, out[side], dest, src);
+      const auto bin = sendrecv(comm, bout[side], dest, src);
+      for (const auto& m : in) {
+        const double v = d == 0 ? m.x : (d == 1 ? m.y : m.z);
+        if (!(v >= dec_.lo(d) && v < dec_.hi(d)) && !error)
+          error = fmt::format(
+              "particle id {} at ({}, {}, {}) moved more than one rank's region between two neighbour-list "
+              "rebuilds (arrived at rank {} owning [{}, {}) along axis {})",
+              m.id, m.x, m.y, m.z, dec_.comm().rank(), dec_.lo(d), dec_.hi(d), "xyz"[d]);
+        p.push_owned(m.id, Real(m.x), Real(m.y), Real(m.z), Real(m.r), m.tag, Real(m.inv_mass), Real(m.vx), Real(m.vy),
+                     Real(m.vz));
+      }
+      for (const auto& b : bin) bonds.push(b.a, b.b, Real(b.r0), static_cast<std::uint8_t>(b.group));
+    }
+  }
+  // Keep each bond once, and only while one of its ends is owned here. Ends may have been swapped
+  // (resolution puts the owned end first), so compare them ordered.
+  for (std::size_t k = 0; k < bonds.size(); ++k)
+    if (bonds.a[k] > bonds.b[k]) std::swap(bonds.a[k], bonds.b[k]);
+  std::vector<std::int64_t> owned(p.id.begin(), p.id.begin() + static_cast<std::ptrdiff_t>(p.n_owned));
+  std::sort(owned.begin(), owned.end());
+  std::vector<std::uint32_t> order(bonds.size());
+  for (std::uint32_t k = 0; k < order.size(); ++k) order[k] = k;
+  std::sort(order.begin(), order.end(), [&](std::uint32_t i, std::uint32_t j) {
+    return bonds.a[i] != bonds.a[j] ? bonds.a[i] < bonds.a[j] : bonds.b[i] < bonds.b[j];
+  });
+  std::vector<std::uint32_t> keep;
+  keep.reserve(order.size());
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    const auto i = order[k];
+    if (!keep.empty() && bonds.a[keep.back()] == bonds.a[i] && bonds.b[keep.back()] == bonds.b[i]) continue;
+    if (std::binary_search(owned.begin(), owned.end(), bonds.a[i]) ||
+        std::binary_search(owned.begin(), owned.end(), bonds.b[i]))
+      keep.push_back(i);
+  }
+  bonds.ia.clear();
+  bonds.ib.clear();
+  bonds.permute(keep);
+  return error;
+}
+
+template <class Real>
+void Halo<Real>::build_ghosts(Particles<Real>& p, double width) {
+  const MPI_Comm comm = dec_.comm().raw();
+  for (int d = 0; d < 3; ++d) {
+    for (int side = 0; side < 2; ++side) {
+      send_[d][side].clear();
+      recv_count_[d][side] = 0;
+      recv_begin_[d][side] = p.size();
+    }
+    if (dec_.dims()[d] == 1) continue;
+    const auto& c = axis(p, d);
+    const std::size_t n = p.size();
+    const double lo = dec_.lo(d) + width, hi = dec_.hi(d) - width;
+    const bool has_lo = dec_.neighbor(d, 0) != MPI_PROC_NULL, has_hi = dec_.neighbor(d, 1) != MPI_PROC_NULL;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (has_lo && c[i] < lo) send_[d][0].push_back(static_cast<std::int32_t>(i));
+      if (has_hi && c[i] >= hi) send_[d][1].push_back(static_cast<std::int32_t>(i));
+    }
+    for (int side = 0; side < 2; ++side) {
+      std::vector<GhostRecord> out;
+      out.reserve(send_[d][side].size());
+      for (auto i : send_[d][side])
+        out.push_back(GhostRecord{p.id[i], p.tag[i], 0, double(p.x[i]), double(p.y[i]), double(p.z[i]),
+                                  double(p.radius[i])});
+      // Sending to side s means receiving from the other side.
+      const auto in = sendrecv(comm, out, dec_.neighbor(d, side), dec_.neighbor(d, 1 - side));
+      recv_begin_[d][1 - side] = p.size();
+      recv_count_[d][1 - side] = in.size();
+      for (const auto& g : in) {
+        p.x.push_back(Real(g.x));
+        p.y.push_back(Real(g.y));
+        p.z.push_back(Real(g.z));
+        p.radius.push_back(Real(g.r));
+        p.id.push_back(g.id);
+        p.tag.push_back(g.tag);
+      }
+    }
+  }
+}
+
+template <class Real>
+void Halo<Real>::update_ghosts(Particles<Real>& p) {
+  const MPI_Comm comm = dec_.comm().raw();
+  const MPI_Datatype type = sizeof(Real) == sizeof(double) ? MPI_DOUBLE : MPI_FLOAT;
+  for (int d = 0; d < 3; ++d) {
+    if (dec_.dims()[d] == 1) continue;
+    for (int side = 0; side < 2; ++side) {
+      const auto& list = send_[d][side];
+      sbuf_.resize(3 * list.size());
+      for (std::size_t k = 0; k < list.size(); ++k) {
+        const auto i = list[k];
+        sbuf_[3 * k] = p.x[i];
+        sbuf_[3 * k + 1] = p.y[i];
+        sbuf_[3 * k + 2] = p.z[i];
+      }
+      const std::size_t nin = recv_count_[d][1 - side], begin = recv_begin_[d][1 - side];
+      rbuf_.resize(3 * nin);
+      MPI_Sendrecv(sbuf_.data(), static_cast<int>(sbuf_.size()), type, dec_.neighbor(d, side), 21, rbuf_.data(),
+                   static_cast<int>(rbuf_.size()), type, dec_.neighbor(d, 1 - side), 21, comm, MPI_STATUS_IGNORE);
+      for (std::size_t k = 0; k < nin; ++k) {
+        p.x[begin + k] = rbuf_[3 * k];
+        p.y[begin + k] = rbuf_[3 * k + 1];
+        p.z[begin + k] = rbuf_[3 * k + 2];
+      }
+    }
+  }
+}
+
+template <class Real>
+std::size_t Halo<Real>::memory_bytes() const {
+  std::size_t b = (sbuf_.capacity() + rbuf_.capacity()) * sizeof(Real);
+  for (const auto& a : send_)
+    for (const auto& s : a) b += s.capacity() * sizeof(std::int32_t);
+  return b;
+}
+
+template class Halo<double>;
+template class Halo<float>;
+
+}  // namespace basalt::solver

@@ -1,0 +1,232 @@
+#include "basalt/solver/scene/scene.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+namespace basalt::solver {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::array<double, 3> unit(TableReader& t, const std::string& key) {
+  auto v = t.vec3(key);
+  const double n = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+  if (!(n > 0)) t.fail(key, "must have non-zero length");
+  return {v[0] / n, v[1] / n, v[2] / n};
+}
+
+TagFilter pair_tags(TableReader& t) {
+  auto tags = t.integers_or("tags", {});
+  if (!tags.empty() && tags.size() != 2) t.fail("tags", "must name two particle tags, e.g. [0, 0]");
+  return tags;
+}
+
+std::string group_name(TableReader& t, const std::string& fallback, std::set<std::string>& seen) {
+  std::string name = t.string_or("name", fallback);
+  if (name.empty()) t.fail("name", "must not be empty");
+  if (!seen.insert(name).second) t.fail("name", fmt::format("\"{}\" is used twice", name));
+  return name;
+}
+
+WallMotion parse_motion(TableReader& t, const std::array<double, 3>& normal) {
+  WallMotion m;
+  const std::string type = t.choice_or("type", {"fixed", "constant_velocity", "half_sine", "sine"}, "fixed");
+  if (type == "fixed") {
+    m.type = WallMotion::Type::fixed;
+  } else if (type == "constant_velocity") {
+    m.type = WallMotion::Type::constant_velocity;
+    m.velocity = t.vec3("velocity");
+  } else {
+    m.type = type == "half_sine" ? WallMotion::Type::half_sine : WallMotion::Type::sine;
+    m.amplitude = t.number("amplitude");
+    if (!std::isfinite(m.amplitude)) t.fail("amplitude", "must be finite");
+    m.period = t.positive("period");
+    m.direction = t.has("direction") ? unit(t, "direction") : normal;
+  }
+  t.finish();
+  return m;
+}
+
+}  // namespace
+
+Scene parse_scene_text(const std::string& text, const std::string& label, const fs::path& base_dir) {
+  toml::table root;
+  try {
+    root = toml::parse(text, label);
+  } catch (const toml::parse_error& e) {
+    throw InputError(fmt::format("{}:{}:{}: {}", label, e.source().begin.line, e.source().begin.column,
+                                 e.description()));
+  }
+  Scene s;
+  s.text = text;
+  TableReader top(root, label, "");
+
+  if (const auto* u = top.subtable("units")) {
+    TableReader t(*u, label, "units");
+    s.units.length = t.choice_or("length", {"mm", "m"}, "mm");
+    s.units.time = t.choice_or("time", {"ms", "s"}, "ms");
+    s.units.force = t.choice_or("force", {"N", "kN"}, "N");
+    t.finish();
+  }
+
+  {
+    const auto* g = top.subtable("geometry");
+    if (!g) top.fail("geometry", "missing (required): a [geometry] table with file = \"...\"");
+    TableReader t(*g, label, "geometry");
+    fs::path p = t.string("file");
+    s.geometry = p.is_absolute() ? p : base_dir / p;
+    t.finish();
+  }
+
+  if (const auto* m = top.subtable("material")) {
+    TableReader t(*m, label, "material");
+    if (t.has("density")) s.density = t.positive("density");
+    t.finish();
+  }
+
+  {
+    const auto* r = top.subtable("run");
+    if (!r) top.fail("run", "missing (required): a [run] table with dt, steps, skin");
+    TableReader t(*r, label, "run");
+    s.dt = t.positive("dt");
+    s.steps = t.integer("steps");
+    if (s.steps < 0) t.fail("steps", fmt::format("must be >= 0, got {}", s.steps));
+    s.skin = t.positive("skin");
+    s.integrator = t.choice_or("integrator", {"velocity_verlet", "symplectic_euler"}, "velocity_verlet") ==
+                           "symplectic_euler"
+                       ? Integrator::symplectic_euler
+                       : Integrator::velocity_verlet;
+    s.force_dt = t.boolean_or("force_dt", false);
+    if (t.has("dt_safety")) {
+      s.dt_safety = t.positive("dt_safety");
+      if (s.dt_safety > 1) t.fail("dt_safety", "must be <= 1 (a fraction of the critical time step)");
+    }
+    s.energy_check_every = t.integer_or("energy_check_every", 100);
+    if (s.energy_check_every < 0) t.fail("energy_check_every", "must be >= 0 (0 turns the guard off)");
+    t.finish();
+  }
+
+  std::set<std::string> names;
+  if (const auto* arr = top.table_array("interactions")) {
+    for (std::size_t k = 0; k < arr->size(); ++k) {
+      TableReader t(*(*arr)[k].as_table(), label, fmt::format("interactions[{}]", k));
+      const std::string type = t.choice_or("type", {"linear_bond", "linear_elastic"}, "");
+      if (type == "linear_bond") {
+        Group<LinearBond> g;
+        g.name = group_name(t, fmt::format("bonds{}", k), names);
+        g.params = LinearBond::parse(t);
+        g.tags = pair_tags(t);
+        if (t.has("bond_tag")) g.bond_tag = t.integer("bond_tag");
+        s.bonds.push_back(std::move(g));
+      } else {
+        Group<LinearElastic> g;
+        g.name = group_name(t, fmt::format("contacts{}", k), names);
+        g.params = LinearElastic::parse(t);
+        g.tags = pair_tags(t);
+        s.contacts.push_back(std::move(g));
+      }
+      t.finish();
+    }
+  }
+
+  if (const auto* arr = top.table_array("walls")) {
+    for (std::size_t k = 0; k < arr->size(); ++k) {
+      TableReader t(*(*arr)[k].as_table(), label, fmt::format("walls[{}]", k));
+      WallSpec w;
+      w.name = group_name(t, fmt::format("wall{}", k), names);
+      w.point = t.vec3("point");
+      w.normal = unit(t, "normal");
+      t.choice_or("interaction", {"elastic"}, "elastic");
+      w.params = ElasticWall::parse(t);
+      w.tags = t.integers_or("tags", {});
+      if (const auto* m = t.subtable("motion")) {
+        TableReader tm(*m, label, fmt::format("walls[{}].motion", k));
+        w.motion = parse_motion(tm, w.normal);
+      }
+      t.finish();
+      s.walls.push_back(std::move(w));
+    }
+  }
+
+  if (const auto* o = top.subtable("output")) {
+    TableReader t(*o, label, "output");
+    if (t.has("directory")) {
+      fs::path d = t.string("directory");
+      s.output_dir = d.is_absolute() ? d : base_dir / d;
+    }
+    if (const auto* arr = t.table_array("fields")) {
+      for (std::size_t k = 0; k < arr->size(); ++k) {
+        TableReader tf(*(*arr)[k].as_table(), label, fmt::format("output.fields[{}]", k));
+        static const std::map<std::string, FieldSpec::Type> kTypes{
+            {"kinetic_energy", FieldSpec::Type::kinetic_energy},
+            {"bond_potential_energy", FieldSpec::Type::bond_potential_energy},
+            {"contact_potential_energy", FieldSpec::Type::contact_potential_energy},
+            {"wall_potential_energy", FieldSpec::Type::wall_potential_energy},
+            {"bond_count", FieldSpec::Type::bond_count},
+            {"wall_force", FieldSpec::Type::wall_force}};
+        std::vector<std::string> allowed;
+        for (const auto& [n, _] : kTypes) allowed.push_back(n);
+        FieldSpec f;
+        f.type = kTypes.at(tf.choice_or("type", allowed, ""));
+        f.every = tf.integer_or("every", 1);
+        if (f.every < 1) tf.fail("every", fmt::format("must be >= 1, got {}", f.every));
+        if (f.type == FieldSpec::Type::wall_force) {
+          f.wall = tf.string("wall");
+          bool found = false;
+          for (const auto& w : s.walls) found = found || w.name == f.wall;
+          if (!found) tf.fail("wall", fmt::format("no wall named \"{}\"", f.wall));
+        }
+        tf.finish();
+        s.fields.push_back(std::move(f));
+      }
+    }
+    t.finish();
+  }
+  top.finish();
+  return s;
+}
+
+Scene parse_scene(const fs::path& file) {
+  std::ifstream in(file);
+  if (!in) throw InputError(fmt::format("{}: cannot open the scene file", file.string()));
+  std::stringstream ss;
+  ss << in.rdbuf();
+  Scene s = parse_scene_text(ss.str(), file.string(), file.parent_path());
+  s.file = file;
+  return s;
+}
+
+std::vector<std::string> field_columns(const Scene& scene) {
+  std::vector<std::string> cols;
+  for (const auto& f : scene.fields) {
+    switch (f.type) {
+      case FieldSpec::Type::kinetic_energy:
+        cols.push_back("kinetic_energy");
+        break;
+      case FieldSpec::Type::bond_potential_energy:
+        cols.push_back("bond_potential_energy");
+        break;
+      case FieldSpec::Type::contact_potential_energy:
+        cols.push_back("contact_potential_energy");
+        break;
+      case FieldSpec::Type::wall_potential_energy:
+        cols.push_back("wall_potential_energy");
+        break;
+      case FieldSpec::Type::bond_count:
+        cols.push_back("bond_count");
+        break;
+      case FieldSpec::Type::wall_force:
+        for (const char* c : {"x", "y", "z"}) cols.push_back(fmt::format("wall_force_{}_{}", f.wall, c));
+        break;
+    }
+  }
+  return cols;
+}
+
+}  // namespace basalt::solver

@@ -1,0 +1,503 @@
+#include "basalt/solver/simulation.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <cstdlib>
+#include <numbers>
+
+#include "basalt/solver/core/errors.hpp"
+#include "basalt/solver/integrate/integrators.hpp"
+
+namespace basalt::solver {
+
+namespace {
+
+double particle_mass(const io::Geometry& g, std::size_t i, double density) {
+  return g.has_mass() ? g.mass[i] : density * 4.0 / 3.0 * std::numbers::pi * std::pow(g.radius[i], 3);
+}
+
+double distance(const io::Vec3& a, const io::Vec3& b) {
+  return std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
+}
+
+bool tags_match(const TagFilter& t, std::int64_t ta, std::int64_t tb) {
+  return t.empty() || (t[0] == ta && t[1] == tb) || (t[0] == tb && t[1] == ta);
+}
+
+}  // namespace
+
+template <class Real>
+Simulation<Real>::Simulation(const Scene& scene, io::Geometry g, MPI_Comm comm, const RunOptions& options)
+    : scene_(scene),
+      options_(options),
+      bond_driver_(scene.bonds),
+      pair_driver_(scene.contacts),
+      wall_driver_(scene.walls) {
+  if (g.size() == 0) throw InputError(fmt::format("{}: the geometry has no particles", scene.geometry.string()));
+  if (scene.bonds.size() > 254) throw InputError("interactions: at most 254 bond groups");
+  const bool se = scene.integrator == Integrator::symplectic_euler;
+  kick1_ = Real(se ? scene.dt : scene.dt / 2);
+  kick2_ = Real(se ? 0.0 : scene.dt / 2);
+  rebuild_limit2_ = 0.25 * scene.skin * scene.skin;
+  check_stability(g);
+  distribute(g, comm);
+  rebuild();
+  const auto pe = compute_forces<true>();
+  energy0_ = total_energy(pe);
+}
+
+template <class Real>
+double Simulation<Real>::kinetic_energy_local() const {
+  return basalt::solver::kinetic_energy(p_);
+}
+
+template <class Real>
+double Simulation<Real>::total_energy(const std::array<double, 3>& pe) const {
+  std::vector<double> v{kinetic_energy_local(), pe[0], pe[1], pe[2]};
+  comm().sum_all(v);
+  return v[0] + v[1] + v[2] + v[3];
+}
+
+template <class Real>
+double Simulation<Real>::kinetic_energy() const {
+  return comm().sum(kinetic_energy_local());
+}
+
+template <class Real>
+std::array<double, 4> Simulation<Real>::energies() {
+  const auto pe = compute_forces<true>();
+  std::vector<double> v{kinetic_energy_local(), pe[0], pe[1], pe[2]};
+  comm().sum_all(v);
+  return {v[0], v[1], v[2], v[3]};
+}
+
+template <class Real>
+std::int64_t Simulation<Real>::bond_count() const {
+  return comm().sum(static_cast<long long>(BondDriver<Real, LinearBond>::count(p_, bonds_)));
+}
+
+template <class Real>
+void Simulation<Real>::check_stability(const io::Geometry& g) {
+  double m_min = std::numeric_limits<double>::infinity(), rmax = 0;
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    m_min = std::min(m_min, particle_mass(g, i, scene_.density));
+    rmax = std::max(rmax, g.radius[i]);
+  }
+  const double k_max = std::max({double(bond_driver_.max_stiffness()), double(pair_driver_.max_stiffness()),
+                                 double(wall_driver_.max_stiffness(Real(rmax)))});
+  stability_.m_min = m_min;
+  stability_.k_max = k_max;
+  if (k_max <= 0) return;
+  stability_.dt_critical = 2 * std::sqrt(m_min / k_max);
+  stability_.fraction = scene_.dt / stability_.dt_critical;
+  stability_.warn = stability_.fraction > scene_.dt_safety;
+  if (stability_.fraction > 1 && !(scene_.force_dt || options_.force_dt))
+    throw InputError(fmt::format(
+        "run.dt = {} is {:.3g} times the critical time step {:.6g} (2 sqrt(m_min / k_max), m_min = {:.6g}, "
+        "k_max = {:.6g}): the run would be unstable. Lower dt (a safe choice is <= {} x critical), or set "
+        "run.force_dt = true / --force-dt to run anyway",
+        scene_.dt, stability_.fraction, stability_.dt_critical, m_min, k_max, scene_.dt_safety));
+}
+
+template <class Real>
+void Simulation<Real>::distribute(io::Geometry& g, MPI_Comm comm) {
+  // The decomposition starts from the packing's bounding box; outer ranks own half-infinite regions.
+  std::array<double, 3> lo{}, hi{};
+  lo.fill(std::numeric_limits<double>::infinity());
+  hi.fill(-std::numeric_limits<double>::infinity());
+  double rmax = 0;
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    for (int d = 0; d < 3; ++d) {
+      lo[d] = std::min(lo[d], g.position[i][d] - g.radius[i]);
+      hi[d] = std::max(hi[d], g.position[i][d] + g.radius[i]);
+    }
+    rmax = std::max(rmax, g.radius[i]);
+  }
+  dec_ = std::make_unique<Decomposition>(Comm(comm), options_.dims, lo, hi);
+  halo_ = std::make_unique<Halo<Real>>(*dec_);
+  n_global_ = static_cast<std::int64_t>(g.size());
+  ids_.configure(g.id.front(), g.id.back(), g.size());
+
+  // Which bond group takes each geometry bond (first match), and the longest bond.
+  constexpr std::uint8_t kNone = 255;
+  std::vector<std::uint8_t> bond_group(g.bonds.size(), kNone);
+  double longest = 0;
+  std::size_t unassigned = 0;
+  for (std::size_t k = 0; k < g.bonds.size(); ++k) {
+    const auto& b = g.bonds[k];
+    const auto ia = static_cast<std::size_t>(g.index_of(b.a)), ib = static_cast<std::size_t>(g.index_of(b.b));
+    for (std::size_t gi = 0; gi < scene_.bonds.size(); ++gi) {
+      const auto& grp = scene_.bonds[gi];
+      if (grp.bond_tag && *grp.bond_tag != b.tag) continue;
+      if (!tags_match(grp.tags, g.tag[ia], g.tag[ib])) continue;
+      bond_group[k] = static_cast<std::uint8_t>(gi);
+      break;
+    }
+    if (bond_group[k] == kNone) {
+      ++unassigned;
+      continue;
+    }
+    longest = std::max(longest, distance(g.position[ia], g.position[ib]));
+  }
+  unassigned_bonds_ = unassigned;
+  ghost_width_ = std::max(pair_driver_.empty() ? 0.0 : 2 * rmax, longest) + scene_.skin;
+  contact_cutoff_ = 2 * rmax + scene_.skin;
+  if (dec_->min_interior_width() < ghost_width_)
+    throw InputError(fmt::format(
+        "too many ranks for this geometry: a rank's region would be {:.4g} wide, less than the ghost width "
+        "{:.4g} (longest interaction + skin); use fewer ranks or other --dims (now {}x{}x{})",
+        dec_->min_interior_width(), ghost_width_, dec_->dims()[0], dec_->dims()[1], dec_->dims()[2]));
+
+  std::vector<char> owned(g.size(), 0);
+  std::size_t n_mine = 0;
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    const auto& x = g.position[i];
+    owned[i] = dec_->owns(x[0], x[1], x[2]);
+    n_mine += static_cast<std::size_t>(owned[i]);
+  }
+  // Bonds with an owned end, then particles; each part of the geometry is released once copied, so
+  // the geometry and the solver's copy never coexist in full (peak memory).
+  std::size_t n_bonds = 0;
+  for (std::size_t k = 0; k < g.bonds.size(); ++k)
+    if (bond_group[k] != kNone)
+      n_bonds += owned[static_cast<std::size_t>(g.index_of(g.bonds[k].a))] ||
+                 owned[static_cast<std::size_t>(g.index_of(g.bonds[k].b))];
+  bonds_.reserve(n_bonds);
+  for (std::size_t k = 0; k < g.bonds.size(); ++k) {
+    if (bond_group[k] == kNone) continue;
+    const auto& b = g.bonds[k];
+    const auto ia = static_cast<std::size_t>(g.index_of(b.a)), ib = static_cast<std::size_t>(g.index_of(b.b));
+    if (!owned[ia] && !owned[ib]) continue;
+    const auto& params = scene_.bonds[bond_group[k]].params;
+    const double r0 =
+        LinearBond::rest_length(params, g.radius[ia], g.radius[ib], distance(g.position[ia], g.position[ib]));
+    bonds_.push(b.a, b.b, Real(r0), bond_group[k]);
+  }
+  std::vector<io::Bond>().swap(g.bonds);
+  std::vector<std::uint8_t>().swap(bond_group);
+  p_.reserve_owned(n_mine);
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    if (!owned[i]) continue;
+    const auto& x = g.position[i];
+    p_.push_owned(g.id[i], Real(x[0]), Real(x[1]), Real(x[2]), Real(g.radius[i]), g.tag[i],
+                  Real(1.0 / particle_mass(g, i, scene_.density)));
+  }
+  std::vector<io::Vec3>().swap(g.position);
+  std::vector<double>().swap(g.radius);
+  std::vector<double>().swap(g.mass);
+  std::vector<std::int32_t>().swap(g.tag);
+}
+
+template <class Real>
+std::optional<std::string> Simulation<Real>::check_finite() const {
+  for (std::size_t i = 0; i < p_.n_owned; ++i) {
+    const bool ok = std::isfinite(p_.x[i]) && std::isfinite(p_.y[i]) && std::isfinite(p_.z[i]) &&
+                    std::isfinite(p_.vx[i]) && std::isfinite(p_.vy[i]) && std::isfinite(p_.vz[i]) &&
+                    std::isfinite(p_.fx[i]) && std::isfinite(p_.fy[i]) && std::isfinite(p_.fz[i]);
+    if (!ok)
+      return fmt::format(
+          "step {}: particle id {} went non-finite: position ({}, {}, {}), velocity ({}, {}, {}), force ({}, {}, "
+          "{}); dt = {} is {:.3g} x the critical time step",
+          step_, p_.id[i], p_.x[i], p_.y[i], p_.z[i], p_.vx[i], p_.vy[i], p_.vz[i], p_.fx[i], p_.fy[i], p_.fz[i],
+          scene_.dt, stability_.fraction);
+  }
+  return std::nullopt;
+}
+
+template <class Real>
+void Simulation<Real>::spatial_sort() {
+  // Owned particles in cell order: neighbours in space become neighbours in memory.
+  grid_.build(p_.x, p_.y, p_.z, p_.n_owned, contact_cutoff_);
+  const auto& order = grid_.order();
+  std::vector<std::uint32_t> perm(order.begin(), order.end());
+  p_.permute_owned(perm);
+}
+
+template <class Real>
+void Simulation<Real>::resolve_bonds() {
+  ids_.assign(p_.id, p_.size());
+  std::optional<std::string> error;
+  const std::size_t nb = bonds_.size(), n = p_.n_owned;
+  bonds_.ia.resize(nb);
+  bonds_.ib.resize(nb);
+  for (std::size_t k = 0; k < nb; ++k) {
+    auto ia = ids_.find(bonds_.a[k]), ib = ids_.find(bonds_.b[k]);
+    if ((ia < 0 || ib < 0) && !error) {
+      error = fmt::format(
+          "step {}: the bond between particle ids {} and {} is longer than the ghost width {:.6g} (particle {} "
+          "is not within reach of rank {}): bonds must not stretch beyond the longest initial bond + skin",
+          step_, bonds_.a[k], bonds_.b[k], ghost_width_, ia < 0 ? bonds_.a[k] : bonds_.b[k], comm().rank());
+      ia = std::max(ia, 0);
+      ib = std::max(ib, 0);
+    }
+    if (static_cast<std::size_t>(ia) >= n) {
+      std::swap(ia, ib);
+      std::swap(bonds_.a[k], bonds_.b[k]);
+    }
+    bonds_.ia[k] = ia;
+    bonds_.ib[k] = ib;
+  }
+  if (comm().size() > 1) error = comm().agree_error(error);
+  if (error) throw RunError(*error);
+  // Both ends owned first, each part in memory order of its first end.
+  std::vector<std::uint32_t> order(nb);
+  for (std::uint32_t k = 0; k < nb; ++k) order[k] = k;
+  auto key = [&](std::uint32_t k) {
+    const bool ghost = static_cast<std::size_t>(bonds_.ib[k]) >= n;
+    return std::pair<int, std::int32_t>(ghost ? 1 : 0, bonds_.ia[k]);
+  };
+  std::sort(order.begin(), order.end(), [&](std::uint32_t i, std::uint32_t j) { return key(i) < key(j); });
+  bonds_.permute(order);
+  bonds_.n_both_owned = 0;
+  while (bonds_.n_both_owned < nb && static_cast<std::size_t>(bonds_.ib[bonds_.n_both_owned]) < n)
+    ++bonds_.n_both_owned;
+}
+
+template <class Real>
+void Simulation<Real>::rebuild() {
+  Stopwatch sw;
+  auto error = check_finite();
+  const bool parallel = comm().size() > 1;
+  if (parallel) error = comm().agree_error(error);
+  if (error) throw RunError(*error);
+  p_.drop_ghosts();
+  if (parallel) {
+    error = halo_->migrate(p_, bonds_);
+    error = comm().agree_error(error);
+    if (error) throw RunError(*error);
+    const long long total = comm().sum(static_cast<long long>(p_.n_owned));
+    if (total != n_global_)
+      throw RunError(fmt::format("step {}: {} particles on the ranks, {} expected: particles were lost", step_,
+                                 total, n_global_));
+  }
+  times_.communication += sw.lap();
+  spatial_sort();
+  times_.neighbor += sw.lap();
+  if (parallel) halo_->build_ghosts(p_, ghost_width_);
+  times_.communication += sw.lap();
+  resolve_bonds();
+  if (!pair_driver_.empty()) {
+    grid_.build(p_.x, p_.y, p_.z, p_.size(), contact_cutoff_);
+    exclusions_.build(bonds_.ia, bonds_.ib, p_.size());
+    if (pair_driver_.takes_all()) {
+      build_pair_lists(p_, grid_, scene_.skin, exclusions_, [](std::size_t, std::size_t) { return true; }, own_,
+                       ghost_);
+    } else {
+      auto accept = [this](std::size_t i, std::size_t j) {
+        return pair_driver_.group_of(p_.tag[i], p_.tag[j]) >= 0;
+      };
+      build_pair_lists(p_, grid_, scene_.skin, exclusions_, accept, own_, ghost_);
+    }
+    exclusions_.release();
+  }
+  grid_.release();
+  for (std::size_t i = 0; i < p_.n_owned; ++i) {
+    p_.x0[i] = float(p_.x[i]);
+    p_.y0[i] = float(p_.y[i]);
+    p_.z0[i] = float(p_.z[i]);
+  }
+  bond_broke_ = false;
+  ++rebuilds_;
+  if (std::getenv("BASALT_DEBUG_REBUILD")) fmt::print(stderr, "rank {} rebuild at step {} owned {} ghosts {} bonds {} (both owned {}) pairs {}+{}\n", comm().rank(), step_, p_.n_owned, p_.n_ghost(), bonds_.size(), bonds_.n_both_owned, own_.pairs(), ghost_.pairs());
+  times_.neighbor += sw.lap();
+}
+
+template <class Real>
+template <bool Energy>
+std::array<double, 3> Simulation<Real>::compute_forces() {
+  zero_forces(p_);
+  std::array<double, 3> pe{0, 0, 0};
+  const std::size_t before = broken_.size();
+  if (bonds_.size() > 0) pe[0] = bond_driver_.template compute<Energy>(p_, bonds_, broken_);
+  if (!pair_driver_.empty()) pe[1] = pair_driver_.template compute<Energy>(p_, own_, ghost_);
+  if (!wall_driver_.empty()) {
+    wall_driver_.move_to(time_);
+    pe[2] = wall_driver_.template compute<Energy>(p_);
+  }
+  if (broken_.size() != before) bond_broke_ = true;  // the lists must learn the pair is now unbonded
+  return pe;
+}
+
+template <class Real>
+bool Simulation<Real>::energy_due(std::int64_t s) const {
+  for (const auto& f : scene_.fields)
+    if (s % f.every == 0 && f.type != FieldSpec::Type::kinetic_energy && f.type != FieldSpec::Type::bond_count &&
+        f.type != FieldSpec::Type::wall_force)
+      return true;
+  return scene_.energy_check_every > 0 && s % scene_.energy_check_every == 0;
+}
+
+template <class Real>
+void Simulation<Real>::step(FieldSink* sink) {
+  Stopwatch sw;
+  kick(p_, kick1_);
+  const double moved2 = drift(p_, Real(scene_.dt));
+  times_.integration += sw.lap();
+  const bool parallel = comm().size() > 1;
+  double need = bond_broke_ ? std::numeric_limits<double>::infinity() : moved2;
+  if (parallel) need = comm().max(need);
+  times_.communication += sw.lap();
+  if (!(need <= rebuild_limit2_)) {
+    rebuild();
+    sw.lap();
+  } else if (parallel) {
+    halo_->update_ghosts(p_);
+    times_.communication += sw.lap();
+  }
+  ++step_;
+  time_ = double(step_) * scene_.dt;
+  const bool energy = energy_due(step_);
+  const auto pe = energy ? compute_forces<true>() : compute_forces<false>();
+  times_.forces += sw.lap();
+  if (kick2_ != Real(0)) kick(p_, kick2_);
+  times_.integration += sw.lap();
+  if (!wall_driver_.empty()) wall_work_in_ += std::max(0.0, wall_driver_.power(time_)) * scene_.dt;
+  save_fields(sink, pe);
+  times_.output += sw.lap();
+  if (scene_.energy_check_every > 0 && step_ % scene_.energy_check_every == 0) guard_energy(pe);
+}
+
+template <class Real>
+void Simulation<Real>::save_fields(FieldSink* sink, const std::array<double, 3>& pe) {
+  std::vector<double> local;
+  std::vector<char> due;
+  bool any = false;
+  for (const auto& f : scene_.fields) {
+    const bool d = step_ % f.every == 0;
+    any = any || d;
+    const std::size_t width = f.type == FieldSpec::Type::wall_force ? 3 : 1;
+    for (std::size_t c = 0; c < width; ++c) due.push_back(d);
+    if (!d) {
+      local.insert(local.end(), width, 0.0);
+      continue;
+    }
+    switch (f.type) {
+      case FieldSpec::Type::kinetic_energy:
+        local.push_back(kinetic_energy_local());
+        break;
+      case FieldSpec::Type::bond_potential_energy:
+        local.push_back(pe[0]);
+        break;
+      case FieldSpec::Type::contact_potential_energy:
+        local.push_back(pe[1]);
+        break;
+      case FieldSpec::Type::wall_potential_energy:
+        local.push_back(pe[2]);
+        break;
+      case FieldSpec::Type::bond_count:
+        local.push_back(double(BondDriver<Real, LinearBond>::count(p_, bonds_)));
+        break;
+      case FieldSpec::Type::wall_force: {
+        std::size_t w = 0;
+        while (wall_driver_.spec(w).name != f.wall) ++w;
+        const auto& fw = wall_driver_.force(w);
+        local.insert(local.end(), fw.begin(), fw.end());
+        break;
+      }
+    }
+  }
+  if (!any) return;
+  comm().sum_to_root(local);
+  if (comm().rank() != 0 || !sink) return;
+  std::vector<std::optional<double>> row(local.size());
+  for (std::size_t c = 0; c < local.size(); ++c)
+    if (due[c]) row[c] = local[c];
+  sink->row(step_, time_, row);
+}
+
+template <class Real>
+void Simulation<Real>::guard_energy(const std::array<double, 3>& pe) {
+  std::vector<double> v{kinetic_energy_local(), pe[0], pe[1], pe[2], wall_work_in_};
+  comm().sum_all(v);
+  const double e = v[0] + v[1] + v[2] + v[3];
+  const double allowed = 2 * (energy0_ + v[4]);
+  if (!(e > allowed && e > 0) && std::isfinite(e)) return;
+  // Name the fastest particle.
+  double best = -1;
+  std::size_t bi = 0;
+  for (std::size_t i = 0; i < p_.n_owned; ++i) {
+    const double ke = 0.5 * double(p_.mass(i)) * double(p_.vx[i] * p_.vx[i] + p_.vy[i] * p_.vy[i] + p_.vz[i] * p_.vz[i]);
+    if (!(ke <= best)) {
+      best = ke;
+      bi = i;
+    }
+  }
+  const auto [top, who] = comm().max_loc(std::isfinite(best) ? best : std::numeric_limits<double>::max());
+  std::string msg;
+  if (comm().rank() == who && p_.n_owned > 0)
+    msg = fmt::format(
+        "step {}: the energy grows without a source: total {:.6g} (kinetic {:.6g}, bonds {:.6g}, contacts "
+        "{:.6g}, walls {:.6g}) > 2 x (initial {:.6g} + work done by walls {:.6g}). Fastest particle: id {} "
+        "with kinetic energy {:.6g}, velocity ({:.6g}, {:.6g}, {:.6g}) at ({:.6g}, {:.6g}, {:.6g}). dt = {} is "
+        "{:.3g} x the critical time step {:.6g}",
+        step_, e, v[0], v[1], v[2], v[3], energy0_, v[4], p_.id[bi], best, p_.vx[bi], p_.vy[bi], p_.vz[bi],
+        p_.x[bi], p_.y[bi], p_.z[bi], scene_.dt, stability_.fraction, stability_.dt_critical);
+  throw RunError(comm().broadcast(msg, who));
+}
+
+template <class Real>
+void Simulation<Real>::progress(std::int64_t done, std::int64_t total, double seconds) const {
+  const double sps = done / std::max(seconds, 1e-9);
+  fmt::print("step {:>8}/{}  {:8.1f} steps/s  {:6.2f} M particle-steps/s  ETA {:.1f} s\n", step_,
+             step_ + (total - done), sps, sps * double(n_global_) * 1e-6, (total - done) / std::max(sps, 1e-9));
+  std::fflush(stdout);
+}
+
+template <class Real>
+void Simulation<Real>::run(std::int64_t steps, FieldSink* sink) {
+  if (steps < 0) steps = scene_.steps;
+  Stopwatch clock;
+  double elapsed = 0, last = 0;
+  const bool show = !options_.quiet && comm().rank() == 0;
+  for (std::int64_t k = 0; k < steps; ++k) {
+    step(sink);
+    if (show && (k & 15) == 15) {
+      elapsed += clock.lap();
+      if (elapsed - last >= options_.progress_seconds) {
+        progress(k + 1, steps, elapsed);
+        last = elapsed;
+      }
+    }
+  }
+  if (sink && comm().rank() == 0) sink->flush();
+}
+
+template <class Real>
+void Simulation<Real>::state_changed() {
+  energy0_ = total_energy(compute_forces<true>());
+  wall_work_in_ = 0;
+}
+
+template <class Real>
+void Simulation<Real>::force_rebuild() {
+  rebuild();
+  compute_forces<false>();
+}
+
+template <class Real>
+std::size_t Simulation<Real>::memory_bytes() const {
+  std::size_t b = 0;
+  auto add = [&](const auto& v) { b += v.capacity() * sizeof(typename std::decay_t<decltype(v)>::value_type); };
+  for (const auto* v : {&p_.x, &p_.y, &p_.z, &p_.radius, &p_.vx, &p_.vy, &p_.vz, &p_.fx, &p_.fy, &p_.fz,
+                        &p_.inv_mass})
+    add(*v);
+  for (const auto* v : {&p_.x0, &p_.y0, &p_.z0}) add(*v);
+  add(p_.id);
+  add(p_.tag);
+  add(bonds_.a);
+  add(bonds_.b);
+  add(bonds_.r0);
+  add(bonds_.group);
+  add(bonds_.ia);
+  add(bonds_.ib);
+  b += own_.memory_bytes() + ghost_.memory_bytes() + ids_.memory_bytes() + halo_->memory_bytes();
+  return b;
+}
+
+template class Simulation<double>;
+template class Simulation<float>;
+
+}  // namespace basalt::solver

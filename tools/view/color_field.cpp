@@ -1,0 +1,97 @@
+#include "color_field.hpp"
+
+#include <fmt/format.h>
+#include <vtkDataArray.h>
+#include <vtkPointData.h>
+
+#include <cmath>
+#include <stdexcept>
+
+#include "units.hpp"
+
+namespace basalt::view {
+
+namespace {
+
+/// A 3-vector array and component (-1: magnitude) named by `field`, or nullptr.
+vtkDataArray* find(vtkPolyData& pd, const std::string& field, int& component) {
+  vtkPointData* p = pd.GetPointData();
+  component = -1;
+  if (vtkDataArray* a = p->GetArray(field.c_str())) return a;
+  if (field.size() > 2 && field[field.size() - 2] == '_') {
+    const char c = field.back();
+    if (c == 'x' || c == 'y' || c == 'z') {
+      vtkDataArray* a = p->GetArray(field.substr(0, field.size() - 2).c_str());
+      if (a != nullptr && a->GetNumberOfComponents() == 3) {
+        component = c - 'x';
+        return a;
+      }
+    }
+  }
+  return nullptr;
+}
+
+}  // namespace
+
+std::vector<std::string> color_fields(vtkPolyData& pd) {
+  std::vector<std::string> names;
+  vtkPointData* p = pd.GetPointData();
+  for (int i = 0; i < p->GetNumberOfArrays(); ++i) {
+    vtkDataArray* a = p->GetArray(i);
+    if (a == nullptr || a->GetName() == nullptr) continue;
+    const std::string name = a->GetName();
+    if (a->GetNumberOfComponents() == 1) {
+      names.push_back(name);
+    } else if (a->GetNumberOfComponents() == 3) {
+      names.push_back(name);
+      for (const char* c : {"_x", "_y", "_z"}) names.push_back(name + c);
+    }
+  }
+  return names;
+}
+
+vtkSmartPointer<vtkDoubleArray> color_values(vtkPolyData& pd, const std::string& field) {
+  int component = -1;
+  vtkDataArray* a = find(pd, field, component);
+  if (a == nullptr) {
+    std::string hint;
+    if (field == "displacement")
+      hint = " (displacement needs --reference <initial geometry or checkpoint>)";
+    else if (field == "speed" || field == "velocity")
+      hint = " (a geometry has no velocities: give a checkpoint)";
+    throw std::invalid_argument(fmt::format("unknown colour field \"{}\"{}; available: {}", field, hint,
+                                            fmt::join(color_fields(pd), ", ")));
+  }
+  auto out = vtkSmartPointer<vtkDoubleArray>::New();
+  out->SetName(field.c_str());
+  const vtkIdType n = a->GetNumberOfTuples();
+  out->SetNumberOfTuples(n);
+  const int nc = a->GetNumberOfComponents();
+  for (vtkIdType i = 0; i < n; ++i) {
+    if (component >= 0) {
+      out->SetValue(i, a->GetComponent(i, component));
+    } else if (nc == 1) {
+      out->SetValue(i, a->GetComponent(i, 0));
+    } else {
+      double s = 0;
+      for (int c = 0; c < nc; ++c) s += a->GetComponent(i, c) * a->GetComponent(i, c);
+      out->SetValue(i, std::sqrt(s));
+    }
+  }
+  return out;
+}
+
+std::string field_units(const std::string& field, const io::Units& units) {
+  std::string base = field;
+  if (base.size() > 2 && base[base.size() - 2] == '_' &&
+      (base.back() == 'x' || base.back() == 'y' || base.back() == 'z'))
+    base = base.substr(0, base.size() - 2);
+  return quantity_units(base, units);
+}
+
+std::string field_title(const std::string& field, const io::Units& units) {
+  const std::string u = field_units(field, units);
+  return u.empty() ? field : fmt::format("{} ({})", field, u);
+}
+
+}  // namespace basalt::view

@@ -1,0 +1,127 @@
+// basalt-view: render checkpoints and geometries to PNG, convert them to VTK, plot field series.
+#include <fmt/format.h>
+#include <vtkPointData.h>
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <exception>
+#include <string>
+
+#include "basalt/version.hpp"
+#include "color_field.hpp"
+#include "convert_command.hpp"
+#include "display.hpp"
+#include "options.hpp"
+#include "particle_frame.hpp"
+#include "plot_command.hpp"
+#include "render_command.hpp"
+
+namespace bv = basalt::view;
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "basalt-view: render Basalt checkpoints and geometries to PNG, convert them to VTK for ParaView, "
+      "plot field series.\nRendering needs X: without DISPLAY, basalt-view runs itself under xvfb-run."};
+  app.set_version_flag("--version", std::string(basalt::kVersion));
+  app.require_subcommand(1);
+
+  bv::RenderOptions r;
+  std::string size = "1600x1200", view = "iso", cut, range, color;
+  std::string reference;
+  auto* render =
+      app.add_subcommand("render", "Draw the particles as spheres coloured by a field, write a PNG");
+  render->add_option("file", r.input, "checkpoint (.h5), geometry (.h5/.geo) or VTK frame (.vtp/.pvtp)")
+      ->required();
+  render->add_option("-o,--output", r.output, "PNG to write")->required();
+  render->add_option("--color", color,
+                     "field: speed, displacement, tag, id, radius, mass, velocity_z, any stored array "
+                     "(default: speed if present, else radius)");
+  render->add_option("--size", size, "image WIDTHxHEIGHT")->capture_default_str();
+  render->add_option("--view", view, "camera side: +x -x +y -y +z -z iso")->capture_default_str();
+  render->add_option("--cut", cut,
+                     "x|y|z[:VALUE]: drop the particles on the camera's side of this plane "
+                     "(default VALUE: the middle)");
+  render->add_option("--range", range, "MIN:MAX of the colour map (default: the field's range)");
+  render->add_option("--reference", reference, "initial geometry/checkpoint, for --color displacement");
+  render
+      ->add_option("--mapper", r.mapper, "imposter (ray-cast spheres, fast) or glyph (triangulated spheres)")
+      ->capture_default_str();
+  bool draw_all = false;
+  render->add_flag(
+      "--all", draw_all,
+      "draw every particle, also those buried inside the packing (slower; same picture up to a few "
+      "pixels)");
+  render->add_flag("-q,--quiet", r.quiet, "print nothing on success");
+
+  bv::ConvertOptions c;
+  std::string convert_reference;
+  auto* convert =
+      app.add_subcommand("convert", "Write VTK XML for ParaView: one input to .vtp, many to a .pvd series");
+  convert->add_option("files", c.inputs, "checkpoints (.h5) or geometries (.h5/.geo)")->required();
+  convert->add_option("-o,--output", c.output, "frame.vtp (one input) or series.pvd (any number)")
+      ->required();
+  convert->add_option("--reference", convert_reference,
+                      "initial geometry/checkpoint: adds a displacement array");
+  convert->add_flag("-q,--quiet", c.quiet, "print nothing on success");
+
+  bv::PlotOptions p;
+  std::string plot_size = "1200x800", columns, units_from;
+  auto* plot = app.add_subcommand("plot", "Plot field-saver series (fields.csv) against time, write a PNG");
+  plot->add_option("file", p.input, "CSV: step,time,<field>... then numeric rows")->required();
+  plot->add_option("-o,--output", p.output, "PNG to write")->required();
+  plot->add_option("--columns", columns, "comma-separated columns (default: all after step,time)");
+  plot->add_option("--units-from", units_from,
+                   "scene TOML whose [units] gives length/time/force (default mm, ms, N)");
+  plot->add_option("--ylabel", p.ylabel,
+                   "label of the vertical axis (default: from the column and its units)");
+  plot->add_option("--title", p.title, "title above the chart");
+  plot->add_option("--size", plot_size, "image WIDTHxHEIGHT")->capture_default_str();
+  plot->add_flag("-q,--quiet", p.quiet, "print nothing on success");
+
+  auto* info =
+      app.add_subcommand("info", "Print a file's particle count, clock and the fields it can be coloured by");
+  std::string info_file;
+  info->add_option("file", info_file, "checkpoint, geometry or VTK frame")->required();
+
+  CLI11_PARSE(app, argc, argv);
+
+  try {
+    if (render->parsed()) {
+      r.size = bv::parse_size(size);
+      r.view = bv::parse_view(view);
+      if (!cut.empty()) r.cut = bv::parse_cut(cut);
+      if (!range.empty()) r.range = bv::parse_range(range);
+      if (!reference.empty()) r.reference = reference;
+      r.color = color;
+      r.cull = !draw_all;
+      bv::ensure_display(argc, argv);
+      bv::render(r);
+    } else if (convert->parsed()) {
+      if (!convert_reference.empty()) c.reference = convert_reference;
+      bv::convert(c);
+    } else if (plot->parsed()) {
+      p.size = bv::parse_size(plot_size);
+      if (!columns.empty()) {
+        std::string rest = columns;
+        for (std::size_t comma; (comma = rest.find(',')) != std::string::npos; rest.erase(0, comma + 1))
+          p.columns.push_back(rest.substr(0, comma));
+        p.columns.push_back(rest);
+      }
+      if (!units_from.empty()) p.units_from = units_from;
+      bv::ensure_display(argc, argv);
+      bv::plot(p);
+    } else if (info->parsed()) {
+      const bv::Frame f = bv::read_frame(info_file, std::nullopt);
+      fmt::print("{}: {}, {} particles\n", info_file, f.kind, f.polydata->GetNumberOfPoints());
+      if (f.info.has_clock) fmt::print("step {}, time {} {}\n", f.info.step, f.info.time, f.info.units.time);
+      fmt::print("units: length {}, time {}, force {}\n", f.info.units.length, f.info.units.time,
+                 f.info.units.force);
+      fmt::print("colour fields: {}\n", fmt::join(bv::color_fields(*f.polydata), ", "));
+    }
+  } catch (const std::exception& e) {
+    std::fflush(stdout);
+    fmt::print(stderr, "basalt-view: error: {}\n", e.what());
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,42 @@
+#pragma once
+// What basalt-view draws or converts: one frame of particles read from a checkpoint (.h5),
+// a geometry (.h5/.geo) or a VTK file (.vtp/.pvtp), as a vtkPolyData with named point arrays.
+#include <vtkPolyData.h>
+#include <vtkSmartPointer.h>
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "basalt/io/checkpoint.hpp"
+#include "basalt/io/vtk_frames.hpp"
+
+namespace basalt::view {
+
+/// Particles read from a Basalt file, owning their arrays.
+struct ParticleSet {
+  io::Geometry geometry;
+  std::vector<io::Vec3> velocity;      ///< empty for a geometry
+  std::vector<io::Vec3> displacement;  ///< filled when a reference was given
+  io::FrameInfo info;
+  std::string kind;  ///< "checkpoint" or "geometry"
+
+  io::ParticleArrays arrays() const;
+};
+
+/// Reads a checkpoint or geometry (.h5, .hdf5, .geo). With `reference` (a geometry or checkpoint
+/// holding the initial positions), fills `displacement`. Throws io::FormatError naming the file.
+ParticleSet read_particles(const std::filesystem::path& file,
+                           const std::optional<std::filesystem::path>& reference);
+
+struct Frame {
+  vtkSmartPointer<vtkPolyData> polydata;
+  io::FrameInfo info;
+  std::string kind;  ///< "checkpoint", "geometry" or "VTK frame"
+};
+
+/// Any file basalt-view reads, as polydata (.vtp/.pvtp through VTK's readers).
+Frame read_frame(const std::filesystem::path& file, const std::optional<std::filesystem::path>& reference);
+
+}  // namespace basalt::view

@@ -1,0 +1,27 @@
+#pragma once
+// Choosing which particles to draw: the half kept by a cut plane, and the particles that can be
+// seen at all (a dense packing hides its interior; drawing it only costs time).
+#include <vtkPolyData.h>
+#include <vtkSmartPointer.h>
+
+#include <vector>
+
+#include "options.hpp"
+
+namespace basalt::view {
+
+/// Indices of the particles on the far side of the cut plane as seen from `view` (so the cut face
+/// looks at the camera); the plane sits at cut.value or the middle of the bounding box.
+std::vector<vtkIdType> cut_indices(vtkPolyData& pd, const Cut& cut, const ViewDirection& view);
+
+/// Drops particles buried in the packing: those whose cell of a grid with spacing `cell` (2 x the
+/// largest radius) and all 26 neighbouring cells hold particles, so that at least `cell` of packing
+/// lies between them and any empty space or the edge of the cloud. The camera is outside the cloud,
+/// so such particles are hidden behind others. Returns `indices` unchanged when the grid would be
+/// too large (sparse, scattered particles).
+std::vector<vtkIdType> drop_buried(vtkPolyData& pd, const std::vector<vtkIdType>& indices, double cell);
+
+/// A new polydata with the given points and all their point arrays, one vertex cell each.
+vtkSmartPointer<vtkPolyData> select_points(vtkPolyData& pd, const std::vector<vtkIdType>& indices);
+
+}  // namespace basalt::view
