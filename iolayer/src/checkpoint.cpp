@@ -35,6 +35,9 @@ void Checkpoint::validate(const fs::path& source) const {
     if (!finite(velocity[i]))
       throw FormatError(source, "/particles/velocity",
                         fmt::format("particle id {}: velocity is not finite", geometry.id[i]));
+  if (!inv_mass.empty() && inv_mass.size() != n)
+    throw FormatError(source, "/particles/inverse_mass",
+                      fmt::format("{} inverse masses for {} particles", inv_mass.size(), n));
   if (bond_rest_length.size() != m)
     throw FormatError(source, "/bonds/rest_length",
                       fmt::format("{} values for {} bonds", bond_rest_length.size(), m));

@@ -52,6 +52,8 @@ void write_checkpoint(const Checkpoint& c, const fs::path& file) {
     storage = c;
     storage.geometry.sort_by_id();  // the same stable order as `order`
     for (std::size_t k = 0; k < order.size(); ++k) storage.velocity[k] = c.velocity[order[k]];
+    if (!c.inv_mass.empty())
+      for (std::size_t k = 0; k < order.size(); ++k) storage.inv_mass[k] = c.inv_mass[order[k]];
     s = &storage;
   }
 
@@ -59,6 +61,7 @@ void write_checkpoint(const Checkpoint& c, const fs::path& file) {
   h5::write_schema(w, kSchema, kSchemaVersion);
   h5::write_geometry_layout(w, s->geometry, kRunAttributes);
   w.dataset("/particles/velocity", reinterpret_cast<const double*>(s->velocity.data()), s->size(), 3);
+  if (!s->inv_mass.empty()) w.dataset("/particles/inverse_mass", s->inv_mass);
   w.dataset("/bonds/rest_length", s->bond_rest_length);
   w.dataset("/bonds/broken", s->bond_broken);
   w.group("/walls");
@@ -96,6 +99,11 @@ Checkpoint read_checkpoint_unguarded(const fs::path& file) {
   c.velocity.resize(n);
   if (n) r.read_into("/particles/velocity", reinterpret_cast<double*>(c.velocity.data()));
 
+  if (r.exists("/particles/inverse_mass")) {
+    const auto irows = r.rows<double>("/particles/inverse_mass");
+    if (irows != n) r.fail("/particles/inverse_mass", fmt::format("{} values for {} particles", irows, n));
+    c.inv_mass = r.read<double>("/particles/inverse_mass");
+  }
   const auto lrows = r.rows<double>("/bonds/rest_length");
   if (lrows != m) r.fail("/bonds/rest_length", fmt::format("{} values for {} bonds", lrows, m));
   c.bond_rest_length = r.read<double>("/bonds/rest_length");

@@ -1,6 +1,9 @@
 #include "h5_support.hpp"
 
 #include <fcntl.h>
+#include <cerrno>
+#include <cstring>
+#include <vector>
 #include <fmt/format.h>
 #include <unistd.h>
 
@@ -271,7 +274,12 @@ Writer::Writer(const fs::path& file, const fs::path& temp) : file_(file), temp_(
     fail("", fmt::format("cannot create: folder '{}' does not exist", folder.string()));
   if (!fs::is_directory(folder, ec))
     fail("", fmt::format("cannot create: '{}' is not a folder", folder.string()));
-  file_id_ = Handle(H5Fcreate(temp.c_str(), H5F_ACC_TRUNC, fcpl.get(), H5P_DEFAULT), H5Fclose);
+  // The file is built in memory (core driver, no backing store) and written by commit() with plain
+  // POSIX calls: a full disk or a file-size limit then fails there with errno, named, and HDF5 never
+  // holds a half-written file it cannot close (it would crash at exit).
+  Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
+  if (!fapl.valid() || H5Pset_fapl_core(fapl.get(), 4 << 20, 0) < 0) fail("", "cannot set up the in-memory HDF5 file");
+  file_id_ = Handle(H5Fcreate(temp.c_str(), H5F_ACC_TRUNC, fcpl.get(), fapl.get()), H5Fclose);
   if (!file_id_.valid())
     fail("", fmt::format("cannot create '{}' (does the folder exist and is it writable?)", temp.string()));
 }
@@ -336,14 +344,33 @@ void Writer::write_numeric_attribute(const std::string& object, const std::strin
 }
 
 void Writer::commit() {
-  if (!file_id_.reset()) fail("", "cannot close the file (disk full?)");
-  // Make the bytes durable before the rename makes them visible under the final name.
-  const int fd = ::open(temp_.c_str(), O_RDONLY);
-  if (fd < 0 || ::fsync(fd) != 0) {
-    if (fd >= 0) ::close(fd);
-    fail("", fmt::format("cannot sync '{}' to disk", temp_.string()));
+  if (H5Fflush(file_id_.get(), H5F_SCOPE_GLOBAL) < 0) fail("", "cannot finish the file in memory");
+  const ssize_t size = H5Fget_file_image(file_id_.get(), nullptr, 0);
+  if (size < 0) fail("", "cannot take the file image");
+  std::vector<char> image(static_cast<std::size_t>(size));
+  if (H5Fget_file_image(file_id_.get(), image.data(), image.size()) != size) fail("", "cannot take the file image");
+  if (!file_id_.reset()) fail("", "cannot close the in-memory file");
+  // Write, then make the bytes durable before the rename makes them visible under the final name.
+  const int fd = ::open(temp_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  if (fd < 0) fail("", fmt::format("cannot create '{}': {}", temp_.string(), std::strerror(errno)));
+  std::size_t done = 0;
+  while (done < image.size()) {
+    const ssize_t n = ::write(fd, image.data() + done, image.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      const int err = n < 0 ? errno : ENOSPC;
+      ::close(fd);
+      fail("", fmt::format("cannot write '{}' ({} of {} bytes written): {}", temp_.string(), done, image.size(),
+                           std::strerror(err)));
+    }
+    done += static_cast<std::size_t>(n);
   }
-  ::close(fd);
+  if (::fsync(fd) != 0) {
+    const int err = errno;
+    ::close(fd);
+    fail("", fmt::format("cannot sync '{}' to disk: {}", temp_.string(), std::strerror(err)));
+  }
+  if (::close(fd) != 0) fail("", fmt::format("cannot close '{}': {}", temp_.string(), std::strerror(errno)));
   std::error_code ec;
   fs::rename(temp_, file_, ec);
   if (ec) fail("", fmt::format("cannot rename '{}' into place: {}", temp_.string(), ec.message()));

@@ -15,7 +15,9 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <map>
 
 #include "basalt/packer/error.hpp"
 #include "basalt/packer/volume.hpp"
@@ -40,6 +42,7 @@ class MeshVolume final : public Volume {
     volume_ = CGAL::to_double(PMP::volume(mesh_));
     auto bb = tree_.bbox();
     bounds_ = {{bb.xmin(), bb.ymin(), bb.zmin()}, {bb.xmax(), bb.ymax(), bb.zmax()}};
+    group_planes();
   }
   std::string description() const override {
     return fmt::format("mesh {} ({} triangles, volume {:.6g})", name_, mesh_.number_of_faces(), volume_);
@@ -51,11 +54,34 @@ class MeshVolume final : public Volume {
     double d = std::sqrt(CGAL::to_double(tree_.squared_distance(p)));
     return (*inside_)(p) == CGAL::ON_UNBOUNDED_SIDE ? -d : d;
   }
+  /// Each plane of the mesh (coplanar triangles grouped) is one flat piece: spheres touch the faces exactly
+  /// and edges and corners behave like a box's.
   void pieces_near(const Vec3& x, double reach, std::vector<BoundaryPiece>& out) const override {
     K::Point_3 p(x[0], x[1], x[2]);
-    if (tree_.squared_distance(p) <= reach * reach) out.push_back({0, false, tangent_plane(0, x)});
+    if (tree_.squared_distance(p) > reach * reach) return;
+    hits_.clear();
+    const CGAL::Bbox_3 box(x[0] - reach, x[1] - reach, x[2] - reach, x[0] + reach, x[1] + reach,
+                           x[2] + reach);
+    tree_.all_intersected_primitives(box, std::back_inserter(hits_));
+    const std::size_t first = out.size();
+    for (auto f : hits_) {
+      const int group = group_of_[f.idx()];
+      bool seen = false;
+      for (std::size_t k = first; k < out.size(); ++k) seen = seen || out[k].id == group;
+      if (seen) continue;
+      // Only faces whose plane's closest point to x lies on the face: mirroring across the plane of a face
+      // beyond a concave edge would put the ghost inside the volume.
+      const double d_face = std::sqrt(CGAL::to_double(CGAL::squared_distance(p, triangle(f))));
+      const double d_plane = std::abs(planes_[group].distance(x));
+      if (d_face <= reach && d_face - d_plane <= 1e-9 * (1 + d_face))
+        out.push_back({group, true, planes_[group]});
+    }
   }
-  Plane tangent_plane(int, const Vec3& x) const override {
+  Plane tangent_plane(int id, const Vec3& x) const override {
+    if (id >= 0) return planes_[id];
+    return closest_tangent_plane(x);
+  }
+  Plane closest_tangent_plane(const Vec3& x) const {
     K::Point_3 p(x[0], x[1], x[2]);
     auto [q, face] = tree_.closest_point_and_primitive(p);
     Vec3 qv{q.x(), q.y(), q.z()};
@@ -75,8 +101,38 @@ class MeshVolume final : public Volume {
   std::vector<std::string> piece_names() const override { return {"surface"}; }
 
  private:
+  K::Triangle_3 triangle(Mesh::Face_index f) const {
+    auto h = mesh_.halfedge(f);
+    return {mesh_.point(mesh_.source(h)), mesh_.point(mesh_.target(h)),
+            mesh_.point(mesh_.target(mesh_.next(h)))};
+  }
+
+  /// Groups coplanar triangles (same inward plane within 1e-9 of the mesh size) into one piece each.
+  void group_planes() {
+    const double scale = std::max(
+        {bounds_.hi[0] - bounds_.lo[0], bounds_.hi[1] - bounds_.lo[1], bounds_.hi[2] - bounds_.lo[2]});
+    group_of_.assign(mesh_.number_of_faces(), -1);
+    std::map<std::array<long long, 4>, int> index;
+    for (auto f : mesh_.faces()) {
+      auto nrm = PMP::compute_face_normal(f, mesh_);  // outward, unit
+      Plane pl;
+      pl.n = {-nrm.x(), -nrm.y(), -nrm.z()};
+      const auto& q = mesh_.point(mesh_.target(mesh_.halfedge(f)));
+      pl.d = dot(pl.n, Vec3{q.x(), q.y(), q.z()});
+      const std::array<long long, 4> key = {std::llround(pl.n[0] * 1e9), std::llround(pl.n[1] * 1e9),
+                                            std::llround(pl.n[2] * 1e9), std::llround(pl.d / scale * 1e9)};
+      auto [it, fresh] = index.emplace(key, static_cast<int>(planes_.size()));
+      if (fresh) planes_.push_back(pl);
+      const int found = it->second;
+      group_of_[f.idx()] = found;
+    }
+  }
+
   Mesh mesh_;
   std::string name_;
+  std::vector<Plane> planes_;
+  std::vector<int> group_of_;
+  mutable std::vector<Mesh::Face_index> hits_;
   Tree tree_;
   std::unique_ptr<Inside> inside_;
   double volume_ = 0;

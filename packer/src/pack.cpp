@@ -70,8 +70,9 @@ void check_options(const PackOptions& o) {
     if (!(o.target_fraction > 0 && o.target_fraction < 0.8))
       throw PackError(fmt::format("target solid fraction must be in (0, 0.8), got {}", o.target_fraction));
   }
-  if (!(o.seed_fraction >= 0 && o.seed_fraction < 0.35))
-    throw PackError(fmt::format("seed fraction must be in [0, 0.35), got {}", o.seed_fraction));
+  // Void filling grows from the seeds' triangulation: too few seeds leave regions it never reaches.
+  if (!(o.seed_fraction >= 0.05 && o.seed_fraction < 0.35))
+    throw PackError(fmt::format("seed fraction must be in [0.05, 0.35), got {}", o.seed_fraction));
 }
 
 std::vector<double> power_law_radii(double rmin, double rmax, double alpha, double solid_volume,

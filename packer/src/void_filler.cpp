@@ -56,8 +56,9 @@ struct Void {
   bool operator<(const Void& o) const { return cap != o.cap ? cap < o.cap : serial < o.serial; }
 };
 
-/// Dense mode's queue entry: voids are taken slab by slab along z (the working set stays in cache), and
-/// within a slab largest first. Stale entries (their cell has died since) are skipped when taken.
+/// Dense mode's queue entry: voids are taken block by block (6 rmax square in y and z, the working set stays
+/// in cache), and within a slab largest first. Stale entries (their cell has died since) are skipped when
+/// taken.
 struct QueuedVoid {
   Void v;
   std::int32_t slab;
@@ -298,8 +299,7 @@ class Filler {
     const double cap = std::min(ball->r, vol_.signed_distance(ball->c));
     if (!(cap >= rmin_ * (1 - 1e-12))) return;
     if (!ctx_.radii) {
-      queue_.push({Void{cap, info.serial, c, ball->c},
-                   static_cast<std::int32_t>(std::floor((ball->c[2] - zlo_) / slab_))});
+      queue_.push({Void{cap, info.serial, c, ball->c}, block_of(ball->c)});
       return;
     }
     info.cap = cap;
@@ -380,8 +380,17 @@ class Filler {
   std::uint64_t serial_ = 0;
   std::set<Void> voids_;                   // power-law mode: best fit by capacity
   std::priority_queue<QueuedVoid> queue_;  // dense mode
-  const double zlo_ = vol_.bounds().lo[2];
   const double slab_ = 6 * rmax_;
+  const Bounds bounds_ = vol_.bounds();
+  const std::int32_t ny_ = 1 + static_cast<std::int32_t>((bounds_.hi[1] - bounds_.lo[1]) / slab_);
+
+  /// Blocks of slab_ x slab_ across y and z (x runs the whole length), z slowest.
+  std::int32_t block_of(const Vec3& c) const {
+    const auto z = static_cast<std::int32_t>(std::floor((c[2] - bounds_.lo[2]) / slab_));
+    const auto y =
+        std::clamp(static_cast<std::int32_t>(std::floor((c[1] - bounds_.lo[1]) / slab_)), 0, ny_ - 1);
+    return z * ny_ + y;
+  }
   std::vector<int> ghost_piece_;
   std::vector<bool> piece_flat_;
   std::vector<Cell> conflicts_, incident_;

@@ -1,37 +1,56 @@
-// basalt-run: runs a scene (TOML) on the compute ranks.
-//   mpirun -np N basalt-run scenes/wave.toml [--geometry FILE] [--steps N] [--output DIR] [--dims x,y,z]
-//                                            [--quiet] [--force-dt]
-// Rank 0 prints a progress line (step, steps/s, particle-steps/s, ETA) and a summary of the time per
-// step split into phases. Field savers go to DIR/fields.csv (rank 0).
+// basalt-run: runs a scene (TOML) on P compute ranks with Q dedicated I/O ranks.
+//   mpirun -np P+Q basalt-run scenes/wave.toml [--io-ranks Q] [--geometry FILE] [--steps N] [--output DIR]
+//          [--dims x,y,z] [--checkpoint-every N] [--frames-every N] [--fields-every N]
+//          [--restart FILE|DIR] [--quiet] [--force-dt]
+// The only code that touches MPI_COMM_WORLD: it creates the output folder (world rank 0, a failure
+// stops every rank before anything starts) and splits the world into compute and I/O ranks. Compute
+// rank 0 prints progress, a summary of the time per step and the output report (docs/io-ranks.md).
+#include <fmt/format.h>
 #include <mpi.h>
+#include <sys/resource.h>
 
 #include <CLI/CLI.hpp>
 #include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
-#include <fmt/format.h>
+#include <fstream>
 #include <memory>
 #include <optional>
-#include <sys/resource.h>
 
+#include "basalt/io/checkpoint.hpp"
 #include "basalt/io/geometry.hpp"
+#include "basalt/io/io_ranks.hpp"
 #include "basalt/solver/core/errors.hpp"
-#include "basalt/solver/output/field_sink.hpp"
 #include "basalt/solver/parallel/communicator.hpp"
 #include "basalt/solver/scene/scene.hpp"
 #include "basalt/solver/simulation.hpp"
 #include "basalt/version.hpp"
+#include "client_sink.hpp"
+#include "restart_support.hpp"
+#include "vtk_frame_writer.hpp"
 
 namespace fs = std::filesystem;
 using namespace basalt::solver;
+namespace io = basalt::io;
 
 namespace {
 
+struct Cli {
+  std::string scene_file, geometry, output, dims_text, restart;
+  std::int64_t steps = -1;
+  bool quiet = false, force_dt = false, no_exact_restart = false;
+  int io_ranks = 0;
+  std::int64_t checkpoint_every = -1, frames_every = -1, fields_every = -1;
+  double throttle_mbps = 0;
+  int frames_in_flight = 0;
+};
 /// User + system CPU seconds of this process.
 double cpu_seconds() {
   rusage u{};
   getrusage(RUSAGE_SELF, &u);
-  return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+  return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
 }
 
 std::array<int, 3> parse_dims(const std::string& s) {
@@ -39,68 +58,120 @@ std::array<int, 3> parse_dims(const std::string& s) {
   if (s.empty()) return d;
   char c1 = 0, c2 = 0;
   int n = 0;
-  if (std::sscanf(s.c_str(), "%d%c%d%c%d%n", &d[0], &c1, &d[1], &c2, &d[2], &n) != 5 || c1 != ',' || c2 != ',' ||
-      static_cast<std::size_t>(n) != s.size() || d[0] < 1 || d[1] < 1 || d[2] < 1)
+  if (std::sscanf(s.c_str(), "%d%c%d%c%d%n", &d[0], &c1, &d[1], &c2, &d[2], &n) != 5 || c1 != ',' ||
+      c2 != ',' || static_cast<std::size_t>(n) != s.size() || d[0] < 1 || d[1] < 1 || d[2] < 1)
     throw InputError(fmt::format("--dims {}: expected three positive integers, e.g. --dims 2,1,1", s));
   return d;
 }
 
-int run(int argc, char** argv, MPI_Comm compute) {
-  const Comm comm(compute);
-  const bool root = comm.rank() == 0;
-  CLI::App app{"basalt-run: parallel DEM solver (Basalt)"};
-  std::string scene_file, geometry, output, dims_text;
-  std::int64_t steps = -1;
-  bool quiet = false, force_dt = false;
-  app.add_option("scene", scene_file, "scene file (TOML, docs/scenes.md)")->required();
-  app.add_option("--geometry", geometry, "geometry file (.h5 or .geo); overrides the scene's geometry.file");
-  app.add_option("--steps", steps, "number of steps; overrides run.steps")->check(CLI::NonNegativeNumber);
-  app.add_option("--output", output, "output folder; overrides output.directory");
-  app.add_option("--dims", dims_text, "rank grid x,y,z (default: MPI_Dims_create)");
-  app.add_flag("--quiet", quiet, "no progress line");
-  app.add_flag("--force-dt", force_dt, "run even when dt exceeds the critical time step");
-  app.set_version_flag("--version", std::string(basalt::kVersion));
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    if (root) return app.exit(e);
-    return e.get_exit_code();
+/// World rank 0 creates the output folder and checks it can write there; every rank learns the outcome.
+void prepare_output_folder(const fs::path& dir) {
+  int rank = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  std::optional<std::string> error;
+  if (rank == 0) {
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    if (ec) {
+      error = fmt::format("{}: cannot create the output folder: {}", dir.string(), ec.message());
+    } else {
+      const fs::path probe = dir / ".basalt-write-probe";
+      std::ofstream f(probe);
+      if (!f || !(f << "ok\n") || !f.flush())
+        error = fmt::format("{}: the output folder is not writable", dir.string());
+      f.close();
+      fs::remove(probe, ec);
+    }
   }
+  if (auto e = Comm(MPI_COMM_WORLD).agree_error(error)) throw InputError(*e);
+}
 
-  Scene scene = parse_scene(scene_file);
-  if (!geometry.empty()) scene.geometry = geometry;
-  if (steps >= 0) scene.steps = steps;
-  if (!output.empty()) scene.output_dir = output;
-  if (!fs::exists(scene.geometry))
-    throw InputError(fmt::format("{}: geometry file {} does not exist{}", scene_file, scene.geometry.string(),
-                                 geometry.empty() ? " (geometry.file; --geometry overrides it)" : " (--geometry)"));
+std::string mb(std::uint64_t bytes) { return fmt::format("{:.2f} MB", double(bytes) * 1e-6); }
+
+void print_report(const io::OutputReport& r, int n_io) {
+  auto kind = [](const char* name, const io::OutputKindReport& k) {
+    return fmt::format("  {:<12} {:>5} files {:>12}  write {:8.3f} s\n", name, k.files, mb(k.bytes),
+                       k.write_seconds);
+  };
+  std::string text = fmt::format("output ({}):\n", n_io > 0 ? fmt::format("{} I/O rank(s)", n_io)
+                                                            : std::string("written by the compute ranks"));
+  text += kind("checkpoints", r.checkpoints) + kind("frames", r.frames) + kind("fields", r.fields);
+  text += fmt::format("  compute ranks waited {:.4f} s for output", r.compute_wait_seconds);
+  if (n_io > 0)
+    text += fmt::format("; I/O rank CPU time {:.3f} s over {:.3f} s wall ({:.1f} %)", r.io_cpu_seconds,
+                        r.io_wall_seconds, 100 * r.io_cpu_seconds / std::max(r.io_wall_seconds, 1e-12));
+  fmt::print("{}\n", text);
+}
+
+int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::OutputConfig cfg,
+                const io::VtkFrameWriter& vtk, const io::Checkpoint* ckpt, const fs::path& ckpt_file) {
+  const Comm comm(layout.compute);
+  const bool root = comm.rank() == 0;
   RunOptions options;
-  options.dims = parse_dims(dims_text);
-  options.quiet = quiet;
-  options.force_dt = force_dt;
+  options.dims = parse_dims(cli.dims_text);
+  options.quiet = cli.quiet;
+  options.force_dt = cli.force_dt;
 
   const auto t0 = std::chrono::steady_clock::now();
   std::unique_ptr<Simulation<double>> sim;
-  {
-    auto g = basalt::io::read_geometry(scene.geometry);
-    if (root && (g.units.length != scene.units.length || g.units.time != scene.units.time ||
-                 g.units.force != scene.units.force))
-      fmt::print(stderr, "warning: the geometry declares units {}, {}, {}; the scene {}, {}, {}\n", g.units.length,
-                 g.units.time, g.units.force, scene.units.length, scene.units.time, scene.units.force);
-    sim = std::make_unique<Simulation<double>>(scene, std::move(g), compute, options);
+  io::RunInfo info;
+  std::optional<std::string> setup_error;
+  try {
+    if (ckpt) {
+      sim = std::make_unique<Simulation<double>>(
+          scene, *ckpt, basalt::run::restart_layout_of(*ckpt, ckpt_file), layout.compute, options);
+      info.box_min = ckpt->geometry.box_min;
+      info.box_max = ckpt->geometry.box_max;
+      info.periodic = ckpt->geometry.periodic;
+      info.units = ckpt->geometry.units;
+    } else {
+      auto g = io::read_geometry(scene.geometry);
+      if (root && (g.units.length != scene.units.length || g.units.time != scene.units.time ||
+                   g.units.force != scene.units.force))
+        fmt::print(stderr, "warning: the geometry declares units {}, {}, {}; the scene {}, {}, {}\n",
+                   g.units.length, g.units.time, g.units.force, scene.units.length, scene.units.time,
+                   scene.units.force);
+      info.box_min = g.box_min;
+      info.box_max = g.box_max;
+      info.periodic = g.periodic;
+      info.units = g.units;
+      sim = std::make_unique<Simulation<double>>(scene, std::move(g), layout.compute, options);
+    }
+    info.attributes = basalt::run::restart_attributes(sim->restart_layout());
+    info.attributes["code_version"] = std::string(basalt::kVersion);
+    info.scene_text = scene.text;
+  } catch (const std::exception& e) {
+    setup_error = e.what();
   }
+  if (setup_error) {
+    // Release the I/O ranks (they wait for the run's information), then report.
+    cfg.checkpoint_every = cfg.frames_every = cfg.fields_every = 0;
+    io::OutputClient client(layout, cfg, info, vtk);
+    client.finish();
+    throw InputError(*setup_error);
+  }
+
+  std::int64_t steps = scene.steps;
+  if (ckpt) steps = cli.steps >= 0 ? cli.steps : std::max<std::int64_t>(0, scene.steps - ckpt->step);
   const auto& st = sim->stability();
   if (root) {
-    fmt::print("basalt-run {}: {} particles, {} bonds on {} rank(s) ({}x{}x{}), {} steps of dt = {} {}\n",
-               basalt::kVersion, sim->total_particles(), sim->bond_count(), comm.size(), sim->decomposition().dims()[0],
-               sim->decomposition().dims()[1], sim->decomposition().dims()[2], scene.steps, scene.dt, scene.units.time);
+    fmt::print(
+        "basalt-run {}: {} particles, {} bonds on {} compute rank(s) ({}x{}x{}) + {} I/O rank(s), {} steps "
+        "of "
+        "dt = {} {}{}\n",
+        basalt::kVersion, sim->total_particles(), sim->bond_count(), comm.size(),
+        sim->decomposition().dims()[0], sim->decomposition().dims()[1], sim->decomposition().dims()[2],
+        layout.n_io, steps, scene.dt, scene.units.time,
+        ckpt ? fmt::format(", continuing from step {} ({})", ckpt->step, ckpt_file.string()) : std::string());
     if (st.dt_critical > 0)
-      fmt::print("time step: dt = {:.3g} x critical step {:.4g} (2 sqrt(m_min/k_max), m_min = {:.4g}, k_max = {:.4g}); "
-                 "safe fraction {}\n",
-                 st.fraction, st.dt_critical, st.m_min, st.k_max, scene.dt_safety);
+      fmt::print(
+          "time step: dt = {:.3g} x critical step {:.4g} (2 sqrt(m_min/k_max), m_min = {:.4g}, k_max = "
+          "{:.4g}); "
+          "safe fraction {}\n",
+          st.fraction, st.dt_critical, st.m_min, st.k_max, scene.dt_safety);
     if (st.warn)
-      fmt::print(stderr, "warning: dt = {} is {:.3g} x the critical time step, above the safe fraction {}\n", scene.dt,
-                 st.fraction, scene.dt_safety);
+      fmt::print(stderr, "warning: dt = {} is {:.3g} x the critical time step, above the safe fraction {}\n",
+                 scene.dt, st.fraction, scene.dt_safety);
     if (sim->unassigned_bonds() > 0)
       fmt::print(stderr, "warning: {} bonds of the geometry match no bond interaction and exert no force\n",
                  sim->unassigned_bonds());
@@ -108,34 +179,47 @@ int run(int argc, char** argv, MPI_Comm compute) {
     (void)sim->bond_count();
   }
 
-  std::unique_ptr<FieldSink> sink;
-  std::optional<std::string> sink_error;
-  if (root && !scene.fields.empty()) {
-    try {
-      sink = std::make_unique<CsvFieldSink>(scene.output_dir);
-      sink->begin(field_columns(scene));
-    } catch (const std::exception& e) {
-      sink_error = e.what();
-    }
-  }
-  if (auto e = comm.agree_error(sink_error)) throw InputError(*e);
-
+  io::OutputClient client(layout, cfg, info, vtk);
+  basalt::run::ClientSink sink(client, cfg.continue_on_error);
+  // Checkpoint steps are restart points: the lists are rebuilt there in canonical order.
+  sim->set_canonical_every(scene.exact_restart ? cfg.checkpoint_every : 0);
   const double startup = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const auto t1 = std::chrono::steady_clock::now();
   const double cpu0 = cpu_seconds();
-  sim->run(scene.steps, sink.get());
-  const double loop = comm.max(std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count());
-  const double cpu = comm.max(cpu_seconds() - cpu0);
+  std::optional<std::string> run_error;
+  if (client.error() && !cfg.continue_on_error) {
+    run_error = *client.error();
+  } else {
+    try {
+      sim->run(steps, sink);
+    } catch (const std::exception& e) {
+      run_error = e.what();  // raised alike on every compute rank
+    }
+  }
+  const double loop_local = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+  const double cpu_local = cpu_seconds() - cpu0;
+  const io::OutputReport report = client.finish();
+  // An error the I/O ranks reported after the last check still fails the run (unless "continue").
+  if (!run_error && report.error && !cfg.continue_on_error)
+    run_error = fmt::format("output failed (reported at the end of the run): {}", *report.error);
+  if (run_error) {
+    if (root) print_report(report, layout.n_io);
+    throw RunError(*run_error);
+  }
+  const double loop = comm.max(loop_local);
+  const double cpu = comm.max(cpu_local);
 
   const auto& t = sim->times();
-  const double n = std::max<double>(1, double(scene.steps));
+  const double n = std::max<double>(1, double(steps));
   const double parts[5] = {comm.max(t.forces), comm.max(t.neighbor), comm.max(t.communication),
                            comm.max(t.integration), comm.max(t.output)};
   const double mem = comm.sum(double(sim->memory_bytes()));
   if (root) {
-    const double ps = double(sim->total_particles()) * double(scene.steps) / std::max(loop, 1e-12);
-    fmt::print("done: {} steps in {:.3f} s ({:.1f} steps/s, {:.3f} M particle-steps/s); start-up {:.3f} s; {} rebuilds\n",
-               scene.steps, loop, double(scene.steps) / std::max(loop, 1e-12), ps * 1e-6, startup, sim->rebuilds());
+    const double ps = double(sim->total_particles()) * double(steps) / std::max(loop, 1e-12);
+    fmt::print(
+        "done: {} steps in {:.3f} s ({:.1f} steps/s, {:.3f} M particle-steps/s); start-up {:.3f} s; {} "
+        "rebuilds\n",
+        steps, loop, double(steps) / std::max(loop, 1e-12), ps * 1e-6, startup, sim->rebuilds());
     fmt::print("cpu time of the loop: {:.3f} s per rank (max), {:.0f} % of the wall time{}\n", cpu,
                100 * cpu / std::max(loop, 1e-12),
                cpu < 0.8 * loop ? ": the machine is shared, the wall time is inflated" : "");
@@ -147,29 +231,138 @@ int run(int argc, char** argv, MPI_Comm compute) {
     fmt::print("{}\n", line);
     fmt::print("solver arrays: {:.1f} MB ({:.0f} bytes per particle)\n", mem / 1e6,
                mem / double(sim->total_particles()));
-    if (sink) fmt::print("fields: {}\n", static_cast<CsvFieldSink*>(sink.get())->path().string());
+    print_report(report, layout.n_io);
+    if (cfg.fields_every > 0) fmt::print("fields: {}\n", (cfg.dir / "fields.csv").string());
+    if (report.error)
+      fmt::print(stderr, "basalt-run: warning: output failed (on_error = \"continue\"): {}\n", *report.error);
   }
   return 0;
+}
+
+int run_world(int argc, char** argv) {
+  int world_rank = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &world_rank);
+  const bool world_root = world_rank == 0;
+  Cli cli;
+  CLI::App app{"basalt-run: parallel DEM solver (Basalt)"};
+  app.add_option("scene", cli.scene_file, "scene file (TOML, docs/scenes.md)")->required();
+  app.add_option("--geometry", cli.geometry,
+                 "geometry file (.h5 or .geo); overrides the scene's geometry.file");
+  app.add_option("--steps", cli.steps, "number of steps; overrides run.steps (with --restart: steps to add)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--output", cli.output, "output folder; overrides output.directory");
+  app.add_option("--dims", cli.dims_text, "compute-rank grid x,y,z (default: MPI_Dims_create)");
+  app.add_option("--io-ranks", cli.io_ranks,
+                 "dedicated I/O ranks among the mpirun ranks (0: compute ranks write)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--checkpoint-every", cli.checkpoint_every, "HDF5 checkpoint every N steps (0 = off)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--frames-every", cli.frames_every, "VTK frame every N steps (0 = off)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--fields-every", cli.fields_every, "every field saver every N steps (0 = off)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--restart", cli.restart,
+                 "continue from a checkpoint, or from the latest complete one in a folder");
+  app.add_option("--frames-in-flight", cli.frames_in_flight, "frames a compute rank may have posted (bound)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--throttle-io-mbps", cli.throttle_mbps,
+                 "benchmark only: make output storage this slow (MB/s)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_flag("--no-exact-restart", cli.no_exact_restart,
+               "checkpoint steps are not bit-for-bit restart points (saves one list rebuild per checkpoint)");
+  app.add_flag("--quiet", cli.quiet, "no progress line");
+  app.add_flag("--force-dt", cli.force_dt, "run even when dt exceeds the critical time step");
+  app.set_version_flag("--version", std::string(basalt::kVersion));
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (world_root) return app.exit(e);
+    return e.get_exit_code();
+  }
+
+  Scene scene = parse_scene(cli.scene_file);
+  if (!cli.geometry.empty()) scene.geometry = cli.geometry;
+  if (cli.steps >= 0) scene.steps = cli.steps;
+  if (!cli.output.empty()) scene.output_dir = cli.output;
+  if (cli.checkpoint_every >= 0) scene.checkpoint_every = cli.checkpoint_every;
+  if (cli.frames_every >= 0) scene.frames_every = cli.frames_every;
+  if (cli.fields_every == 0) scene.fields.clear();
+  if (cli.fields_every > 0)
+    for (auto& f : scene.fields) f.every = cli.fields_every;
+  if (cli.frames_in_flight > 0) scene.frames_in_flight = cli.frames_in_flight;
+  if (cli.no_exact_restart) scene.exact_restart = false;
+
+  // A restart reads its checkpoint on every rank (so that a bad one stops all ranks alike, early).
+  std::optional<io::Checkpoint> ckpt;
+  fs::path ckpt_file;
+  if (!cli.restart.empty()) {
+    ckpt_file = basalt::run::resolve_restart(cli.restart);
+    try {
+      ckpt = io::read_checkpoint(ckpt_file);
+    } catch (const std::exception& e) {
+      throw InputError(fmt::format("--restart: {}", e.what()));
+    }
+    basalt::run::check_same_scene(*ckpt, ckpt_file, scene);
+    (void)basalt::run::restart_layout_of(*ckpt, ckpt_file);
+  } else if (!fs::exists(scene.geometry)) {
+    throw InputError(
+        fmt::format("{}: geometry file {} does not exist{}", cli.scene_file, scene.geometry.string(),
+                    cli.geometry.empty() ? " (geometry.file; --geometry overrides it)" : " (--geometry)"));
+  }
+
+  prepare_output_folder(scene.output_dir);
+  if (ckpt && world_root && !scene.fields.empty())
+    basalt::run::truncate_fields(scene.output_dir / "fields.csv", ckpt->step);
+
+  io::OutputConfig cfg;
+  cfg.dir = scene.output_dir;
+  cfg.checkpoint_every = scene.checkpoint_every;
+  cfg.frames_every = scene.frames_every;
+  cfg.fields_every = scene.fields.empty() ? 0 : 1;  // the solver decides which savers are due
+  cfg.field_names = field_columns(scene);
+  cfg.max_frames_in_flight = static_cast<int>(scene.frames_in_flight);
+  cfg.continue_on_error = scene.output_continue_on_error;
+  cfg.throttle_mb_per_s = cli.throttle_mbps;
+  cfg.append_fields = ckpt.has_value();
+  const auto vtk = basalt::run::make_vtk_frame_writer(
+      io::Units{scene.units.length, scene.units.time, scene.units.force, io::Units{}.mass},
+      ckpt ? ckpt->time : -1.0);
+
+  io::RankLayout layout;
+  try {
+    layout = io::split_ranks(MPI_COMM_WORLD, cli.io_ranks);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(e.what());
+  }
+  struct Free {
+    io::RankLayout& l;
+    ~Free() { io::free_layout(l); }
+  } free_layout{layout};
+  if (layout.is_io) {
+    // I/O ranks print nothing but errors (compute rank 0 prints the report).
+    io::IoServer server(layout, cfg, vtk);
+    const auto report = server.run();
+    return report.error && !cfg.continue_on_error ? 1 : 0;
+  }
+  return run_compute(cli, scene, layout, cfg, vtk, ckpt ? &*ckpt : nullptr, ckpt_file);
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
+  // A file-size limit (ulimit -f) must make the write fail with EFBIG, named, not kill the rank.
+  std::signal(SIGXFSZ, SIG_IGN);
   MPI_Init(&argc, &argv);
   int rank = 0;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  // The compute communicator: today all ranks; the I/O-ranks issue will split some off here.
-  MPI_Comm compute = MPI_COMM_NULL;
-  MPI_Comm_dup(MPI_COMM_WORLD, &compute);
   int code = 0;
   try {
-    code = run(argc, argv, compute);
+    code = run_world(argc, argv);
   } catch (const std::exception& e) {
-    // Every error reaching here is raised alike on all ranks (scene, geometry, agreed run errors).
+    // Every error reaching here is raised alike on all compute ranks (scene, geometry, agreed run errors).
     if (rank == 0) fmt::print(stderr, "basalt-run: error: {}\n", e.what());
     code = 1;
   }
-  MPI_Comm_free(&compute);
   MPI_Finalize();
   return code;
 }

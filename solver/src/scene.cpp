@@ -160,6 +160,14 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
       fs::path d = t.string("directory");
       s.output_dir = d.is_absolute() ? d : base_dir / d;
     }
+    s.checkpoint_every = t.integer_or("checkpoint_every", 0);
+    if (s.checkpoint_every < 0) t.fail("checkpoint_every", fmt::format("must be >= 0 (0 = off), got {}", s.checkpoint_every));
+    s.frames_every = t.integer_or("frames_every", 0);
+    if (s.frames_every < 0) t.fail("frames_every", fmt::format("must be >= 0 (0 = off), got {}", s.frames_every));
+    s.output_continue_on_error = t.choice_or("on_error", {"stop", "continue"}, "stop") == "continue";
+    s.exact_restart = t.boolean_or("exact_restart", true);
+    s.frames_in_flight = t.integer_or("frames_in_flight", 2);
+    if (s.frames_in_flight < 1) t.fail("frames_in_flight", fmt::format("must be >= 1, got {}", s.frames_in_flight));
     if (const auto* arr = t.table_array("fields")) {
       for (std::size_t k = 0; k < arr->size(); ++k) {
         TableReader tf(*(*arr)[k].as_table(), label, fmt::format("output.fields[{}]", k));

@@ -282,6 +282,8 @@ void Simulation<Real>::rebuild() {
                                  total, n_global_));
   }
   times_.communication += sw.lap();
+  if (canonical_) canonical_order();
+  canonical_ = false;
   spatial_sort();
   times_.neighbor += sw.lap();
   if (parallel) halo_->build_ghosts(p_, ghost_width_);
@@ -368,7 +370,8 @@ void Simulation<Real>::step(FieldSink* sink) {
   if (parallel) need = comm().max(need);
   times_.communication += sw.lap();
   bool in_flight = false;
-  if (!(need <= rebuild_limit2_)) {
+  canonical_ = canonical_due(step_ + 1);  // a restart point: rebuild in canonical order
+  if (!(need <= rebuild_limit2_) || canonical_) {
     rebuild();
     sw.lap();
   } else if (parallel) {
@@ -394,43 +397,10 @@ void Simulation<Real>::step(FieldSink* sink) {
 
 template <class Real>
 void Simulation<Real>::save_fields(FieldSink* sink, const std::array<double, 3>& pe) {
+  if (output_) return output_fields(pe);
   std::vector<double> local;
   std::vector<char> due;
-  bool any = false;
-  for (const auto& f : scene_.fields) {
-    const bool d = step_ % f.every == 0;
-    any = any || d;
-    const std::size_t width = f.type == FieldSpec::Type::wall_force ? 3 : 1;
-    for (std::size_t c = 0; c < width; ++c) due.push_back(d);
-    if (!d) {
-      local.insert(local.end(), width, 0.0);
-      continue;
-    }
-    switch (f.type) {
-      case FieldSpec::Type::kinetic_energy:
-        local.push_back(kinetic_energy_local());
-        break;
-      case FieldSpec::Type::bond_potential_energy:
-        local.push_back(pe[0]);
-        break;
-      case FieldSpec::Type::contact_potential_energy:
-        local.push_back(pe[1]);
-        break;
-      case FieldSpec::Type::wall_potential_energy:
-        local.push_back(pe[2]);
-        break;
-      case FieldSpec::Type::bond_count:
-        local.push_back(double(BondDriver<Real, LinearBond>::count(p_, bonds_)));
-        break;
-      case FieldSpec::Type::wall_force: {
-        std::size_t w = 0;
-        while (wall_driver_.spec(w).name != f.wall) ++w;
-        const auto& fw = wall_driver_.force(w);
-        local.insert(local.end(), fw.begin(), fw.end());
-        break;
-      }
-    }
-  }
+  const bool any = field_partials(pe, local, due);
   if (!any) return;
   if (comm().size() == 1) {
     if (!sink) return;

@@ -97,6 +97,39 @@ TEST(Pack, ClosedTriangleMeshVolume) {
   auto box = make_box({0, 0, 0}, {5, 5, 5});
   EXPECT_LE(chk::worst_protrusion(*box, p), 1e-6);
   EXPECT_GT(chk::solid_fraction(*mesh, p), 0.6);
+  // Mesh faces are flat pieces: spheres touch them exactly, as they touch a box's walls.
+  int touching_floor = 0;
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (std::abs(p.centre[i][2] - p.radius[i]) < 1e-9) ++touching_floor;
+  EXPECT_GT(touching_floor, 5);
+}
+
+TEST(Pack, NonConvexMeshVolume) {
+  // An L-shaped prism: the union of [0,4]x[0,2] and [0,2]x[0,4], 3 high (polygon faces, triangulated by
+  // CGAL).
+  const auto dir = basalt::test::scratch_dir("packer-lmesh");
+  chk::write_text(
+      dir / "L.off",
+      "OFF\n12 8 0\n0 0 0\n4 0 0\n4 2 0\n2 2 0\n2 4 0\n0 4 0\n0 0 3\n4 0 3\n4 2 3\n2 2 3\n"
+      "2 4 3\n0 4 3\n6 5 4 3 2 1 0\n6 6 7 8 9 10 11\n4 0 1 7 6\n4 1 2 8 7\n4 2 3 9 8\n4 3 4 10 9\n"
+      "4 4 5 11 10\n4 5 0 6 11\n");
+  auto mesh = load_mesh(dir / "L.off");
+  EXPECT_NEAR(mesh->measure(), 36.0, 1e-9);
+  const auto o = options(0.15, 0.6, 12);
+  const auto p = pack(*mesh, o);
+  expect_valid(*mesh, p, o);
+  // Inside the L by an analytic test, independent of CGAL.
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const auto& c = p.centre[i];
+    const double r = p.radius[i] - 1e-6;
+    const bool arm1 = c[0] >= r && c[0] <= 4 - r && c[1] >= r && c[1] <= 2 - r;
+    const bool arm2 = c[0] >= r && c[0] <= 2 - r && c[1] >= r && c[1] <= 4 - r;
+    const bool corner = c[0] >= r && c[1] >= r && c[0] <= 4 - r && c[1] <= 4 - r &&
+                        (c[0] <= 2 || c[1] <= 2) &&
+                        (c[0] <= 2 - r || c[1] <= 2 - r || std::hypot(c[0] - 2, c[1] - 2) >= r);
+    EXPECT_TRUE((arm1 || arm2 || corner) && c[2] >= r && c[2] <= 3 - r) << "sphere " << i << " pokes out";
+  }
+  EXPECT_GT(chk::solid_fraction(*mesh, p), 0.5);  // 3 high with rmax 0.6: mostly wall layer
 }
 
 TEST(Pack, BadMeshesAreRefusedWithTheReason) {
@@ -292,6 +325,9 @@ TEST(Pack, ImpossibleRequestsAreRefused) {
   chk::write_text(dir / "tet.off",
                   "OFF\n4 4 0\n0 0 0\n4 0 0\n0 4 0\n0 0 4\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n");
   expect_error(*load_mesh(dir / "tet.off"), options(0.9, 1.0), "too small for one sphere");
+  auto few = options(0.2, 1.0);
+  few.seed_fraction = 0.0;
+  expect_error(*box, few, "seed fraction must be in");
   auto pl = options(0.2, 1.0);
   pl.exponent = -1;
   expect_error(*box, pl, "exponent must be > 0");
@@ -305,4 +341,17 @@ TEST(Pack, ASmallVolumeHoldsAtLeastOneSphere) {
   const auto o = options(0.2, 1.0);
   const auto p = pack(*box, o);
   expect_valid(*box, p, o);
+}
+
+TEST(Pack, ProgressIsReportedAndEndsAtOne) {
+  auto box = make_box({0, 0, 0}, {15, 15, 15});  // ~5,000 spheres: progress every 4,096 placements
+  auto o = options(0.2, 1.0, 6);
+  std::vector<double> seen;
+  o.progress = [&](double f) { seen.push_back(f); };
+  const auto p = pack(*box, o);
+  ASSERT_GE(seen.size(), 2u) << p.size() << " spheres";
+  EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
+  EXPECT_GT(seen.front(), 0.0);
+  EXPECT_LT(seen[seen.size() - 2], 1.0);
+  EXPECT_EQ(seen.back(), 1.0);
 }

@@ -1,5 +1,6 @@
 // basalt-view end to end: the command run as a user would, without DISPLAY (it starts its own
 // virtual X server), its outputs checked through VTK's readers: PNG size and content, VTK frames.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <vtkDataArray.h>
@@ -43,9 +44,10 @@ struct Outcome {
   std::string out;  ///< stdout and stderr together
 };
 
-Outcome basalt_view(const std::string& args, const fs::path& dir) {
+Outcome basalt_view(const std::string& args, const fs::path& dir, const std::string& env = "") {
   const fs::path log = dir / "basalt-view.log";
-  const std::string cmd = "env -u DISPLAY " BASALT_VIEW_EXE " " + args + " > '" + log.string() + "' 2>&1";
+  const std::string cmd =
+      fmt::format("env -u DISPLAY {} {} {} > '{}' 2>&1", env, BASALT_VIEW_EXE, args, log.string());
   const int status = std::system(cmd.c_str());
   Outcome r;
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128;
@@ -265,6 +267,21 @@ TEST(BasaltView, ConvertsManyInputsToAPvdSeries) {
   for (vtkIdType i = 0; i < 20; ++i)
     EXPECT_EQ(pd->GetPoint(i)[2], b_read.position[static_cast<std::size_t>(i)][2]);
 
+  // A missing input is found before anything is written.
+  r = basalt_view(fmt_args("convert", (dir / "a.geo").string(), (dir / "nope.geo").string(), "-o",
+                           (dir / "other.pvd").string()),
+                  dir);
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.out.find("nope.geo: no such file"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(dir / "other"));
+  EXPECT_FALSE(fs::exists(dir / "other.pvd"));
+
+  // An output folder that does not exist.
+  r = basalt_view(fmt_args("convert", (dir / "a.geo").string(), "-o", (dir / "missing" / "a.vtp").string()),
+                  dir);
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.out.find("does not exist"), std::string::npos) << r.out;
+
   // Several inputs cannot go to one .vtp.
   r = basalt_view(fmt_args("convert", (dir / "a.geo").string(), (dir / "b.geo").string(), "-o",
                            (dir / "one.vtp").string()),
@@ -377,4 +394,68 @@ TEST(BasaltView, ConvertsCheckpointsToASeriesInTimeOrder) {
     EXPECT_EQ(v->GetComponent(i, 0), 0.5);
     EXPECT_EQ(v->GetComponent(i, 2), c.velocity[static_cast<std::size_t>(i)][2]);
   }
+}
+
+TEST(BasaltView, RendersAParallelFrameAndReportsItsFields) {
+  const fs::path dir = basalt::test::scratch_dir("view-pvtp");
+  // The lattice split in two pieces, as two I/O ranks write it.
+  const basalt::io::Checkpoint c = lattice_checkpoint();
+  const auto all = basalt::io::arrays_of(c);
+  const std::size_t half = c.size() / 2;
+  basalt::io::ParticleArrays lo = all, hi = all;
+  lo.id = all.id.subspan(0, half);
+  lo.position = all.position.subspan(0, half);
+  lo.radius = all.radius.subspan(0, half);
+  lo.tag = all.tag.subspan(0, half);
+  lo.velocity = all.velocity.subspan(0, half);
+  lo.mass = all.mass.subspan(0, half);
+  hi.id = all.id.subspan(half);
+  hi.position = all.position.subspan(half);
+  hi.radius = all.radius.subspan(half);
+  hi.tag = all.tag.subspan(half);
+  hi.velocity = all.velocity.subspan(half);
+  hi.mass = all.mass.subspan(half);
+  const auto layout = basalt::io::layout_of(all);
+  basalt::io::write_piece(dir, c.step, 0, 2, lo, basalt::io::info_of(c), layout);
+  basalt::io::write_piece(dir, c.step, 1, 2, hi, basalt::io::info_of(c), layout);
+  const fs::path pvtp = basalt::io::write_pvtp(dir, c.step, 2, layout);
+
+  Outcome r = basalt_view(fmt_args("info", pvtp.string()), dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("1728 particles"), std::string::npos) << r.out;
+  EXPECT_NE(
+      r.out.find("colour fields: id, radius, tag, mass, velocity, velocity_x, velocity_y, velocity_z, speed"),
+      std::string::npos)
+      << r.out;
+
+  r = basalt_view(fmt_args("render", pvtp.string(), "-o", (dir / "p.png").string(),
+                           "--size 400x300 --view -y --color velocity_z"),
+                  dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  const Image img = read_png(dir / "p.png");
+  EXPECT_GT(img.count(kLow, 30, kSceneFraction), 30);   // bottom half (piece 0) at rest
+  EXPECT_GT(img.count(kHigh, 30, kSceneFraction), 30);  // top half (piece 1) fastest
+}
+
+TEST(BasaltView, StartsItsOwnXServerAlsoForConcurrentCommands) {
+  const fs::path dir = basalt::test::scratch_dir("view-xvfb");
+  const fs::path geo = basalt::test::reference_dir() / "cube1.geo";
+  // Three renders at once, each starting its own Xvfb: the servers pick distinct free displays.
+  std::string cmd = "env -u DISPLAY sh -c '";
+  for (int i = 0; i < 3; ++i)
+    cmd += fmt::format("\"{}\" render \"{}\" -o \"{}\" --size 200x150 -q & ", BASALT_VIEW_EXE, geo.string(),
+                       (dir / fmt::format("c{}.png", i)).string());
+  cmd += "wait'";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+  for (int i = 0; i < 3; ++i) {
+    const Image img = read_png(dir / fmt::format("c{}.png", i));
+    EXPECT_EQ(img.width, 200) << i;
+    EXPECT_EQ(img.height, 150) << i;
+  }
+
+  // Without Xvfb on the PATH, a clear error instead of VTK's.
+  const Outcome r =
+      basalt_view(fmt_args("render", geo.string(), "-o", (dir / "x.png").string()), dir, "PATH=/nonexistent");
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.out.find("Xvfb is not installed"), std::string::npos) << r.out;
 }

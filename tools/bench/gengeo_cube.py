@@ -38,7 +38,26 @@ def main():
     vol = sum(4.0 / 3.0 * math.pi * float(l.split()[3]) ** 3 for l in lines[i + 3:i + 3 + n])
     j = lines.index("BeginConnect")
     nb = int(lines[j + 1])
-    print(json.dumps({"particles": n, "bonds": nb, "solid_fraction": vol / size ** 3, "seconds": seconds}))
+    radii = [float(l.split()[3]) for l in lines[i + 3:i + 3 + n]]
+    print(json.dumps({"particles": n, "bonds": nb, "solid_fraction": vol / size ** 3, "seconds": seconds,
+                      "exponent": fitted_exponent(radii, rmin, rmax)}))
+
+
+def fitted_exponent(radii, rmin, rmax, bins=16):
+    """basalt-pack's definition (docs/packer.md): 16 bins equally spaced in ln r over [rmin, rmax]; minus the
+    slope of the least-squares line through (ln r_centre, ln count), each non-empty bin weighted by its count."""
+    l0, l1 = math.log(rmin), math.log(rmax)
+    width = (l1 - l0) / bins
+    counts = [0] * bins
+    for r in radii:
+        counts[min(bins - 1, max(0, int(math.floor((math.log(r) - l0) / width))))] += 1
+    pts = [(l0 + width * (k + 0.5), math.log(c), c) for k, c in enumerate(counts) if c > 0]
+    sw = sum(w for _, _, w in pts)
+    sx = sum(w * x for x, _, w in pts)
+    sy = sum(w * y for _, y, w in pts)
+    sxx = sum(w * x * x for x, _, w in pts)
+    sxy = sum(w * x * y for x, y, w in pts)
+    return -(sw * sxy - sx * sy) / (sw * sxx - sx * sx)
 
 
 if __name__ == "__main__":

@@ -67,6 +67,8 @@ def main():
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--large", action="store_true", help="also the ~1 M and the 150 mm (~8.7 M) packs")
     ap.add_argument("--large-only", action="store_true", help="only the large packs")
+    ap.add_argument("--large-cases", default="1m,150-dense,8.7m",
+                    help="which large packs (rows of other cases already in packer-large.md are kept)")
     ap.add_argument("--out", default=os.path.join(ROOT, "docs", "bench"),
                     help="folder for packer-cube.md (side by side) and packer-large.md (--large)")
     ap.add_argument("--doc", default=os.path.join(ROOT, "docs", "packer.md"),
@@ -90,11 +92,15 @@ def main():
     # Stored statistics need particles and seconds only; wall includes process start and file writing.
     large = []
     if a.large or a.large_only:
-        for label, args in (
-                ("~1 M spheres: 90 mm cube, dense", ["box", "--size", "90,90,90", "--rmin", "0.2", "--rmax", "1.0"]),
-                ("150 mm cube, dense", ["box", "--size", "150,150,150", "--rmin", "0.2", "--rmax", "1.0"]),
-                ("paper's largest: 150 mm cube, GenGeo-like (exponent 2.2, then fill)",
-                 ["box", "--size", "150,150,150", "--rmin", "0.2", "--rmax", "1.0"] + genlike)):
+        cases = {
+            "1m": ("~1 M spheres: 90 mm cube, dense", ["box", "--size", "90,90,90", "--rmin", "0.2", "--rmax", "1.0"]),
+            "150-dense": ("150 mm cube, dense", ["box", "--size", "150,150,150", "--rmin", "0.2", "--rmax", "1.0"]),
+            "8.7m": ("~8.7 M spheres (the paper's largest count): 180 mm cube, dense",
+                     ["box", "--size", "180,180,180", "--rmin", "0.2", "--rmax", "1.0"]),
+            "150-genlike": ("paper's largest: 150 mm cube, GenGeo-like (`--exponent 2.2 --target-fraction 0.62 --fill`)",
+                            ["box", "--size", "150,150,150", "--rmin", "0.2", "--rmax", "1.0"] + genlike)}
+        for key in a.large_cases.split(","):
+            label, args = cases[key]
             r = basalt(exe, args + ["--seed", "1"], os.path.join(tmp, "large.geo"))
             r["label"] = label
             large.append(r)
@@ -122,7 +128,7 @@ def main():
         w("<!-- Written by tools/bench/pack_benchmark.py --large; do not edit by hand. -->")
         w(stamp + ".")
         w("")
-        write_large(w, large)
+        write_large(w, large, os.path.join(a.out, "packer-large.md"))
         with open(os.path.join(a.out, "packer-large.md"), "w") as f:
             f.write("\n".join(lines) + "\n")
         splice(a.doc, "large", lines)
@@ -149,7 +155,7 @@ def write_cube(w, gg, bp, bl):
     w("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
     if gg:
         w(f"| GenGeo (python3-gengeo, InsertGenerator3D) | {med(gg, 'particles'):.0f} | "
-          f"{med(gg, 'solid_fraction'):.4f} | | {med(gg, 'bonds'):.0f} | "
+          f"{med(gg, 'solid_fraction'):.4f} | {med(gg, 'exponent'):.2f} | {med(gg, 'bonds'):.0f} | "
           f"{2 * med(gg, 'bonds') / med(gg, 'particles'):.2f} | {med(gg, 'seconds'):.2f} | {med(gg, 'rss_mib'):.0f} |")
     for name, rows in (("basalt-pack, dense (default)", bp),
                        ("basalt-pack, GenGeo-like: `--exponent 2.2 --target-fraction 0.62 --fill`", bl)):
@@ -164,16 +170,27 @@ def write_cube(w, gg, bp, bl):
         w("")
 
 
-def write_large(w, large):
-    if large:
-        w("Large packs (one run each, `/usr/bin/time -v`):")
-        w("")
-        w("| pack | spheres | solid fraction | time [s] | wall incl. writing .geo [s] | user CPU [s] | peak RSS [MiB] | bytes per sphere |")
-        w("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
-        for r in large:
-            w(f"| {r['label']} | {r['particles']} | {r['solid_fraction']:.4f} | {r['seconds']:.1f} | {r['wall']:.1f} | "
-              f"{r['user']:.1f} | {r['rss_mib']:.0f} | {r['rss_mib'] * 2 ** 20 / r['particles']:.0f} |")
-        w("")
+def write_large(w, large, previous):
+    """One row per case; rows of cases not run this time are kept from the previous file."""
+    rows = {}
+    if os.path.exists(previous):
+        for line in open(previous):
+            if line.startswith("| ") and not line.startswith("| pack ") and not line.startswith("| ---"):
+                rows[line.split(" | ")[0][2:]] = line.rstrip("\n")
+    stamp = f"{datetime.datetime.utcnow():%Y-%m-%d %H:%M} UTC, load {os.getloadavg()[0]:.1f}"
+    for r in large:
+        rows[r["label"]] = (
+            f"| {r['label']} | {r['particles']} | {r['solid_fraction']:.4f} | {r['seconds']:.1f} | {r['wall']:.1f} | "
+            f"{r['user']:.1f} | {r['rss_mib']:.0f} | {r['rss_mib'] * 2 ** 20 / r['particles']:.0f} | {stamp} |")
+    w("Large packs (one run each, `/usr/bin/time -v`; \"time\" is basalt-pack's own, packing + bonding + statistics;")
+    w("wall adds start-up and writing the .geo file; on a machine shared with other work wall time is longer than")
+    w("the CPU time by the load factor):")
+    w("")
+    w("| pack | spheres | solid fraction | time [s] | wall [s] | user CPU [s] | peak RSS [MiB] | bytes per sphere | measured |")
+    w("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- |")
+    for line in rows.values():
+        w(line)
+    w("")
 
 
 if __name__ == "__main__":

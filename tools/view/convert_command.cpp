@@ -17,6 +17,11 @@ namespace fs = std::filesystem;
 void convert(const ConvertOptions& o) {
   if (o.inputs.empty()) throw std::invalid_argument("convert: no input files");
   require_writable(o.output.string());
+  // Check every input before writing anything, so that a typo in the 100th name costs no work.
+  for (const auto& in : o.inputs) {
+    std::error_code ec;
+    if (!fs::is_regular_file(in, ec)) throw io::FormatError(in, "", "no such file");
+  }
   for (const auto& in : o.inputs)
     if (in.extension() == ".vtp" || in.extension() == ".pvtp")
       throw std::invalid_argument(

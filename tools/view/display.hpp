@@ -1,12 +1,14 @@
 #pragma once
-// Debian's VTK 9.1 renders only through X. Without a display, basalt-view runs itself again under
-// xvfb-run (a virtual X server), so that `basalt-view render` works on a headless machine as is.
+// Debian's VTK 9.1 renders only through X. Without a display, basalt-view starts its own virtual
+// X server (Xvfb, package xvfb) for the duration of the command, so that `basalt-view render` works
+// on a headless machine as is.
 
 namespace basalt::view {
 
-/// When DISPLAY is unset and this process was not already started under xvfb-run by us,
-/// replaces the process by `xvfb-run -a <this program> <args>` (never returns on success).
-/// Throws std::runtime_error when xvfb-run is missing. BASALT_VIEW_NO_XVFB=1 disables it.
-void ensure_display(int argc, char** argv);
+/// When DISPLAY is unset (and BASALT_VIEW_NO_XVFB is not), starts `Xvfb -displayfd`, which picks a
+/// free display number itself (so concurrent commands never collide), sets DISPLAY, and stops the
+/// server when this process exits (also if it dies: the server gets SIGTERM with its parent).
+/// Throws std::runtime_error when Xvfb is missing or does not start within 20 s.
+void ensure_display();
 
 }  // namespace basalt::view

@@ -21,7 +21,7 @@ namespace bv = basalt::view;
 int main(int argc, char** argv) {
   CLI::App app{
       "basalt-view: render Basalt checkpoints and geometries to PNG, convert them to VTK for ParaView, "
-      "plot field series.\nRendering needs X: without DISPLAY, basalt-view runs itself under xvfb-run."};
+      "plot field series.\nRendering needs X: without DISPLAY, basalt-view starts its own Xvfb."};
   app.set_version_flag("--version", std::string(basalt::kVersion));
   app.require_subcommand(1);
 
@@ -94,7 +94,7 @@ int main(int argc, char** argv) {
       if (!reference.empty()) r.reference = reference;
       r.color = color;
       r.cull = !draw_all;
-      bv::ensure_display(argc, argv);
+      bv::ensure_display();
       bv::render(r);
     } else if (convert->parsed()) {
       if (!convert_reference.empty()) c.reference = convert_reference;
@@ -108,7 +108,7 @@ int main(int argc, char** argv) {
         p.columns.push_back(rest);
       }
       if (!units_from.empty()) p.units_from = units_from;
-      bv::ensure_display(argc, argv);
+      bv::ensure_display();
       bv::plot(p);
     } else if (info->parsed()) {
       const bv::Frame f = bv::read_frame(info_file, std::nullopt);

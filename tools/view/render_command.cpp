@@ -2,16 +2,12 @@
 
 #include <fmt/format.h>
 #include <vtkCamera.h>
-#include <vtkCellArray.h>
 #include <vtkColorTransferFunction.h>
 #include <vtkFloatArray.h>
 #include <vtkGlyph3DMapper.h>
-#include <vtkIdTypeArray.h>
 #include <vtkLookupTable.h>
 #include <vtkOpenGLSphereMapper.h>
-#include <vtkPNGWriter.h>
 #include <vtkPointData.h>
-#include <vtkPoints.h>
 #include <vtkProperty.h>
 #include <vtkRenderWindow.h>
 #include <vtkRenderer.h>
@@ -19,13 +15,11 @@
 #include <vtkSphereSource.h>
 #include <vtkTextActor.h>
 #include <vtkTextProperty.h>
-#include <vtkWindowToImageFilter.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
-#include <system_error>
 
 #include "color_field.hpp"
 #include "particle_frame.hpp"

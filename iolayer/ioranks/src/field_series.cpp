@@ -4,14 +4,18 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
+
 #include "basalt/io/geometry.hpp"
 
 namespace basalt::io::detail {
 
-FieldSeriesWriter::FieldSeriesWriter(std::filesystem::path file, const std::vector<std::string>& names)
+FieldSeriesWriter::FieldSeriesWriter(std::filesystem::path file, const std::vector<std::string>& names, bool append)
     : file_(std::move(file)) {
-  out_ = std::fopen(file_.c_str(), "w");
+  const bool resume = append && std::filesystem::exists(file_);
+  out_ = std::fopen(file_.c_str(), resume ? "a" : "w");
   if (!out_) throw FormatError(file_, "", "cannot open for writing (does the folder exist and is it writable?)");
+  if (resume) return;
   buffer_ = "step,time";
   for (const auto& n : names) buffer_ += "," + n;
   buffer_ += "\n";
@@ -29,7 +33,12 @@ FieldSeriesWriter::~FieldSeriesWriter() {
 
 void FieldSeriesWriter::append(std::int64_t step, double time, std::span<const double> values) {
   fmt::format_to(std::back_inserter(buffer_), "{},{}", step, time);
-  for (double v : values) fmt::format_to(std::back_inserter(buffer_), ",{}", v);
+  // NaN marks a saver not due at this step: an empty cell.
+  for (double v : values)
+    if (std::isnan(v))
+      buffer_ += ',';
+    else
+      fmt::format_to(std::back_inserter(buffer_), ",{}", v);
   buffer_ += '\n';
 }
 

@@ -12,7 +12,8 @@ namespace basalt::io::detail {
 
 class FieldSeriesWriter {
  public:
-  FieldSeriesWriter(std::filesystem::path file, const std::vector<std::string>& names);
+  /// With `append`, continues an existing file (a restart): no header, rows go after its last line.
+  FieldSeriesWriter(std::filesystem::path file, const std::vector<std::string>& names, bool append = false);
   ~FieldSeriesWriter();
   FieldSeriesWriter(const FieldSeriesWriter&) = delete;
   FieldSeriesWriter& operator=(const FieldSeriesWriter&) = delete;

@@ -89,6 +89,7 @@ void FramePiece::clear() {
   radius.clear();
   mass.clear();
   tag.clear();
+  inv_mass.clear();
   bonds.clear();
   bond_rest_length.clear();
   bond_broken.clear();
@@ -120,6 +121,7 @@ void serialize(const FramePiece& p, std::vector<std::byte>& out) {
     w.value(wall.velocity);
     w.value(wall.force);
   }
+  w.array(p.inv_mass);
 }
 
 FramePiece deserialize(std::span<const std::byte> bytes) {
@@ -150,7 +152,10 @@ FramePiece deserialize(std::span<const std::byte> bytes) {
     wall.velocity = r.value<Vec3>();
     wall.force = r.value<Vec3>();
   }
+  r.array(p.inv_mass);
   const std::size_t n = p.id.size();
+  if (!p.inv_mass.empty() && p.inv_mass.size() != n)
+    throw std::runtime_error("frame: inverse masses differ in length from the particles");
   if (p.position.size() != n || p.velocity.size() != n || p.radius.size() != n || p.mass.size() != n ||
       p.tag.size() != n)
     throw std::runtime_error("frame: particle arrays differ in length");
@@ -227,6 +232,9 @@ Checkpoint assemble(std::vector<FramePiece>& pieces, const RunInfo& run) {
   g.tag.resize(n);
   g.mass.resize(n);
   c.velocity.resize(n);
+  const bool inv = std::all_of(pieces.begin(), pieces.end(),
+                               [](const FramePiece& p) { return p.inv_mass.size() == p.size(); }) && n > 0;
+  if (inv) c.inv_mass.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     const auto& p = pieces[order[i].second.first];
     const auto j = order[i].second.second;
@@ -236,6 +244,7 @@ Checkpoint assemble(std::vector<FramePiece>& pieces, const RunInfo& run) {
     g.tag[i] = p.tag[j];
     g.mass[i] = p.mass[j];
     c.velocity[i] = p.velocity[j];
+    if (inv) c.inv_mass[i] = p.inv_mass[j];
   }
 
   struct BondRow {

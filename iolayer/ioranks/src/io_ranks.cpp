@@ -9,6 +9,8 @@
 #include <stdexcept>
 #include <thread>
 
+#include <sys/resource.h>
+
 #include <fmt/format.h>
 
 #include "field_series.hpp"
@@ -21,7 +23,7 @@ enum Tag : int { kTagInfo = 701, kTagFrame, kTagFields, kTagDone, kTagError, kTa
 
 // Report layout for the final reductions.
 enum SumSlot { kCkptFiles, kCkptBytes, kFrameFiles, kFrameBytes, kFieldFiles, kFieldBytes, kFramesSent, kErrors, kSumSlots };
-enum MaxSlot { kCkptSeconds, kFrameSeconds, kFieldSeconds, kWaitSeconds, kMaxSlots };
+enum MaxSlot { kCkptSeconds, kFrameSeconds, kFieldSeconds, kWaitSeconds, kIoCpu, kIoWall, kMaxSlots };
 
 int checked_count(std::size_t bytes) {
   if (bytes > static_cast<std::size_t>(INT_MAX))
@@ -29,6 +31,13 @@ int checked_count(std::size_t bytes) {
                                          "use more compute ranks",
                                          bytes));
   return static_cast<int>(bytes);
+}
+
+/// CPU time (user + system) of this process so far: shows that an idle I/O rank sleeps.
+double process_cpu_seconds() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
 }
 
 void throttle(double mb_per_s, std::uint64_t bytes, double elapsed) {
@@ -95,7 +104,7 @@ OutputReport reduce_report(MPI_Comm comm, const OutputReport& mine) {
                             double(mine.fields.files),      double(mine.fields.bytes),
                             double(mine.frames_sent),       mine.error ? 1.0 : 0.0};
   double maxs[kMaxSlots] = {mine.checkpoints.write_seconds, mine.frames.write_seconds, mine.fields.write_seconds,
-                            mine.compute_wait_seconds};
+                            mine.compute_wait_seconds, mine.io_cpu_seconds, mine.io_wall_seconds};
   double gsum[kSumSlots], gmax[kMaxSlots];
   MPI_Allreduce(sums, gsum, kSumSlots, MPI_DOUBLE, MPI_SUM, comm);
   MPI_Allreduce(maxs, gmax, kMaxSlots, MPI_DOUBLE, MPI_MAX, comm);
@@ -105,6 +114,8 @@ OutputReport reduce_report(MPI_Comm comm, const OutputReport& mine) {
   r.fields = {std::uint64_t(gsum[kFieldFiles]), std::uint64_t(gsum[kFieldBytes]), gmax[kFieldSeconds]};
   r.frames_sent = std::uint64_t(gsum[kFramesSent]);
   r.compute_wait_seconds = gmax[kWaitSeconds];
+  r.io_cpu_seconds = gmax[kIoCpu];
+  r.io_wall_seconds = gmax[kIoWall];
   if (gsum[kErrors] > 0) {
     int rank = 0;
     MPI_Comm_rank(comm, &rank);
@@ -208,7 +219,9 @@ struct OutputClient::Impl {
       int done = 0;
       if (block) {
         const double t0 = MPI_Wtime();
-        MPI_Wait(&q.front().request, MPI_STATUS_IGNORE);
+        // A compute rank blocked on a full queue sleeps too: on a shared node its core is what the
+        // I/O rank may need to drain the queue.
+        wait_without_spinning(q.front().request);
         local.compute_wait_seconds += MPI_Wtime() - t0;
         done = 1;
       } else {
@@ -248,7 +261,8 @@ OutputClient::OutputClient(const RankLayout& layout, OutputConfig config, RunInf
     }
   } else if (I.compute_rank == 0 && I.cfg.fields_every > 0) {
     try {
-      I.csv = std::make_unique<detail::FieldSeriesWriter>(I.cfg.dir / "fields.csv", I.cfg.field_names);
+      I.csv = std::make_unique<detail::FieldSeriesWriter>(I.cfg.dir / "fields.csv", I.cfg.field_names,
+                                                          I.cfg.append_fields);
     } catch (const std::exception& e) {
       I.local.error = e.what();
     }
@@ -431,6 +445,8 @@ OutputReport IoServer::run() {
   const RankLayout& L = layout_;
   const int io_index = L.world_rank - L.n_compute;
   OutputReport local;
+  const double wall0 = MPI_Wtime();
+  const double cpu0 = process_cpu_seconds();
   int errors_sent = 0;
 
   auto report_error = [&](const std::string& text) {
@@ -465,7 +481,8 @@ OutputReport IoServer::run() {
   std::unique_ptr<detail::FieldSeriesWriter> csv;
   if (io_index == 0 && config_.fields_every > 0 && !config_.field_names.empty()) {
     try {
-      csv = std::make_unique<detail::FieldSeriesWriter>(config_.dir / "fields.csv", config_.field_names);
+      csv = std::make_unique<detail::FieldSeriesWriter>(config_.dir / "fields.csv", config_.field_names,
+                                                        config_.append_fields);
     } catch (const std::exception& e) {
       report_error(e.what());
     }
@@ -610,6 +627,8 @@ OutputReport IoServer::run() {
     local.fields.bytes = csv->bytes();
     local.fields.write_seconds = csv->seconds();
   }
+  local.io_cpu_seconds = process_cpu_seconds() - cpu0;
+  local.io_wall_seconds = MPI_Wtime() - wall0;
   OutputReport all = reduce_report(L.bridge, local);
   int expected = 0;
   MPI_Allreduce(&errors_sent, &expected, 1, MPI_INT, MPI_SUM, L.bridge);

@@ -23,6 +23,9 @@ struct Checkpoint {
   /// Particles (sorted by id), bonds, box, units, provenance. geometry.mass is always present.
   Geometry geometry;
   std::vector<Vec3> velocity;  ///< one per particle, same order as geometry.id
+  /// Optional (empty or one per particle; /particles/inverse_mass): 1 / mass exactly as the solver
+  /// held it, so that a restart reproduces the run bit for bit. geometry.mass stays the mass.
+  std::vector<double> inv_mass;
 
   // Bond state, one entry per geometry.bonds entry.
   std::vector<double> bond_rest_length;

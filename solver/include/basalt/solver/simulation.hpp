@@ -11,6 +11,8 @@
 #include <utility>
 #include <vector>
 
+#include "basalt/io/checkpoint.hpp"
+#include "basalt/io/frame.hpp"
 #include "basalt/io/geometry.hpp"
 #include "basalt/solver/core/bonds.hpp"
 #include "basalt/solver/core/id_map.hpp"
@@ -20,6 +22,7 @@
 #include "basalt/solver/interactions/wall_driver.hpp"
 #include "basalt/solver/neighbor/verlet_list.hpp"
 #include "basalt/solver/output/field_sink.hpp"
+#include "basalt/solver/output/output_sink.hpp"
 #include "basalt/solver/parallel/decomposition.hpp"
 #include "basalt/solver/parallel/halo.hpp"
 #include "basalt/solver/scene/scene.hpp"
@@ -40,6 +43,14 @@ struct StabilityReport {
   bool warn = false;
 };
 
+/// What a restart needs besides the checkpoint's particles to rebuild the SAME decomposition and
+/// lists as the original run (stored in the checkpoint's attributes, docs/formats.md).
+struct RestartLayout {
+  std::array<double, 3> box_min{0, 0, 0}, box_max{0, 0, 0};  ///< the decomposition's box
+  double ghost_width = 0;
+  double contact_cutoff = 0;
+};
+
 template <class Real = double>
 class Simulation {
  public:
@@ -47,6 +58,26 @@ class Simulation {
   /// geometry is taken by value and released part by part as it is copied: pass std::move(g) to keep
   /// peak memory low. Throws InputError (bad scene/geometry combination, unstable dt) on every rank alike.
   Simulation(const Scene& scene, io::Geometry geometry, MPI_Comm comm, const RunOptions& options = {});
+
+  /// Continues a run from a checkpoint (simulation_restart.cpp): particles, velocities, masses,
+  /// bonds with their rest lengths, step and time; the decomposition from `layout`. The first
+  /// rebuild is canonical (see set_canonical_every), so that on the same ranks the continued run
+  /// is bit-for-bit the uninterrupted one. Throws InputError when the checkpoint does not fit.
+  Simulation(const Scene& scene, const io::Checkpoint& checkpoint, const RestartLayout& layout, MPI_Comm comm,
+             const RunOptions& options = {});
+
+  /// Runs `steps` steps with output through `out` (simulation_output.cpp): field partials every
+  /// saved step, frames when out.frame_kinds() asks. An output error stops the run on every rank
+  /// at the same step (RunError naming it) unless out.continue_on_error().
+  void run(std::int64_t steps, OutputSink& out);
+  /// Fills `piece` with this rank's share of the state (owned particles; bonds each once across
+  /// ranks; walls on rank 0 only).
+  void pack_frame(io::FramePiece& piece, std::uint32_t kinds) const;
+  /// Rebuilds the lists in canonical order (a pure function of ids and positions) at every step that
+  /// is a multiple of `every` (0 = never): a run restarted from such a step is then bit-for-bit equal.
+  void set_canonical_every(std::int64_t every) { canonical_every_ = every; }
+  /// The decomposition's box, ghost width and contact cut-off (stored in checkpoints).
+  RestartLayout restart_layout() const;
 
   /// Runs `steps` steps (scene.steps when negative), writing field rows to `sink` (rank 0 only; may be null).
   void run(std::int64_t steps = -1, FieldSink* sink = nullptr);
@@ -103,6 +134,11 @@ class Simulation {
   template <bool Energy>
   std::array<double, 3> compute_forces(bool ghosts_in_flight = false);
   void save_fields(FieldSink* sink, const std::array<double, 3>& pe);
+  bool field_partials(const std::array<double, 3>& pe, std::vector<double>& local, std::vector<char>& due) const;
+  void output_fields(const std::array<double, 3>& pe);
+  void distribute_checkpoint(const io::Checkpoint& c, const RestartLayout& layout, MPI_Comm comm);
+  void canonical_order();
+  bool canonical_due(std::int64_t s) const { return canonical_every_ > 0 && s % canonical_every_ == 0; }
   /// Writes the row whose reduction is still in flight (ranks > 1), if any.
   void finish_row(FieldSink* sink);
   /// Collective: delivers pending output, then throws RunError(message).
@@ -147,6 +183,9 @@ class Simulation {
   double ghost_wait_ = 0;
   bool forces_zeroed_ = false;  ///< set by the fused kick-zero-drift pass
   StabilityReport stability_;
+  OutputSink* output_ = nullptr;        ///< set during run(steps, OutputSink&)
+  std::int64_t canonical_every_ = 0;    ///< canonical rebuild at these steps (restart points)
+  bool canonical_ = false;              ///< the next rebuild is canonical
 };
 
 extern template class Simulation<double>;

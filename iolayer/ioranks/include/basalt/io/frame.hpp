@@ -33,6 +33,9 @@ struct FramePiece {
   std::vector<double> radius;
   std::vector<double> mass;
   std::vector<std::int32_t> tag;
+  /// Optional (empty or one per particle): 1 / mass exactly as the solver holds it, so that a
+  /// restart gets the same bits (1 / (1 / m) is not always m in floating point).
+  std::vector<double> inv_mass;
 
   // Bonds this rank is responsible for (each bond in exactly one piece), with their state.
   std::vector<Bond> bonds;

@@ -54,6 +54,7 @@ struct OutputConfig {
   int field_batch_rows = 256;    ///< field rows a compute rank collects before sending them
   bool continue_on_error = false;  ///< a failed output stops the run unless this is set
   double throttle_mb_per_s = 0;    ///< benchmark only: make storage this slow on purpose (0 = off)
+  bool append_fields = false;      ///< restart: continue an existing fields.csv instead of replacing it
 };
 
 /// Per output kind: what was written and what it cost.
@@ -65,6 +66,8 @@ struct OutputKindReport {
 struct OutputReport {
   OutputKindReport checkpoints, frames, fields;
   double compute_wait_seconds = 0;  ///< max over compute ranks: time blocked on output
+  double io_cpu_seconds = 0;        ///< max over I/O ranks: CPU time (user + system) of the I/O process
+  double io_wall_seconds = 0;       ///< max over I/O ranks: wall time of IoServer::run
   std::uint64_t frames_sent = 0;
   std::optional<std::string> error;  ///< first output error, if any
 };

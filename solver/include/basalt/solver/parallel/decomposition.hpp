@@ -26,6 +26,9 @@ class Decomposition {
   const std::array<int, 3>& coords() const { return coords_; }
   /// Neighbouring rank along axis d on side 0 (low) or 1 (high); MPI_PROC_NULL on an open face.
   int neighbor(int d, int side) const { return nb_[d][side]; }
+  /// The box the cut planes split (restart rebuilds the same decomposition from it).
+  const std::array<double, 3>& box_min() const { return box_min_; }
+  const std::array<double, 3>& box_max() const { return box_max_; }
   double lo(int d) const { return lo_[d]; }
   double hi(int d) const { return hi_[d]; }
   /// Grid coordinate along d of the rank owning coordinate v.

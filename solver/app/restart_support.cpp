@@ -1,0 +1,117 @@
+#include "restart_support.hpp"
+
+#include <fmt/format.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include "basalt/solver/core/errors.hpp"
+
+namespace basalt::run {
+
+namespace fs = std::filesystem;
+using solver::InputError;
+
+fs::path resolve_restart(const fs::path& p) {
+  if (fs::is_directory(p)) {
+    const auto latest = io::latest_complete_checkpoint(p);
+    if (latest.empty())
+      throw InputError(
+          fmt::format("--restart {}: no complete checkpoint (ckpt_<step>.h5) in this folder", p.string()));
+    return latest;
+  }
+  if (!fs::exists(p)) throw InputError(fmt::format("--restart {}: no such file or folder", p.string()));
+  return p;
+}
+
+namespace {
+std::string vec_text(const std::array<double, 3>& v) {
+  return fmt::format("{:.17g},{:.17g},{:.17g}", v[0], v[1], v[2]);
+}
+
+const std::string& attribute(const io::Checkpoint& c, const fs::path& file, const std::string& key) {
+  const auto it = c.geometry.attributes.find(key);
+  if (it == c.geometry.attributes.end())
+    throw InputError(
+        fmt::format("{}: attribute '{}' is missing: a restart needs the decomposition the run used "
+                    "(checkpoints written by basalt-run carry it)",
+                    file.string(), key));
+  return it->second;
+}
+
+double number(const io::Checkpoint& c, const fs::path& file, const std::string& key) {
+  const auto& t = attribute(c, file, key);
+  char* end = nullptr;
+  const double v = std::strtod(t.c_str(), &end);
+  if (end == t.c_str() || *end != '\0')
+    throw InputError(fmt::format("{}: attribute '{}' = \"{}\" is not a number", file.string(), key, t));
+  return v;
+}
+
+std::array<double, 3> vec(const io::Checkpoint& c, const fs::path& file, const std::string& key) {
+  const auto& t = attribute(c, file, key);
+  std::array<double, 3> v{};
+  const char* s = t.c_str();
+  for (int d = 0; d < 3; ++d) {
+    char* end = nullptr;
+    v[d] = std::strtod(s, &end);
+    if (end == s || (d < 2 && *end != ',') || (d == 2 && *end != '\0'))
+      throw InputError(
+          fmt::format("{}: attribute '{}' = \"{}\" is not three numbers", file.string(), key, t));
+    s = end + 1;
+  }
+  return v;
+}
+}  // namespace
+
+std::map<std::string, std::string> restart_attributes(const solver::RestartLayout& l) {
+  return {{"decomposition_box_min", vec_text(l.box_min)},
+          {"decomposition_box_max", vec_text(l.box_max)},
+          {"ghost_width", fmt::format("{:.17g}", l.ghost_width)},
+          {"contact_cutoff", fmt::format("{:.17g}", l.contact_cutoff)}};
+}
+
+solver::RestartLayout restart_layout_of(const io::Checkpoint& c, const fs::path& file) {
+  solver::RestartLayout l;
+  l.box_min = vec(c, file, "decomposition_box_min");
+  l.box_max = vec(c, file, "decomposition_box_max");
+  l.ghost_width = number(c, file, "ghost_width");
+  l.contact_cutoff = number(c, file, "contact_cutoff");
+  return l;
+}
+
+void check_same_scene(const io::Checkpoint& c, const fs::path& file, const solver::Scene& scene) {
+  if (c.scene_text != scene.text)
+    throw InputError(
+        fmt::format("{}: this checkpoint was written by another scene ({} particles; its stored scene text "
+                    "differs from {}): "
+                    "restart it with the scene file that wrote it",
+                    file.string(), c.size(), scene.file.string()));
+}
+
+void truncate_fields(const fs::path& csv, std::int64_t step) {
+  if (!fs::exists(csv)) return;
+  std::ifstream in(csv);
+  std::string line, kept;
+  bool header = true;
+  while (std::getline(in, line)) {
+    if (header) {
+      kept += line + "\n";
+      header = false;
+      continue;
+    }
+    if (line.empty()) continue;
+    const long long s = std::strtoll(line.c_str(), nullptr, 10);
+    if (s <= step) kept += line + "\n";
+  }
+  const fs::path tmp = csv.string() + ".partial";
+  {
+    std::ofstream out(tmp, std::ios::trunc);
+    out << kept;
+    if (!out.flush()) throw InputError(fmt::format("{}: cannot rewrite for the restart", tmp.string()));
+  }
+  fs::rename(tmp, csv);
+}
+
+}  // namespace basalt::run

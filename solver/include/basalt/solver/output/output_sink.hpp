@@ -1,0 +1,36 @@
+#pragma once
+// Where a run's output goes, seen from the solver. Called on EVERY compute rank with this rank's
+// local data: partial sums of the field savers (no reduction in the solver) and its share of a
+// frame (owned particles, its bonds). The implementation decides where it goes: basalt-run's
+// adapter hands it to basalt::io::OutputClient (dedicated I/O ranks, or synchronous writing from
+// the compute ranks with --io-ranks 0). The solver library stays free of the I/O service.
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "basalt/io/frame.hpp"
+
+namespace basalt::solver {
+
+class OutputSink {
+ public:
+  virtual ~OutputSink() = default;
+  /// Field-saver column names (after "step" and "time"); called once before the first step.
+  virtual void begin(const std::vector<std::string>& columns) = 0;
+  /// This rank's partial sums at a step where at least one saver is due; NaN = saver not due.
+  virtual void fields(std::int64_t step, double time, std::span<const double> local_partials) = 0;
+  /// io::FrameKind bits wanted at this step (0: none). Must be the same on every compute rank.
+  virtual std::uint32_t frame_kinds(std::int64_t step) const = 0;
+  /// This rank's piece of the frame of its step (kinds set).
+  virtual void frame(const io::FramePiece& piece) = 0;
+  /// Cheap, once per step: an output error seen by this rank, if any (not collective).
+  virtual std::optional<std::string> poll() = 0;
+  /// Whether the run goes on without the failed output (scene: [output] on_error = "continue").
+  virtual bool continue_on_error() const = 0;
+  /// End of the run (collective over the compute ranks).
+  virtual void flush() = 0;
+};
+
+}  // namespace basalt::solver

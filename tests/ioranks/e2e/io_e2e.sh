@@ -1,0 +1,178 @@
+#!/usr/bin/env bash
+# End-to-end tests of basalt-run's output layer (compute + I/O ranks). Usage:
+#   io_e2e.sh CASE   with BASALT_RUN, MPIEXEC, SCENE, GEOMETRY, SCENE_OTHER, WORK set by CTest.
+# Each case exits non-zero with a message when the behaviour is wrong.
+set -u
+case_name=$1
+W=$WORK/$case_name
+rm -rf "$W"
+mkdir -p "$W"
+# hwloc's GL probe would connect to an X server on :0 if one runs (and die with it): not wanted.
+export HWLOC_COMPONENTS=-gl
+CHECK="/usr/bin/python3 $(dirname "$0")/output_checks.py"
+fail() { echo "FAIL ($case_name): $*"; exit 1; }
+
+# run NP ARGS... : basalt-run on NP ranks with the test scene and geometry; output in $W/last.log
+run() {
+  local np=$1; shift
+  "$MPIEXEC" -np "$np" "$BASALT_RUN" "$SCENE" --geometry "$GEOMETRY" --quiet "$@" >"$W/last.log" 2>&1
+}
+must_run() { run "$@" || { cat "$W/last.log"; fail "basalt-run $* exited non-zero"; }; }
+must_fail() {  # must_fail REGEX NP ARGS...
+  local regex=$1; shift
+  if run "$@"; then cat "$W/last.log"; fail "basalt-run $* succeeded, expected an error"; fi
+  grep -Eq -- "$regex" "$W/last.log" || { cat "$W/last.log"; fail "the error does not match /$regex/"; }
+  cat "$W/last.log"
+}
+
+# Bit-for-bit restart: 200 steps straight vs 100 + restart + 100, on the same ranks.
+restart_bitwise() {  # NP Q
+  local np=$1 q=$2
+  must_run "$np" --io-ranks "$q" --steps 200 --checkpoint-every 100 --output "$W/straight"
+  must_run "$np" --io-ranks "$q" --steps 100 --checkpoint-every 100 --output "$W/split"
+  must_run "$np" --io-ranks "$q" --steps 100 --checkpoint-every 100 --output "$W/split" --restart "$W/split"
+  grep -q "continuing from step 100" "$W/last.log" || fail "the restart did not continue from step 100"
+  $CHECK same "$W/straight/ckpt_000200.h5" "$W/split/ckpt_000200.h5" || fail "final checkpoints differ"
+  cmp "$W/straight/ckpt_000200.h5" "$W/split/ckpt_000200.h5" || fail "final checkpoint files differ in their bytes"
+  cmp "$W/straight/fields.csv" "$W/split/fields.csv" || fail "fields.csv differs (restart appends after step 100)"
+  echo "np $np, --io-ranks $q: step-200 checkpoints identical (datasets and bytes), fields.csv identical"
+}
+
+case $case_name in
+  restart_np1_q0) restart_bitwise 1 0 ;;
+  restart_np2_q0) restart_bitwise 2 0 ;;
+  restart_np1_q1) restart_bitwise 2 1 ;;
+  restart_np2_q1) restart_bitwise 3 1 ;;
+  restart_other_ranks)
+    must_run 2 --steps 200 --checkpoint-every 100 --output "$W/straight"
+    must_run 2 --steps 100 --checkpoint-every 100 --output "$W/a"
+    cp -r "$W/a" "$W/b"
+    must_run 1 --steps 100 --checkpoint-every 100 --output "$W/a" --restart "$W/a/ckpt_000100.h5"
+    must_run 4 --io-ranks 1 --steps 100 --checkpoint-every 100 --output "$W/b" --restart "$W/b"
+    $CHECK close "$W/straight/ckpt_000200.h5" "$W/a/ckpt_000200.h5" 1e-9 || fail "np 2 -> 1 drifted"
+    $CHECK close "$W/straight/ckpt_000200.h5" "$W/b/ckpt_000200.h5" 1e-9 || fail "np 2 -> 3+1 drifted"
+    ;;
+  fields_q0_q1)
+    must_run 2 --io-ranks 0 --steps 150 --fields-every 1 --output "$W/q0"
+    must_run 3 --io-ranks 1 --steps 150 --fields-every 1 --output "$W/q1"
+    [ "$(wc -l <"$W/q0/fields.csv")" -eq 151 ] || fail "expected a header and 150 rows"
+    cmp "$W/q0/fields.csv" "$W/q1/fields.csv" || fail "fields.csv differs between --io-ranks 0 and 1"
+    ;;
+  vtk_frames)
+    must_run 3 --io-ranks 1 --steps 100 --checkpoint-every 50 --frames-every 25 --output "$W/out"
+    [ "$(grep -c '<DataSet' "$W/out/frames.pvd")" -eq 4 ] || fail "expected 4 frames in frames.pvd"
+    $CHECK pvd "$W/out" || fail "VTK frames disagree with the checkpoints"
+    grep -Eq "frames +4 files" "$W/last.log" || fail "the report does not count 4 frames"
+    # A restart from step 50 in the same folder: the series drops the frames after it and continues;
+    # fields.csv keeps its rows up to step 50 and appends, with no step twice.
+    must_run 3 --io-ranks 1 --steps 50 --checkpoint-every 50 --frames-every 25 --output "$W/out" \
+      --restart "$W/out/ckpt_000050.h5"
+    [ "$(grep -c '<DataSet' "$W/out/frames.pvd")" -eq 4 ] || fail "frames.pvd after the restart: expected 4 frames"
+    [ -z "$(cut -d, -f1 "$W/out/fields.csv" | sort | uniq -d)" ] || fail "fields.csv has a step twice"
+    [ "$(wc -l <"$W/out/fields.csv")" -eq 101 ] || fail "fields.csv: expected a header and 100 rows"
+    $CHECK pvd "$W/out" || fail "VTK frames disagree with the checkpoints after the restart"
+    ;;
+  two_io_ranks)
+    # 2 compute + 2 I/O ranks: one checkpoint file per step (I/O rank 0 gathers), one VTK piece per I/O
+    # rank; the checkpoints equal those of 2 compute ranks writing themselves.
+    must_run 4 --io-ranks 2 --steps 100 --checkpoint-every 50 --frames-every 50 --output "$W/q2"
+    must_run 2 --io-ranks 0 --steps 100 --checkpoint-every 50 --output "$W/q0"
+    [ -e "$W/q2/frame_00000100/piece_0001.vtp" ] || fail "no VTK piece from the second I/O rank"
+    $CHECK same "$W/q2/ckpt_000100.h5" "$W/q0/ckpt_000100.h5" || fail "checkpoints differ between Q = 2 and Q = 0"
+    $CHECK pvd "$W/q2" || fail "VTK frames disagree with the checkpoints"
+    ;;
+  unwritable_output)
+    touch "$W/a_file"
+    must_fail "$W/a_file/out: cannot create the output folder" 3 --io-ranks 1 --steps 10 --output "$W/a_file/out"
+    must_fail "$W/a_file/out: cannot create the output folder" 1 --steps 10 --output "$W/a_file/out"
+    ;;
+  disk_full)
+    # A 1 MB file-size limit on the ranks (not on mpirun, whose PMIx needs its shared-memory files): a
+    # checkpoint (~1.6 MB) fails with EFBIG (SIGXFSZ is ignored) and the error names the file; no
+    # checkpoint is left under its final name; the run stops non-zero at the same step on all ranks.
+    for q in 0 1; do
+      np=$((1 + q))
+      "$MPIEXEC" -np $np bash -c "ulimit -f 1000; exec \"$BASALT_RUN\" \"$SCENE\" --geometry \"$GEOMETRY\" --quiet --io-ranks $q --steps 100 --checkpoint-every 50 --output \"$W/q$q\"" >"$W/last.log" 2>&1
+      code=$?
+      cat "$W/last.log"
+      [ $code -ne 0 ] || fail "--io-ranks $q: the run succeeded although the disk was full"
+      grep -Eq "$W/q$q/ckpt_000050.h5" "$W/last.log" || fail "--io-ranks $q: the error does not name the checkpoint"
+      grep -q "error: output failed" "$W/last.log" || fail "--io-ranks $q: no clean stop"
+      [ ! -e "$W/q$q/ckpt_000050.h5" ] || fail "--io-ranks $q: a failed checkpoint is left under its final name"
+    done
+    # on_error = "continue": the run goes on without checkpoints and exits 0, reporting the failure.
+    sed 's/^\[output\]$/[output]\non_error = "continue"/' "$SCENE" >"$W/continue.toml"
+    "$MPIEXEC" -np 2 bash -c "ulimit -f 1000; exec \"$BASALT_RUN\" \"$W/continue.toml\" --geometry \"$GEOMETRY\" \
+        --quiet --io-ranks 1 --steps 100 --checkpoint-every 50 --output \"$W/cont\"" >"$W/last.log" 2>&1
+    code=$?
+    cat "$W/last.log"
+    [ $code -eq 0 ] || fail "on_error = continue: the run stopped"
+    grep -q "done: 100 steps" "$W/last.log" || fail "on_error = continue: the run did not finish"
+    grep -q "ckpt_000050.h5" "$W/last.log" || fail "on_error = continue: the failure is not reported"
+    ;;
+  killed_mid_checkpoint)
+    # Slow storage (throttled I/O rank), checkpoints every 20 steps; SIGKILL the ranks once two
+    # checkpoints exist, plant a cut-off newer checkpoint and a .partial: --restart DIR must take the
+    # last complete one.
+    "$MPIEXEC" -np 2 "$BASALT_RUN" "$SCENE" --geometry "$GEOMETRY" --quiet --io-ranks 1 --steps 100000 \
+      --checkpoint-every 20 --throttle-io-mbps 4 --output "$W/out" >"$W/killed.log" 2>&1 &
+    mpirun_pid=$!
+    for _ in $(seq 1 600); do
+      [ "$(ls "$W/out"/ckpt_*.h5 2>/dev/null | wc -l)" -ge 2 ] && break
+      sleep 0.1
+    done
+    for pid in $(pgrep -P "$mpirun_pid"); do kill -9 "$pid"; done
+    kill -9 "$mpirun_pid" 2>/dev/null
+    wait "$mpirun_pid" 2>/dev/null
+    last=$(ls "$W/out"/ckpt_*.h5 | sort | tail -1)
+    [ -n "$last" ] || fail "no checkpoint written before the kill"
+    $CHECK complete "$last" || fail "$last is incomplete"
+    head -c 100000 "$last" >"$W/out/ckpt_999999.h5"
+    cp "$last" "$W/out/ckpt_999990.h5.partial"
+    must_run 2 --io-ranks 1 --steps 20 --checkpoint-every 20 --output "$W/out" --restart "$W/out"
+    step=$(basename "$last" .h5 | sed 's/ckpt_0*//')
+    grep -q "continuing from step $step ($last)" "$W/last.log" || { cat "$W/last.log"; fail "did not restart from $last"; }
+    must_fail "ckpt_999999.h5" 2 --io-ranks 1 --steps 20 --output "$W/out2" --restart "$W/out/ckpt_999999.h5"
+    ;;
+  folder_removed)
+    # The output folder disappears mid-run: the next checkpoint fails naming its path, the run stops
+    # cleanly (exit 1, I/O rank released); a checkpoint completed elsewhere before stays restartable.
+    "$MPIEXEC" -np 2 "$BASALT_RUN" "$SCENE" --geometry "$GEOMETRY" --quiet --io-ranks 1 --steps 3000 \
+      --checkpoint-every 20 --throttle-io-mbps 8 --output "$W/out" >"$W/last.log" 2>&1 &
+    mpirun_pid=$!
+    for _ in $(seq 1 600); do
+      [ -e "$W/out/ckpt_000020.h5" ] && break
+      sleep 0.1
+    done
+    mkdir -p "$W/kept" && cp "$W/out/ckpt_000020.h5" "$W/kept/"
+    rm -rf "$W/out"
+    wait "$mpirun_pid"
+    code=$?
+    cat "$W/last.log"
+    [ $code -ne 0 ] || fail "the run succeeded although its output folder was removed"
+    grep -Eq "error: output failed.*$W/out/" "$W/last.log" || fail "the error does not name a path in the removed folder"
+    must_run 1 --steps 10 --output "$W/again" --restart "$W/kept"
+    ;;
+  other_scene)
+    must_run 1 --steps 20 --checkpoint-every 20 --output "$W/out"
+    if "$MPIEXEC" -np 1 "$BASALT_RUN" "$SCENE_OTHER" --geometry "$GEOMETRY" --quiet --steps 10 --output "$W/o2" \
+         --restart "$W/out/ckpt_000020.h5" >"$W/last.log" 2>&1; then
+      fail "a checkpoint of another scene was accepted"
+    fi
+    cat "$W/last.log"
+    grep -q "ckpt_000020.h5: this checkpoint was written by another scene" "$W/last.log" || fail "unclear error"
+    must_fail "--restart .*nothing_here: no such file" 1 --steps 10 --output "$W/o3" --restart "$W/nothing_here"
+    mkdir -p "$W/empty"
+    must_fail "--restart .*empty: no complete checkpoint" 1 --steps 10 --output "$W/o3" --restart "$W/empty"
+    ;;
+  io_rank_sleeps)
+    # Rare output: the I/O rank's CPU time must stay a small part of the wall time (it sleeps).
+    must_run 2 --io-ranks 1 --steps 600 --checkpoint-every 500 --output "$W/out"
+    cat "$W/last.log"
+    pct=$(sed -nE 's/.*I\/O rank CPU time .* wall \(([0-9.]+) %\).*/\1/p' "$W/last.log")
+    [ -n "$pct" ] || fail "no I/O-rank CPU time in the report"
+    awk -v p="$pct" 'BEGIN { exit !(p < 50) }' || fail "the I/O rank used $pct % of a core while mostly idle"
+    ;;
+  *) fail "unknown case" ;;
+esac
+echo "PASS ($case_name)"

@@ -1,0 +1,92 @@
+#!/usr/bin/python3
+"""Checks on basalt-run output for the I/O-layer end-to-end tests (h5py + VTK's Python reader).
+  same FILE_A FILE_B          every dataset of A equals B's exactly (and vice versa); exit 1 otherwise
+  close FILE_A FILE_B TOL     particle positions and velocities agree to TOL relative (same ids)
+  complete FILE               the checkpoint carries the completion mark
+  pvd DIR                     every frame of DIR/frames.pvd, read with vtkXMLPPolyDataReader, has the
+                              positions of DIR/ckpt_<step>.h5 (same ids), when that checkpoint exists
+"""
+import sys
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+
+def datasets(f):
+    out = {}
+    f.visititems(lambda n, o: out.__setitem__(n, o[()]) if isinstance(o, h5py.Dataset) else None)
+    return out
+
+
+def same(a, b):
+    da, db = datasets(h5py.File(a, "r")), datasets(h5py.File(b, "r"))
+    bad = sorted(set(da) ^ set(db))
+    for k in sorted(set(da) & set(db)):
+        if da[k].shape != db[k].shape or not np.array_equal(da[k], db[k]):
+            bad.append(k)
+    for k in bad:
+        print(f"differs: {k}")
+    print(f"{len(da)} datasets compared, {len(bad)} differ")
+    return not bad
+
+
+def close(a, b, tol):
+    fa, fb = h5py.File(a, "r"), h5py.File(b, "r")
+    if not np.array_equal(fa["particles/id"][()], fb["particles/id"][()]):
+        print("particle ids differ")
+        return False
+    ok = True
+    for k in ["particles/position", "particles/velocity"]:
+        x, y = fa[k][()], fb[k][()]
+        rel = np.max(np.abs(x - y)) / max(np.max(np.abs(x)), 1e-300)
+        print(f"{k}: max difference {rel:.3g} relative to the largest value")
+        ok = ok and rel <= tol
+    return ok
+
+
+def complete(f):
+    with h5py.File(f, "r") as h:
+        return int(h.attrs.get("complete", 0)) == 1
+
+
+def pvd(folder):
+    import vtk
+    from vtk.util.numpy_support import vtk_to_numpy
+
+    folder = Path(folder)
+    root = ET.parse(folder / "frames.pvd").getroot()
+    entries = root.findall(".//DataSet")
+    compared = 0
+    for e in entries:
+        pvtp = folder / e.get("file")
+        step = int(pvtp.stem.split("_")[-1])
+        ck = folder / f"ckpt_{step:06d}.h5"
+        r = vtk.vtkXMLPPolyDataReader()
+        r.SetFileName(str(pvtp))
+        r.Update()
+        poly = r.GetOutput()
+        if poly.GetNumberOfPoints() == 0:
+            print(f"{pvtp}: no points read")
+            return False
+        pos = vtk_to_numpy(poly.GetPoints().GetData())
+        ids = vtk_to_numpy(poly.GetPointData().GetArray("id"))
+        if not ck.exists():
+            continue
+        with h5py.File(ck, "r") as h:
+            cid, cpos = h["particles/id"][()], h["particles/position"][()]
+        order = np.argsort(ids)
+        if not np.array_equal(ids[order], cid) or not np.array_equal(pos[order], cpos):
+            print(f"{pvtp}: positions differ from {ck}")
+            return False
+        compared += 1
+    print(f"{len(entries)} frames in the .pvd, {compared} compared with checkpoints")
+    return compared > 0
+
+
+if __name__ == "__main__":
+    cmd, args = sys.argv[1], sys.argv[2:]
+    ok = {"same": lambda: same(*args), "close": lambda: close(args[0], args[1], float(args[2])),
+          "complete": lambda: complete(args[0]), "pvd": lambda: pvd(args[0])}[cmd]()
+    sys.exit(0 if ok else 1)

@@ -1,0 +1,99 @@
+#!/usr/bin/python3
+"""Cost of output in basalt-run: the paper's four output stages (none; field saver every step;
+checkpoint every 100 steps; both) with --io-ranks 0 (1 rank computes and writes) and --io-ranks 1
+(1 compute + 1 I/O rank), and the slow-storage experiment (--throttle-io-mbps). Prints Markdown
+tables of medians over repeats and ratios against "none" with the same Q measured in the same run.
+
+  tools/bench/output_bench.py --basalt-run build/bin/basalt-run --geometry /work/data/cube30.geo \
+      --steps 300 --repeats 3 [--throttle 0,50,20,10,5]
+The time is the stepping loop's ("done: N steps in X s"), start-up excluded.
+"""
+import argparse
+import os
+import re
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+STAGES = {
+    "none": ["--fields-every", "0", "--checkpoint-every", "0"],
+    "fields every step": ["--fields-every", "1", "--checkpoint-every", "0"],
+    "checkpoint every 100": ["--fields-every", "0", "--checkpoint-every", "100"],
+    "both": ["--fields-every", "1", "--checkpoint-every", "100"],
+    "checkpoint every 100, --no-exact-restart": ["--fields-every", "0", "--checkpoint-every", "100",
+                                                 "--no-exact-restart"],
+}
+
+
+def run(a, q, extra, out):
+    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
+               OMPI_MCA_rmaps_base_oversubscribe="1", OMPI_MCA_mpi_yield_when_idle="0",
+               HWLOC_COMPONENTS="-gl")
+    # Compute ranks should not yield (the I/O rank sleeps by itself); hwloc's GL probe would connect to an
+    # X server on :0 if another session runs one, and die when it goes away.
+    shutil.rmtree(out, ignore_errors=True)
+    cmd = ["mpirun", "-np", str(1 + q), a.basalt_run, str(ROOT / "scenes/wave.toml"), "--geometry", a.geometry,
+           "--steps", str(a.steps), "--quiet", "--frames-every", "0", "--io-ranks", str(q), "--output", str(out)] + extra
+    p = subprocess.run(cmd, capture_output=True, text=True, env=env)
+    if p.returncode != 0:
+        sys.exit(f"failed: {' '.join(cmd)}\n{p.stdout}\n{p.stderr}")
+    loop = float(re.search(r"done: \d+ steps in ([0-9.]+) s", p.stdout).group(1))
+    wait = float(re.search(r"compute ranks waited ([0-9.]+) s", p.stdout).group(1))
+    cpu = float(re.search(r"cpu time of the loop: ([0-9.]+) s", p.stdout).group(1))
+    return loop, wait, cpu
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--basalt-run", default=str(ROOT / "build/bin/basalt-run"))
+    ap.add_argument("--geometry", required=True)
+    ap.add_argument("--steps", type=int, default=300)
+    ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--throttle", default="", help="MB/s values for the slow-storage table (0 = unthrottled)")
+    ap.add_argument("--throttle-checkpoint-every", type=int, default=100)
+    ap.add_argument("--stages", default="", help="';'-separated subset of the stages (default: all)")
+    ap.add_argument("--output-root", default=None, help="where the runs write (default: the system's temp folder; "
+                    "/dev/shm takes the disk out of the measurement)")
+    a = ap.parse_args()
+    tmp = Path(tempfile.mkdtemp(prefix="basalt-output-bench-", dir=a.output_root))
+    print(f"geometry {a.geometry}, {a.steps} steps, median of {a.repeats} (interleaved), loop seconds, "
+          f"output under {tmp.parent}\n")
+    if a.stages:
+        for s in list(STAGES):
+            if s not in a.stages.split(";") and s != "none":
+                del STAGES[s]
+    def table(cases, label, extra_of, base_case):
+        res = {(c, q): [] for c in cases for q in (0, 1)}
+        for _ in range(a.repeats):  # interleave so that load changes hit every case alike
+            for c in cases:
+                for q in (0, 1):
+                    res[(c, q)].append(run(a, q, extra_of(c), tmp / "out"))
+        med = {k: [statistics.median(x[i] for x in v) for i in range(3)] for k, v in res.items()}
+        print(f"| {label} | Q = 0: loop s | vs {base_case} | CPU s | vs {base_case} | Q = 1: loop s | vs {base_case} "
+              f"| CPU s | vs {base_case} | Q = 1 compute wait s |")
+        print("| --- " * 10 + "|")
+        for c in cases:
+            row = f"| {c} "
+            for q in (0, 1):
+                t, w, cpu = med[(c, q)]
+                bt, _, bcpu = med[(base_case, q)]
+                row += f"| {t:.3f} | {100 * (t / bt - 1):+.1f} % | {cpu:.3f} | {100 * (cpu / bcpu - 1):+.1f} % "
+            print(row + f"| {med[(c, 1)][1]:.4f} |")
+
+    if not a.throttle:
+        table(list(STAGES), "stage", lambda c: STAGES[c], "none")
+    else:
+        rates = [float(x) for x in a.throttle.split(",")]
+        every = str(a.throttle_checkpoint_every)
+        print(f"checkpoint every {every} steps, storage throttled to R MB/s (0 = not throttled)\n")
+        table(rates, "R MB/s", lambda r: ["--fields-every", "0", "--checkpoint-every", every,
+                                          "--throttle-io-mbps", str(r)], rates[0])
+    shutil.rmtree(tmp, ignore_errors=True)
+
+
+if __name__ == "__main__":
+    main()
