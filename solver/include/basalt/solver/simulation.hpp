@@ -91,7 +91,11 @@ class Simulation {
   std::int64_t current_step() const { return step_; }
   double time() const { return time_; }
   const Particles<Real>& particles() const { return p_; }
-  Particles<Real>& particles() { return p_; }
+  /// Mutable access (tests, set-up) drops the kinetic energy cached by the last step.
+  Particles<Real>& particles() {
+    ke_fresh_ = false;
+    return p_;
+  }
   const Bonds<Real>& bonds() const { return bonds_; }
   const PairList& own_pairs() const { return own_; }
   const PairList& ghost_pairs() const { return ghost_; }
@@ -145,6 +149,8 @@ class Simulation {
   [[noreturn]] void stop(const std::string& message);
   void guard_energy(const std::array<double, 3>& pe);
   bool energy_due(std::int64_t s) const;
+  /// Whether step s needs the kinetic energy (a saver or the energy guard).
+  bool kinetic_due(std::int64_t s) const;
 
   Scene scene_;
   RunOptions options_;
@@ -181,6 +187,8 @@ class Simulation {
   double wall_work_in_ = 0;  ///< this rank's share of the positive work done by walls
   PhaseTimes times_;
   double ghost_wait_ = 0;
+  double ke_local_ = 0;    ///< this rank's kinetic energy, valid while ke_fresh_
+  bool ke_fresh_ = false;  ///< set when the second half-kick computed ke_local_ this step
   bool forces_zeroed_ = false;  ///< set by the fused kick-zero-drift pass
   StabilityReport stability_;
   OutputSink* output_ = nullptr;        ///< set during run(steps, OutputSink&)

@@ -104,13 +104,56 @@ void zero_forces(Particles<Real>& p) {
   std::fill(p.fz.begin(), p.fz.end(), Real(0));
 }
 
+namespace detail {
+/// Adds v^2 / (1/m) of particle i to lane i mod 8 of `lane`: the one summation order shared by
+/// kinetic_energy() and kick_energy(), so both give the same bits.
+constexpr std::size_t kEnergyLanes = 8;
+inline double lane_sum(const double (&lane)[kEnergyLanes]) {
+  double e = 0;
+  for (double l : lane) e += l;
+  return 0.5 * e;
+}
+}  // namespace detail
+
+/// Total kinetic energy of the owned particles, sum of m v^2 / 2. Eight independent partial sums
+/// (particle i goes to lane i mod 8) let the compiler vectorise; the order is fixed, so the result
+/// is deterministic.
 template <class Real>
 double kinetic_energy(const Particles<Real>& p) {
-  double e = 0;
-  for (std::size_t i = 0; i < p.n_owned; ++i)
-    e += 0.5 / double(p.inv_mass[i]) *
-         double(p.vx[i] * p.vx[i] + p.vy[i] * p.vy[i] + p.vz[i] * p.vz[i]);
-  return e;
+  double lane[detail::kEnergyLanes] = {};
+  const Real* vx = p.vx.data();
+  const Real* vy = p.vy.data();
+  const Real* vz = p.vz.data();
+  const Real* im = p.inv_mass.data();
+  for (std::size_t i = 0; i < p.n_owned; ++i) {
+    const double v2 = double(vx[i]) * double(vx[i]) + double(vy[i]) * double(vy[i]) + double(vz[i]) * double(vz[i]);
+    lane[i % detail::kEnergyLanes] += v2 / double(im[i]);
+  }
+  return detail::lane_sum(lane);
+}
+
+/// kick(h) fused with kinetic_energy() of the kicked velocities (the same bits as calling the two
+/// in turn): one pass over the velocities instead of two on steps that save the kinetic energy.
+template <class Real>
+double kick_energy(Particles<Real>& p, Real h) {
+  double lane[detail::kEnergyLanes] = {};
+  const std::size_t n = p.n_owned;
+  Real* __restrict vx = p.vx.data();
+  Real* __restrict vy = p.vy.data();
+  Real* __restrict vz = p.vz.data();
+  const Real* __restrict fx = p.fx.data();
+  const Real* __restrict fy = p.fy.data();
+  const Real* __restrict fz = p.fz.data();
+  const Real* __restrict im = p.inv_mass.data();
+  for (std::size_t i = 0; i < n; ++i) {
+    const Real s = h * im[i];
+    vx[i] += s * fx[i];
+    vy[i] += s * fy[i];
+    vz[i] += s * fz[i];
+    const double v2 = double(vx[i]) * double(vx[i]) + double(vy[i]) * double(vy[i]) + double(vz[i]) * double(vz[i]);
+    lane[i % detail::kEnergyLanes] += v2 / double(im[i]);
+  }
+  return detail::lane_sum(lane);
 }
 
 }  // namespace basalt::solver
