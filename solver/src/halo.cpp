@@ -75,7 +75,7 @@ std::optional<std::string> Halo<Real>::migrate(Particles<Real>& p, Bonds<Real>& 
       for (std::size_t k = 0; k < bonds.size(); ++k)
         if (std::binary_search(ids.begin(), ids.end(), bonds.a[k]) ||
             std::binary_search(ids.begin(), ids.end(), bonds.b[k]))
-          bout[side].push_back(BondRecord{bonds.a[k], bonds.b[k], double(bonds.r0[k]), bonds.group[k], 0});
+          bout[side].push_back(BondRecord{bonds.a[k], bonds.b[k], double(bonds.r0[k]), bonds.group_of(k), 0});
     }
     for (auto it = leaving.rbegin(); it != leaving.rend(); ++it) p.swap_remove_owned(*it);
 

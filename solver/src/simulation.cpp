@@ -165,6 +165,7 @@ void Simulation<Real>::distribute(io::Geometry& g, MPI_Comm comm) {
     if (bond_group[k] != kNone)
       n_bonds += owned[static_cast<std::size_t>(g.index_of(g.bonds[k].a))] ||
                  owned[static_cast<std::size_t>(g.index_of(g.bonds[k].b))];
+  bonds_.grouped = scene_.bonds.size() > 1;
   bonds_.reserve(n_bonds);
   for (std::size_t k = 0; k < g.bonds.size(); ++k) {
     if (bond_group[k] == kNone) continue;
@@ -254,8 +255,10 @@ void Simulation<Real>::resolve_bonds() {
   for (std::size_t c = 0; c < 2 * n; ++c) start[c + 1] += start[c];
   std::vector<std::uint32_t> order(nb);
   for (std::size_t k = 0; k < nb; ++k) order[start[key(k)]++] = static_cast<std::uint32_t>(k);
-  std::vector<std::uint32_t>().swap(start);
   bonds_.permute(order);
+  // start[c] is now the end of bucket c: the bonds of owned particle i are the bucket i (both ends
+  // owned) and n + i (to a ghost). The pair-list build uses these buckets to exclude bonded pairs.
+  bond_bucket_end_.swap(start);
   bonds_.n_both_owned = 0;
   while (bonds_.n_both_owned < nb && static_cast<std::size_t>(bonds_.ib[bonds_.n_both_owned]) < n)
     ++bonds_.n_both_owned;
@@ -288,7 +291,7 @@ void Simulation<Real>::rebuild() {
   resolve_bonds();
   if (!pair_driver_.empty()) {
     grid_.build(p_.x, p_.y, p_.z, p_.size(), contact_cutoff_);
-    exclusions_.build(bonds_.ia, bonds_.ib, p_.size());
+    exclusions_.bind(bond_bucket_end_, bonds_.ib, p_.n_owned);
     if (pair_driver_.takes_all()) {
       build_pair_lists(p_, grid_, scene_.skin, exclusions_, [](std::size_t, std::size_t) { return true; }, own_,
                        ghost_);
@@ -298,7 +301,7 @@ void Simulation<Real>::rebuild() {
       };
       build_pair_lists(p_, grid_, scene_.skin, exclusions_, accept, own_, ghost_);
     }
-    exclusions_.release();
+    std::vector<std::uint32_t>().swap(bond_bucket_end_);
   }
   grid_.release();
   if (!wall_driver_.empty()) wall_driver_.rebuild(p_, scene_.skin);

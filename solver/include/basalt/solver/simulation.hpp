@@ -164,6 +164,7 @@ class Simulation {
   PairList own_, ghost_;
   CellGrid grid_;
   Exclusions exclusions_;
+  std::vector<std::uint32_t> bond_bucket_end_;  ///< bonds per owned end, kept during a rebuild only
   std::vector<BrokenBond> broken_;
   bool bond_broke_ = false;
 

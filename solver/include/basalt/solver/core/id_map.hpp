@@ -2,7 +2,7 @@
 // Global id -> local index, rebuilt at each neighbour-list rebuild. Stores only local indices
 // (4 bytes per slot); the id itself is read back from the particle array to confirm a hit.
 //  - dense ids (range <= 8 x count): a direct table over the global id range;
-//  - sparse ids (GenGeo's are): open addressing with linear probing, 2-4 slots per local particle.
+//  - sparse ids (GenGeo's are): open addressing with linear probing, 1.4-2.8 slots per local particle.
 #include <cstdint>
 #include <vector>
 
@@ -27,7 +27,7 @@ class IdMap {
       return;
     }
     std::size_t cap = 16;
-    while (cap < 2 * n) cap *= 2;
+    while (10 * cap < 14 * n) cap *= 2;  // load factor <= 0.71
     mask_ = cap - 1;
     table_.assign(cap, -1);
     for (std::size_t i = 0; i < n; ++i) {

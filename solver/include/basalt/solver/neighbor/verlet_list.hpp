@@ -22,29 +22,33 @@ struct PairList {
   }
 };
 
-/// Bonded partners keyed by the smaller local index of the pair (every listed pair (i, j) has i < j).
+/// Which pairs are bonded, read from the bond list itself (no copy): bonds ordered by owned end, bucket
+/// i holding the bonds of owned particle i with another owned particle and bucket n + i those with a
+/// ghost; bucket_end[c] is the end of bucket c in the bond arrays, ib the other end of each bond.
 struct Exclusions {
-  std::vector<std::uint32_t> offset;
-  std::vector<std::int32_t> partner;
-  bool empty() const { return partner.empty(); }
+  const std::vector<std::uint32_t>* bucket_end = nullptr;
+  const std::vector<std::int32_t>* other = nullptr;
+  std::size_t n = 0;
+
+  void bind(const std::vector<std::uint32_t>& end, const std::vector<std::int32_t>& ib, std::size_t n_owned) {
+    bucket_end = &end;
+    other = &ib;
+    n = n_owned;
+  }
+  bool empty() const { return other == nullptr || other->empty(); }
+  /// Pair (i, j) with i < j, i owned.
   bool has(std::size_t i, std::int32_t j) const {
-    for (auto k = offset[i]; k < offset[i + 1]; ++k)
-      if (partner[k] == j) return true;
+    const auto ju = static_cast<std::size_t>(j);
+    if (ju >= n) return in_bucket(n + i, j);
+    return in_bucket(i, j) || in_bucket(ju, static_cast<std::int32_t>(i));
+  }
+
+ private:
+  bool in_bucket(std::size_t c, std::int32_t j) const {
+    const auto& e = *bucket_end;
+    for (std::uint32_t k = c == 0 ? 0 : e[c - 1]; k < e[c]; ++k)
+      if ((*other)[k] == j) return true;
     return false;
-  }
-  /// From local pairs (ia, ib); n = number of local particles.
-  void build(const std::vector<std::int32_t>& ia, const std::vector<std::int32_t>& ib, std::size_t n) {
-    offset.assign(n + 1, 0);
-    for (std::size_t k = 0; k < ia.size(); ++k) ++offset[static_cast<std::size_t>(std::min(ia[k], ib[k])) + 1];
-    for (std::size_t i = 0; i < n; ++i) offset[i + 1] += offset[i];
-    partner.resize(ia.size());
-    std::vector<std::uint32_t> fill(offset.begin(), offset.end() - 1);
-    for (std::size_t k = 0; k < ia.size(); ++k)
-      partner[fill[static_cast<std::size_t>(std::min(ia[k], ib[k]))]++] = std::max(ia[k], ib[k]);
-  }
-  void release() {
-    std::vector<std::uint32_t>().swap(offset);
-    std::vector<std::int32_t>().swap(partner);
   }
 };
 
@@ -87,6 +91,8 @@ void build_pair_lists(const Particles<Real>& p, const CellGrid& grid, double ski
     own.offset[i + 1] = static_cast<std::uint32_t>(own.neigh.size());
     ghost.offset[i + 1] = static_cast<std::uint32_t>(ghost.neigh.size());
   }
+  own.neigh.shrink_to_fit();
+  ghost.neigh.shrink_to_fit();
 }
 
 }  // namespace basalt::solver
