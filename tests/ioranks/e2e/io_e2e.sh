@@ -43,6 +43,28 @@ case $case_name in
   restart_np2_q0) restart_bitwise 2 0 ;;
   restart_np1_q1) restart_bitwise 2 1 ;;
   restart_np2_q1) restart_bitwise 3 1 ;;
+  restart_old_lists)
+    # A skin so small that the lists are rebuilt every few steps (migrating particles at np 2), but
+    # not at step 100: the checkpoint's lists date from an earlier step, which the restart replays.
+    sed 's/^skin = .*/skin = 0.005/' "$SCENE" >"$W/small_skin.toml"
+    grep -q '^skin = 0.005' "$W/small_skin.toml" || fail "could not set the skin in $W/small_skin.toml"
+    SCENE=$W/small_skin.toml
+    restart_bitwise 1 0
+    $CHECK old_lists "$W/split/ckpt_000100.h5" || fail "np 1: the lists were rebuilt at the checkpoint step"
+    rm -rf "$W/straight" "$W/split"
+    restart_bitwise 3 1
+    $CHECK old_lists "$W/split/ckpt_000100.h5" || fail "np 2: the lists were rebuilt at the checkpoint step"
+    ;;
+  restart_old_checkpoint)
+    # A checkpoint without the positions at the last rebuild (older basalt-run): the restart warns
+    # and rebuilds plainly; the continuation agrees to rounding.
+    must_run 2 --steps 200 --checkpoint-every 100 --output "$W/straight"
+    must_run 2 --steps 100 --checkpoint-every 100 --output "$W/old"
+    $CHECK strip_rebuild "$W/old/ckpt_000100.h5" || fail "could not strip the checkpoint"
+    must_run 2 --steps 100 --checkpoint-every 100 --output "$W/old" --restart "$W/old/ckpt_000100.h5"
+    grep -q "has no /particles/position_at_rebuild" "$W/last.log" || fail "no warning about the old checkpoint"
+    $CHECK close "$W/straight/ckpt_000200.h5" "$W/old/ckpt_000200.h5" 1e-9 || fail "the continuation drifted"
+    ;;
   restart_other_ranks)
     must_run 2 --steps 200 --checkpoint-every 100 --output "$W/straight"
     must_run 2 --steps 100 --checkpoint-every 100 --output "$W/a"
