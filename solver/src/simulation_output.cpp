@@ -91,7 +91,8 @@ void Simulation<Real>::pack_frame(io::FramePiece& piece, std::uint32_t kinds) co
   // Owned particles now are those of the last rebuild (only a rebuild migrates or reorders them).
   if ((kinds & io::kFrameCheckpoint) && xr_.size() == n) {
     piece.position_at_rebuild.resize(n);
-    for (std::size_t i = 0; i < n; ++i) piece.position_at_rebuild[i] = {double(xr_[i]), double(yr_[i]), double(zr_[i])};
+    for (std::size_t i = 0; i < n; ++i)
+      piece.position_at_rebuild[i] = {double(xr_[i]), double(yr_[i]), double(zr_[i])};
     piece.rebuild_step = rebuild_step_;
     piece.rebuild_pending = bond_broke_ ? 1 : 0;
   } else {

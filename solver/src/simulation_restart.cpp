@@ -129,9 +129,9 @@ void Simulation<Real>::replay_rebuild(const io::Checkpoint& c) {
   bond_broke_ = c.rebuild_pending;  // a bond broke at the checkpoint step: the next step rebuilds
 }
 
-#define BASALT_INSTANTIATE(R)                                                                             \
-  template Simulation<R>::Simulation(const Scene&, const io::Checkpoint&, const RestartLayout&, MPI_Comm, \
-                                     const RunOptions&);                                                  \
+#define BASALT_INSTANTIATE(R)                                                                                \
+  template Simulation<R>::Simulation(const Scene&, const io::Checkpoint&, const RestartLayout&, MPI_Comm,    \
+                                     const RunOptions&);                                                     \
   template void Simulation<R>::distribute_checkpoint(const io::Checkpoint&, const RestartLayout&, MPI_Comm); \
   template void Simulation<R>::replay_rebuild(const io::Checkpoint&);
 BASALT_INSTANTIATE(double)

@@ -40,7 +40,7 @@ struct FramePiece {
   /// rebuild, exactly as the solver held it; with rebuild_step it lets a restart replay that
   /// rebuild (bit-for-bit continuation, docs/ARCHITECTURE.md).
   std::vector<Vec3> position_at_rebuild;
-  std::int64_t rebuild_step = -1;  ///< step of the last neighbour-list rebuild (-1: unknown)
+  std::int64_t rebuild_step = -1;    ///< step of the last neighbour-list rebuild (-1: unknown)
   std::uint8_t rebuild_pending = 0;  ///< 1: the next step rebuilds whatever moved (a bond broke)
 
   // Bonds this rank is responsible for (each bond in exactly one piece), with their state.
