@@ -1,5 +1,6 @@
 #!/usr/bin/python3
-"""Driver of tools/bench/wave_benchmark.sh: runs the wave benchmark and writes docs/BENCHMARKS.md.
+"""Driver of tools/bench/wave_benchmark.sh: runs the wave benchmark and writes docs/bench/wave.md
+(docs/BENCHMARKS.md quotes its table).
 
 Cases: the 15 mm GenGeo cube (cube1.geo, 8,948 particles) and a 30 mm cube (/work/data/cube30.geo when
 present, else cube1.geo tiled 2x2x2 = 71,584 particles), each at 1 and 2 ranks. Every repeat runs
@@ -92,11 +93,11 @@ def main():
     p.add_argument("--esys-30mm", action="store_true", help="also run ESyS on the 30 mm cube (slow: minutes per run)")
     p.add_argument("--lammps-skin", type=float, default=0.1, help="LAMMPS neighbour skin (Basalt's scene uses 0.1)")
     p.add_argument("--no-memory", action="store_true")
-    p.add_argument("--output", default=None, help="report (default ROOT/docs/BENCHMARKS.md)")
+    p.add_argument("--output", default=None, help="report (default ROOT/docs/bench/wave.md)")
     a = p.parse_args()
     a.build = a.build or os.path.join(a.root, "build")
     a.peer_dir = a.peer_dir or a.root
-    a.output = a.output or os.path.join(a.root, "docs", "BENCHMARKS.md")
+    a.output = a.output or os.path.join(a.root, "docs", "bench", "wave.md")
     ref = os.environ.get("BASALT_REFERENCE_DIR") or os.path.join(a.root, "..", "shared", "reference")
     cube15 = os.path.join(ref, "cube1.geo")
     work = tempfile.mkdtemp(prefix="basalt-bench-")
@@ -157,7 +158,7 @@ def main():
     host = os.uname().nodename
     cpu = next((l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if l.startswith("model name")), "?")
     load = open("/proc/loadavg").read().split()[:3]
-    lines = ["# Benchmarks", "",
+    lines = ["# Wave benchmark: throughput and memory of basalt-run", "",
              f"Made by `bash tools/bench/wave_benchmark.sh` on {datetime.datetime.utcnow():%Y-%m-%d %H:%M} UTC, "
              f"{os.cpu_count()} cores ({cpu}), load average {' '.join(load)} at the end (the machine is shared: "
              "other jobs ran meanwhile, so compare the ratios, measured back to back, more than the absolute "
