@@ -55,6 +55,25 @@ case $case_name in
     restart_bitwise 3 1
     $CHECK old_lists "$W/split/ckpt_000100.h5" || fail "np 2: the lists were rebuilt at the checkpoint step"
     ;;
+  restart_migration)
+    # Particles change rank between rebuilds (a stronger wall pulse, 3 ranks stacked along z): the
+    # replayed rebuild must give each particle the owner the uninterrupted run's migration gave it.
+    sed -e 's/^skin = .*/skin = 0.005/' -e 's/amplitude = 0.1,/amplitude = 0.5,/' "$SCENE" >"$W/migrate.toml"
+    grep -q 'amplitude = 0.5,' "$W/migrate.toml" || fail "could not set the amplitude in $W/migrate.toml"
+    SCENE=$W/migrate.toml
+    export BASALT_DEBUG_REBUILD=1
+    must_run 3 --dims 1,1,3 --steps 300 --checkpoint-every 150 --output "$W/straight"
+    # Owned counts of rank 0 at its rebuilds up to step 150: they must change (particles migrated).
+    counts=$(grep '^rank 0 rebuild' "$W/last.log" | awk '$6 < 150 {print $8}' | sort -u | wc -l)
+    [ "$counts" -gt 1 ] || fail "no particle migrated before the checkpoint: the case tests nothing"
+    unset BASALT_DEBUG_REBUILD
+    must_run 3 --dims 1,1,3 --steps 150 --checkpoint-every 150 --output "$W/split"
+    $CHECK old_lists "$W/split/ckpt_000150.h5" || fail "the lists were rebuilt at the checkpoint step"
+    must_run 3 --dims 1,1,3 --steps 150 --checkpoint-every 150 --output "$W/split" --restart "$W/split"
+    $CHECK same "$W/straight/ckpt_000300.h5" "$W/split/ckpt_000300.h5" || fail "final checkpoints differ"
+    cmp "$W/straight/ckpt_000300.h5" "$W/split/ckpt_000300.h5" || fail "final checkpoint files differ in their bytes"
+    echo "np 3 (1x1x3), migration before the checkpoint: step-300 checkpoints identical"
+    ;;
   restart_old_checkpoint)
     # A checkpoint without the positions at the last rebuild (older basalt-run): the restart warns
     # and rebuilds plainly; the continuation agrees to rounding.
