@@ -38,6 +38,13 @@ void Checkpoint::validate(const fs::path& source) const {
   if (!inv_mass.empty() && inv_mass.size() != n)
     throw FormatError(source, "/particles/inverse_mass",
                       fmt::format("{} inverse masses for {} particles", inv_mass.size(), n));
+  if (!position_at_rebuild.empty() && position_at_rebuild.size() != n)
+    throw FormatError(source, "/particles/position_at_rebuild",
+                      fmt::format("{} rows for {} particles", position_at_rebuild.size(), n));
+  if (!position_at_rebuild.empty() && (rebuild_step < 0 || rebuild_step > step))
+    throw FormatError(
+        source, "attribute 'rebuild_step' of /",
+        fmt::format("is {}, expected a step in [0, {}] (the checkpoint's step)", rebuild_step, step));
   if (bond_rest_length.size() != m)
     throw FormatError(source, "/bonds/rest_length",
                       fmt::format("{} values for {} bonds", bond_rest_length.size(), m));

@@ -19,7 +19,8 @@ namespace {
 constexpr const char* kSchema = "basalt-checkpoint";
 constexpr int kSchemaVersion = 1;
 // Root attributes of this schema besides the geometry's; "complete" is written last.
-constexpr std::string_view kRunAttributes[] = {"step", "time", "dt", "scene_text", "complete"};
+constexpr std::string_view kRunAttributes[] = {
+    "step", "time", "dt", "scene_text", "rebuild_step", "rebuild_pending", "complete"};
 constexpr const char* kWallVectors[] = {"position", "normal", "velocity", "force"};
 
 Vec3& wall_vector(WallState& w, int k) {
@@ -54,6 +55,9 @@ void write_checkpoint(const Checkpoint& c, const fs::path& file) {
     for (std::size_t k = 0; k < order.size(); ++k) storage.velocity[k] = c.velocity[order[k]];
     if (!c.inv_mass.empty())
       for (std::size_t k = 0; k < order.size(); ++k) storage.inv_mass[k] = c.inv_mass[order[k]];
+    if (!c.position_at_rebuild.empty())
+      for (std::size_t k = 0; k < order.size(); ++k)
+        storage.position_at_rebuild[k] = c.position_at_rebuild[order[k]];
     s = &storage;
   }
 
@@ -62,6 +66,12 @@ void write_checkpoint(const Checkpoint& c, const fs::path& file) {
   h5::write_geometry_layout(w, s->geometry, kRunAttributes);
   w.dataset("/particles/velocity", reinterpret_cast<const double*>(s->velocity.data()), s->size(), 3);
   if (!s->inv_mass.empty()) w.dataset("/particles/inverse_mass", s->inv_mass);
+  if (!s->position_at_rebuild.empty()) {
+    w.dataset("/particles/position_at_rebuild",
+              reinterpret_cast<const double*>(s->position_at_rebuild.data()), s->size(), 3);
+    w.scalar_attribute<std::int64_t>("/", "rebuild_step", s->rebuild_step);
+    w.scalar_attribute<std::uint8_t>("/", "rebuild_pending", s->rebuild_pending ? 1 : 0);
+  }
   w.dataset("/bonds/rest_length", s->bond_rest_length);
   w.dataset("/bonds/broken", s->bond_broken);
   w.group("/walls");
@@ -103,6 +113,19 @@ Checkpoint read_checkpoint_unguarded(const fs::path& file) {
     const auto irows = r.rows<double>("/particles/inverse_mass");
     if (irows != n) r.fail("/particles/inverse_mass", fmt::format("{} values for {} particles", irows, n));
     c.inv_mass = r.read<double>("/particles/inverse_mass");
+  }
+  if (r.exists("/particles/position_at_rebuild")) {
+    const auto prows = r.rows<double>("/particles/position_at_rebuild", 3);
+    if (prows != n)
+      r.fail("/particles/position_at_rebuild", fmt::format("{} rows for {} particles", prows, n));
+    if (!r.has_attribute("/", "rebuild_step"))
+      r.fail(root_attribute("rebuild_step"), "missing (required with /particles/position_at_rebuild)");
+    c.position_at_rebuild.resize(n);
+    if (n)
+      r.read_into("/particles/position_at_rebuild", reinterpret_cast<double*>(c.position_at_rebuild.data()));
+    c.rebuild_step = r.scalar_attribute<std::int64_t>("/", "rebuild_step");
+    c.rebuild_pending = r.has_attribute("/", "rebuild_pending") &&
+                        r.scalar_attribute<std::uint8_t>("/", "rebuild_pending") != 0;
   }
   const auto lrows = r.rows<double>("/bonds/rest_length");
   if (lrows != m) r.fail("/bonds/rest_length", fmt::format("{} values for {} bonds", lrows, m));

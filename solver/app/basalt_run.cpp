@@ -39,7 +39,7 @@ namespace {
 struct Cli {
   std::string scene_file, geometry, output, dims_text, restart;
   std::int64_t steps = -1;
-  bool quiet = false, force_dt = false, no_exact_restart = false;
+  bool quiet = false, force_dt = false;
   int io_ranks = 0;
   std::int64_t checkpoint_every = -1, frames_every = -1, fields_every = -1;
   double throttle_mbps = 0;
@@ -182,7 +182,6 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
   io::OutputClient client(layout, cfg, info, vtk);
   basalt::run::ClientSink sink(client, cfg.continue_on_error);
   // Checkpoint steps are restart points: the lists are rebuilt there in canonical order.
-  sim->set_canonical_every(scene.exact_restart ? cfg.checkpoint_every : 0);
   const double startup = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const auto t1 = std::chrono::steady_clock::now();
   const double cpu0 = cpu_seconds();
@@ -268,8 +267,6 @@ int run_world(int argc, char** argv) {
   app.add_option("--throttle-io-mbps", cli.throttle_mbps,
                  "benchmark only: make output storage this slow (MB/s)")
       ->check(CLI::NonNegativeNumber);
-  app.add_flag("--no-exact-restart", cli.no_exact_restart,
-               "checkpoint steps are not bit-for-bit restart points (saves one list rebuild per checkpoint)");
   app.add_flag("--quiet", cli.quiet, "no progress line");
   app.add_flag("--force-dt", cli.force_dt, "run even when dt exceeds the critical time step");
   app.set_version_flag("--version", std::string(basalt::kVersion));
@@ -290,7 +287,6 @@ int run_world(int argc, char** argv) {
   if (cli.fields_every > 0)
     for (auto& f : scene.fields) f.every = cli.fields_every;
   if (cli.frames_in_flight > 0) scene.frames_in_flight = cli.frames_in_flight;
-  if (cli.no_exact_restart) scene.exact_restart = false;
 
   // A restart reads its checkpoint on every rank (so that a bad one stops all ranks alike, early).
   std::optional<io::Checkpoint> ckpt;

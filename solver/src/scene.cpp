@@ -165,7 +165,9 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
     s.frames_every = t.integer_or("frames_every", 0);
     if (s.frames_every < 0) t.fail("frames_every", fmt::format("must be >= 0 (0 = off), got {}", s.frames_every));
     s.output_continue_on_error = t.choice_or("on_error", {"stop", "continue"}, "stop") == "continue";
-    s.exact_restart = t.boolean_or("exact_restart", true);
+    // Obsolete since every checkpoint is a bit-for-bit restart point at no cost (a restart replays
+    // the last rebuild); still accepted so that older scene files load.
+    (void)t.boolean_or("exact_restart", true);
     s.frames_in_flight = t.integer_or("frames_in_flight", 2);
     if (s.frames_in_flight < 1) t.fail("frames_in_flight", fmt::format("must be >= 1, got {}", s.frames_in_flight));
     if (const auto* arr = t.table_array("fields")) {

@@ -210,10 +210,17 @@ std::optional<std::string> Simulation<Real>::check_finite() const {
 
 template <class Real>
 void Simulation<Real>::spatial_sort() {
-  // Owned particles in cell order: neighbours in space become neighbours in memory.
+  // Owned particles in cell order: neighbours in space become neighbours in memory. Within a cell
+  // by id, so the order is a function of the owned (id, position) set alone, never of the order
+  // migration or a restart left them in: every rebuild is canonical (a restart replays one bit for
+  // bit, docs/ARCHITECTURE.md). A cell holds a few particles: sorting them costs little.
   grid_.build(p_.x, p_.y, p_.z, p_.n_owned, contact_cutoff_);
   const auto& order = grid_.order();
+  const auto& start = grid_.start();
   std::vector<std::uint32_t> perm(order.begin(), order.end());
+  const auto by_id = [&](std::uint32_t i, std::uint32_t j) { return p_.id[i] < p_.id[j]; };
+  for (std::size_t c = 0; c + 1 < start.size(); ++c)
+    if (start[c + 1] - start[c] > 1) std::sort(perm.begin() + start[c], perm.begin() + start[c + 1], by_id);
   p_.permute_owned(perm);
 }
 
@@ -237,7 +244,9 @@ void Simulation<Real>::resolve_bonds() {
       ia = std::max(ia, 0);
       ib = std::max(ib, 0);
     }
-    if (static_cast<std::size_t>(ia) >= n) {
+    // Owned end first; both owned: the lower index first (a canonical orientation, whatever
+    // orientation the bond arrived in).
+    if (static_cast<std::size_t>(ia) >= n || (static_cast<std::size_t>(ib) < n && ib < ia)) {
       std::swap(ia, ib);
       std::swap(bonds_.a[k], bonds_.b[k]);
     }
@@ -246,7 +255,9 @@ void Simulation<Real>::resolve_bonds() {
   }
   if (comm().size() > 1) error = comm().agree_error(error);
   if (error) stop(*error);
-  // Both ends owned first, each part in memory order of its owned end (a counting sort: O(bonds)).
+  // Both ends owned first, each part in memory order of its owned end (a counting sort: O(bonds)),
+  // then by the other end within a bucket: a total order on (ghost?, ia, ib), so the bond order
+  // (and with it the force summation order) is canonical like the particles'.
   std::vector<std::uint32_t> start(2 * n + 1, 0);
   auto key = [&](std::size_t k) {
     return (static_cast<std::size_t>(bonds_.ib[k]) >= n ? n : 0) + static_cast<std::size_t>(bonds_.ia[k]);
@@ -255,6 +266,10 @@ void Simulation<Real>::resolve_bonds() {
   for (std::size_t c = 0; c < 2 * n; ++c) start[c + 1] += start[c];
   std::vector<std::uint32_t> order(nb);
   for (std::size_t k = 0; k < nb; ++k) order[start[key(k)]++] = static_cast<std::uint32_t>(k);
+  for (std::size_t c = 0, b = 0; c < 2 * n; b = start[c], ++c)
+    if (start[c] - b > 1)
+      std::sort(order.begin() + static_cast<std::ptrdiff_t>(b), order.begin() + start[c],
+                [&](std::uint32_t i, std::uint32_t j) { return bonds_.ib[i] < bonds_.ib[j]; });
   bonds_.permute(order);
   // start[c] is now the end of bucket c: the bonds of owned particle i are the bucket i (both ends
   // owned) and n + i (to a ghost). The pair-list build uses these buckets to exclude bonded pairs.
@@ -282,8 +297,6 @@ void Simulation<Real>::rebuild() {
                                  total, n_global_));
   }
   times_.communication += sw.lap();
-  if (canonical_) canonical_order();
-  canonical_ = false;
   spatial_sort();
   times_.neighbor += sw.lap();
   if (parallel) halo_->build_ghosts(p_, ghost_width_);
@@ -310,6 +323,12 @@ void Simulation<Real>::rebuild() {
     p_.y0[i] = float(p_.y[i]);
     p_.z0[i] = float(p_.z[i]);
   }
+  if (scene_.checkpoint_every > 0) {  // exact copies for the checkpoints (x0 is float); memory only then
+    xr_.assign(p_.x.begin(), p_.x.begin() + static_cast<std::ptrdiff_t>(p_.n_owned));
+    yr_.assign(p_.y.begin(), p_.y.begin() + static_cast<std::ptrdiff_t>(p_.n_owned));
+    zr_.assign(p_.z.begin(), p_.z.begin() + static_cast<std::ptrdiff_t>(p_.n_owned));
+  }
+  rebuild_step_ = step_;
   bond_broke_ = false;
   ++rebuilds_;
   if (std::getenv("BASALT_DEBUG_REBUILD")) fmt::print(stderr, "rank {} rebuild at step {} owned {} ghosts {} bonds {} (both owned {}) pairs {}+{}\n", comm().rank(), step_, p_.n_owned, p_.n_ghost(), bonds_.size(), bonds_.n_both_owned, own_.pairs(), ghost_.pairs());
@@ -378,9 +397,9 @@ void Simulation<Real>::step(FieldSink* sink) {
   if (parallel) need = comm().max(need);
   times_.communication += sw.lap();
   bool in_flight = false;
-  canonical_ = canonical_due(step_ + 1);  // a restart point: rebuild in canonical order
-  if (!(need <= rebuild_limit2_) || canonical_) {
+  if (!(need <= rebuild_limit2_)) {
     rebuild();
+    rebuild_step_ = step_ + 1;  // the positions it used are those of the step being completed
     sw.lap();
   } else if (parallel) {
     halo_->begin_update_ghosts(p_);
@@ -532,6 +551,7 @@ std::size_t Simulation<Real>::memory_bytes() const {
                         &p_.inv_mass})
     add(*v);
   for (const auto* v : {&p_.x0, &p_.y0, &p_.z0}) add(*v);
+  for (const auto* v : {&xr_, &yr_, &zr_}) add(*v);
   add(p_.id);
   add(p_.tag);
   add(bonds_.a);

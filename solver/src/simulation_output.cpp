@@ -1,13 +1,11 @@
 // The run loop with output (OutputSink): field-saver partial sums from every compute rank, frames
-// (checkpoints, VTK) packed from this rank's particles, output errors agreed on by all ranks; and
-// the canonical rebuild that makes a checkpoint step a bit-for-bit restart point.
+// (checkpoints, VTK) packed from this rank's particles (with the positions at the last rebuild,
+// which a restart replays), output errors agreed on by all ranks.
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <numeric>
-#include <tuple>
 
 #include "basalt/solver/core/errors.hpp"
 #include "basalt/solver/simulation.hpp"
@@ -90,6 +88,16 @@ void Simulation<Real>::pack_frame(io::FramePiece& piece, std::uint32_t kinds) co
     piece.inv_mass[i] = double(p_.inv_mass[i]);
     piece.mass[i] = 1.0 / piece.inv_mass[i];
   }
+  // Owned particles now are those of the last rebuild (only a rebuild migrates or reorders them).
+  if ((kinds & io::kFrameCheckpoint) && xr_.size() == n) {
+    piece.position_at_rebuild.resize(n);
+    for (std::size_t i = 0; i < n; ++i)
+      piece.position_at_rebuild[i] = {double(xr_[i]), double(yr_[i]), double(zr_[i])};
+    piece.rebuild_step = rebuild_step_;
+    piece.rebuild_pending = bond_broke_ ? 1 : 0;
+  } else {
+    piece.position_at_rebuild.clear();
+  }
   // Bonds, each exactly once across ranks: both ends owned -> this rank; one end a ghost -> the
   // rank owning the lower id. The bond tag carries the solver's interaction group (restart).
   piece.bonds.clear();
@@ -100,7 +108,7 @@ void Simulation<Real>::pack_frame(io::FramePiece& piece, std::uint32_t kinds) co
       const auto i = static_cast<std::size_t>(bonds_.ia[k]), j = static_cast<std::size_t>(bonds_.ib[k]);
       if (!(p_.id[i] < p_.id[j])) continue;
     }
-    piece.bonds.push_back({bonds_.a[k], bonds_.b[k], std::int32_t(bonds_.group[k])});
+    piece.bonds.push_back({bonds_.a[k], bonds_.b[k], std::int32_t(bonds_.group_of(k))});
     piece.bond_rest_length.push_back(double(bonds_.r0[k]));
     piece.bond_broken.push_back(0);
   }
@@ -138,29 +146,6 @@ RestartLayout Simulation<Real>::restart_layout() const {
   r.ghost_width = ghost_width_;
   r.contact_cutoff = contact_cutoff_;
   return r;
-}
-
-template <class Real>
-void Simulation<Real>::canonical_order() {
-  // Owned particles by id (the spatial sort that follows is stable), bonds by their ordered ends:
-  // from here on every order is a function of ids and positions only, not of earlier memory order.
-  const std::size_t n = p_.n_owned;
-  std::vector<std::uint32_t> order(n);
-  std::iota(order.begin(), order.end(), 0u);
-  std::sort(order.begin(), order.end(),
-            [&](std::uint32_t i, std::uint32_t j) { return p_.id[i] < p_.id[j]; });
-  p_.permute_owned(order);
-  const std::size_t nb = bonds_.size();
-  for (std::size_t k = 0; k < nb; ++k)
-    if (bonds_.a[k] > bonds_.b[k]) std::swap(bonds_.a[k], bonds_.b[k]);
-  std::vector<std::uint32_t> border(nb);
-  std::iota(border.begin(), border.end(), 0u);
-  std::sort(border.begin(), border.end(), [&](std::uint32_t i, std::uint32_t j) {
-    return std::tie(bonds_.a[i], bonds_.b[i]) < std::tie(bonds_.a[j], bonds_.b[j]);
-  });
-  bonds_.ia.clear();
-  bonds_.ib.clear();
-  bonds_.permute(border);
 }
 
 template <class Real>
@@ -222,7 +207,6 @@ void Simulation<Real>::run(std::int64_t steps, OutputSink& out) {
   template void Simulation<R>::output_fields(const std::array<double, 3>&);                       \
   template void Simulation<R>::pack_frame(io::FramePiece&, std::uint32_t) const;                  \
   template RestartLayout Simulation<R>::restart_layout() const;                                   \
-  template void Simulation<R>::canonical_order();                                                 \
   template void Simulation<R>::run(std::int64_t, OutputSink&);
 BASALT_INSTANTIATE(double)
 BASALT_INSTANTIATE(float)

@@ -1,7 +1,9 @@
 // Continuing a run from a checkpoint: the same decomposition (box, ghost width and contact cut-off
 // stored with the checkpoint), particles with their velocities and exact inverse masses, bonds with
-// their rest lengths, the clock. The first rebuild is canonical, as the uninterrupted run's rebuild
-// at the checkpoint step was, so on the same ranks both runs continue bit for bit.
+// their rest lengths, the clock. Every rebuild is canonical (its result is a function of the owned
+// (id, position) sets), so replaying the uninterrupted run's last rebuild from the positions it
+// used (stored in the checkpoint) gives the same lists, ghosts and summation order: on the same
+// ranks both runs continue bit for bit, and the uninterrupted run needs no extra rebuild.
 #include <fmt/format.h>
 
 #include <cmath>
@@ -30,10 +32,18 @@ Simulation<Real>::Simulation(const Scene& scene, const io::Checkpoint& c, const 
   rebuild_limit2_ = 0.25 * scene.skin * scene.skin;
   check_stability(c.geometry);
   distribute_checkpoint(c, layout, comm);
-  // Walls where the uninterrupted run had them at this step's rebuild (step() moves them first).
-  if (!wall_driver_.empty()) wall_driver_.move_to(double(step_) * scene.dt);
-  canonical_ = true;
-  rebuild();
+  if (!c.position_at_rebuild.empty()) {
+    replay_rebuild(c);
+  } else {
+    if (dec_->comm().rank() == 0)
+      fmt::print(stderr,
+                 "basalt-run: warning: the checkpoint has no /particles/position_at_rebuild (written by an "
+                 "older basalt-run): the lists are rebuilt at step {}, so the continuation agrees with the "
+                 "uninterrupted run to rounding only\n",
+                 step_);
+    if (!wall_driver_.empty()) wall_driver_.move_to(double(step_) * scene.dt);
+    rebuild();
+  }
   const auto pe = compute_forces<true>();
   energy0_ = total_energy(pe);
 }
@@ -53,9 +63,12 @@ void Simulation<Real>::distribute_checkpoint(const io::Checkpoint& c, const Rest
         "too many ranks for this geometry: a rank's region would be {:.4g} wide, less than the ghost width "
         "{:.4g} (longest interaction + skin); use fewer ranks or other --dims (now {}x{}x{})",
         dec_->min_interior_width(), ghost_width_, dec_->dims()[0], dec_->dims()[1], dec_->dims()[2]));
+  // Particles go where the last rebuild's migration put them: by their positions at that rebuild
+  // (replay_rebuild restores the current ones), or by the current ones for an old checkpoint.
+  const auto& at = c.position_at_rebuild.empty() ? g.position : c.position_at_rebuild;
   std::vector<char> owned(g.size(), 0);
   for (std::size_t i = 0; i < g.size(); ++i) {
-    const auto& x = g.position[i];
+    const auto& x = at[i];
     if (!dec_->owns(x[0], x[1], x[2])) continue;
     owned[i] = 1;
     const double im = c.inv_mass.empty() ? 1.0 / g.mass[i] : c.inv_mass[i];
@@ -90,10 +103,37 @@ void Simulation<Real>::distribute_checkpoint(const io::Checkpoint& c, const Rest
   time_ = c.time;
 }
 
-#define BASALT_INSTANTIATE(R)                                                                             \
-  template Simulation<R>::Simulation(const Scene&, const io::Checkpoint&, const RestartLayout&, MPI_Comm, \
-                                     const RunOptions&);                                                  \
-  template void Simulation<R>::distribute_checkpoint(const io::Checkpoint&, const RestartLayout&, MPI_Comm);
+template <class Real>
+void Simulation<Real>::replay_rebuild(const io::Checkpoint& c) {
+  // The particles sit at their positions at the last rebuild (distribute_checkpoint), the walls go
+  // where that rebuild saw them (step() moves them before rebuilding); the rebuild then reproduces
+  // everything the uninterrupted run's did: ownership, order, ghosts, bond order, pair and wall
+  // lists, the cell grid, x0 for the skin criterion.
+  const auto& g = c.geometry;
+  const std::int64_t now = step_;
+  step_ = c.rebuild_step;
+  if (!wall_driver_.empty()) wall_driver_.move_to(double(c.rebuild_step) * scene_.dt);
+  rebuild();
+  step_ = now;
+  // Back to the checkpoint's positions; the ghosts follow as after any step without a rebuild.
+  for (std::size_t i = 0; i < p_.n_owned; ++i) {
+    const auto& x = g.position[static_cast<std::size_t>(g.index_of(p_.id[i]))];
+    p_.x[i] = Real(x[0]);
+    p_.y[i] = Real(x[1]);
+    p_.z[i] = Real(x[2]);
+  }
+  if (comm().size() > 1) {
+    halo_->begin_update_ghosts(p_);
+    halo_->end_update_ghosts(p_);
+  }
+  bond_broke_ = c.rebuild_pending;  // a bond broke at the checkpoint step: the next step rebuilds
+}
+
+#define BASALT_INSTANTIATE(R)                                                                                \
+  template Simulation<R>::Simulation(const Scene&, const io::Checkpoint&, const RestartLayout&, MPI_Comm,    \
+                                     const RunOptions&);                                                     \
+  template void Simulation<R>::distribute_checkpoint(const io::Checkpoint&, const RestartLayout&, MPI_Comm); \
+  template void Simulation<R>::replay_rebuild(const io::Checkpoint&);
 BASALT_INSTANTIATE(double)
 BASALT_INSTANTIATE(float)
 #undef BASALT_INSTANTIATE

@@ -122,6 +122,38 @@ TEST(Checkpoint, RoundTripIsExact) {
   expect_same(read_checkpoint(dir / "cube.h5"), cube);
 }
 
+TEST(Checkpoint, PositionsAtRebuildRoundTripSortedWithTheIds) {
+  const auto dir = basalt::test::scratch_dir("ckpt-rebuild");
+  Checkpoint c = sample_checkpoint();
+  for (std::size_t i = 0; i < c.size(); ++i)
+    c.position_at_rebuild.push_back({0.1 * double(c.geometry.id[i]) + 1e-17, 0, -1.0 / 3});
+  c.rebuild_step = 1650;
+  c.rebuild_pending = true;
+  write_checkpoint(c, dir / "ckpt_1700.h5");
+  const Checkpoint back = read_checkpoint(dir / "ckpt_1700.h5");
+  ASSERT_EQ(back.position_at_rebuild.size(), back.size());
+  for (std::size_t i = 0; i < back.size(); ++i)
+    EXPECT_EQ(back.position_at_rebuild[i][0], 0.1 * double(back.geometry.id[i]) + 1e-17);
+  EXPECT_EQ(back.rebuild_step, 1650);
+  EXPECT_TRUE(back.rebuild_pending);
+  EXPECT_TRUE(back.geometry.attributes.count("rebuild_step") == 0);  // not taken for provenance
+  // Without them (an older checkpoint): empty, step -1.
+  const Checkpoint plain = read_checkpoint([&] {
+    write_checkpoint(sample_checkpoint(), dir / "plain.h5");
+    return dir / "plain.h5";
+  }());
+  EXPECT_TRUE(plain.position_at_rebuild.empty());
+  EXPECT_EQ(plain.rebuild_step, -1);
+  // A rebuild after the checkpoint's own step is refused, naming the attribute.
+  c.rebuild_step = 1701;
+  expect_format_error([&] { write_checkpoint(c, dir / "bad.h5"); }, {"rebuild_step", "1701"});
+  // The dataset without its attribute is refused on reading.
+  c.rebuild_step = 1650;
+  write_checkpoint(c, dir / "noattr.h5");
+  edit_file(dir / "noattr.h5", [](hid_t f) { H5Adelete(f, "rebuild_step"); });
+  expect_format_error([&] { read_checkpoint(dir / "noattr.h5"); }, {"noattr.h5", "rebuild_step", "missing"});
+}
+
 TEST(Checkpoint, CompletionMarkIsRequired) {
   const auto dir = basalt::test::scratch_dir("ckpt-complete");
   const auto file = dir / "ckpt_5.h5";

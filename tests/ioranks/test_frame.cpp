@@ -49,6 +49,36 @@ TEST(Frame, RoundTripIsExact) {
   ASSERT_EQ(q.walls.size(), 1u);
   EXPECT_EQ(q.walls[0].name, "base");
   EXPECT_EQ(q.walls[0].force, p.walls[0].force);
+  EXPECT_TRUE(q.position_at_rebuild.empty());
+  EXPECT_EQ(q.rebuild_step, -1);
+}
+
+TEST(Frame, PositionsAtRebuildTravelAndAssemble) {
+  // The state a restart replays the last neighbour-list rebuild from: exact, following the ids.
+  std::vector<FramePiece> pieces{make_piece(1, 4, 7), make_piece(0, 4, 7)};
+  for (auto& p : pieces) {
+    for (const auto id : p.id) p.position_at_rebuild.push_back({double(id) + 1e-17, 0.25 * id, 1.0 / 3});
+    p.rebuild_step = 3;
+  }
+  pieces[1].rebuild_pending = 1;
+  std::vector<std::byte> bytes;
+  serialize(pieces[0], bytes);
+  const auto q = deserialize(bytes);
+  EXPECT_EQ(q.position_at_rebuild, pieces[0].position_at_rebuild);
+  EXPECT_EQ(q.rebuild_step, 3);
+  EXPECT_EQ(q.rebuild_pending, 0);
+  const auto c = assemble(pieces, RunInfo{});
+  ASSERT_EQ(c.position_at_rebuild.size(), c.size());
+  for (std::size_t i = 0; i < c.size(); ++i) EXPECT_EQ(c.position_at_rebuild[i][1], 0.25 * c.geometry.id[i]);
+  EXPECT_EQ(c.rebuild_step, 3);
+  EXPECT_TRUE(c.rebuild_pending);  // any rank's pending rebuild is everyone's
+  // A piece without them (or another rebuild step): the checkpoint has none.
+  pieces[0].position_at_rebuild.clear();
+  EXPECT_TRUE(assemble(pieces, RunInfo{}).position_at_rebuild.empty());
+  // Lengths that differ from the particles' are refused on arrival.
+  pieces[1].position_at_rebuild.pop_back();
+  serialize(pieces[1], bytes);
+  EXPECT_THROW(deserialize(bytes), std::runtime_error);
 }
 
 TEST(Frame, DamagedBuffersAreRejected) {

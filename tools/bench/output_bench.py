@@ -5,7 +5,9 @@ checkpoint every 100 steps; both) with --io-ranks 0 (1 rank computes and writes)
 tables of medians over repeats and ratios against "none" with the same Q measured in the same run.
 
   tools/bench/output_bench.py --basalt-run build/bin/basalt-run --geometry /work/data/cube30.geo \
-      --steps 300 --repeats 3 [--throttle 0,50,20,10,5]
+      --steps 300 --repeats 3 [--throttle 0,50,20,10,5] [--baseline-run OTHER/bin/basalt-run]
+With --baseline-run, "none" and "checkpoint every 100" also run with that binary (e.g. the previous
+commit built in another folder), interleaved with the others: a before/after comparison in one session.
 The time is the stepping loop's ("done: N steps in X s"), start-up excluded.
 """
 import argparse
@@ -24,9 +26,8 @@ STAGES = {
     "fields every step": ["--fields-every", "1", "--checkpoint-every", "0"],
     "checkpoint every 100": ["--fields-every", "0", "--checkpoint-every", "100"],
     "both": ["--fields-every", "1", "--checkpoint-every", "100"],
-    "checkpoint every 100, --no-exact-restart": ["--fields-every", "0", "--checkpoint-every", "100",
-                                                 "--no-exact-restart"],
 }
+BASELINE = " (baseline build)"  # suffix of the stages run with --baseline-run's binary
 
 
 def run(a, q, extra, out):
@@ -36,7 +37,10 @@ def run(a, q, extra, out):
     # Compute ranks should not yield (the I/O rank sleeps by itself); hwloc's GL probe would connect to an
     # X server on :0 if another session runs one, and die when it goes away.
     shutil.rmtree(out, ignore_errors=True)
-    cmd = ["mpirun", "-np", str(1 + q), a.basalt_run, str(ROOT / "scenes/wave.toml"), "--geometry", a.geometry,
+    binary = a.basalt_run
+    if extra and extra[0] == "--baseline":
+        binary, extra = a.baseline_run, extra[1:]
+    cmd = ["mpirun", "-np", str(1 + q), binary, a.scene, "--geometry", a.geometry,
            "--steps", str(a.steps), "--quiet", "--frames-every", "0", "--io-ranks", str(q), "--output", str(out)] + extra
     p = subprocess.run(cmd, capture_output=True, text=True, env=env)
     if p.returncode != 0:
@@ -50,7 +54,9 @@ def run(a, q, extra, out):
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--basalt-run", default=str(ROOT / "build/bin/basalt-run"))
+    ap.add_argument("--baseline-run", default=None, help="a second basalt-run binary to compare with")
     ap.add_argument("--geometry", required=True)
+    ap.add_argument("--scene", default=str(ROOT / "scenes/wave.toml"))
     ap.add_argument("--steps", type=int, default=300)
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--throttle", default="", help="MB/s values for the slow-storage table (0 = unthrottled)")
@@ -84,6 +90,9 @@ def main():
                 row += f"| {t:.3f} | {100 * (t / bt - 1):+.1f} % | {cpu:.3f} | {100 * (cpu / bcpu - 1):+.1f} % "
             print(row + f"| {med[(c, 1)][1]:.4f} |")
 
+    if a.baseline_run:
+        for s in [s for s in ["none", "checkpoint every 100"] if s in STAGES]:
+            STAGES[s + BASELINE] = ["--baseline"] + STAGES[s]
     if not a.throttle:
         table(list(STAGES), "stage", lambda c: STAGES[c], "none")
     else:

@@ -90,6 +90,7 @@ void FramePiece::clear() {
   mass.clear();
   tag.clear();
   inv_mass.clear();
+  position_at_rebuild.clear();
   bonds.clear();
   bond_rest_length.clear();
   bond_broken.clear();
@@ -122,6 +123,9 @@ void serialize(const FramePiece& p, std::vector<std::byte>& out) {
     w.value(wall.force);
   }
   w.array(p.inv_mass);
+  w.array(p.position_at_rebuild);
+  w.value(p.rebuild_step);
+  w.value(p.rebuild_pending);
 }
 
 FramePiece deserialize(std::span<const std::byte> bytes) {
@@ -153,9 +157,14 @@ FramePiece deserialize(std::span<const std::byte> bytes) {
     wall.force = r.value<Vec3>();
   }
   r.array(p.inv_mass);
+  r.array(p.position_at_rebuild);
+  p.rebuild_step = r.value<std::int64_t>();
+  p.rebuild_pending = r.value<std::uint8_t>();
   const std::size_t n = p.id.size();
   if (!p.inv_mass.empty() && p.inv_mass.size() != n)
     throw std::runtime_error("frame: inverse masses differ in length from the particles");
+  if (!p.position_at_rebuild.empty() && p.position_at_rebuild.size() != n)
+    throw std::runtime_error("frame: positions at rebuild differ in length from the particles");
   if (p.position.size() != n || p.velocity.size() != n || p.radius.size() != n || p.mass.size() != n ||
       p.tag.size() != n)
     throw std::runtime_error("frame: particle arrays differ in length");
@@ -235,6 +244,15 @@ Checkpoint assemble(std::vector<FramePiece>& pieces, const RunInfo& run) {
   const bool inv = std::all_of(pieces.begin(), pieces.end(),
                                [](const FramePiece& p) { return p.inv_mass.size() == p.size(); }) && n > 0;
   if (inv) c.inv_mass.resize(n);
+  const bool at_rebuild =
+      n > 0 && std::all_of(pieces.begin(), pieces.end(), [&](const FramePiece& p) {
+        return p.position_at_rebuild.size() == p.size() && p.rebuild_step == pieces.front().rebuild_step;
+      });
+  if (at_rebuild) {
+    c.position_at_rebuild.resize(n);
+    c.rebuild_step = pieces.front().rebuild_step;
+    for (const auto& p : pieces) c.rebuild_pending = c.rebuild_pending || p.rebuild_pending != 0;
+  }
   for (std::size_t i = 0; i < n; ++i) {
     const auto& p = pieces[order[i].second.first];
     const auto j = order[i].second.second;
@@ -245,6 +263,7 @@ Checkpoint assemble(std::vector<FramePiece>& pieces, const RunInfo& run) {
     g.mass[i] = p.mass[j];
     c.velocity[i] = p.velocity[j];
     if (inv) c.inv_mass[i] = p.inv_mass[j];
+    if (at_rebuild) c.position_at_rebuild[i] = p.position_at_rebuild[j];
   }
 
   struct BondRow {

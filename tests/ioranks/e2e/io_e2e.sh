@@ -43,6 +43,47 @@ case $case_name in
   restart_np2_q0) restart_bitwise 2 0 ;;
   restart_np1_q1) restart_bitwise 2 1 ;;
   restart_np2_q1) restart_bitwise 3 1 ;;
+  restart_old_lists)
+    # A skin so small that the lists are rebuilt every few steps (migrating particles at np 2), but
+    # not at step 100: the checkpoint's lists date from an earlier step, which the restart replays.
+    sed 's/^skin = .*/skin = 0.005/' "$SCENE" >"$W/small_skin.toml"
+    grep -q '^skin = 0.005' "$W/small_skin.toml" || fail "could not set the skin in $W/small_skin.toml"
+    SCENE=$W/small_skin.toml
+    restart_bitwise 1 0
+    $CHECK old_lists "$W/split/ckpt_000100.h5" || fail "np 1: the lists were rebuilt at the checkpoint step"
+    rm -rf "$W/straight" "$W/split"
+    restart_bitwise 3 1
+    $CHECK old_lists "$W/split/ckpt_000100.h5" || fail "np 2: the lists were rebuilt at the checkpoint step"
+    ;;
+  restart_migration)
+    # Particles change rank between rebuilds (a stronger wall pulse, 3 ranks stacked along z): the
+    # replayed rebuild must give each particle the owner the uninterrupted run's migration gave it.
+    sed -e 's/^skin = .*/skin = 0.005/' -e 's/amplitude = 0.1,/amplitude = 0.5,/' "$SCENE" >"$W/migrate.toml"
+    grep -q 'amplitude = 0.5,' "$W/migrate.toml" || fail "could not set the amplitude in $W/migrate.toml"
+    SCENE=$W/migrate.toml
+    export BASALT_DEBUG_REBUILD=1
+    must_run 3 --dims 1,1,3 --steps 300 --checkpoint-every 150 --output "$W/straight"
+    # Owned counts of rank 0 at its rebuilds up to step 150: they must change (particles migrated).
+    counts=$(grep '^rank 0 rebuild' "$W/last.log" | awk '$6 < 150 {print $8}' | sort -u | wc -l)
+    [ "$counts" -gt 1 ] || fail "no particle migrated before the checkpoint: the case tests nothing"
+    unset BASALT_DEBUG_REBUILD
+    must_run 3 --dims 1,1,3 --steps 150 --checkpoint-every 150 --output "$W/split"
+    $CHECK old_lists "$W/split/ckpt_000150.h5" || fail "the lists were rebuilt at the checkpoint step"
+    must_run 3 --dims 1,1,3 --steps 150 --checkpoint-every 150 --output "$W/split" --restart "$W/split"
+    $CHECK same "$W/straight/ckpt_000300.h5" "$W/split/ckpt_000300.h5" || fail "final checkpoints differ"
+    cmp "$W/straight/ckpt_000300.h5" "$W/split/ckpt_000300.h5" || fail "final checkpoint files differ in their bytes"
+    echo "np 3 (1x1x3), migration before the checkpoint: step-300 checkpoints identical"
+    ;;
+  restart_old_checkpoint)
+    # A checkpoint without the positions at the last rebuild (older basalt-run): the restart warns
+    # and rebuilds plainly; the continuation agrees to rounding.
+    must_run 2 --steps 200 --checkpoint-every 100 --output "$W/straight"
+    must_run 2 --steps 100 --checkpoint-every 100 --output "$W/old"
+    $CHECK strip_rebuild "$W/old/ckpt_000100.h5" || fail "could not strip the checkpoint"
+    must_run 2 --steps 100 --checkpoint-every 100 --output "$W/old" --restart "$W/old/ckpt_000100.h5"
+    grep -q "has no /particles/position_at_rebuild" "$W/last.log" || fail "no warning about the old checkpoint"
+    $CHECK close "$W/straight/ckpt_000200.h5" "$W/old/ckpt_000200.h5" 1e-9 || fail "the continuation drifted"
+    ;;
   restart_other_ranks)
     must_run 2 --steps 200 --checkpoint-every 100 --output "$W/straight"
     must_run 2 --steps 100 --checkpoint-every 100 --output "$W/a"

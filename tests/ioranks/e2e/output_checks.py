@@ -3,6 +3,10 @@
   same FILE_A FILE_B          every dataset of A equals B's exactly (and vice versa); exit 1 otherwise
   close FILE_A FILE_B TOL     particle positions and velocities agree to TOL relative (same ids)
   complete FILE               the checkpoint carries the completion mark
+  old_lists FILE              the checkpoint's lists are older than it: 0 < rebuild_step < step, and
+                              position_at_rebuild differs from position
+  strip_rebuild FILE          removes position_at_rebuild, rebuild_step and rebuild_pending (an older
+                              basalt-run's checkpoint)
   pvd DIR                     every frame of DIR/frames.pvd, read with vtkXMLPPolyDataReader, has the
                               positions of DIR/ckpt_<step>.h5 (same ids), when that checkpoint exists
 """
@@ -51,6 +55,22 @@ def complete(f):
         return int(h.attrs.get("complete", 0)) == 1
 
 
+def old_lists(f):
+    with h5py.File(f, "r") as h:
+        step, rb = int(h.attrs["step"]), int(h.attrs["rebuild_step"])
+        moved = not np.array_equal(h["particles/position_at_rebuild"][()], h["particles/position"][()])
+        print(f"step {step}: last rebuild at step {rb}; positions moved since: {moved}")
+        return 0 < rb < step and moved
+
+
+def strip_rebuild(f):
+    with h5py.File(f, "r+") as h:
+        del h["particles/position_at_rebuild"]
+        del h.attrs["rebuild_step"]
+        del h.attrs["rebuild_pending"]
+    return True
+
+
 def pvd(folder):
     import vtk
     from vtk.util.numpy_support import vtk_to_numpy
@@ -88,5 +108,6 @@ def pvd(folder):
 if __name__ == "__main__":
     cmd, args = sys.argv[1], sys.argv[2:]
     ok = {"same": lambda: same(*args), "close": lambda: close(args[0], args[1], float(args[2])),
-          "complete": lambda: complete(args[0]), "pvd": lambda: pvd(args[0])}[cmd]()
+          "complete": lambda: complete(args[0]),
+          "old_lists": lambda: old_lists(args[0]), "strip_rebuild": lambda: strip_rebuild(args[0]), "pvd": lambda: pvd(args[0])}[cmd]()
     sys.exit(0 if ok else 1)

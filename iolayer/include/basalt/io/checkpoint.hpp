@@ -26,6 +26,14 @@ struct Checkpoint {
   /// Optional (empty or one per particle; /particles/inverse_mass): 1 / mass exactly as the solver
   /// held it, so that a restart reproduces the run bit for bit. geometry.mass stays the mass.
   std::vector<double> inv_mass;
+  /// Optional (empty or one per particle; /particles/position_at_rebuild): each particle's position
+  /// at the last neighbour-list rebuild (step rebuild_step), exactly as the solver held it. A
+  /// restart replays that rebuild to get the uninterrupted run's lists bit for bit.
+  std::vector<Vec3> position_at_rebuild;
+  std::int64_t rebuild_step = -1;  ///< root attribute "rebuild_step"; -1 when absent
+  /// Root attribute "rebuild_pending" (with position_at_rebuild): a bond broke at this step, so the
+  /// next step rebuilds the lists whatever the particles moved.
+  bool rebuild_pending = false;
 
   // Bond state, one entry per geometry.bonds entry.
   std::vector<double> bond_rest_length;

@@ -60,9 +60,10 @@ class Simulation {
   Simulation(const Scene& scene, io::Geometry geometry, MPI_Comm comm, const RunOptions& options = {});
 
   /// Continues a run from a checkpoint (simulation_restart.cpp): particles, velocities, masses,
-  /// bonds with their rest lengths, step and time; the decomposition from `layout`. The first
-  /// rebuild is canonical (see set_canonical_every), so that on the same ranks the continued run
-  /// is bit-for-bit the uninterrupted one. Throws InputError when the checkpoint does not fit.
+  /// bonds with their rest lengths, step and time; the decomposition from `layout`. Replays the
+  /// uninterrupted run's last rebuild from the checkpoint's positions at that rebuild, so that on
+  /// the same ranks the continued run is bit-for-bit the uninterrupted one (a checkpoint without
+  /// them: a plain rebuild, exact to rounding only). Throws InputError when the checkpoint does not fit.
   Simulation(const Scene& scene, const io::Checkpoint& checkpoint, const RestartLayout& layout, MPI_Comm comm,
              const RunOptions& options = {});
 
@@ -73,9 +74,6 @@ class Simulation {
   /// Fills `piece` with this rank's share of the state (owned particles; bonds each once across
   /// ranks; walls on rank 0 only).
   void pack_frame(io::FramePiece& piece, std::uint32_t kinds) const;
-  /// Rebuilds the lists in canonical order (a pure function of ids and positions) at every step that
-  /// is a multiple of `every` (0 = never): a run restarted from such a step is then bit-for-bit equal.
-  void set_canonical_every(std::int64_t every) { canonical_every_ = every; }
   /// The decomposition's box, ghost width and contact cut-off (stored in checkpoints).
   RestartLayout restart_layout() const;
 
@@ -104,6 +102,8 @@ class Simulation {
   const PhaseTimes& times() const { return times_; }
   const StabilityReport& stability() const { return stability_; }
   std::int64_t rebuilds() const { return rebuilds_; }
+  /// Step of the last neighbour-list rebuild.
+  std::int64_t last_rebuild_step() const { return rebuild_step_; }
   std::int64_t total_particles() const { return n_global_; }
   double ghost_width() const { return ghost_width_; }
   /// Geometry bonds that no bond group takes (they exert no force).
@@ -141,8 +141,8 @@ class Simulation {
   bool field_partials(const std::array<double, 3>& pe, std::vector<double>& local, std::vector<char>& due) const;
   void output_fields(const std::array<double, 3>& pe);
   void distribute_checkpoint(const io::Checkpoint& c, const RestartLayout& layout, MPI_Comm comm);
-  void canonical_order();
-  bool canonical_due(std::int64_t s) const { return canonical_every_ > 0 && s % canonical_every_ == 0; }
+  /// Restart: the lists of the uninterrupted run's last rebuild (see the restart constructor).
+  void replay_rebuild(const io::Checkpoint& c);
   /// Writes the row whose reduction is still in flight (ranks > 1), if any.
   void finish_row(FieldSink* sink);
   /// Collective: delivers pending output, then throws RunError(message).
@@ -192,8 +192,10 @@ class Simulation {
   bool forces_zeroed_ = false;  ///< set by the fused kick-zero-drift pass
   StabilityReport stability_;
   OutputSink* output_ = nullptr;        ///< set during run(steps, OutputSink&)
-  std::int64_t canonical_every_ = 0;    ///< canonical rebuild at these steps (restart points)
-  bool canonical_ = false;              ///< the next rebuild is canonical
+  /// Owned positions at the last rebuild, exactly (x0 is only a float copy) and that rebuild's step:
+  /// checkpoints store them so that a restart can replay the rebuild.
+  std::vector<Real> xr_, yr_, zr_;
+  std::int64_t rebuild_step_ = 0;
 };
 
 extern template class Simulation<double>;

@@ -36,6 +36,12 @@ struct FramePiece {
   /// Optional (empty or one per particle): 1 / mass exactly as the solver holds it, so that a
   /// restart gets the same bits (1 / (1 / m) is not always m in floating point).
   std::vector<double> inv_mass;
+  /// Optional (empty or one per particle): each particle's position at the last neighbour-list
+  /// rebuild, exactly as the solver held it; with rebuild_step it lets a restart replay that
+  /// rebuild (bit-for-bit continuation, docs/ARCHITECTURE.md).
+  std::vector<Vec3> position_at_rebuild;
+  std::int64_t rebuild_step = -1;    ///< step of the last neighbour-list rebuild (-1: unknown)
+  std::uint8_t rebuild_pending = 0;  ///< 1: the next step rebuilds whatever moved (a bond broke)
 
   // Bonds this rank is responsible for (each bond in exactly one piece), with their state.
   std::vector<Bond> bonds;

@@ -72,7 +72,6 @@ struct Scene {
   std::int64_t frames_every = 0;      ///< VTK frame every N steps (0 = off)
   bool output_continue_on_error = false;  ///< on_error = "continue": a failed output does not stop the run
   std::int64_t frames_in_flight = 2;      ///< per compute rank: frames posted but not yet received
-  bool exact_restart = true;  ///< checkpoint steps are bit-for-bit restart points (one rebuild each)
 };
 
 /// Reads and checks a scene file. Throws InputError naming file, line and key.
