@@ -1,11 +1,12 @@
 #include "h5_support.hpp"
 
 #include <fcntl.h>
+#include <fmt/format.h>
+#include <unistd.h>
+
 #include <cerrno>
 #include <cstring>
 #include <vector>
-#include <fmt/format.h>
-#include <unistd.h>
 
 namespace basalt::io::h5 {
 
@@ -278,7 +279,8 @@ Writer::Writer(const fs::path& file, const fs::path& temp) : file_(file), temp_(
   // POSIX calls: a full disk or a file-size limit then fails there with errno, named, and HDF5 never
   // holds a half-written file it cannot close (it would crash at exit).
   Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
-  if (!fapl.valid() || H5Pset_fapl_core(fapl.get(), 4 << 20, 0) < 0) fail("", "cannot set up the in-memory HDF5 file");
+  if (!fapl.valid() || H5Pset_fapl_core(fapl.get(), 4 << 20, 0) < 0)
+    fail("", "cannot set up the in-memory HDF5 file");
   file_id_ = Handle(H5Fcreate(temp.c_str(), H5F_ACC_TRUNC, fcpl.get(), fapl.get()), H5Fclose);
   if (!file_id_.valid())
     fail("", fmt::format("cannot create '{}' (does the folder exist and is it writable?)", temp.string()));
@@ -348,7 +350,8 @@ void Writer::commit() {
   const ssize_t size = H5Fget_file_image(file_id_.get(), nullptr, 0);
   if (size < 0) fail("", "cannot take the file image");
   std::vector<char> image(static_cast<std::size_t>(size));
-  if (H5Fget_file_image(file_id_.get(), image.data(), image.size()) != size) fail("", "cannot take the file image");
+  if (H5Fget_file_image(file_id_.get(), image.data(), image.size()) != size)
+    fail("", "cannot take the file image");
   if (!file_id_.reset()) fail("", "cannot close the in-memory file");
   // Write, then make the bytes durable before the rename makes them visible under the final name.
   const int fd = ::open(temp_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
@@ -360,8 +363,8 @@ void Writer::commit() {
     if (n <= 0) {
       const int err = n < 0 ? errno : ENOSPC;
       ::close(fd);
-      fail("", fmt::format("cannot write '{}' ({} of {} bytes written): {}", temp_.string(), done, image.size(),
-                           std::strerror(err)));
+      fail("", fmt::format("cannot write '{}' ({} of {} bytes written): {}", temp_.string(), done,
+                           image.size(), std::strerror(err)));
     }
     done += static_cast<std::size_t>(n);
   }

@@ -14,7 +14,8 @@ namespace fs = std::filesystem;
 CsvFieldSink::CsvFieldSink(const fs::path& dir) : path_(dir / "fields.csv") {
   std::error_code ec;
   fs::create_directories(dir, ec);
-  if (ec) throw InputError(fmt::format("{}: cannot create the output folder: {}", dir.string(), ec.message()));
+  if (ec)
+    throw InputError(fmt::format("{}: cannot create the output folder: {}", dir.string(), ec.message()));
   file_ = std::fopen(path_.c_str(), "w");
   if (!file_) throw InputError(fmt::format("{}: cannot write: {}", path_.string(), std::strerror(errno)));
 }

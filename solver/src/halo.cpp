@@ -90,8 +90,8 @@ std::optional<std::string> Halo<Real>::migrate(Particles<Real>& p, Bonds<Real>& 
               "particle id {} at ({}, {}, {}) moved more than one rank's region between two neighbour-list "
               "rebuilds (arrived at rank {} owning [{}, {}) along axis {})",
               m.id, m.x, m.y, m.z, dec_.comm().rank(), dec_.lo(d), dec_.hi(d), "xyz"[d]);
-        p.push_owned(m.id, Real(m.x), Real(m.y), Real(m.z), Real(m.r), m.tag, Real(m.inv_mass), Real(m.vx), Real(m.vy),
-                     Real(m.vz));
+        p.push_owned(m.id, Real(m.x), Real(m.y), Real(m.z), Real(m.r), m.tag, Real(m.inv_mass), Real(m.vx),
+                     Real(m.vy), Real(m.vz));
       }
       for (const auto& b : bin) bonds.push(b.a, b.b, Real(b.r0), static_cast<std::uint8_t>(b.group));
     }
@@ -187,8 +187,10 @@ void Halo<Real>::begin_update_ghosts(Particles<Real>& p) {
       rbuf.resize(3 * nin);
       const int dest = dec_.neighbor(d, side), src = dec_.neighbor(d, 1 - side);
       if (d == last) {
-        MPI_Irecv(rbuf.data(), static_cast<int>(rbuf.size()), type, src, 21 + side, comm, &requests_[2 * side]);
-        MPI_Isend(sbuf.data(), static_cast<int>(sbuf.size()), type, dest, 21 + side, comm, &requests_[2 * side + 1]);
+        MPI_Irecv(rbuf.data(), static_cast<int>(rbuf.size()), type, src, 21 + side, comm,
+                  &requests_[2 * side]);
+        MPI_Isend(sbuf.data(), static_cast<int>(sbuf.size()), type, dest, 21 + side, comm,
+                  &requests_[2 * side + 1]);
         continue;
       }
       MPI_Sendrecv(sbuf.data(), static_cast<int>(sbuf.size()), type, dest, 21, rbuf.data(),

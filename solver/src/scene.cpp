@@ -60,8 +60,8 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
   try {
     root = toml::parse(text, label);
   } catch (const toml::parse_error& e) {
-    throw InputError(fmt::format("{}:{}:{}: {}", label, e.source().begin.line, e.source().begin.column,
-                                 e.description()));
+    throw InputError(
+        fmt::format("{}:{}:{}: {}", label, e.source().begin.line, e.source().begin.column, e.description()));
   }
   Scene s;
   s.text = text;
@@ -161,15 +161,18 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
       s.output_dir = d.is_absolute() ? d : base_dir / d;
     }
     s.checkpoint_every = t.integer_or("checkpoint_every", 0);
-    if (s.checkpoint_every < 0) t.fail("checkpoint_every", fmt::format("must be >= 0 (0 = off), got {}", s.checkpoint_every));
+    if (s.checkpoint_every < 0)
+      t.fail("checkpoint_every", fmt::format("must be >= 0 (0 = off), got {}", s.checkpoint_every));
     s.frames_every = t.integer_or("frames_every", 0);
-    if (s.frames_every < 0) t.fail("frames_every", fmt::format("must be >= 0 (0 = off), got {}", s.frames_every));
+    if (s.frames_every < 0)
+      t.fail("frames_every", fmt::format("must be >= 0 (0 = off), got {}", s.frames_every));
     s.output_continue_on_error = t.choice_or("on_error", {"stop", "continue"}, "stop") == "continue";
     // Obsolete since every checkpoint is a bit-for-bit restart point at no cost (a restart replays
     // the last rebuild); still accepted so that older scene files load.
     (void)t.boolean_or("exact_restart", true);
     s.frames_in_flight = t.integer_or("frames_in_flight", 2);
-    if (s.frames_in_flight < 1) t.fail("frames_in_flight", fmt::format("must be >= 1, got {}", s.frames_in_flight));
+    if (s.frames_in_flight < 1)
+      t.fail("frames_in_flight", fmt::format("must be >= 1, got {}", s.frames_in_flight));
     if (const auto* arr = t.table_array("fields")) {
       for (std::size_t k = 0; k < arr->size(); ++k) {
         TableReader tf(*(*arr)[k].as_table(), label, fmt::format("output.fields[{}]", k));

@@ -4,8 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <cstdlib>
+#include <limits>
 #include <numbers>
 
 #include "basalt/solver/core/errors.hpp"
@@ -20,7 +20,8 @@ double particle_mass(const io::Geometry& g, std::size_t i, double density) {
 }
 
 double distance(const io::Vec3& a, const io::Vec3& b) {
-  return std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
+  return std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+                   (a[2] - b[2]) * (a[2] - b[2]));
 }
 
 bool tags_match(const TagFilter& t, std::int64_t ta, std::int64_t tb) {
@@ -36,7 +37,8 @@ Simulation<Real>::Simulation(const Scene& scene, io::Geometry g, MPI_Comm comm, 
       bond_driver_(scene.bonds),
       pair_driver_(scene.contacts),
       wall_driver_(scene.walls) {
-  if (g.size() == 0) throw InputError(fmt::format("{}: the geometry has no particles", scene.geometry.string()));
+  if (g.size() == 0)
+    throw InputError(fmt::format("{}: the geometry has no particles", scene.geometry.string()));
   if (scene.bonds.size() > 254) throw InputError("interactions: at most 254 bond groups");
   const bool se = scene.integrator == Integrator::symplectic_euler;
   kick1_ = Real(se ? scene.dt : scene.dt / 2);
@@ -200,10 +202,11 @@ std::optional<std::string> Simulation<Real>::check_finite() const {
                     std::isfinite(p_.fx[i]) && std::isfinite(p_.fy[i]) && std::isfinite(p_.fz[i]);
     if (!ok)
       return fmt::format(
-          "step {}: particle id {} went non-finite: position ({}, {}, {}), velocity ({}, {}, {}), force ({}, {}, "
+          "step {}: particle id {} went non-finite: position ({}, {}, {}), velocity ({}, {}, {}), force ({}, "
+          "{}, "
           "{}); dt = {} is {:.3g} x the critical time step",
-          step_, p_.id[i], p_.x[i], p_.y[i], p_.z[i], p_.vx[i], p_.vy[i], p_.vz[i], p_.fx[i], p_.fy[i], p_.fz[i],
-          scene_.dt, stability_.fraction);
+          step_, p_.id[i], p_.x[i], p_.y[i], p_.z[i], p_.vx[i], p_.vy[i], p_.vz[i], p_.fx[i], p_.fy[i],
+          p_.fz[i], scene_.dt, stability_.fraction);
   }
   return std::nullopt;
 }
@@ -235,7 +238,8 @@ void Simulation<Real>::resolve_bonds() {
     auto ia = ids_.find(bonds_.a[k]), ib = ids_.find(bonds_.b[k]);
     if ((ia < 0 || ib < 0) && !error) {
       error = fmt::format(
-          "step {}: the bond between particle ids {} and {} is longer than the ghost width {:.6g} (particle {} "
+          "step {}: the bond between particle ids {} and {} is longer than the ghost width {:.6g} (particle "
+          "{} "
           "is not within reach of rank {}): bonds must not stretch beyond the longest initial bond + skin",
           step_, bonds_.a[k], bonds_.b[k], ghost_width_, ia < 0 ? bonds_.a[k] : bonds_.b[k], comm().rank());
       if (stability_.warn)
@@ -293,8 +297,8 @@ void Simulation<Real>::rebuild() {
     if (error) stop(*error);
     const long long total = comm().sum(static_cast<long long>(p_.n_owned));
     if (total != n_global_)
-      stop(fmt::format("step {}: {} particles on the ranks, {} expected: particles were lost", step_,
-                                 total, n_global_));
+      stop(fmt::format("step {}: {} particles on the ranks, {} expected: particles were lost", step_, total,
+                       n_global_));
   }
   times_.communication += sw.lap();
   spatial_sort();
@@ -306,8 +310,8 @@ void Simulation<Real>::rebuild() {
     grid_.build(p_.x, p_.y, p_.z, p_.size(), contact_cutoff_);
     exclusions_.bind(bond_bucket_end_, bonds_.ib, p_.n_owned);
     if (pair_driver_.takes_all()) {
-      build_pair_lists(p_, grid_, scene_.skin, exclusions_, [](std::size_t, std::size_t) { return true; }, own_,
-                       ghost_);
+      build_pair_lists(
+          p_, grid_, scene_.skin, exclusions_, [](std::size_t, std::size_t) { return true; }, own_, ghost_);
     } else {
       auto accept = [this](std::size_t i, std::size_t j) {
         return pair_driver_.group_of(p_.tag[i], p_.tag[j]) >= 0;
@@ -331,7 +335,10 @@ void Simulation<Real>::rebuild() {
   rebuild_step_ = step_;
   bond_broke_ = false;
   ++rebuilds_;
-  if (std::getenv("BASALT_DEBUG_REBUILD")) fmt::print(stderr, "rank {} rebuild at step {} owned {} ghosts {} bonds {} (both owned {}) pairs {}+{}\n", comm().rank(), step_, p_.n_owned, p_.n_ghost(), bonds_.size(), bonds_.n_both_owned, own_.pairs(), ghost_.pairs());
+  if (std::getenv("BASALT_DEBUG_REBUILD"))
+    fmt::print(stderr, "rank {} rebuild at step {} owned {} ghosts {} bonds {} (both owned {}) pairs {}+{}\n",
+               comm().rank(), step_, p_.n_owned, p_.n_ghost(), bonds_.size(), bonds_.n_both_owned,
+               own_.pairs(), ghost_.pairs());
   times_.neighbor += sw.lap();
 }
 
@@ -367,8 +374,8 @@ std::array<double, 3> Simulation<Real>::compute_forces(bool ghosts_in_flight) {
 template <class Real>
 bool Simulation<Real>::energy_due(std::int64_t s) const {
   for (const auto& f : scene_.fields)
-    if (s % f.every == 0 && f.type != FieldSpec::Type::kinetic_energy && f.type != FieldSpec::Type::bond_count &&
-        f.type != FieldSpec::Type::wall_force)
+    if (s % f.every == 0 && f.type != FieldSpec::Type::kinetic_energy &&
+        f.type != FieldSpec::Type::bond_count && f.type != FieldSpec::Type::wall_force)
       return true;
   return scene_.energy_check_every > 0 && s % scene_.energy_check_every == 0;
 }
@@ -392,8 +399,9 @@ void Simulation<Real>::step(FieldSink* sink) {
   times_.integration += sw.lap();
   const bool parallel = comm().size() > 1;
   if (!wall_driver_.empty()) wall_driver_.move_to(double(step_ + 1) * scene_.dt);
-  double need = bond_broke_ ? std::numeric_limits<double>::infinity()
-                            : std::max(moved2, wall_driver_.empty() ? 0.0 : wall_driver_.moved2_since_rebuild());
+  double need = bond_broke_
+                    ? std::numeric_limits<double>::infinity()
+                    : std::max(moved2, wall_driver_.empty() ? 0.0 : wall_driver_.moved2_since_rebuild());
   if (parallel) need = comm().max(need);
   times_.communication += sw.lap();
   bool in_flight = false;
@@ -482,7 +490,8 @@ void Simulation<Real>::guard_energy(const std::array<double, 3>& pe) {
   double best = -1;
   std::size_t bi = 0;
   for (std::size_t i = 0; i < p_.n_owned; ++i) {
-    const double ke = 0.5 * double(p_.mass(i)) * double(p_.vx[i] * p_.vx[i] + p_.vy[i] * p_.vy[i] + p_.vz[i] * p_.vz[i]);
+    const double ke =
+        0.5 * double(p_.mass(i)) * double(p_.vx[i] * p_.vx[i] + p_.vy[i] * p_.vy[i] + p_.vz[i] * p_.vz[i]);
     if (!(ke <= best)) {
       best = ke;
       bi = i;
@@ -494,7 +503,8 @@ void Simulation<Real>::guard_energy(const std::array<double, 3>& pe) {
     msg = fmt::format(
         "step {}: the energy grows without a source: total {:.6g} (kinetic {:.6g}, bonds {:.6g}, contacts "
         "{:.6g}, walls {:.6g}) > 2 x (initial {:.6g} + work done by walls {:.6g}). Fastest particle: id {} "
-        "with kinetic energy {:.6g}, velocity ({:.6g}, {:.6g}, {:.6g}) at ({:.6g}, {:.6g}, {:.6g}). dt = {} is "
+        "with kinetic energy {:.6g}, velocity ({:.6g}, {:.6g}, {:.6g}) at ({:.6g}, {:.6g}, {:.6g}). dt = {} "
+        "is "
         "{:.3g} x the critical time step {:.6g}",
         step_, e, v[0], v[1], v[2], v[3], energy0_, v[4], p_.id[bi], best, p_.vx[bi], p_.vy[bi], p_.vz[bi],
         p_.x[bi], p_.y[bi], p_.z[bi], scene_.dt, stability_.fraction, stability_.dt_critical);
@@ -505,7 +515,8 @@ template <class Real>
 void Simulation<Real>::progress(std::int64_t done, std::int64_t total, double seconds) const {
   const double sps = done / std::max(seconds, 1e-9);
   fmt::print("step {:>8}/{}  {:8.1f} steps/s  {:6.2f} M particle-steps/s  ETA {:.1f} s\n", step_,
-             step_ + (total - done), sps, sps * double(n_global_) * 1e-6, (total - done) / std::max(sps, 1e-9));
+             step_ + (total - done), sps, sps * double(n_global_) * 1e-6,
+             (total - done) / std::max(sps, 1e-9));
   std::fflush(stdout);
 }
 
@@ -546,9 +557,11 @@ void Simulation<Real>::force_rebuild() {
 template <class Real>
 std::size_t Simulation<Real>::memory_bytes() const {
   std::size_t b = 0;
-  auto add = [&](const auto& v) { b += v.capacity() * sizeof(typename std::decay_t<decltype(v)>::value_type); };
-  for (const auto* v : {&p_.x, &p_.y, &p_.z, &p_.radius, &p_.vx, &p_.vy, &p_.vz, &p_.fx, &p_.fy, &p_.fz,
-                        &p_.inv_mass})
+  auto add = [&](const auto& v) {
+    b += v.capacity() * sizeof(typename std::decay_t<decltype(v)>::value_type);
+  };
+  for (const auto* v :
+       {&p_.x, &p_.y, &p_.z, &p_.radius, &p_.vx, &p_.vy, &p_.vz, &p_.fx, &p_.fy, &p_.fz, &p_.inv_mass})
     add(*v);
   for (const auto* v : {&p_.x0, &p_.y0, &p_.z0}) add(*v);
   for (const auto* v : {&xr_, &yr_, &zr_}) add(*v);

@@ -10,7 +10,8 @@ int TableReader::line_of(const std::string& key) const {
 }
 
 void TableReader::fail(const std::string& key, const std::string& what) const {
-  throw InputError(fmt::format("{}:{}: {}{}{}: {}", file_, line_of(key), path_, path_.empty() ? "" : ".", key, what));
+  throw InputError(
+      fmt::format("{}:{}: {}{}{}: {}", file_, line_of(key), path_, path_.empty() ? "" : ".", key, what));
 }
 
 void TableReader::fail_here(const std::string& what) const {
@@ -31,7 +32,9 @@ double TableReader::number(const std::string& key) {
   fail(key, "must be a number");
 }
 
-double TableReader::number_or(const std::string& key, double fallback) { return has(key) ? number(key) : fallback; }
+double TableReader::number_or(const std::string& key, double fallback) {
+  return has(key) ? number(key) : fallback;
+}
 
 std::int64_t TableReader::integer(const std::string& key) {
   const auto& n = node(key);
@@ -62,7 +65,8 @@ std::string TableReader::string_or(const std::string& key, const std::string& fa
 
 std::string TableReader::choice_or(const std::string& key, const std::vector<std::string>& allowed,
                                    const std::string& fallback) {
-  if (!has(key) && fallback.empty()) fail(key, fmt::format("missing (required): one of {}", fmt::join(allowed, ", ")));
+  if (!has(key) && fallback.empty())
+    fail(key, fmt::format("missing (required): one of {}", fmt::join(allowed, ", ")));
   std::string s = string_or(key, fallback);
   for (const auto& a : allowed)
     if (a == s) return s;
@@ -92,7 +96,8 @@ std::optional<std::array<double, 3>> TableReader::vec3_opt(const std::string& ke
   return vec3(key);
 }
 
-std::vector<std::int64_t> TableReader::integers_or(const std::string& key, std::vector<std::int64_t> fallback) {
+std::vector<std::int64_t> TableReader::integers_or(const std::string& key,
+                                                   std::vector<std::int64_t> fallback) {
   if (!has(key)) return fallback;
   const auto& n = node(key);
   const auto* arr = n.as_array();
@@ -141,8 +146,8 @@ void TableReader::finish() const {
   for (const auto& [k, v] : table_) {
     std::string key(k.str());
     if (!used_.count(key))
-      throw InputError(fmt::format("{}:{}: {}{}{}: unknown key (misspelled?)", file_, v.source().begin.line, path_,
-                                   path_.empty() ? "" : ".", key));
+      throw InputError(fmt::format("{}:{}: {}{}{}: unknown key (misspelled?)", file_, v.source().begin.line,
+                                   path_, path_.empty() ? "" : ".", key));
   }
 }
 

@@ -3,12 +3,11 @@
 // fields.csv and checkpoints. Checked: the series sums every rank's partials in step order,
 // checkpoints hold every particle sorted by id, an unwritable output folder reaches every
 // compute rank as an error naming the path, and nothing hangs.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <fstream>
 #include <sstream>
-
-#include <fmt/format.h>
 
 #include "basalt/io/io_ranks.hpp"
 #include "test_support.hpp"
@@ -70,7 +69,8 @@ RunResult run_fake_solver(const OutputConfig& cfg, int steps, int per_rank = kPe
       const double partials[2] = {double(c + 1), double(step)};
       client.submit_fields(step, step * 0.5, partials);
     }
-    if (auto kinds = client.frame_kinds(step)) client.submit_frame(piece_for(c, res.layout.n_compute, step, kinds, per_rank));
+    if (auto kinds = client.frame_kinds(step))
+      client.submit_frame(piece_for(c, res.layout.n_compute, step, kinds, per_rank));
     client.poll();
   }
   res.report = client.finish();

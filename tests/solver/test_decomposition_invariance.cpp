@@ -58,8 +58,10 @@ TEST(DecompositionInvariance, WaveKineticEnergyMatchesSerialRun) {
         at = k + 1;
       }
     }
-    EXPECT_LT(worst, 1e-9) << "dims " << dims[0] << "," << dims[1] << "," << dims[2] << ": worst at step " << at;
-    std::printf("np %d dims %d,%d,%d: max relative KE difference %.3g\n", n, dims[0], dims[1], dims[2], worst);
+    EXPECT_LT(worst, 1e-9) << "dims " << dims[0] << "," << dims[1] << "," << dims[2] << ": worst at step "
+                           << at;
+    std::printf("np %d dims %d,%d,%d: max relative KE difference %.3g\n", n, dims[0], dims[1], dims[2],
+                worst);
   }
 }
 

@@ -112,17 +112,19 @@ void check_lists(const Simulation<double>& sim, const std::set<Pair>& bonded, co
   EXPECT_EQ(listed.size(), all_own.size()) << when << ": an owned pair listed twice";
   std::multiset<Pair> ghost_count(all_ghost.begin(), all_ghost.end());
   for (const auto& pr : std::set<Pair>(all_ghost.begin(), all_ghost.end())) {
-    EXPECT_EQ(ghost_count.count(pr), 2u) << when << ": ghost pair " << pr.first << "-" << pr.second
-                                         << " not listed by both ranks";
+    EXPECT_EQ(ghost_count.count(pr), 2u)
+        << when << ": ghost pair " << pr.first << "-" << pr.second << " not listed by both ranks";
     EXPECT_FALSE(listed.count(pr)) << when << ": pair listed as owned and as ghost";
     listed.insert(pr);
   }
   EXPECT_EQ(listed.size(), expected.size()) << when;
   std::vector<Pair> missing, extra;
-  std::set_difference(expected.begin(), expected.end(), listed.begin(), listed.end(), std::back_inserter(missing));
-  std::set_difference(listed.begin(), listed.end(), expected.begin(), expected.end(), std::back_inserter(extra));
-  EXPECT_TRUE(missing.empty()) << when << ": " << missing.size() << " pairs missing, first " << missing[0].first
-                               << "-" << missing[0].second;
+  std::set_difference(expected.begin(), expected.end(), listed.begin(), listed.end(),
+                      std::back_inserter(missing));
+  std::set_difference(listed.begin(), listed.end(), expected.begin(), expected.end(),
+                      std::back_inserter(extra));
+  EXPECT_TRUE(missing.empty()) << when << ": " << missing.size() << " pairs missing, first "
+                               << missing[0].first << "-" << missing[0].second;
   EXPECT_TRUE(extra.empty()) << when << ": " << extra.size() << " pairs too many";
 
   // Halo property: ghosts are owned elsewhere and lie within the ghost width of this rank's region.
@@ -154,7 +156,8 @@ K = 1000.0
 
 TEST(Neighbors, BondedCubeMatchesBruteForce) {
   const auto g = basalt::io::read_geometry(basalt::test::reference_dir() / "cube1.geo");
-  const auto scene = basalt::test::scene_from(std::string(kScene) + "[[interactions]]\ntype = \"linear_bond\"\nK = 1000.0\n");
+  const auto scene = basalt::test::scene_from(std::string(kScene) +
+                                              "[[interactions]]\ntype = \"linear_bond\"\nK = 1000.0\n");
   Simulation<double> sim(scene, g, basalt::test::world());
   std::set<Pair> bonded;
   for (const auto& b : g.bonds) bonded.insert({std::min(b.a, b.b), std::max(b.a, b.b)});
@@ -163,8 +166,8 @@ TEST(Neighbors, BondedCubeMatchesBruteForce) {
 
 TEST(Neighbors, AfterMigrationMatchesBruteForce) {
   // Unbonded particles flying apart (an expanding cloud): they cross rank boundaries and the box.
-  const auto g = basalt::test::sub_cube(basalt::io::read_geometry(basalt::test::reference_dir() / "cube1.geo"), 0.0,
-                                        9.0);
+  const auto g = basalt::test::sub_cube(
+      basalt::io::read_geometry(basalt::test::reference_dir() / "cube1.geo"), 0.0, 9.0);
   Simulation<double> sim(basalt::test::scene_from(kScene), g, basalt::test::world());
   auto& p = sim.particles();
   for (std::size_t i = 0; i < p.n_owned; ++i) {

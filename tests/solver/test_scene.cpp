@@ -133,8 +133,8 @@ every = 5
 type = "wall_force"
 wall = "base"
 )");
-  EXPECT_EQ(field_columns(s),
-            (std::vector<std::string>{"kinetic_energy", "wall_force_base_x", "wall_force_base_y", "wall_force_base_z"}));
+  EXPECT_EQ(field_columns(s), (std::vector<std::string>{"kinetic_energy", "wall_force_base_x",
+                                                        "wall_force_base_y", "wall_force_base_z"}));
   auto msg = error_of(kGood + "[output]\n[[output.fields]]\ntype = \"wall_force\"\nwall = \"top\"\n");
   EXPECT_NE(msg.find("output.fields[0].wall: no wall named \"top\""), std::string::npos) << msg;
   msg = error_of(kGood + "[output]\n[[output.fields]]\ntype = \"kinetic_energy\"\nevery = 0\n");

@@ -83,7 +83,8 @@ rest_length = "sum_of_radii"
   EXPECT_NEAR(max_s, delta, tol * delta);
   EXPECT_NEAR(min_s, -delta, tol * delta);
   ASSERT_GE(up_crossings.size(), 2u);
-  EXPECT_NEAR(up_crossings[1] - up_crossings[0], period, (std::is_same_v<Real, float> ? 1e-3 : 1e-5) * period);
+  EXPECT_NEAR(up_crossings[1] - up_crossings[0], period,
+              (std::is_same_v<Real, float> ? 1e-3 : 1e-5) * period);
 }
 
 TEST(Bond, BreaksAtItsBreakStrainOnce) {

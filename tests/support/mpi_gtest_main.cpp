@@ -19,8 +19,8 @@ int g_failed_tests = 0;  // tests that failed on some rank, as agreed by all ran
 class RankFailurePrinter : public testing::EmptyTestEventListener {
   void OnTestPartResult(const testing::TestPartResult& r) override {
     if (!r.failed()) return;
-    std::fprintf(stderr, "[rank %d] %s:%d: Failure\n%s\n", g_rank,
-                 r.file_name() ? r.file_name() : "?", r.line_number(), r.summary());
+    std::fprintf(stderr, "[rank %d] %s:%d: Failure\n%s\n", g_rank, r.file_name() ? r.file_name() : "?",
+                 r.line_number(), r.summary());
     std::fflush(stderr);
   }
 };
@@ -43,8 +43,8 @@ class CrossRankVerdict : public testing::EmptyTestEventListener {
       }
     }
     if (g_rank == 0 && g_size > 1)
-      std::fprintf(stderr, "[  FAILED  ] %s.%s failed on rank(s) %s\n", info.test_suite_name(),
-                   info.name(), who.c_str());
+      std::fprintf(stderr, "[  FAILED  ] %s.%s failed on rank(s) %s\n", info.test_suite_name(), info.name(),
+                   who.c_str());
   }
 };
 

@@ -1,8 +1,7 @@
 #include "field_series.hpp"
 
-#include <mpi.h>
-
 #include <fmt/format.h>
+#include <mpi.h>
 
 #include <cmath>
 
@@ -10,11 +9,13 @@
 
 namespace basalt::io::detail {
 
-FieldSeriesWriter::FieldSeriesWriter(std::filesystem::path file, const std::vector<std::string>& names, bool append)
+FieldSeriesWriter::FieldSeriesWriter(std::filesystem::path file, const std::vector<std::string>& names,
+                                     bool append)
     : file_(std::move(file)) {
   const bool resume = append && std::filesystem::exists(file_);
   out_ = std::fopen(file_.c_str(), resume ? "a" : "w");
-  if (!out_) throw FormatError(file_, "", "cannot open for writing (does the folder exist and is it writable?)");
+  if (!out_)
+    throw FormatError(file_, "", "cannot open for writing (does the folder exist and is it writable?)");
   if (resume) return;
   buffer_ = "step,time";
   for (const auto& n : names) buffer_ += "," + n;
@@ -45,7 +46,8 @@ void FieldSeriesWriter::append(std::int64_t step, double time, std::span<const d
 void FieldSeriesWriter::flush() {
   if (buffer_.empty()) return;
   const double t0 = MPI_Wtime();
-  const bool ok = std::fwrite(buffer_.data(), 1, buffer_.size(), out_) == buffer_.size() && std::fflush(out_) == 0;
+  const bool ok =
+      std::fwrite(buffer_.data(), 1, buffer_.size(), out_) == buffer_.size() && std::fflush(out_) == 0;
   seconds_ += MPI_Wtime() - t0;
   if (!ok) throw FormatError(file_, "", "write failed (disk full or file-size limit?)");
   bytes_ += buffer_.size();

@@ -1,12 +1,12 @@
 #include "basalt/io/frame.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cstring>
 #include <numeric>
 #include <stdexcept>
 #include <type_traits>
-
-#include <fmt/format.h>
 
 namespace basalt::io {
 
@@ -231,7 +231,8 @@ Checkpoint assemble(std::vector<FramePiece>& pieces, const RunInfo& run) {
   std::sort(order.begin(), order.end());
   for (std::size_t i = 1; i < order.size(); ++i)
     if (order[i].first == order[i - 1].first)
-      throw std::runtime_error(fmt::format("assemble: particle id {} appears twice at step {}", order[i].first, step));
+      throw std::runtime_error(
+          fmt::format("assemble: particle id {} appears twice at step {}", order[i].first, step));
 
   Checkpoint c;
   auto& g = c.geometry;
@@ -242,7 +243,8 @@ Checkpoint assemble(std::vector<FramePiece>& pieces, const RunInfo& run) {
   g.mass.resize(n);
   c.velocity.resize(n);
   const bool inv = std::all_of(pieces.begin(), pieces.end(),
-                               [](const FramePiece& p) { return p.inv_mass.size() == p.size(); }) && n > 0;
+                               [](const FramePiece& p) { return p.inv_mass.size() == p.size(); }) &&
+                   n > 0;
   if (inv) c.inv_mass.resize(n);
   const bool at_rebuild =
       n > 0 && std::all_of(pieces.begin(), pieces.end(), [&](const FramePiece& p) {
@@ -279,8 +281,9 @@ Checkpoint assemble(std::vector<FramePiece>& pieces, const RunInfo& run) {
       if (b.a > b.b) std::swap(b.a, b.b);
       bonds.push_back({b, p.bond_rest_length[k], p.bond_broken[k]});
     }
-  std::sort(bonds.begin(), bonds.end(),
-            [](const BondRow& x, const BondRow& y) { return std::tie(x.b.a, x.b.b) < std::tie(y.b.a, y.b.b); });
+  std::sort(bonds.begin(), bonds.end(), [](const BondRow& x, const BondRow& y) {
+    return std::tie(x.b.a, x.b.b) < std::tie(y.b.a, y.b.b);
+  });
   g.bonds.reserve(m);
   c.bond_rest_length.reserve(m);
   c.bond_broken.reserve(m);

@@ -1,5 +1,8 @@
 #include "basalt/io/io_ranks.hpp"
 
+#include <fmt/format.h>
+#include <sys/resource.h>
+
 #include <algorithm>
 #include <climits>
 #include <cstring>
@@ -8,10 +11,6 @@
 #include <memory>
 #include <stdexcept>
 #include <thread>
-
-#include <sys/resource.h>
-
-#include <fmt/format.h>
 
 #include "field_series.hpp"
 
@@ -22,14 +21,25 @@ namespace {
 enum Tag : int { kTagInfo = 701, kTagFrame, kTagFields, kTagDone, kTagError, kTagGather };
 
 // Report layout for the final reductions.
-enum SumSlot { kCkptFiles, kCkptBytes, kFrameFiles, kFrameBytes, kFieldFiles, kFieldBytes, kFramesSent, kErrors, kSumSlots };
+enum SumSlot {
+  kCkptFiles,
+  kCkptBytes,
+  kFrameFiles,
+  kFrameBytes,
+  kFieldFiles,
+  kFieldBytes,
+  kFramesSent,
+  kErrors,
+  kSumSlots
+};
 enum MaxSlot { kCkptSeconds, kFrameSeconds, kFieldSeconds, kWaitSeconds, kIoCpu, kIoWall, kMaxSlots };
 
 int checked_count(std::size_t bytes) {
   if (bytes > static_cast<std::size_t>(INT_MAX))
-    throw std::runtime_error(fmt::format("output frame of {} bytes exceeds MPI's 2 GiB message limit: "
-                                         "use more compute ranks",
-                                         bytes));
+    throw std::runtime_error(
+        fmt::format("output frame of {} bytes exceeds MPI's 2 GiB message limit: "
+                    "use more compute ranks",
+                    bytes));
   return static_cast<int>(bytes);
 }
 
@@ -37,7 +47,8 @@ int checked_count(std::size_t bytes) {
 double process_cpu_seconds() {
   rusage u{};
   getrusage(RUSAGE_SELF, &u);
-  return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+  return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
 }
 
 void throttle(double mb_per_s, std::uint64_t bytes, double elapsed) {
@@ -57,8 +68,8 @@ std::filesystem::path checkpoint_path(const std::filesystem::path& dir, std::int
 }
 
 /// Writes one assembled checkpoint; returns bytes written.
-std::uint64_t write_checkpoint_step(std::vector<FramePiece>& pieces, const RunInfo& info, const OutputConfig& cfg,
-                                    OutputKindReport& rep) {
+std::uint64_t write_checkpoint_step(std::vector<FramePiece>& pieces, const RunInfo& info,
+                                    const OutputConfig& cfg, OutputKindReport& rep) {
   const double t0 = MPI_Wtime();
   Checkpoint c = assemble(pieces, info);
   const auto path = checkpoint_path(cfg.dir, c.step);
@@ -103,8 +114,9 @@ OutputReport reduce_report(MPI_Comm comm, const OutputReport& mine) {
                             double(mine.frames.files),      double(mine.frames.bytes),
                             double(mine.fields.files),      double(mine.fields.bytes),
                             double(mine.frames_sent),       mine.error ? 1.0 : 0.0};
-  double maxs[kMaxSlots] = {mine.checkpoints.write_seconds, mine.frames.write_seconds, mine.fields.write_seconds,
-                            mine.compute_wait_seconds, mine.io_cpu_seconds, mine.io_wall_seconds};
+  double maxs[kMaxSlots] = {
+      mine.checkpoints.write_seconds, mine.frames.write_seconds, mine.fields.write_seconds,
+      mine.compute_wait_seconds,      mine.io_cpu_seconds,       mine.io_wall_seconds};
   double gsum[kSumSlots], gmax[kMaxSlots];
   MPI_Allreduce(sums, gsum, kSumSlots, MPI_DOUBLE, MPI_SUM, comm);
   MPI_Allreduce(maxs, gmax, kMaxSlots, MPI_DOUBLE, MPI_MAX, comm);
@@ -151,10 +163,11 @@ RankLayout split_ranks(MPI_Comm world, int io_ranks) {
   MPI_Comm_size(world, &size);
   if (io_ranks < 0) throw std::invalid_argument(fmt::format("--io-ranks must be >= 0, got {}", io_ranks));
   if (io_ranks > 0 && size - io_ranks < io_ranks)
-    throw std::invalid_argument(fmt::format(
-        "--io-ranks {} with {} ranks in all leaves {} compute ranks; each I/O rank needs at least one compute rank "
-        "(start more ranks: mpirun -np P+Q)",
-        io_ranks, size, size - io_ranks));
+    throw std::invalid_argument(
+        fmt::format("--io-ranks {} with {} ranks in all leaves {} compute ranks; each I/O rank needs at "
+                    "least one compute rank "
+                    "(start more ranks: mpirun -np P+Q)",
+                    io_ranks, size, size - io_ranks));
   RankLayout L;
   L.world_rank = rank;
   L.n_io = io_ranks;
@@ -322,7 +335,8 @@ void OutputClient::submit_frame(const FramePiece& piece) {
     }
     all.resize(checked_count(total));
   }
-  MPI_Gatherv(mine.data(), n, MPI_BYTE, all.data(), counts.data(), displs.data(), MPI_BYTE, 0, I.layout.compute);
+  MPI_Gatherv(mine.data(), n, MPI_BYTE, all.data(), counts.data(), displs.data(), MPI_BYTE, 0,
+              I.layout.compute);
   int bad = 0;
   if (I.compute_rank == 0 && !I.local.error) {
     try {
@@ -358,7 +372,8 @@ void OutputClient::submit_fields(std::int64_t step, double time, std::span<const
     I.field_rows.push_back(static_cast<double>(step));
     I.field_rows.push_back(time);
     I.field_rows.insert(I.field_rows.end(), partials.begin(), partials.end());
-    if (++I.field_rows_count >= static_cast<std::size_t>(std::max(1, I.cfg.field_batch_rows))) I.send_field_batch();
+    if (++I.field_rows_count >= static_cast<std::size_t>(std::max(1, I.cfg.field_batch_rows)))
+      I.send_field_batch();
     return;
   }
   const double t0 = MPI_Wtime();
@@ -600,7 +615,8 @@ OutputReport IoServer::run() {
         }
         // Rows complete in step order (every rank sends its rows in order).
         while (!rows.empty() && rows.begin()->second.count == L.n_compute) {
-          if (csv && !fields_failed) csv->append(rows.begin()->first, rows.begin()->second.time, rows.begin()->second.sum);
+          if (csv && !fields_failed)
+            csv->append(rows.begin()->first, rows.begin()->second.time, rows.begin()->second.sum);
           rows.erase(rows.begin());
         }
         if (csv && !fields_failed) try {

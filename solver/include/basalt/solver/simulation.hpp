@@ -138,7 +138,8 @@ class Simulation {
   template <bool Energy>
   std::array<double, 3> compute_forces(bool ghosts_in_flight = false);
   void save_fields(FieldSink* sink, const std::array<double, 3>& pe);
-  bool field_partials(const std::array<double, 3>& pe, std::vector<double>& local, std::vector<char>& due) const;
+  bool field_partials(const std::array<double, 3>& pe, std::vector<double>& local,
+                      std::vector<char>& due) const;
   void output_fields(const std::array<double, 3>& pe);
   void distribute_checkpoint(const io::Checkpoint& c, const RestartLayout& layout, MPI_Comm comm);
   /// Restart: the lists of the uninterrupted run's last rebuild (see the restart constructor).
@@ -187,11 +188,11 @@ class Simulation {
   double wall_work_in_ = 0;  ///< this rank's share of the positive work done by walls
   PhaseTimes times_;
   double ghost_wait_ = 0;
-  double ke_local_ = 0;    ///< this rank's kinetic energy, valid while ke_fresh_
-  bool ke_fresh_ = false;  ///< set when the second half-kick computed ke_local_ this step
+  double ke_local_ = 0;         ///< this rank's kinetic energy, valid while ke_fresh_
+  bool ke_fresh_ = false;       ///< set when the second half-kick computed ke_local_ this step
   bool forces_zeroed_ = false;  ///< set by the fused kick-zero-drift pass
   StabilityReport stability_;
-  OutputSink* output_ = nullptr;        ///< set during run(steps, OutputSink&)
+  OutputSink* output_ = nullptr;  ///< set during run(steps, OutputSink&)
   /// Owned positions at the last rebuild, exactly (x0 is only a float copy) and that rebuild's step:
   /// checkpoints store them so that a restart can replay the rebuild.
   std::vector<Real> xr_, yr_, zr_;

@@ -2,12 +2,12 @@
 // One compute rank's share of a run's state at one output step ("frame piece"), and its flat
 // wire format. Compute ranks fill a FramePiece with their owned particles; the I/O side
 // assembles the pieces of all ranks into a Checkpoint (sorted by id) or writes them as VTK.
-#include <cstddef>
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <map>
-#include <string>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "basalt/io/checkpoint.hpp"

@@ -50,8 +50,8 @@ struct OutputConfig {
   std::int64_t frames_every = 0;      ///< VTK frames; 0 = off
   std::int64_t fields_every = 0;      ///< field savers; 0 = off
   std::vector<std::string> field_names;
-  int max_frames_in_flight = 2;  ///< per compute rank: bounds memory, sets when a slow disk bites
-  int field_batch_rows = 256;    ///< field rows a compute rank collects before sending them
+  int max_frames_in_flight = 2;    ///< per compute rank: bounds memory, sets when a slow disk bites
+  int field_batch_rows = 256;      ///< field rows a compute rank collects before sending them
   bool continue_on_error = false;  ///< a failed output stops the run unless this is set
   double throttle_mb_per_s = 0;    ///< benchmark only: make storage this slow on purpose (0 = off)
   bool append_fields = false;      ///< restart: continue an existing fields.csv instead of replacing it
@@ -74,9 +74,9 @@ struct OutputReport {
 
 /// Writes a VTK frame: the pieces this writer holds, as piece `piece_index` of `n_pieces`.
 /// Supplied by the VTK layer (basalt::io_vtk) so this library does not link VTK.
-using VtkFrameWriter = std::function<std::uint64_t(const std::vector<FramePiece>& pieces, std::int64_t step,
-                                                   double time, int piece_index, int n_pieces,
-                                                   const std::filesystem::path& dir)>;
+using VtkFrameWriter =
+    std::function<std::uint64_t(const std::vector<FramePiece>& pieces, std::int64_t step, double time,
+                                int piece_index, int n_pieces, const std::filesystem::path& dir)>;
 
 /// Compute side. One per compute rank; every call except submit_* and poll is collective
 /// over the compute ranks (and, for finish, the I/O ranks).

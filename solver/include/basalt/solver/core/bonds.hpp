@@ -11,10 +11,10 @@ namespace basalt::solver {
 
 template <class Real>
 struct Bonds {
-  std::vector<std::int64_t> a, b;  ///< global ids of the ends
-  std::vector<Real> r0;            ///< rest length (the bond's history)
-  std::vector<std::uint8_t> group;  ///< index of the bond's interaction group (only when grouped)
-  bool grouped = false;             ///< more than one bond group: group[] is kept
+  std::vector<std::int64_t> a, b;    ///< global ids of the ends
+  std::vector<Real> r0;              ///< rest length (the bond's history)
+  std::vector<std::uint8_t> group;   ///< index of the bond's interaction group (only when grouped)
+  bool grouped = false;              ///< more than one bond group: group[] is kept
   std::vector<std::int32_t> ia, ib;  ///< local indices (valid between rebuilds)
   std::size_t n_both_owned = 0;
 

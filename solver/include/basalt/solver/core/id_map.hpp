@@ -23,7 +23,8 @@ class IdMap {
     ids_ = &ids;
     n_ = n;
     if (dense_) {
-      for (std::size_t i = 0; i < n; ++i) table_[static_cast<std::size_t>(ids[i] - min_)] = static_cast<std::int32_t>(i);
+      for (std::size_t i = 0; i < n; ++i)
+        table_[static_cast<std::size_t>(ids[i] - min_)] = static_cast<std::int32_t>(i);
       return;
     }
     std::size_t cap = 16;
@@ -43,7 +44,8 @@ class IdMap {
       const auto k = gid - min_;
       if (k < 0 || static_cast<std::size_t>(k) >= table_.size()) return -1;
       const auto i = table_[static_cast<std::size_t>(k)];  // stale entries from earlier calls are checked
-      return i >= 0 && static_cast<std::size_t>(i) < n_ && (*ids_)[static_cast<std::size_t>(i)] == gid ? i : -1;
+      return i >= 0 && static_cast<std::size_t>(i) < n_ && (*ids_)[static_cast<std::size_t>(i)] == gid ? i
+                                                                                                       : -1;
     }
     for (std::size_t s = slot(gid);; s = (s + 1) & mask_) {
       const auto i = table_[s];

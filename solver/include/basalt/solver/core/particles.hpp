@@ -20,7 +20,7 @@ struct Particles {
   // Owned only (ghosts need no velocity, force or mass):
   std::vector<Real> vx, vy, vz;
   std::vector<Real> fx, fy, fz;
-  std::vector<Real> inv_mass;    ///< 1 / mass (the mass itself is mass(i))
+  std::vector<Real> inv_mass;     ///< 1 / mass (the mass itself is mass(i))
   std::vector<float> x0, y0, z0;  ///< positions at the last neighbour-list rebuild (float: only
                                   ///< compared with half the skin)
 

@@ -126,7 +126,8 @@ double kinetic_energy(const Particles<Real>& p) {
   const Real* vz = p.vz.data();
   const Real* im = p.inv_mass.data();
   for (std::size_t i = 0; i < p.n_owned; ++i) {
-    const double v2 = double(vx[i]) * double(vx[i]) + double(vy[i]) * double(vy[i]) + double(vz[i]) * double(vz[i]);
+    const double v2 =
+        double(vx[i]) * double(vx[i]) + double(vy[i]) * double(vy[i]) + double(vz[i]) * double(vz[i]);
     lane[i % detail::kEnergyLanes] += v2 / double(im[i]);
   }
   return detail::lane_sum(lane);
@@ -150,7 +151,8 @@ double kick_energy(Particles<Real>& p, Real h) {
     vx[i] += s * fx[i];
     vy[i] += s * fy[i];
     vz[i] += s * fz[i];
-    const double v2 = double(vx[i]) * double(vx[i]) + double(vy[i]) * double(vy[i]) + double(vz[i]) * double(vz[i]);
+    const double v2 =
+        double(vx[i]) * double(vx[i]) + double(vy[i]) * double(vy[i]) + double(vz[i]) * double(vz[i]);
     lane[i % detail::kEnergyLanes] += v2 / double(im[i]);
   }
   return detail::lane_sum(lane);

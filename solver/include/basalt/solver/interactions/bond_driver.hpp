@@ -34,7 +34,8 @@ class BondDriver {
   /// that broke (they are removed at once).
   template <bool Energy>
   double compute(Particles<Real>& p, Bonds<Real>& bonds, std::vector<BrokenBond>& broken) {
-    const double e = compute_part<Energy, true>(p, bonds, broken) + compute_part<Energy, false>(p, bonds, broken);
+    const double e =
+        compute_part<Energy, true>(p, bonds, broken) + compute_part<Energy, false>(p, bonds, broken);
     commit(bonds);
     return e;
   }
@@ -43,7 +44,8 @@ class BondDriver {
   template <bool Energy, bool BothOwned>
   double compute_part(Particles<Real>& p, const Bonds<Real>& bonds, std::vector<BrokenBond>& broken) {
     if (BothOwned) gone_.clear();
-    const std::size_t b = BothOwned ? 0 : bonds.n_both_owned, e = BothOwned ? bonds.n_both_owned : bonds.size();
+    const std::size_t b = BothOwned ? 0 : bonds.n_both_owned,
+                      e = BothOwned ? bonds.n_both_owned : bonds.size();
     if (K_.size() == 1 && !breakable_) return loop<Energy, true, false, BothOwned>(p, bonds, broken, b, e);
     if (K_.size() == 1) return loop<Energy, true, true, BothOwned>(p, bonds, broken, b, e);
     return loop<Energy, false, true, BothOwned>(p, bonds, broken, b, e);
@@ -71,8 +73,8 @@ class BondDriver {
 
  private:
   template <bool Energy, bool Uniform, bool Breakable, bool BothOwned>
-  double loop(Particles<Real>& p, const Bonds<Real>& bonds, std::vector<BrokenBond>& broken, std::size_t begin,
-              std::size_t end) {
+  double loop(Particles<Real>& p, const Bonds<Real>& bonds, std::vector<BrokenBond>& broken,
+              std::size_t begin, std::size_t end) {
     double energy = 0;
     const Real* __restrict x = p.x.data();
     const Real* __restrict y = p.y.data();
@@ -94,7 +96,8 @@ class BondDriver {
       if constexpr (Breakable) {
         if (Model::broken(Uniform ? eps0 : eps_[g], r0, r)) [[unlikely]] {
           gone_.push_back(k);
-          if (BothOwned || p.id[i] < p.id[j]) broken.push_back({bonds.a[k], bonds.b[k], double(r), double(r0)});
+          if (BothOwned || p.id[i] < p.id[j])
+            broken.push_back({bonds.a[k], bonds.b[k], double(r), double(r0)});
           continue;
         }
       }

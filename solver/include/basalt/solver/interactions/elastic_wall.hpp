@@ -23,9 +23,9 @@ struct ElasticWall {
   static Params parse(TableReader& t) {
     Params p;
     p.K = t.non_negative("K");
-    p.stiffness =
-        t.choice_or("stiffness", {"plain", "esys_pi_r"}, "plain") == "esys_pi_r" ? Stiffness::esys_pi_r
-                                                                                  : Stiffness::plain;
+    p.stiffness = t.choice_or("stiffness", {"plain", "esys_pi_r"}, "plain") == "esys_pi_r"
+                      ? Stiffness::esys_pi_r
+                      : Stiffness::plain;
     return p;
   }
 

@@ -30,10 +30,10 @@ struct LinearBond {
     Params p;
     p.K = t.non_negative("K");
     if (t.has("break_strain")) p.break_strain = t.positive("break_strain");
-    p.rest_length = t.choice_or("rest_length", {"initial_distance", "sum_of_radii"}, "initial_distance") ==
-                            "sum_of_radii"
-                        ? RestLength::sum_of_radii
-                        : RestLength::initial_distance;
+    p.rest_length =
+        t.choice_or("rest_length", {"initial_distance", "sum_of_radii"}, "initial_distance") == "sum_of_radii"
+            ? RestLength::sum_of_radii
+            : RestLength::initial_distance;
     return p;
   }
 

@@ -4,8 +4,8 @@
 // the work walls do on the particles (the energy source the stability guard allows for).
 #include <algorithm>
 #include <array>
-#include <cstdint>
 #include <cmath>
+#include <cstdint>
 #include <vector>
 
 #include "basalt/solver/core/particles.hpp"
@@ -16,7 +16,8 @@ namespace basalt::solver {
 template <class Real, class Model>
 class WallDriver {
  public:
-  explicit WallDriver(const std::vector<WallSpec>& walls) : walls_(walls), point_(walls.size()), force_(walls.size()) {
+  explicit WallDriver(const std::vector<WallSpec>& walls)
+      : walls_(walls), point_(walls.size()), force_(walls.size()) {
     for (std::size_t w = 0; w < walls.size(); ++w) point_[w] = walls[w].point;
   }
 
@@ -58,7 +59,8 @@ class WallDriver {
         const double d = (p.x[i] - point_[w][0]) * spec.normal[0] + (p.y[i] - point_[w][1]) * spec.normal[1] +
                          (p.z[i] - point_[w][2]) * spec.normal[2];
         if (d >= double(p.radius[i]) + skin) continue;
-        if (!spec.tags.empty() && std::find(spec.tags.begin(), spec.tags.end(), p.tag[i]) == spec.tags.end()) continue;
+        if (!spec.tags.empty() && std::find(spec.tags.begin(), spec.tags.end(), p.tag[i]) == spec.tags.end())
+          continue;
         c.push_back(static_cast<std::int32_t>(i));
       }
     }
@@ -70,7 +72,8 @@ class WallDriver {
     double m = 0;
     for (std::size_t w = 0; w < walls_.size() && w < point_at_rebuild_.size(); ++w) {
       const auto& n = walls_[w].normal;
-      const double u = (point_[w][0] - point_at_rebuild_[w][0]) * n[0] + (point_[w][1] - point_at_rebuild_[w][1]) * n[1] +
+      const double u = (point_[w][0] - point_at_rebuild_[w][0]) * n[0] +
+                       (point_[w][1] - point_at_rebuild_[w][1]) * n[1] +
                        (point_[w][2] - point_at_rebuild_[w][2]) * n[2];
       if (u > 0) m = std::max(m, u * u);
     }

@@ -14,8 +14,8 @@ namespace basalt::solver {
 class CellGrid {
  public:
   template <class Real>
-  void build(const std::vector<Real>& x, const std::vector<Real>& y, const std::vector<Real>& z, std::size_t n,
-             double cell) {
+  void build(const std::vector<Real>& x, const std::vector<Real>& y, const std::vector<Real>& z,
+             std::size_t n, double cell) {
     std::array<double, 3> lo{0, 0, 0}, hi{0, 0, 0};
     if (n > 0) {
       lo = hi = {double(x[0]), double(y[0]), double(z[0])};

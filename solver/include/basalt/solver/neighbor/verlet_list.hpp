@@ -78,7 +78,8 @@ void build_pair_lists(const Particles<Real>& p, const CellGrid& grid, double ski
           // once; ghosts all have j >= n > i) without a per-candidate branch.
           const auto* first = order.data() + start[static_cast<std::size_t>(cell)];
           const auto* last = order.data() + start[static_cast<std::size_t>(cell) + 1];
-          for (const auto* it = std::upper_bound(first, last, static_cast<std::uint32_t>(i)); it != last; ++it) {
+          for (const auto* it = std::upper_bound(first, last, static_cast<std::uint32_t>(i)); it != last;
+               ++it) {
             const std::uint32_t j = *it;
             const Real dx = xi - p.x[j], dy = yi - p.y[j], dz = zi - p.z[j];
             const Real cut = ri + p.radius[j];

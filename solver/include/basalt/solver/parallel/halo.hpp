@@ -44,11 +44,12 @@ class Halo {
  private:
   const Decomposition& dec_;
   std::array<std::array<std::vector<std::int32_t>, 2>, 3> send_;  ///< [axis][side] local indices
-  std::array<std::array<std::size_t, 2>, 3> recv_begin_{};         ///< where ghosts from [axis][from side] start
+  std::array<std::array<std::size_t, 2>, 3> recv_begin_{};  ///< where ghosts from [axis][from side] start
   std::array<std::array<std::size_t, 2>, 3> recv_count_{};
   std::vector<Real> sbuf_, rbuf_;
   std::array<std::vector<Real>, 2> async_send_, async_recv_;
-  std::array<MPI_Request, 4> requests_{MPI_REQUEST_NULL, MPI_REQUEST_NULL, MPI_REQUEST_NULL, MPI_REQUEST_NULL};
+  std::array<MPI_Request, 4> requests_{MPI_REQUEST_NULL, MPI_REQUEST_NULL, MPI_REQUEST_NULL,
+                                       MPI_REQUEST_NULL};
   int async_axis_ = -1;
 };
 

@@ -38,8 +38,14 @@ struct WallSpec {
 };
 
 struct FieldSpec {
-  enum class Type { kinetic_energy, bond_potential_energy, contact_potential_energy, wall_potential_energy,
-                    bond_count, wall_force };
+  enum class Type {
+    kinetic_energy,
+    bond_potential_energy,
+    contact_potential_energy,
+    wall_potential_energy,
+    bond_count,
+    wall_force
+  };
   Type type = Type::kinetic_energy;
   std::int64_t every = 1;
   std::string wall;  ///< wall_force only
@@ -60,7 +66,7 @@ struct Scene {
   double skin = 0;
   Integrator integrator = Integrator::velocity_verlet;
   bool force_dt = false;
-  double dt_safety = 0.2;                ///< warn when dt > dt_safety * critical step
+  double dt_safety = 0.2;                 ///< warn when dt > dt_safety * critical step
   std::int64_t energy_check_every = 100;  ///< 0: no energy-growth guard
   std::vector<Group<LinearBond>> bonds;
   std::vector<Group<LinearElastic>> contacts;
@@ -68,8 +74,8 @@ struct Scene {
   std::filesystem::path output_dir = "out";
   std::vector<FieldSpec> fields;
   // [output] frames and checkpoints (written by the I/O layer; docs/io-ranks.md)
-  std::int64_t checkpoint_every = 0;  ///< HDF5 checkpoint every N steps (0 = off)
-  std::int64_t frames_every = 0;      ///< VTK frame every N steps (0 = off)
+  std::int64_t checkpoint_every = 0;      ///< HDF5 checkpoint every N steps (0 = off)
+  std::int64_t frames_every = 0;          ///< VTK frame every N steps (0 = off)
   bool output_continue_on_error = false;  ///< on_error = "continue": a failed output does not stop the run
   std::int64_t frames_in_flight = 2;      ///< per compute rank: frames posted but not yet received
 };
@@ -77,7 +83,8 @@ struct Scene {
 /// Reads and checks a scene file. Throws InputError naming file, line and key.
 Scene parse_scene(const std::filesystem::path& file);
 /// Same from text; `label` names the source in errors, relative paths resolve against `base_dir`.
-Scene parse_scene_text(const std::string& text, const std::string& label, const std::filesystem::path& base_dir);
+Scene parse_scene_text(const std::string& text, const std::string& label,
+                       const std::filesystem::path& base_dir);
 
 /// Column names of fields.csv for these savers (after "step" and "time").
 std::vector<std::string> field_columns(const Scene& scene);

@@ -45,8 +45,8 @@ class TableReader {
   /// An array of tables (may be absent).
   const toml::array* table_array(const std::string& key);
 
-  double positive(const std::string& key);             ///< > 0 and finite
-  double non_negative(const std::string& key);         ///< >= 0 and finite
+  double positive(const std::string& key);      ///< > 0 and finite
+  double non_negative(const std::string& key);  ///< >= 0 and finite
   double non_negative_or(const std::string& key, double fallback);
 
   /// Throws naming the first key that was never read (unknown or misspelled).
