@@ -11,22 +11,16 @@
 
 namespace basalt::solver {
 
+namespace detail {
+/// The half-kick v += h f / m, and with Energy also the kinetic energy of the kicked velocities
+/// (sum of m v^2 / 2 with the given masses, particle i in lane i mod 8). Returns 0 without Energy.
+template <bool Energy, class Real>
+double kick_pass(Particles<Real>& p, Real h, const double* __restrict mass);
+}  // namespace detail
+
 template <class Real>
 void kick(Particles<Real>& p, Real h) {
-  const std::size_t n = p.n_owned;
-  Real* __restrict vx = p.vx.data();
-  Real* __restrict vy = p.vy.data();
-  Real* __restrict vz = p.vz.data();
-  const Real* __restrict fx = p.fx.data();
-  const Real* __restrict fy = p.fy.data();
-  const Real* __restrict fz = p.fz.data();
-  const Real* __restrict im = p.inv_mass.data();
-  for (std::size_t i = 0; i < n; ++i) {
-    const Real s = h * im[i];
-    vx[i] += s * fx[i];
-    vy[i] += s * fy[i];
-    vz[i] += s * fz[i];
-  }
+  detail::kick_pass<false>(p, h, nullptr);
 }
 
 template <class Real>
@@ -138,7 +132,12 @@ double kinetic_energy(const Particles<Real>& p) {
 /// velocities and no division on steps that save the kinetic energy.
 template <class Real>
 double kick_energy(Particles<Real>& p, Real h, const double* __restrict mass) {
-  double lane[detail::kEnergyLanes] = {};
+  return detail::kick_pass<true>(p, h, mass);
+}
+
+template <bool Energy, class Real>
+double detail::kick_pass(Particles<Real>& p, Real h, const double* __restrict mass) {
+  double lane[kEnergyLanes] = {};
   const std::size_t n = p.n_owned;
   Real* __restrict vx = p.vx.data();
   Real* __restrict vy = p.vy.data();
@@ -152,11 +151,13 @@ double kick_energy(Particles<Real>& p, Real h, const double* __restrict mass) {
     vx[i] += s * fx[i];
     vy[i] += s * fy[i];
     vz[i] += s * fz[i];
-    const double v2 =
-        double(vx[i]) * double(vx[i]) + double(vy[i]) * double(vy[i]) + double(vz[i]) * double(vz[i]);
-    lane[i % detail::kEnergyLanes] += v2 * mass[i];
+    if constexpr (Energy) {
+      const double v2 =
+          double(vx[i]) * double(vx[i]) + double(vy[i]) * double(vy[i]) + double(vz[i]) * double(vz[i]);
+      lane[i % kEnergyLanes] += v2 * mass[i];
+    }
   }
-  return detail::lane_sum(lane);
+  return Energy ? lane_sum(lane) : 0.0;
 }
 
 }  // namespace basalt::solver
