@@ -143,17 +143,39 @@ OutputReport reduce_report(MPI_Comm comm, const OutputReport& mine) {
   return r;
 }
 
+/// Sleeps between polls, 20 us doubling up to 2 ms: Open MPI's blocking calls busy-poll, and an
+/// I/O rank waiting for work must not burn a core.
+class Backoff {
+ public:
+  void sleep() {
+    std::this_thread::sleep_for(pause_);
+    pause_ = std::min(pause_ * 2, std::chrono::microseconds(2000));
+  }
+  void reset() { pause_ = std::chrono::microseconds(20); }
+
+ private:
+  std::chrono::microseconds pause_{20};
+};
+
+/// Receives the next message from `source` with `tag` (any size), sleeping while none is there.
+void receive_without_spinning(int source, int tag, MPI_Comm comm, std::vector<std::byte>& bytes) {
+  MPI_Status st;
+  int flag = 0;
+  Backoff backoff;
+  for (MPI_Iprobe(source, tag, comm, &flag, &st); !flag; MPI_Iprobe(source, tag, comm, &flag, &st))
+    backoff.sleep();
+  int n = 0;
+  MPI_Get_count(&st, MPI_BYTE, &n);
+  bytes.resize(n);
+  MPI_Recv(bytes.data(), n, MPI_BYTE, source, tag, comm, MPI_STATUS_IGNORE);
+}
+
 }  // namespace
 
 void wait_without_spinning(MPI_Request& request, MPI_Status* status) {
   int done = 0;
-  auto pause = std::chrono::microseconds(20);
-  while (true) {
-    MPI_Test(&request, &done, status);
-    if (done) return;
-    std::this_thread::sleep_for(pause);
-    pause = std::min(pause * 2, std::chrono::microseconds(2000));
-  }
+  Backoff backoff;
+  for (MPI_Test(&request, &done, status); !done; MPI_Test(&request, &done, status)) backoff.sleep();
 }
 
 // ------------------------------------------------------------------------------------------
@@ -476,20 +498,8 @@ OutputReport IoServer::run() {
   // The run's fixed information, from compute rank 0.
   RunInfo info;
   {
-    MPI_Status st;
-    int flag = 0;
-    auto pause = std::chrono::microseconds(20);
-    while (!flag) {
-      MPI_Iprobe(0, kTagInfo, L.bridge, &flag, &st);
-      if (!flag) {
-        std::this_thread::sleep_for(pause);
-        pause = std::min(pause * 2, std::chrono::microseconds(2000));
-      }
-    }
-    int n = 0;
-    MPI_Get_count(&st, MPI_BYTE, &n);
-    std::vector<std::byte> bytes(n);
-    MPI_Recv(bytes.data(), n, MPI_BYTE, 0, kTagInfo, L.bridge, MPI_STATUS_IGNORE);
+    std::vector<std::byte> bytes;
+    receive_without_spinning(0, kTagInfo, L.bridge, bytes);
     info = deserialize_run_info(bytes);
   }
 
@@ -547,20 +557,7 @@ OutputReport IoServer::run() {
         wait_without_spinning(req);
       } else {
         for (int q = 1; q < L.n_io; ++q) {
-          MPI_Status st;
-          int flag = 0;
-          auto pause = std::chrono::microseconds(20);
-          while (!flag) {
-            MPI_Iprobe(q, kTagGather, L.io, &flag, &st);
-            if (!flag) {
-              std::this_thread::sleep_for(pause);
-              pause = std::min(pause * 2, std::chrono::microseconds(2000));
-            }
-          }
-          int n = 0;
-          MPI_Get_count(&st, MPI_BYTE, &n);
-          gathered.resize(n);
-          MPI_Recv(gathered.data(), n, MPI_BYTE, q, kTagGather, L.io, MPI_STATUS_IGNORE);
+          receive_without_spinning(q, kTagGather, L.io, gathered);
           split_pieces(gathered, pieces);
         }
         if (!checkpoints_failed) try {
@@ -575,18 +572,17 @@ OutputReport IoServer::run() {
   };
 
   int done = 0;
-  auto pause = std::chrono::microseconds(20);
+  Backoff backoff;
   while (done < L.n_compute) {
     int flag = 0;
     MPI_Message msg;
     MPI_Status st;
     MPI_Improbe(MPI_ANY_SOURCE, MPI_ANY_TAG, L.bridge, &flag, &msg, &st);
     if (!flag) {
-      std::this_thread::sleep_for(pause);  // an idle I/O rank must not burn a core
-      pause = std::min(pause * 2, std::chrono::microseconds(2000));
+      backoff.sleep();  // an idle I/O rank must not burn a core
       continue;
     }
-    pause = std::chrono::microseconds(20);
+    backoff.reset();
     int n = 0;
     MPI_Get_count(&st, MPI_BYTE, &n);
     buffer.resize(n);

@@ -2,8 +2,9 @@
 // Time integration of owned particles, split into a kick (v += F/m h) and a drift (x += v h).
 //   velocity Verlet:  kick(dt/2), drift(dt), forces, kick(dt/2)
 //   symplectic Euler: kick(dt),   drift(dt), forces            (ESyS-Particle's scheme)
-// drift() returns the largest squared displacement since the last rebuild (NaN/inf if any position
-// went non-finite), which decides the next neighbour-list rebuild.
+// The first kick and the drift run fused in kick_zero_drift(), which returns the largest squared
+// displacement since the last rebuild (inf if any position went non-finite): it decides the next
+// neighbour-list rebuild.
 #include <cmath>
 #include <limits>
 
@@ -23,35 +24,9 @@ void kick(Particles<Real>& p, Real h) {
   detail::kick_pass<false>(p, h, nullptr);
 }
 
-template <class Real>
-double drift(Particles<Real>& p, Real h) {
-  const std::size_t n = p.n_owned;
-  Real* __restrict x = p.x.data();
-  Real* __restrict y = p.y.data();
-  Real* __restrict z = p.z.data();
-  const Real* __restrict vx = p.vx.data();
-  const Real* __restrict vy = p.vy.data();
-  const Real* __restrict vz = p.vz.data();
-  const float* __restrict x0 = p.x0.data();
-  const float* __restrict y0 = p.y0.data();
-  const float* __restrict z0 = p.z0.data();
-  Real m = 0;
-  Real sum = 0;  // non-finite positions make the sum non-finite
-  for (std::size_t i = 0; i < n; ++i) {
-    x[i] += h * vx[i];
-    y[i] += h * vy[i];
-    z[i] += h * vz[i];
-    const Real dx = x[i] - x0[i], dy = y[i] - y0[i], dz = z[i] - z0[i];
-    const Real d2 = dx * dx + dy * dy + dz * dz;
-    m = d2 > m ? d2 : m;
-    sum += d2;
-  }
-  if (!std::isfinite(sum)) return std::numeric_limits<double>::infinity();
-  return double(m);
-}
-
 /// kick(h), zero the forces (the next force computation accumulates from zero), drift(dt), in one
-/// pass over memory. Returns what drift() returns.
+/// pass over memory. Returns the largest squared displacement since the last rebuild, or infinity when
+/// a position went non-finite.
 template <class Real>
 double kick_zero_drift(Particles<Real>& p, Real h, Real dt) {
   const std::size_t n = p.n_owned;
@@ -99,8 +74,8 @@ void zero_forces(Particles<Real>& p) {
 }
 
 namespace detail {
-/// Adds v^2 / (1/m) of particle i to lane i mod 8 of `lane`: the one summation order shared by
-/// kinetic_energy() and kick_energy(), so both give the same bits.
+/// Particle i adds v^2 * m to lane i mod 8, with m = 1 / (1/m) rounded once: the one formula and
+/// summation order shared by kinetic_energy() and kick_energy(), so both give the same bits.
 constexpr std::size_t kEnergyLanes = 8;
 inline double lane_sum(const double (&lane)[kEnergyLanes]) {
   double e = 0;
@@ -122,7 +97,7 @@ double kinetic_energy(const Particles<Real>& p) {
   for (std::size_t i = 0; i < p.n_owned; ++i) {
     const double v2 =
         double(vx[i]) * double(vx[i]) + double(vy[i]) * double(vy[i]) + double(vz[i]) * double(vz[i]);
-    lane[i % detail::kEnergyLanes] += v2 / double(im[i]);
+    lane[i % detail::kEnergyLanes] += v2 * (1.0 / double(im[i]));
   }
   return detail::lane_sum(lane);
 }
