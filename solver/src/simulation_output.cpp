@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 
 #include "basalt/solver/core/errors.hpp"
@@ -163,13 +164,16 @@ void Simulation<Real>::run(std::int64_t steps, OutputSink& out) {
   const bool parallel = comm().size() > 1;
   bool reported = false;
   io::FramePiece piece;
+  std::vector<double> frame_seconds;  // pack + submit of each frame (BASALT_FRAME_TIMES=1 prints them)
   for (std::int64_t k = 0; k < steps; ++k) {
     step(nullptr);
     Stopwatch sw;
     const std::uint32_t kinds = out.frame_kinds(step_);
     if (kinds != 0) {
+      Stopwatch frame_clock;
       pack_frame(piece, kinds);
       out.frame(piece);
+      frame_seconds.push_back(frame_clock.lap());
     }
     // Completed sends and errors from the I/O ranks are picked up at output steps and every 32 steps,
     // where the ranks also agree on errors so that all stop at the same step (one small reduction,
@@ -199,6 +203,19 @@ void Simulation<Real>::run(std::int64_t steps, OutputSink& out) {
     }
   }
   out.flush();
+  report_frame_times(frame_seconds);
+}
+
+template <class Real>
+void Simulation<Real>::report_frame_times(std::vector<double> seconds) const {
+  // Benchmark aid (tools/bench): this compute rank's cost of handing frames to the output.
+  const char* want = std::getenv("BASALT_FRAME_TIMES");
+  if (want == nullptr || *want == '\0' || *want == '0' || seconds.empty()) return;
+  std::sort(seconds.begin(), seconds.end());
+  const double median = seconds.size() % 2 ? seconds[seconds.size() / 2]
+                                           : 0.5 * (seconds[seconds.size() / 2 - 1] + seconds[seconds.size() / 2]);
+  fmt::print("frame times (rank {}): {} frames, median {:.3f} ms, min {:.3f} ms, max {:.3f} ms\n", comm().rank(),
+             seconds.size(), 1e3 * median, 1e3 * seconds.front(), 1e3 * seconds.back());
 }
 
 #define BASALT_INSTANTIATE(R)                                                                     \
@@ -207,6 +224,7 @@ void Simulation<Real>::run(std::int64_t steps, OutputSink& out) {
   template void Simulation<R>::output_fields(const std::array<double, 3>&);                       \
   template void Simulation<R>::pack_frame(io::FramePiece&, std::uint32_t) const;                  \
   template RestartLayout Simulation<R>::restart_layout() const;                                   \
+  template void Simulation<R>::report_frame_times(std::vector<double>) const;                     \
   template void Simulation<R>::run(std::int64_t, OutputSink&);
 BASALT_INSTANTIATE(double)
 BASALT_INSTANTIATE(float)

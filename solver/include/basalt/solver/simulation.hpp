@@ -125,6 +125,8 @@ class Simulation {
   std::size_t memory_bytes() const;
 
  private:
+  /// With BASALT_FRAME_TIMES=1: prints this rank's median/min/max time to pack and submit a frame.
+  void report_frame_times(std::vector<double> seconds) const;
   void distribute(io::Geometry& g, MPI_Comm comm);
   double kinetic_energy_local() const;
   double total_energy(const std::array<double, 3>& pe) const;
