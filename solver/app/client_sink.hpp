@@ -15,7 +15,7 @@ class ClientSink final : public solver::OutputSink {
     client_.submit_fields(step, time, partials);
   }
   std::uint32_t frame_kinds(std::int64_t step) const override { return client_.frame_kinds(step); }
-  void frame(const io::FramePiece& piece) override { client_.submit_frame(piece); }
+  void frame(const io::FrameSource& source) override { client_.submit_frame(source); }
   std::optional<std::string> poll() override {
     client_.poll();
     return client_.error();

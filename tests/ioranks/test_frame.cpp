@@ -1,6 +1,10 @@
-// Frame pieces: the flat wire format round-trips exactly and rejects damaged buffers;
-// assembling pieces sorts particles and bonds by id and refuses duplicates.
+// Frame pieces: the flat wire format round-trips exactly and rejects damaged buffers; the frame
+// writer converts columns exactly and refuses frames not filled exactly; assembling pieces sorts
+// particles and bonds by id and refuses duplicates.
 #include <gtest/gtest.h>
+
+#include <cstring>
+#include <limits>
 
 #include "basalt/io/frame.hpp"
 
@@ -75,10 +79,9 @@ TEST(Frame, PositionsAtRebuildTravelAndAssemble) {
   // A piece without them (or another rebuild step): the checkpoint has none.
   pieces[0].position_at_rebuild.clear();
   EXPECT_TRUE(assemble(pieces, RunInfo{}).position_at_rebuild.empty());
-  // Lengths that differ from the particles' are refused on arrival.
+  // Lengths that differ from the particles' cannot be put on the wire (the header has one count).
   pieces[1].position_at_rebuild.pop_back();
-  serialize(pieces[1], bytes);
-  EXPECT_THROW(deserialize(bytes), std::runtime_error);
+  EXPECT_THROW(serialize(pieces[1], bytes), std::invalid_argument);
 }
 
 TEST(Frame, DamagedBuffersAreRejected) {
@@ -122,4 +125,124 @@ TEST(Frame, AssembleRefusesDuplicateIdsAndMixedSteps) {
   EXPECT_THROW(assemble(dup, RunInfo{}), std::runtime_error);
   std::vector<FramePiece> mixed{make_piece(0, 3, 5), make_piece(1, 3, 6)};
   EXPECT_THROW(assemble(mixed, RunInfo{}), std::runtime_error);
+}
+
+TEST(Frame, InverseMassesTravelAndMassesAreDerivedOnArrival) {
+  auto p = make_piece(0, 6, 3);
+  p.inv_mass.clear();
+  for (const auto id : p.id) p.inv_mass.push_back(1.0 / (0.3 * double(id) + 0.7));
+  p.mass.assign(p.size(), -1.0);  // not sent: the reader derives it
+  std::vector<std::byte> bytes;
+  serialize(p, bytes);
+  const auto q = deserialize(bytes);
+  ASSERT_EQ(q.inv_mass, p.inv_mass);
+  ASSERT_EQ(q.mass.size(), p.size());
+  for (std::size_t i = 0; i < p.size(); ++i) EXPECT_EQ(q.mass[i], 1.0 / p.inv_mass[i]);
+}
+
+namespace {
+FrameHeader small_header(std::uint64_t n, std::uint64_t m) {
+  FrameHeader h;
+  h.kinds = kFrameVtk;
+  h.step = 9;
+  h.particles = n;
+  h.bonds = m;
+  return h;
+}
+/// Fills every column of a frame of n particles and m bonds from float and narrow arrays.
+void fill_all(FrameWriter& w, std::size_t n, std::size_t m) {
+  std::vector<float> f(n);
+  std::vector<std::int64_t> id(n);
+  std::vector<std::int32_t> tag(n, 2);
+  for (std::size_t i = 0; i < n; ++i) {
+    f[i] = 0.1f * float(i + 1);
+    id[i] = std::int64_t(10 * i);
+  }
+  w.column(Column::id, id);
+  w.column(Column::tag, tag);
+  for (auto c :
+       {Column::x, Column::y, Column::z, Column::vx, Column::vy, Column::vz, Column::radius, Column::mass})
+    w.column(c, f);
+  const std::vector<std::uint8_t> group(m, 3);
+  for (std::size_t k = 0; k < m; ++k) {
+    w.set(Column::bond_a, k, id[0]);
+    w.set(Column::bond_b, k, id[1]);
+  }
+  w.column(Column::bond_group, group);
+  w.fill(Column::bond_rest_length, 0, m, 0.5f);
+  w.fill(Column::bond_broken, 0, m, 1);
+}
+}  // namespace
+
+TEST(FrameWriter, FloatColumnsWidenExactly) {
+  std::vector<std::byte> bytes;
+  FrameWriter w(bytes, small_header(4, 2));
+  fill_all(w, 4, 2);
+  EXPECT_EQ(w.finish(), bytes.size());
+  const auto q = deserialize(bytes);
+  ASSERT_EQ(q.size(), 4u);
+  for (std::size_t i = 0; i < 4; ++i) {
+    const double want = double(0.1f * float(i + 1));  // the float's value, not 0.1 * (i + 1)
+    EXPECT_EQ(q.position[i][2], want);
+    EXPECT_EQ(q.velocity[i][0], want);
+    EXPECT_EQ(q.inv_mass[i], want);
+    EXPECT_EQ(q.mass[i], 1.0 / want);
+    EXPECT_EQ(q.id[i], std::int64_t(10 * i));
+    EXPECT_EQ(q.tag[i], 2);
+  }
+  ASSERT_EQ(q.bonds.size(), 2u);
+  EXPECT_EQ(q.bonds[1], (Bond{0, 10, 3}));
+  EXPECT_EQ(q.bond_rest_length[1], 0.5);
+  EXPECT_EQ(q.bond_broken[0], 1);
+  EXPECT_TRUE(q.position_at_rebuild.empty());
+  EXPECT_TRUE(q.walls.empty());
+}
+
+TEST(FrameWriter, RecycledBufferIsOverwrittenNotAppended) {
+  // The output client reuses its send buffers without clearing them.
+  std::vector<std::byte> bytes(100000, std::byte{0xAB});
+  {
+    FrameWriter w(bytes, small_header(3, 1));
+    fill_all(w, 3, 1);
+    w.wall({"base", {0, 0, 1}, {0, 0, 1}, {0, 0, 2}, {0, 0, 3}});
+    w.finish();
+  }
+  const auto q = deserialize(bytes);
+  EXPECT_EQ(q.size(), 3u);
+  ASSERT_EQ(q.walls.size(), 1u);
+  EXPECT_EQ(q.walls[0].name, "base");
+  EXPECT_EQ(q.walls[0].force[2], 3.0);
+}
+
+TEST(FrameWriter, FramesNotFilledExactlyAreRefused) {
+  std::vector<std::byte> bytes;
+  {
+    FrameWriter w(bytes, small_header(4, 2));
+    fill_all(w, 4, 2);
+    w.set(Column::bond_broken, 1, 0);  // one entry twice
+    EXPECT_THROW(w.finish(), std::logic_error);
+  }
+  {
+    FrameWriter w(bytes, small_header(4, 2));
+    fill_all(w, 3, 2);  // particle columns one short
+    EXPECT_THROW(w.finish(), std::logic_error);
+  }
+  FrameWriter w(bytes, small_header(4, 2));
+  const std::vector<double> five(5, 1.0);
+  EXPECT_THROW(w.column(Column::x, five), std::out_of_range);
+  EXPECT_THROW(w.set(Column::bond_a, 2, 1), std::out_of_range);
+  EXPECT_THROW(w.column(Column::x_rebuild, std::vector<double>{}, 1), std::out_of_range);  // absent column
+}
+
+TEST(Frame, ImpossibleCountsAreRejected) {
+  std::vector<std::byte> bytes;
+  serialize(make_piece(0, 5, 1), bytes);
+  auto huge = bytes;  // particle count (bytes 40-47 of the header) far beyond the buffer
+  const std::uint64_t n = std::numeric_limits<std::uint64_t>::max() / 4;
+  std::memcpy(huge.data() + 40, &n, sizeof(n));
+  EXPECT_THROW(deserialize(huge), std::runtime_error);
+  auto more = bytes;  // one particle more than the buffer holds
+  const std::uint64_t six = 6;
+  std::memcpy(more.data() + 40, &six, sizeof(six));
+  EXPECT_THROW(deserialize(more), std::runtime_error);
 }

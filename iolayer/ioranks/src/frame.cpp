@@ -12,8 +12,7 @@ namespace basalt::io {
 
 namespace {
 
-constexpr std::uint64_t kPieceMagic = 0x42534c5446524d31ULL;  // "BSLTFRM1"
-constexpr std::uint64_t kInfoMagic = 0x42534c54494e4631ULL;   // "BSLTINF1"
+constexpr std::uint64_t kInfoMagic = 0x42534c54494e4631ULL;  // "BSLTINF1"
 
 class Writer {
  public:
@@ -22,12 +21,6 @@ class Writer {
   void value(const T& v) {
     static_assert(std::is_trivially_copyable_v<T>);
     raw(&v, sizeof(T));
-  }
-  template <class T>
-  void array(const std::vector<T>& v) {
-    static_assert(std::is_trivially_copyable_v<T>);
-    value<std::uint64_t>(v.size());
-    raw(v.data(), v.size() * sizeof(T));
   }
   void string(const std::string& s) {
     value<std::uint64_t>(s.size());
@@ -52,14 +45,6 @@ class Reader {
     T v;
     raw(&v, sizeof(T));
     return v;
-  }
-  template <class T>
-  void array(std::vector<T>& v) {
-    const auto n = value<std::uint64_t>();
-    if (n > (in_.size() - pos_) / std::max<std::size_t>(sizeof(T), 1))
-      throw std::runtime_error(fmt::format("frame: array of {} elements overruns the buffer", n));
-    v.resize(n);
-    raw(v.data(), n * sizeof(T));
   }
   std::string string() {
     const auto n = value<std::uint64_t>();
@@ -97,55 +82,144 @@ void FramePiece::clear() {
   walls.clear();
 }
 
-void serialize(const FramePiece& p, std::vector<std::byte>& out) {
-  Writer w(out);
-  w.value(kPieceMagic);
-  w.value(p.kinds);
-  w.value(p.step);
-  w.value(p.time);
-  w.value(p.dt);
-  w.value(p.source_rank);
-  w.array(p.id);
-  w.array(p.position);
-  w.array(p.velocity);
-  w.array(p.radius);
-  w.array(p.mass);
-  w.array(p.tag);
-  w.array(p.bonds);
-  w.array(p.bond_rest_length);
-  w.array(p.bond_broken);
-  w.value<std::uint64_t>(p.walls.size());
-  for (const auto& wall : p.walls) {
-    w.string(wall.name);
-    w.value(wall.position);
-    w.value(wall.normal);
-    w.value(wall.velocity);
-    w.value(wall.force);
-  }
-  w.array(p.inv_mass);
-  w.array(p.position_at_rebuild);
-  w.value(p.rebuild_step);
-  w.value(p.rebuild_pending);
+FrameHeader PieceSource::header() const {
+  const std::size_t n = p_.size();
+  if (p_.position.size() != n || p_.velocity.size() != n || p_.radius.size() != n || p_.tag.size() != n)
+    throw std::invalid_argument("frame piece: particle arrays differ in length");
+  if (!p_.inv_mass.empty() && p_.inv_mass.size() != n)
+    throw std::invalid_argument("frame piece: inverse masses differ in length from the particles");
+  if (p_.inv_mass.empty() && p_.mass.size() != n)
+    throw std::invalid_argument("frame piece: masses differ in length from the particles");
+  if (!p_.position_at_rebuild.empty() && p_.position_at_rebuild.size() != n)
+    throw std::invalid_argument("frame piece: positions at rebuild differ in length from the particles");
+  const std::size_t m = p_.bonds.size();
+  if (p_.bond_rest_length.size() != m || p_.bond_broken.size() != m)
+    throw std::invalid_argument("frame piece: bond arrays differ in length");
+  FrameHeader h;
+  h.kinds = p_.kinds;
+  h.step = p_.step;
+  h.time = p_.time;
+  h.dt = p_.dt;
+  h.source_rank = p_.source_rank;
+  h.particles = n;
+  h.bonds = m;
+  h.inverse_mass = !p_.inv_mass.empty();
+  h.with_rebuild = !p_.position_at_rebuild.empty();
+  h.rebuild_step = p_.rebuild_step;
+  h.rebuild_pending = p_.rebuild_pending != 0;
+  return h;
 }
 
+void PieceSource::write(FrameWriter& w) const {
+  const std::size_t n = p_.size();
+  w.column(Column::id, p_.id);
+  w.column(Column::tag, p_.tag);
+  w.column(Column::radius, p_.radius);
+  w.column(Column::mass, w.header().inverse_mass ? p_.inv_mass : p_.mass);
+  std::vector<double> c(n);
+  const auto component = [&](const std::vector<Vec3>& v, std::size_t d, Column col) {
+    for (std::size_t i = 0; i < n; ++i) c[i] = v[i][d];
+    w.column(col, c);
+  };
+  for (std::size_t d = 0; d < 3; ++d) {
+    component(p_.position, d, static_cast<Column>(static_cast<int>(Column::x) + d));
+    component(p_.velocity, d, static_cast<Column>(static_cast<int>(Column::vx) + d));
+    if (w.header().with_rebuild)
+      component(p_.position_at_rebuild, d, static_cast<Column>(static_cast<int>(Column::x_rebuild) + d));
+  }
+  for (std::size_t k = 0; k < p_.bonds.size(); ++k) {
+    w.set(Column::bond_a, k, p_.bonds[k].a);
+    w.set(Column::bond_b, k, p_.bonds[k].b);
+    w.set(Column::bond_group, k, p_.bonds[k].tag);
+  }
+  w.column(Column::bond_rest_length, p_.bond_rest_length);
+  w.column(Column::bond_broken, p_.bond_broken);
+  for (const auto& wall : p_.walls) w.wall(wall);
+}
+
+std::size_t serialize(const FrameSource& source, std::vector<std::byte>& out) {
+  FrameWriter w(out, source.header());
+  source.write(w);
+  return w.finish();
+}
+
+void serialize(const FramePiece& piece, std::vector<std::byte>& out) { serialize(PieceSource(piece), out); }
+
+namespace {
+
+/// Reads the columns of a received frame (sizes checked against the buffer beforehand).
+class ColumnReader {
+ public:
+  ColumnReader(std::span<const std::byte> bytes, const wire::Layout& layout)
+      : bytes_(bytes), layout_(layout) {}
+  template <class T>
+  T at(Column c, std::size_t i) const {
+    T v;
+    std::memcpy(&v, bytes_.data() + layout_.offset[std::size_t(c)] + i * sizeof(T), sizeof(T));
+    return v;
+  }
+  template <class T>
+  void all(Column c, std::vector<T>& out) const {
+    out.resize(layout_.length[std::size_t(c)]);
+    if (!out.empty())
+      std::memcpy(out.data(), bytes_.data() + layout_.offset[std::size_t(c)], out.size() * sizeof(T));
+  }
+  void vec3(Column first, std::vector<Vec3>& out) const {
+    const auto n = layout_.length[std::size_t(first)];
+    out.resize(n);
+    for (std::size_t d = 0; d < 3; ++d) {
+      const auto c = static_cast<Column>(static_cast<int>(first) + d);
+      for (std::size_t i = 0; i < n; ++i) out[i][d] = at<double>(c, i);
+    }
+  }
+
+ private:
+  std::span<const std::byte> bytes_;
+  const wire::Layout& layout_;
+};
+
+}  // namespace
+
 FramePiece deserialize(std::span<const std::byte> bytes) {
-  Reader r(bytes);
-  if (r.value<std::uint64_t>() != kPieceMagic) throw std::runtime_error("frame: bad magic number");
+  wire::Header h;
+  if (bytes.size() < sizeof(h)) throw std::runtime_error("frame: buffer too short for its header");
+  std::memcpy(&h, bytes.data(), sizeof(h));
+  if (h.magic != wire::kFrameMagic) throw std::runtime_error("frame: bad magic number");
+  const wire::Layout layout(h);
+  if (bytes.size() < layout.walls + sizeof(std::uint64_t))
+    throw std::runtime_error(fmt::format("frame: {} particles and {} bonds overrun the buffer of {} bytes",
+                                         h.particles, h.bonds, bytes.size()));
+  const ColumnReader col(bytes, layout);
   FramePiece p;
-  p.kinds = r.value<std::uint32_t>();
-  p.step = r.value<std::int64_t>();
-  p.time = r.value<double>();
-  p.dt = r.value<double>();
-  p.source_rank = r.value<std::int32_t>();
-  r.array(p.id);
-  r.array(p.position);
-  r.array(p.velocity);
-  r.array(p.radius);
-  r.array(p.mass);
-  r.array(p.tag);
-  r.array(p.bonds);
-  r.array(p.bond_rest_length);
-  r.array(p.bond_broken);
+  p.kinds = h.kinds;
+  p.step = h.step;
+  p.time = h.time;
+  p.dt = h.dt;
+  p.source_rank = h.source_rank;
+  p.rebuild_step = h.rebuild_step;
+  p.rebuild_pending = h.rebuild_pending != 0 ? 1 : 0;
+  col.all(Column::id, p.id);
+  col.all(Column::tag, p.tag);
+  col.all(Column::radius, p.radius);
+  col.vec3(Column::x, p.position);
+  col.vec3(Column::vx, p.velocity);
+  if (h.flags & wire::kWithRebuild) col.vec3(Column::x_rebuild, p.position_at_rebuild);
+  if (h.flags & wire::kInverseMass) {
+    col.all(Column::mass, p.inv_mass);
+    p.mass.resize(p.inv_mass.size());
+    for (std::size_t i = 0; i < p.mass.size(); ++i) p.mass[i] = 1.0 / p.inv_mass[i];
+  } else {
+    col.all(Column::mass, p.mass);
+  }
+  const std::size_t m = h.bonds;
+  p.bonds.resize(m);
+  for (std::size_t k = 0; k < m; ++k)
+    p.bonds[k] = {col.at<std::int64_t>(Column::bond_a, k), col.at<std::int64_t>(Column::bond_b, k),
+                  col.at<std::int32_t>(Column::bond_group, k)};
+  col.all(Column::bond_rest_length, p.bond_rest_length);
+  col.all(Column::bond_broken, p.bond_broken);
+
+  Reader r(bytes.subspan(layout.walls));
   const auto n_walls = r.value<std::uint64_t>();
   if (n_walls > bytes.size()) throw std::runtime_error("frame: wall count overruns the buffer");
   p.walls.resize(n_walls);
@@ -156,22 +230,7 @@ FramePiece deserialize(std::span<const std::byte> bytes) {
     wall.velocity = r.value<Vec3>();
     wall.force = r.value<Vec3>();
   }
-  r.array(p.inv_mass);
-  r.array(p.position_at_rebuild);
-  p.rebuild_step = r.value<std::int64_t>();
-  p.rebuild_pending = r.value<std::uint8_t>();
-  const std::size_t n = p.id.size();
-  if (!p.inv_mass.empty() && p.inv_mass.size() != n)
-    throw std::runtime_error("frame: inverse masses differ in length from the particles");
-  if (!p.position_at_rebuild.empty() && p.position_at_rebuild.size() != n)
-    throw std::runtime_error("frame: positions at rebuild differ in length from the particles");
-  if (p.position.size() != n || p.velocity.size() != n || p.radius.size() != n || p.mass.size() != n ||
-      p.tag.size() != n)
-    throw std::runtime_error("frame: particle arrays differ in length");
-  const std::size_t m = p.bonds.size();
-  if (p.bond_rest_length.size() != m || p.bond_broken.size() != m)
-    throw std::runtime_error("frame: bond arrays differ in length");
-  if (!r.at_end()) throw std::runtime_error("frame: trailing bytes after the last array");
+  if (!r.at_end()) throw std::runtime_error("frame: trailing bytes after the walls");
   return p;
 }
 

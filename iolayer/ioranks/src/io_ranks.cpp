@@ -232,6 +232,7 @@ struct OutputClient::Impl {
   std::deque<InFlight> frames_in_flight;
   std::deque<InFlight> fields_in_flight;
   std::vector<std::vector<std::byte>> spare;  // buffers to reuse (keeps capacity)
+  std::vector<std::byte> gather_buffer;       // Q = 0: this rank's frame (reused)
 
   std::vector<double> field_rows;  // [step, time, v...] per row
   std::size_t field_rows_count = 0;
@@ -325,7 +326,9 @@ bool OutputClient::wants_fields(std::int64_t step) const {
   return c.fields_every > 0 && !c.field_names.empty() && step % c.fields_every == 0;
 }
 
-void OutputClient::submit_frame(const FramePiece& piece) {
+void OutputClient::submit_frame(const FramePiece& piece) { submit_frame(PieceSource(piece)); }
+
+void OutputClient::submit_frame(const FrameSource& source) {
   auto& I = *impl_;
   if (I.async()) {
     poll();
@@ -333,7 +336,7 @@ void OutputClient::submit_frame(const FramePiece& piece) {
       I.complete_front(I.frames_in_flight, /*block=*/true);
     Impl::InFlight f;
     f.bytes = I.take_buffer();
-    serialize(piece, f.bytes);
+    serialize(source, f.bytes);  // written once, in place: the buffer is what is sent
     MPI_Isend(f.bytes.data(), checked_count(f.bytes.size()), MPI_BYTE, I.layout.my_io_rank, kTagFrame,
               I.layout.bridge, &f.request);
     I.frames_in_flight.push_back(std::move(f));
@@ -342,8 +345,9 @@ void OutputClient::submit_frame(const FramePiece& piece) {
   }
   // Q = 0: gather to compute rank 0, which writes before anyone goes on (the baseline).
   const double t0 = MPI_Wtime();
-  std::vector<std::byte> mine;
-  serialize(piece, mine);
+  std::vector<std::byte>& mine = I.gather_buffer;
+  const FrameHeader header = source.header();
+  serialize(source, mine);
   int n = checked_count(mine.size()), size = 1;
   MPI_Comm_size(I.layout.compute, &size);
   std::vector<int> counts(size), displs(size);
@@ -365,13 +369,13 @@ void OutputClient::submit_frame(const FramePiece& piece) {
       std::vector<FramePiece> pieces;
       for (int r = 0; r < size; ++r)
         pieces.push_back(deserialize(std::span<const std::byte>(all).subspan(displs[r], counts[r])));
-      if (piece.kinds & kFrameVtk) {
+      if (header.kinds & kFrameVtk) {
         const double tv = MPI_Wtime();
-        I.local.frames.bytes += I.vtk(pieces, piece.step, piece.time, 0, 1, I.cfg.dir);
+        I.local.frames.bytes += I.vtk(pieces, header.step, header.time, 0, 1, I.cfg.dir);
         I.local.frames.files += 1;
         I.local.frames.write_seconds += MPI_Wtime() - tv;
       }
-      if (piece.kinds & kFrameCheckpoint) write_checkpoint_step(pieces, I.info, I.cfg, I.local.checkpoints);
+      if (header.kinds & kFrameCheckpoint) write_checkpoint_step(pieces, I.info, I.cfg, I.local.checkpoints);
     } catch (const std::exception& e) {
       I.local.error = e.what();
       bad = 1;

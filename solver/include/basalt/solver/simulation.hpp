@@ -12,7 +12,6 @@
 #include <vector>
 
 #include "basalt/io/checkpoint.hpp"
-#include "basalt/io/frame.hpp"
 #include "basalt/io/geometry.hpp"
 #include "basalt/solver/core/bonds.hpp"
 #include "basalt/solver/core/id_map.hpp"
@@ -51,6 +50,9 @@ struct RestartLayout {
   double contact_cutoff = 0;
 };
 
+template <class Real>
+class SimulationFrame;  // output/simulation_frame.hpp: this rank's frame, written for the output
+
 template <class Real = double>
 class Simulation {
  public:
@@ -68,12 +70,9 @@ class Simulation {
              const RunOptions& options = {});
 
   /// Runs `steps` steps with output through `out` (simulation_output.cpp): field partials every
-  /// saved step, frames when out.frame_kinds() asks. An output error stops the run on every rank
-  /// at the same step (RunError naming it) unless out.continue_on_error().
+  /// saved step, frames (SimulationFrame) when out.frame_kinds() asks. An output error stops the run on every
+  /// rank at the same step (RunError naming it) unless out.continue_on_error().
   void run(std::int64_t steps, OutputSink& out);
-  /// Fills `piece` with this rank's share of the state (owned particles; bonds each once across
-  /// ranks; walls on rank 0 only).
-  void pack_frame(io::FramePiece& piece, std::uint32_t kinds) const;
   /// The decomposition's box, ghost width and contact cut-off (stored in checkpoints).
   RestartLayout restart_layout() const;
 
@@ -125,6 +124,7 @@ class Simulation {
   std::size_t memory_bytes() const;
 
  private:
+  friend class SimulationFrame<Real>;
   /// With BASALT_FRAME_TIMES=1: prints this rank's median/min/max time to pack and submit a frame.
   void report_frame_times(std::vector<double> seconds) const;
   void distribute(io::Geometry& g, MPI_Comm comm);

@@ -1,7 +1,8 @@
 #pragma once
-// One compute rank's share of a run's state at one output step ("frame piece"), and its flat
-// wire format. Compute ranks fill a FramePiece with their owned particles; the I/O side
-// assembles the pieces of all ranks into a Checkpoint (sorted by id) or writes them as VTK.
+// One compute rank's share of a run's state at one output step ("frame piece") as the I/O side
+// holds it. Compute ranks write their frame straight into the send buffer (frame_writer.hpp);
+// the I/O side reads it into a FramePiece and assembles the pieces of all ranks into a
+// Checkpoint (sorted by id) or writes them as VTK.
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -11,13 +12,9 @@
 #include <vector>
 
 #include "basalt/io/checkpoint.hpp"
+#include "basalt/io/frame_writer.hpp"
 
 namespace basalt::io {
-
-enum FrameKind : std::uint32_t {
-  kFrameCheckpoint = 1u << 0,  ///< write an HDF5 checkpoint of this step
-  kFrameVtk = 1u << 1,         ///< write a VTK frame of this step
-};
 
 struct FramePiece {
   std::uint32_t kinds = 0;  ///< FrameKind bits
@@ -31,7 +28,7 @@ struct FramePiece {
   std::vector<Vec3> position;
   std::vector<Vec3> velocity;
   std::vector<double> radius;
-  std::vector<double> mass;
+  std::vector<double> mass;  ///< with inverse masses on the wire: 1 / inv_mass, derived on arrival
   std::vector<std::int32_t> tag;
   /// Optional (empty or one per particle): 1 / mass exactly as the solver holds it, so that a
   /// restart gets the same bits (1 / (1 / m) is not always m in floating point).
@@ -55,7 +52,22 @@ struct FramePiece {
   void clear();  ///< empties the arrays, keeping their capacity
 };
 
-/// Flat bytes for MPI: a fixed header, then each array. Round-trips exactly.
+/// A FramePiece as a FrameSource (I/O ranks forwarding pieces, tests). With inverse masses the
+/// wire carries those and the reader derives the masses (1 / inv_mass, as the solver would).
+/// header() throws std::invalid_argument when the arrays differ in length.
+class PieceSource final : public FrameSource {
+ public:
+  explicit PieceSource(const FramePiece& piece) : p_(piece) {}
+  FrameHeader header() const override;
+  void write(FrameWriter& w) const override;
+
+ private:
+  const FramePiece& p_;
+};
+
+/// The wire format of frame_writer.hpp: writes `source` into `out`; returns its size in bytes.
+std::size_t serialize(const FrameSource& source, std::vector<std::byte>& out);
+/// Same for a piece. Round-trips exactly (masses: see PieceSource).
 void serialize(const FramePiece& piece, std::vector<std::byte>& out);
 /// Throws std::runtime_error on a malformed buffer (bad magic, sizes that overrun the buffer).
 FramePiece deserialize(std::span<const std::byte> bytes);

@@ -1,8 +1,8 @@
 #pragma once
 // Dedicated I/O ranks. At start the world splits into P compute ranks and Q I/O ranks; compute
-// rank c is served by I/O rank c mod Q. At an output step a compute rank packs its owned
-// particles into a FramePiece and hands it to OutputClient::submit_frame, which serializes it
-// into one of a bounded pool of buffers, posts a non-blocking send and returns; it blocks only
+// rank c is served by I/O rank c mod Q. At an output step a compute rank hands a FrameSource
+// (its owned particles) to OutputClient::submit_frame, which has it write itself straight into
+// one of a bounded pool of buffers, posts a non-blocking send and returns; it blocks only
 // when every buffer is still in flight (a slow disk then slows the run, measured, but memory
 // stays bounded and nothing is lost). Field-saver partial sums travel in batches to I/O rank 0.
 // I/O ranks run IoServer::run(): they wait without spinning, assemble the pieces of a step,
@@ -91,8 +91,11 @@ class OutputClient {
   std::uint32_t frame_kinds(std::int64_t step) const;
   bool wants_fields(std::int64_t step) const;
 
-  /// Hands over this rank's piece (kinds, step, time set). With Q >= 1 returns once it is
-  /// posted; with Q = 0 it is collective over the compute ranks and writes before returning.
+  /// Hands over this rank's frame (kinds, step, time in its header): the source writes it once,
+  /// into the buffer that is sent. With Q >= 1 returns once it is posted; with Q = 0 it is
+  /// collective over the compute ranks and writes before returning.
+  void submit_frame(const FrameSource& source);
+  /// Same for a piece held as a FramePiece (tests).
   void submit_frame(const FramePiece& piece);
   /// This rank's partial sums for one saved step (one value per field name).
   void submit_fields(std::int64_t step, double time, std::span<const double> partials);

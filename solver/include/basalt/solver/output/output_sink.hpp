@@ -1,16 +1,16 @@
 #pragma once
 // Where a run's output goes, seen from the solver. Called on EVERY compute rank with this rank's
 // local data: partial sums of the field savers (no reduction in the solver) and its share of a
-// frame (owned particles, its bonds). The implementation decides where it goes: basalt-run's
-// adapter hands it to basalt::io::OutputClient (dedicated I/O ranks, or synchronous writing from
-// the compute ranks with --io-ranks 0). The solver library stays free of the I/O service.
+// frame (owned particles, its bonds) as a source that writes itself. The implementation decides where it
+// goes: basalt-run's adapter hands it to basalt::io::OutputClient (dedicated I/O ranks, or synchronous
+// writing from the compute ranks with --io-ranks 0). The solver library stays free of the I/O service.
 #include <cstdint>
 #include <optional>
 #include <span>
 #include <string>
 #include <vector>
 
-#include "basalt/io/frame.hpp"
+#include "basalt/io/frame_writer.hpp"
 
 namespace basalt::solver {
 
@@ -23,8 +23,9 @@ class OutputSink {
   virtual void fields(std::int64_t step, double time, std::span<const double> local_partials) = 0;
   /// io::FrameKind bits wanted at this step (0: none). Must be the same on every compute rank.
   virtual std::uint32_t frame_kinds(std::int64_t step) const = 0;
-  /// This rank's piece of the frame of its step (kinds set).
-  virtual void frame(const io::FramePiece& piece) = 0;
+  /// This rank's share of the frame of its step (kinds set in its header): the sink has it write
+  /// itself into whatever it sends or stores (io::FrameWriter).
+  virtual void frame(const io::FrameSource& source) = 0;
   /// Cheap, once per step: an output error seen by this rank, if any (not collective).
   virtual std::optional<std::string> poll() = 0;
   /// Whether the run goes on without the failed output (scene: [output] on_error = "continue").

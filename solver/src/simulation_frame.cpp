@@ -1,0 +1,109 @@
+// Writes a compute rank's frame straight into the output buffer (see simulation_frame.hpp).
+#include "basalt/solver/output/simulation_frame.hpp"
+
+#include <span>
+
+namespace basalt::solver {
+
+template <class Real>
+SimulationFrame<Real>::SimulationFrame(const Simulation<Real>& sim, std::uint32_t kinds) : sim_(sim) {
+  const auto& p = sim.p_;
+  const auto& bonds = sim.bonds_;
+  auto& h = header_;
+  h.kinds = kinds;
+  h.step = sim.step_;
+  h.time = sim.time_;
+  h.dt = sim.scene_.dt;
+  h.source_rank = sim.comm().rank();
+  h.particles = p.n_owned;
+  // Owned particles now are those of the last rebuild (only a rebuild migrates or reorders them).
+  h.with_rebuild = (kinds & io::kFrameCheckpoint) && sim.xr_.size() == p.n_owned;
+  if (h.with_rebuild) {
+    h.rebuild_step = sim.rebuild_step_;
+    h.rebuild_pending = sim.bond_broke_;
+  }
+  std::size_t m = bonds.n_both_owned + sim.broken_.size();
+  for (std::size_t k = bonds.n_both_owned; k < bonds.size(); ++k) m += owns_ghost_bond(k) ? 1 : 0;
+  h.bonds = m;
+  // Walls: global; the force is summed over the ranks (collective), rank 0 carries them.
+  const auto& wd = sim.wall_driver_;
+  if (wd.size() > 0) {
+    std::vector<double> f;
+    for (std::size_t w = 0; w < wd.size(); ++w) f.insert(f.end(), wd.force(w).begin(), wd.force(w).end());
+    if (sim.comm().size() > 1) sim.comm().sum_all(f);
+    if (sim.comm().rank() == 0)
+      for (std::size_t w = 0; w < wd.size(); ++w) {
+        const auto& s = wd.spec(w);
+        const auto v = s.motion.velocity_at(sim.time_);
+        walls_.push_back(
+            {s.name, wd.point(w), s.normal, {v[0], v[1], v[2]}, {f[3 * w], f[3 * w + 1], f[3 * w + 2]}});
+      }
+  }
+}
+
+template <class Real>
+bool SimulationFrame<Real>::owns_ghost_bond(std::size_t k) const {
+  // Both ends owned -> this rank; one end a ghost -> the rank owning the lower id.
+  const auto& b = sim_.bonds_;
+  const auto i = static_cast<std::size_t>(b.ia[k]), j = static_cast<std::size_t>(b.ib[k]);
+  return sim_.p_.id[i] < sim_.p_.id[j];
+}
+
+template <class Real>
+void SimulationFrame<Real>::write(io::FrameWriter& w) const {
+  using io::Column;
+  const auto& p = sim_.p_;
+  const std::size_t n = p.n_owned;
+  const auto owned = [n](const auto& v) { return std::span(v.data(), n); };
+  w.column(Column::id, owned(p.id));
+  w.column(Column::tag, owned(p.tag));
+  w.column(Column::x, owned(p.x));
+  w.column(Column::y, owned(p.y));
+  w.column(Column::z, owned(p.z));
+  w.column(Column::vx, owned(p.vx));
+  w.column(Column::vy, owned(p.vy));
+  w.column(Column::vz, owned(p.vz));
+  w.column(Column::radius, owned(p.radius));
+  w.column(Column::mass, owned(p.inv_mass));
+  if (header_.with_rebuild) {
+    w.column(Column::x_rebuild, sim_.xr_);
+    w.column(Column::y_rebuild, sim_.yr_);
+    w.column(Column::z_rebuild, sim_.zr_);
+  }
+  // Bonds with both ends owned come first and go as they are; the bond tag carries the solver's
+  // interaction group (restart).
+  const auto& b = sim_.bonds_;
+  const std::size_t both = b.n_both_owned;
+  w.column(Column::bond_a, std::span(b.a.data(), both));
+  w.column(Column::bond_b, std::span(b.b.data(), both));
+  w.column(Column::bond_rest_length, std::span(b.r0.data(), both));
+  if (b.grouped)
+    w.column(Column::bond_group, std::span(b.group.data(), both));
+  else
+    w.fill(Column::bond_group, 0, both, 0);
+  std::size_t at = both;
+  for (std::size_t k = both; k < b.size(); ++k) {
+    if (!owns_ghost_bond(k)) continue;
+    w.set(Column::bond_a, at, b.a[k]);
+    w.set(Column::bond_b, at, b.b[k]);
+    w.set(Column::bond_rest_length, at, b.r0[k]);
+    w.set(Column::bond_group, at, b.group_of(k));
+    ++at;
+  }
+  w.fill(Column::bond_broken, 0, at, 0);
+  // Broken bonds: the bond driver records each once across ranks (same lower-id rule).
+  for (const auto& broken : sim_.broken_) {
+    w.set(Column::bond_a, at, broken.a);
+    w.set(Column::bond_b, at, broken.b);
+    w.set(Column::bond_rest_length, at, broken.rest_length);
+    w.set(Column::bond_group, at, 0);
+    w.set(Column::bond_broken, at, 1);
+    ++at;
+  }
+  for (const auto& wall : walls_) w.wall(wall);
+}
+
+template class SimulationFrame<double>;
+template class SimulationFrame<float>;
+
+}  // namespace basalt::solver
