@@ -235,6 +235,13 @@ void Halo<Real>::begin_update_ghosts(Particles<Real>& p) {
 }
 
 template <class Real>
+void Halo<Real>::progress_ghosts() {
+  if (async_axis_ < 0) return;
+  int done = 0;
+  MPI_Testall(4, requests_.data(), &done, MPI_STATUSES_IGNORE);
+}
+
+template <class Real>
 void Halo<Real>::end_update_ghosts(Particles<Real>& p) {
   const int d = async_axis_;
   if (d < 0) return;

@@ -353,6 +353,7 @@ std::array<double, 3> Simulation<Real>::compute_forces(bool ghosts_in_flight) {
   const std::size_t before = broken_.size();
   const bool bonds = bonds_.size() > 0, pairs = !pair_driver_.empty();
   if (bonds) pe[0] += bond_driver_.template compute_part<Energy, true>(p_, bonds_, broken_);
+  if (ghosts_in_flight) halo_->progress_ghosts();  // the neighbours' posts have arrived by now
   if (pairs) pe[1] += pair_driver_.template compute<Energy, true>(p_, own_);
   if (!wall_driver_.empty()) {
     wall_driver_.move_to(time_);

@@ -8,9 +8,12 @@ tables of medians over repeats and ratios against "none" with the same Q measure
       --steps 300 --repeats 3 [--throttle 0,50,20,10,5] [--baseline-run OTHER/bin/basalt-run]
 With --baseline-run, "none" and "checkpoint every 100" also run with that binary (e.g. the previous
 commit built in another folder), interleaved with the others: a before/after comparison in one session.
+With --esys, ESyS-Particle 2.3.5 (tools/esys/wave_benchmark.py: 1 worker + master, its own field saver and
+checkpointer) runs the same four stages on the same .geo file, interleaved with Basalt's runs.
 The time is the stepping loop's ("done: N steps in X s"), start-up excluded.
 """
 import argparse
+import json
 import os
 import re
 import shutil
@@ -51,6 +54,20 @@ def run(a, q, extra, out):
     return loop, wait, cpu
 
 
+def run_esys(a, stage, out):
+    """ESyS-Particle's loop seconds for one of the four stages (its field saver: kinetic energy every step)."""
+    extra = {"none": [], "fields every step": ["--fieldsaver"], "checkpoint every 100": ["--checkpoint-every", "100"],
+             "both": ["--fieldsaver", "--checkpoint-every", "100"]}[stage]
+    shutil.rmtree(out, ignore_errors=True)
+    cmd = ["/usr/bin/python3", str(ROOT / "tools/esys/wave_benchmark.py"), "--geometry", a.geometry,
+           "--steps", str(a.steps), "--output", str(out)] + extra
+    p = subprocess.run(cmd, capture_output=True, text=True)
+    if p.returncode != 0:
+        sys.exit(f"failed: {' '.join(cmd)}\n{p.stdout}\n{p.stderr}")
+    with open(Path(out) / "timing.json") as f:
+        return json.load(f)["loop_s"]
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--basalt-run", default=str(ROOT / "build/bin/basalt-run"))
@@ -62,6 +79,7 @@ def main():
     ap.add_argument("--throttle", default="", help="MB/s values for the slow-storage table (0 = unthrottled)")
     ap.add_argument("--throttle-checkpoint-every", type=int, default=100)
     ap.add_argument("--stages", default="", help="';'-separated subset of the stages (default: all)")
+    ap.add_argument("--esys", action="store_true", help="also run the four stages with ESyS-Particle (.geo only)")
     ap.add_argument("--output-root", default=None, help="where the runs write (default: the system's temp folder; "
                     "/dev/shm takes the disk out of the measurement)")
     a = ap.parse_args()
@@ -72,12 +90,16 @@ def main():
         for s in list(STAGES):
             if s not in a.stages.split(";") and s != "none":
                 del STAGES[s]
+    esys = {}
+
     def table(cases, label, extra_of, base_case):
         res = {(c, q): [] for c in cases for q in (0, 1)}
         for _ in range(a.repeats):  # interleave so that load changes hit every case alike
             for c in cases:
                 for q in (0, 1):
                     res[(c, q)].append(run(a, q, extra_of(c), tmp / "out"))
+                if a.esys and c in STAGES and not c.endswith(BASELINE):
+                    esys.setdefault(c, []).append(run_esys(a, c, tmp / "esys"))
         med = {k: [statistics.median(x[i] for x in v) for i in range(3)] for k, v in res.items()}
         print(f"| {label} | Q = 0: loop s | vs {base_case} | CPU s | vs {base_case} | Q = 1: loop s | vs {base_case} "
               f"| CPU s | vs {base_case} | Q = 1 compute wait s |")
@@ -89,6 +111,16 @@ def main():
                 bt, _, bcpu = med[(base_case, q)]
                 row += f"| {t:.3f} | {100 * (t / bt - 1):+.1f} % | {cpu:.3f} | {100 * (cpu / bcpu - 1):+.1f} % "
             print(row + f"| {med[(c, 1)][1]:.4f} |")
+        if esys:
+            e0 = statistics.median(esys["none"])
+            print(f"\nESyS-Particle 2.3.5 (1 worker + master), same geometry and steps, median of {a.repeats}, "
+                  "against Basalt with one I/O rank from the same runs:\n")
+            print("| stage | ESyS loop s | vs none | Basalt Q = 1 loop s | vs none | ESyS / Basalt |")
+            print("| --- " * 6 + "|")
+            for c in esys:
+                e, t, bt = statistics.median(esys[c]), med[(c, 1)][0], med[(base_case, 1)][0]
+                print(f"| {c} | {e:.2f} | {100 * (e / e0 - 1):+.1f} % | {t:.3f} | {100 * (t / bt - 1):+.1f} % "
+                      f"| {e / t:.0f}x |")
 
     if a.baseline_run:
         for s in [s for s in ["none", "checkpoint every 100"] if s in STAGES]:

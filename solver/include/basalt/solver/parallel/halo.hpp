@@ -36,6 +36,8 @@ class Halo {
   /// forward what earlier ones received); the last one is posted non-blocking, so work on owned
   /// particles can overlap it. end_update_ghosts() completes it.
   void begin_update_ghosts(Particles<Real>& p);
+  /// Lets MPI move the refresh in flight along (a large message moves only inside MPI calls); no wait.
+  void progress_ghosts();
   void end_update_ghosts(Particles<Real>& p);
 
   /// Bytes held by the send lists and buffers.
