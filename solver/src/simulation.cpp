@@ -308,20 +308,27 @@ void Simulation<Real>::rebuild() {
   times_.communication += sw.lap();
   resolve_bonds();
   if (!pair_driver_.empty()) {
-    grid_.build(p_.x, p_.y, p_.z, p_.size(), contact_cutoff_);
+    // Cells half the longest cutoff: each particle searches only as far as it can reach (a third or a
+    // quarter measured slower on the 30 mm cube: more rows to step through).
+    grid_.size_to(p_.x, p_.y, p_.z, p_.size(), contact_cutoff_ / 2);
+    grid_.fill(p_.x, p_.y, p_.z, 0, p_.n_owned);
+    ghost_grid_.size_like(grid_);
+    ghost_grid_.fill(p_.x, p_.y, p_.z, p_.n_owned, p_.size());
     exclusions_.bind(bond_bucket_end_, bonds_.ib, p_.n_owned);
     if (pair_driver_.takes_all()) {
       build_pair_lists(
-          p_, grid_, scene_.skin, exclusions_, [](std::size_t, std::size_t) { return true; }, own_, ghost_);
+          p_, grid_, ghost_grid_, scene_.skin, exclusions_, [](std::size_t, std::size_t) { return true; },
+          own_, ghost_);
     } else {
       auto accept = [this](std::size_t i, std::size_t j) {
         return pair_driver_.group_of(p_.tag[i], p_.tag[j]) >= 0;
       };
-      build_pair_lists(p_, grid_, scene_.skin, exclusions_, accept, own_, ghost_);
+      build_pair_lists(p_, grid_, ghost_grid_, scene_.skin, exclusions_, accept, own_, ghost_);
     }
     std::vector<std::uint32_t>().swap(bond_bucket_end_);
   }
   grid_.release();
+  ghost_grid_.release();
   if (!wall_driver_.empty()) wall_driver_.rebuild(p_, scene_.skin);
   for (std::size_t i = 0; i < p_.n_owned; ++i) {
     p_.x0[i] = float(p_.x[i]);

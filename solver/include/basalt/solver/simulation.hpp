@@ -172,7 +172,7 @@ class Simulation {
   PairDriver<Real, LinearElastic> pair_driver_;
   WallDriver<Real, ElasticWall> wall_driver_;
   PairList own_, ghost_;
-  CellGrid grid_;
+  CellGrid grid_, ghost_grid_;  ///< owned and ghost particles in the same cells (rebuilds only)
   Exclusions exclusions_;
   std::vector<std::uint32_t> bond_bucket_end_;  ///< bonds per owned end, kept during a rebuild only
   std::vector<BrokenBond> broken_;

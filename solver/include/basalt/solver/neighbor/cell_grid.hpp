@@ -1,8 +1,7 @@
 #pragma once
 // Uniform cell grid over the bounding box of the local particles (owned + ghosts), sized at each
-// rebuild from their actual extent: cells at least `cell` wide, so every pair closer than `cell`
-// lies in the same or adjacent cells. Counting sort: particles of cell c are
-// order[start[c] .. start[c+1]).
+// rebuild from their actual extent: cells at least `cell` wide. Counting sort: particles of cell c are
+// order[start[c] .. start[c+1]); cells are numbered x fastest, so a row of cells along x is one range.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -13,9 +12,19 @@ namespace basalt::solver {
 
 class CellGrid {
  public:
+  /// Sizes the grid over the extent of particles [0, n) with cells at least `cell` wide and sorts them
+  /// into it.
   template <class Real>
   void build(const std::vector<Real>& x, const std::vector<Real>& y, const std::vector<Real>& z,
              std::size_t n, double cell) {
+    size_to(x, y, z, n, cell);
+    fill(x, y, z, 0, n);
+  }
+
+  /// Sizes the grid over the extent of particles [0, n); fill() then sorts particles into it.
+  template <class Real>
+  void size_to(const std::vector<Real>& x, const std::vector<Real>& y, const std::vector<Real>& z,
+               std::size_t n, double cell) {
     std::array<double, 3> lo{0, 0, 0}, hi{0, 0, 0};
     if (n > 0) {
       lo = hi = {double(x[0]), double(y[0]), double(z[0])};
@@ -43,17 +52,32 @@ class CellGrid {
       lo_[d] = lo[d];
       inv_[d] = n_[d] / std::max(hi[d] - lo[d], 1e-300);
     }
-    const std::size_t ncell = static_cast<std::size_t>(n_[0] * n_[1] * n_[2]);
+  }
+
+  /// The same cells as `other` (empty until fill()).
+  void size_like(const CellGrid& other) {
+    lo_ = other.lo_;
+    inv_ = other.inv_;
+    n_ = other.n_;
+  }
+
+  /// Counting sort of particles [first, last) into the cells (particles outside the extent go to the
+  /// nearest cell): those of cell c are order[start[c] .. start[c+1]), in increasing index.
+  template <class Real>
+  void fill(const std::vector<Real>& x, const std::vector<Real>& y, const std::vector<Real>& z,
+            std::size_t first, std::size_t last) {
+    const std::size_t ncell = static_cast<std::size_t>(n_[0] * n_[1] * n_[2]), n = last - first;
+    first_ = first;
     start_.assign(ncell + 1, 0);
     cell_of_.resize(n);
     for (std::size_t i = 0; i < n; ++i) {
-      cell_of_[i] = static_cast<std::uint32_t>(index(x[i], y[i], z[i]));
+      cell_of_[i] = static_cast<std::uint32_t>(index(x[first + i], y[first + i], z[first + i]));
       ++start_[cell_of_[i] + 1];
     }
     for (std::size_t c = 0; c < ncell; ++c) start_[c + 1] += start_[c];
     order_.resize(n);
-    std::vector<std::uint32_t> fill(start_.begin(), start_.end() - 1);
-    for (std::size_t i = 0; i < n; ++i) order_[fill[cell_of_[i]]++] = static_cast<std::uint32_t>(i);
+    std::vector<std::uint32_t> at(start_.begin(), start_.end() - 1);
+    for (std::size_t i = 0; i < n; ++i) order_[at[cell_of_[i]]++] = static_cast<std::uint32_t>(first + i);
   }
 
   std::int64_t coord(int d, double v) const {
@@ -63,7 +87,8 @@ class CellGrid {
     return (coord(2, pz) * n_[1] + coord(1, py)) * n_[0] + coord(0, px);
   }
   const std::array<std::int64_t, 3>& dims() const { return n_; }
-  std::uint32_t cell_of(std::size_t i) const { return cell_of_[i]; }
+  /// Cell of particle i (one of those filled).
+  std::uint32_t cell_of(std::size_t i) const { return cell_of_[i - first_]; }
   const std::vector<std::uint32_t>& start() const { return start_; }
   const std::vector<std::uint32_t>& order() const { return order_; }
   std::size_t memory_bytes() const {
@@ -78,6 +103,7 @@ class CellGrid {
  private:
   std::array<double, 3> lo_{}, inv_{};
   std::array<std::int64_t, 3> n_{1, 1, 1};
+  std::size_t first_ = 0;
   std::vector<std::uint32_t> start_, cell_of_, order_;
 };
 

@@ -53,42 +53,67 @@ struct Exclusions {
 };
 
 /// Lists every owned-owned and owned-ghost pair closer than ri + rj + skin that `accept(i, j)` takes
-/// and that is not bonded.
+/// and that is not bonded. `owned` holds the owned particles [0, n_owned), `ghosts` (the same cells)
+/// the ghosts. Cells may be narrower than the longest cutoff: particle i looks as far as it can
+/// interact, ri + skin + the largest radius, so a small sphere (most of a power-law packing) searches a
+/// small box. Each owned-owned pair is listed once, from the particle in the lower cell (cells ordered z,
+/// y, x: the upper half of the box) or, in one cell, from the lower index; a ghost from the whole box.
+/// Rows of cells along x are single ranges of the cell order, scanned without a per-cell step.
 template <class Real, class Accept>
-void build_pair_lists(const Particles<Real>& p, const CellGrid& grid, double skin, const Exclusions& ex,
-                      Accept&& accept, PairList& own, PairList& ghost) {
+void build_pair_lists(const Particles<Real>& p, const CellGrid& owned, const CellGrid& ghosts, double skin,
+                      const Exclusions& ex, Accept&& accept, PairList& own, PairList& ghost) {
   const std::size_t n = p.n_owned;
   own.offset.assign(n + 1, 0);
   ghost.offset.assign(n + 1, 0);
   own.neigh.clear();
   ghost.neigh.clear();
-  const auto& dims = grid.dims();
-  const auto& start = grid.start();
-  const auto& order = grid.order();
   const Real s = Real(skin);
+  const Real rmax = p.size() == 0 ? Real(0) : *std::max_element(p.radius.begin(), p.radius.end());
+  const auto& dims = owned.dims();
+  const auto& ostart = owned.start();
+  const auto& gstart = ghosts.start();
+  const std::uint32_t* oorder = owned.order().data();
+  const std::uint32_t* gorder = ghosts.order().data();
   for (std::size_t i = 0; i < n; ++i) {
-    const std::int64_t c = grid.cell_of(i);
-    const std::int64_t cx = c % dims[0], cy = (c / dims[0]) % dims[1], cz = c / (dims[0] * dims[1]);
-    const Real xi = p.x[i], yi = p.y[i], zi = p.z[i], ri = p.radius[i] + s;
-    for (std::int64_t z = std::max<std::int64_t>(cz - 1, 0); z <= std::min(cz + 1, dims[2] - 1); ++z)
-      for (std::int64_t y = std::max<std::int64_t>(cy - 1, 0); y <= std::min(cy + 1, dims[1] - 1); ++y)
-        for (std::int64_t x = std::max<std::int64_t>(cx - 1, 0); x <= std::min(cx + 1, dims[0] - 1); ++x) {
-          const std::int64_t cell = (z * dims[1] + y) * dims[0] + x;
-          // A cell lists its particles in increasing index: skip to the first j > i (owned-owned pairs
-          // once; ghosts all have j >= n > i) without a per-candidate branch.
-          const auto* first = order.data() + start[static_cast<std::size_t>(cell)];
-          const auto* last = order.data() + start[static_cast<std::size_t>(cell) + 1];
-          for (const auto* it = std::upper_bound(first, last, static_cast<std::uint32_t>(i)); it != last;
-               ++it) {
-            const std::uint32_t j = *it;
-            const Real dx = xi - p.x[j], dy = yi - p.y[j], dz = zi - p.z[j];
-            const Real cut = ri + p.radius[j];
-            if (dx * dx + dy * dy + dz * dz >= cut * cut) continue;
-            if (!accept(i, j)) continue;
-            if (!ex.empty() && ex.has(i, static_cast<std::int32_t>(j))) continue;
-            (j < n ? own : ghost).neigh.push_back(static_cast<std::int32_t>(j));
-          }
+    const Real xi = p.x[i], yi = p.y[i], zi = p.z[i], ri = p.radius[i] + s, reach = ri + rmax;
+    const auto scan = [&](const std::uint32_t* it, const std::uint32_t* last, PairList& list) {
+      for (; it != last; ++it) {
+        const std::uint32_t j = *it;
+        const Real dx = xi - p.x[j], dy = yi - p.y[j], dz = zi - p.z[j];
+        const Real cut = ri + p.radius[j];
+        if (dx * dx + dy * dy + dz * dz >= cut * cut) continue;
+        if (!accept(i, j)) continue;
+        if (!ex.empty() && ex.has(i, static_cast<std::int32_t>(j))) continue;
+        list.neigh.push_back(static_cast<std::int32_t>(j));
+      }
+    };
+    const std::int64_t x0 = owned.coord(0, double(xi - reach)), x1 = owned.coord(0, double(xi + reach));
+    const std::int64_t y0 = owned.coord(1, double(yi - reach)), y1 = owned.coord(1, double(yi + reach));
+    const std::int64_t z0 = owned.coord(2, double(zi - reach)), z1 = owned.coord(2, double(zi + reach));
+    const std::int64_t c = owned.cell_of(i);
+    const std::int64_t cy = (c / dims[0]) % dims[1], cz = c / (dims[0] * dims[1]);
+    // The rest of i's own row: i's cell after i (a cell lists its particles in increasing index), then
+    // the cells after it.
+    const std::int64_t row = (cz * dims[1] + cy) * dims[0];
+    const auto* first = oorder + ostart[static_cast<std::size_t>(c)];
+    const auto* last = oorder + ostart[static_cast<std::size_t>(c) + 1];
+    scan(std::upper_bound(first, last, static_cast<std::uint32_t>(i)),
+         oorder + ostart[static_cast<std::size_t>(row + x1) + 1], own);
+    for (std::int64_t z = cz; z <= z1; ++z)
+      for (std::int64_t y = z == cz ? cy + 1 : y0; y <= y1; ++y) {
+        const auto r = static_cast<std::size_t>((z * dims[1] + y) * dims[0]);
+        scan(oorder + ostart[r + static_cast<std::size_t>(x0)],
+             oorder + ostart[r + static_cast<std::size_t>(x1) + 1], own);
+      }
+    if (gstart.size() > 1 && gstart.back() > 0)
+      for (std::int64_t z = z0; z <= z1; ++z)
+        for (std::int64_t y = y0; y <= y1; ++y) {
+          const auto r = static_cast<std::size_t>((z * dims[1] + y) * dims[0]);
+          scan(gorder + gstart[r + static_cast<std::size_t>(x0)],
+               gorder + gstart[r + static_cast<std::size_t>(x1) + 1], ghost);
         }
+    // In memory order: the force loop then walks the neighbours' data forward.
+    std::sort(own.neigh.begin() + own.offset[i], own.neigh.end());
     own.offset[i + 1] = static_cast<std::uint32_t>(own.neigh.size());
     ghost.offset[i + 1] = static_cast<std::uint32_t>(ghost.neigh.size());
   }
