@@ -270,6 +270,33 @@ struct OutputClient::Impl {
     }
   }
 
+  /// Q = 0: sums the buffered rows over the compute ranks; compute rank 0 appends them to fields.csv.
+  void reduce_field_batch(std::optional<std::string>& error) {
+    if (field_rows_count == 0) return;
+    const double t0 = MPI_Wtime();
+    std::vector<double> sums(compute_rank == 0 ? field_rows.size() : 0);
+    MPI_Reduce(field_rows.data(), sums.data(), static_cast<int>(field_rows.size()), MPI_DOUBLE, MPI_SUM, 0,
+               layout.compute);
+    if (csv && !local.error) {
+      // Step and time were summed too: rank 0's own are the row's.
+      const std::size_t width = field_rows.size() / field_rows_count;
+      for (std::size_t r = 0; r < field_rows_count; ++r) {
+        const double* row = field_rows.data() + r * width;
+        csv->append(static_cast<std::int64_t>(row[0]), row[1],
+                    std::span<const double>(sums.data() + r * width + 2, width - 2));
+      }
+      try {
+        csv->flush();
+      } catch (const std::exception& e) {
+        local.error = e.what();
+        error = local.error;
+      }
+    }
+    field_rows.clear();
+    field_rows_count = 0;
+    local.compute_wait_seconds += MPI_Wtime() - t0;
+  }
+
   void send_field_batch() {
     if (field_rows_count == 0) return;
     InFlight f;
@@ -402,22 +429,13 @@ void OutputClient::submit_fields(std::int64_t step, double time, std::span<const
       I.send_field_batch();
     return;
   }
-  const double t0 = MPI_Wtime();
-  std::vector<double> sums(partials.size());
-  MPI_Reduce(partials.data(), sums.data(), static_cast<int>(partials.size()), MPI_DOUBLE, MPI_SUM, 0,
-             I.layout.compute);
-  if (I.csv && !I.local.error) {
-    I.csv->append(step, time, sums);
-    if (++I.field_rows_count % std::max(1, I.cfg.field_batch_rows) == 0) {
-      try {
-        I.csv->flush();
-      } catch (const std::exception& e) {
-        I.local.error = e.what();
-        error_ = I.local.error;
-      }
-    }
-  }
-  I.local.compute_wait_seconds += MPI_Wtime() - t0;
+  // Q = 0: the rows are summed a batch at a time (one reduction per batch, not a per-step collective
+  // that would make every rank wait for the slowest at every step) and written by compute rank 0.
+  I.field_rows.push_back(static_cast<double>(step));
+  I.field_rows.push_back(time);
+  I.field_rows.insert(I.field_rows.end(), partials.begin(), partials.end());
+  if (++I.field_rows_count >= static_cast<std::size_t>(std::max(1, I.cfg.field_batch_rows)))
+    I.reduce_field_batch(error_);
 }
 
 void OutputClient::poll() {
@@ -447,7 +465,10 @@ OutputReport OutputClient::finish() {
     while (!I.fields_in_flight.empty()) I.complete_front(I.fields_in_flight, true);
     for (int q = 0; q < I.layout.n_io; ++q)
       MPI_Send(nullptr, 0, MPI_BYTE, I.layout.io_bridge_rank(q), kTagDone, I.layout.bridge);
-  } else if (I.csv) {
+  } else {
+    I.reduce_field_batch(error_);
+  }
+  if (!I.async() && I.csv) {
     const double t0 = MPI_Wtime();
     try {
       I.csv->flush();
