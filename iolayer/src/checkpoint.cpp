@@ -55,9 +55,9 @@ void Checkpoint::validate(const fs::path& source) const {
       throw FormatError(
           source, "/bonds/rest_length",
           fmt::format("bond {}: rest length must be finite and >= 0, got {}", k, bond_rest_length[k]));
-    if (bond_broken[k] > 1)
+    if (bond_broken[k] > 2)
       throw FormatError(source, "/bonds/broken",
-                        fmt::format("bond {}: flag must be 0 or 1, got {}", k, bond_broken[k]));
+                        fmt::format("bond {}: flag must be 0, 1 or 2, got {}", k, bond_broken[k]));
   }
   std::set<std::string> names;
   for (const auto& w : walls) {

@@ -377,6 +377,7 @@ std::array<double, 3> Simulation<Real>::compute_forces(bool ghosts_in_flight) {
   }
   if (pairs) pe[1] += pair_driver_.template compute<Energy, false>(p_, ghost_);
   if (broken_.size() != before) bond_broke_ = true;  // the lists must learn the pair is now unbonded
+  for (std::size_t k = before; k < broken_.size(); ++k) broken_[k].step = step_;
   return pe;
 }
 

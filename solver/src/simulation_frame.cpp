@@ -91,13 +91,14 @@ void SimulationFrame<Real>::write(io::FrameWriter& w) const {
     ++at;
   }
   w.fill(Column::bond_broken, 0, at, 0);
-  // Broken bonds: the bond driver records each once across ranks (same lower-id rule).
+  // Broken bonds: the bond driver records each once across ranks (same lower-id rule). Flag 2: it
+  // broke at this very step (a restart from here restores it, docs/formats.md).
   for (const auto& broken : sim_.broken_) {
     w.set(Column::bond_a, at, broken.a);
     w.set(Column::bond_b, at, broken.b);
     w.set(Column::bond_rest_length, at, broken.rest_length);
-    w.set(Column::bond_group, at, 0);
-    w.set(Column::bond_broken, at, 1);
+    w.set(Column::bond_group, at, broken.group);
+    w.set(Column::bond_broken, at, broken.step == sim_.step_ ? 2 : 1);
     ++at;
   }
   for (const auto& wall : walls_) w.wall(wall);

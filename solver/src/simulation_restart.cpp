@@ -76,10 +76,14 @@ void Simulation<Real>::distribute_checkpoint(const io::Checkpoint& c, const Rest
     p_.push_owned(g.id[i], Real(x[0]), Real(x[1]), Real(x[2]), Real(g.radius[i]), g.tag[i], Real(im),
                   Real(v[0]), Real(v[1]), Real(v[2]));
   }
+  // A bond that broke at the checkpoint's own step (flag 2) is restored intact when the rebuild is
+  // replayed: the uninterrupted run's lists, built before it broke, excluded its pair from contacts,
+  // and the restart's first force computation breaks it again from the same positions.
+  const bool replay = !c.position_at_rebuild.empty();
   for (std::size_t k = 0; k < g.bonds.size(); ++k) {
     const auto& b = g.bonds[k];
     const auto ia = static_cast<std::size_t>(g.index_of(b.a)), ib = static_cast<std::size_t>(g.index_of(b.b));
-    if (c.bond_broken[k]) {
+    if (c.bond_broken[k] == 1 || (c.bond_broken[k] == 2 && !replay)) {
       // Kept on record (once, by the rank owning the lower id) so later checkpoints still list it.
       const std::size_t lower = b.a < b.b ? ia : ib;
       if (owned[lower]) {

@@ -84,6 +84,37 @@ case $case_name in
     grep -q "has no /particles/position_at_rebuild" "$W/last.log" || fail "no warning about the old checkpoint"
     $CHECK close "$W/straight/ckpt_000200.h5" "$W/old/ckpt_000200.h5" 1e-9 || fail "the continuation drifted"
     ;;
+  restart_break_at_checkpoint)
+    # Bonds that break at the checkpoint's own step while their spheres still overlap: 20 vertical
+    # pairs (rest length = initial distance 0.99 (r1 + r2), break strain 0.001) on the base wall,
+    # kicked by a stronger pulse; all break at step 194 (the check below proves one did, overlapping).
+    # The restart must not apply the contact force the uninterrupted run could not yet see.
+    {
+      echo "LSMGeometry 1.2"; echo "BoundingBox 0 0 0 40 1 2"; echo "PeriodicBoundaries 0 0 0"
+      echo "Dimension 3D"; echo "BeginParticles"; echo "Simple"; echo 40
+      for k in $(seq 0 19); do
+        echo "$((2 * k)).5 0.5 0.5 0.5 $((2 * k)) 1"
+        echo "$((2 * k)).5 0.5 1.49 0.5 $((2 * k + 1)) 1"
+      done
+      echo "EndParticles"; echo "BeginConnect"; echo 20
+      for k in $(seq 0 19); do echo "$((2 * k)) $((2 * k + 1)) 0"; done
+      echo "EndConnect"
+    } >"$W/pairs.geo"
+    sed -e 's/^rest_length = .*/&\nbreak_strain = 0.001/' -e 's/amplitude = 0.1,/amplitude = 2.0,/' "$SCENE" >"$W/break.toml"
+    grep -q '^break_strain = 0.001' "$W/break.toml" && grep -q 'amplitude = 2.0,' "$W/break.toml" ||
+      fail "could not set the break strain and amplitude in $W/break.toml"
+    SCENE=$W/break.toml GEOMETRY=$W/pairs.geo
+    for np in 1 2; do
+      rm -rf "$W/straight" "$W/split"
+      must_run $np --steps 388 --checkpoint-every 194 --output "$W/straight"
+      $CHECK break_overlap "$W/straight/ckpt_000194.h5" || fail "no bond broke at the checkpoint step: the case tests nothing"
+      must_run $np --steps 194 --checkpoint-every 194 --output "$W/split"
+      must_run $np --steps 194 --checkpoint-every 194 --output "$W/split" --restart "$W/split"
+      $CHECK same "$W/straight/ckpt_000388.h5" "$W/split/ckpt_000388.h5" || fail "np $np: final checkpoints differ"
+      cmp "$W/straight/ckpt_000388.h5" "$W/split/ckpt_000388.h5" || fail "np $np: final checkpoint files differ"
+      echo "np $np: bonds broken at the checkpoint step, step-388 checkpoints identical"
+    done
+    ;;
   restart_other_ranks)
     must_run 2 --steps 200 --checkpoint-every 100 --output "$W/straight"
     must_run 2 --steps 100 --checkpoint-every 100 --output "$W/a"

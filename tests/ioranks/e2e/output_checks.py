@@ -63,6 +63,21 @@ def old_lists(f):
         return 0 < rb < step and moved
 
 
+def break_overlap(f):
+    """Some bond broke at the checkpoint's own step (flag 2) while its spheres still overlap."""
+    with h5py.File(f, "r") as h:
+        ids, pos, r = h["particles/id"][()], h["particles/position"][()], h["particles/radius"][()]
+        pairs, flag = h["bonds/pairs"][()], h["bonds/broken"][()]
+    a, b = pairs[:, 0], pairs[:, 1]
+    at = {int(i): k for k, i in enumerate(ids)}
+    n = 0
+    for ia, ib in zip(a[flag == 2], b[flag == 2]):
+        i, j = at[int(ia)], at[int(ib)]
+        n += np.linalg.norm(pos[i] - pos[j]) < r[i] + r[j]
+    print(f"{int(np.sum(flag == 2))} bonds broke at this step, {n} of them between overlapping spheres")
+    return n > 0
+
+
 def strip_rebuild(f):
     with h5py.File(f, "r+") as h:
         del h["particles/position_at_rebuild"]
@@ -109,5 +124,6 @@ if __name__ == "__main__":
     cmd, args = sys.argv[1], sys.argv[2:]
     ok = {"same": lambda: same(*args), "close": lambda: close(args[0], args[1], float(args[2])),
           "complete": lambda: complete(args[0]),
-          "old_lists": lambda: old_lists(args[0]), "strip_rebuild": lambda: strip_rebuild(args[0]), "pvd": lambda: pvd(args[0])}[cmd]()
+          "old_lists": lambda: old_lists(args[0]), "break_overlap": lambda: break_overlap(args[0]),
+          "strip_rebuild": lambda: strip_rebuild(args[0]), "pvd": lambda: pvd(args[0])}[cmd]()
     sys.exit(0 if ok else 1)

@@ -37,7 +37,8 @@ struct Checkpoint {
 
   // Bond state, one entry per geometry.bonds entry.
   std::vector<double> bond_rest_length;
-  std::vector<std::uint8_t> bond_broken;  ///< 1 once broken (broken bonds are kept so ids stay stable)
+  /// 0 intact; 1 broken (broken bonds are kept so ids stay stable); 2 broke at this very step
+  std::vector<std::uint8_t> bond_broken;
 
   std::vector<WallState> walls;
 

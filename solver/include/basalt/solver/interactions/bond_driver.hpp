@@ -16,6 +16,8 @@ namespace basalt::solver {
 struct BrokenBond {
   std::int64_t a, b;
   double length, rest_length;
+  std::int64_t step = -1;  ///< the step it broke at (set by the simulation)
+  std::uint8_t group = 0;  ///< its interaction group: a restart at that very step restores the bond
 };
 
 template <class Real, class Model>
@@ -97,7 +99,7 @@ class BondDriver {
         if (Model::broken(Uniform ? eps0 : eps_[g], r0, r)) [[unlikely]] {
           gone_.push_back(k);
           if (BothOwned || p.id[i] < p.id[j])
-            broken.push_back({bonds.a[k], bonds.b[k], double(r), double(r0)});
+            broken.push_back({bonds.a[k], bonds.b[k], double(r), double(r0), -1, bonds.group_of(k)});
           continue;
         }
       }
