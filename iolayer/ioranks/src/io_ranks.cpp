@@ -264,7 +264,9 @@ struct OutputClient::Impl {
         MPI_Test(&q.front().request, &done, MPI_STATUS_IGNORE);
       }
       if (!done) return;
-      spare.push_back(std::move(q.front().bytes));
+      // Only frame buffers are kept for reuse: a small field batch handed to the next frame would be
+      // grown to the frame's size again, page by page (~50 ms per checkpoint on 590 k particles).
+      if (&q == &frames_in_flight) spare.push_back(std::move(q.front().bytes));
       q.pop_front();
       if (block) return;
     }
