@@ -285,7 +285,6 @@ void Simulation<Real>::resolve_bonds() {
 
 template <class Real>
 void Simulation<Real>::rebuild() {
-  ke_mass_stale_ = true;  // migration and the spatial sort reorder the owned particles
   Stopwatch sw;
   auto error = check_finite();
   const bool parallel = comm().size() > 1;
@@ -434,12 +433,7 @@ void Simulation<Real>::step(FieldSink* sink) {
   times_.communication += ghost_wait_;
   if (kick2_ != Real(0)) {
     if (kinetic_due(step_)) {
-      if (ke_mass_stale_ || ke_mass_.size() != p_.n_owned) {
-        ke_mass_.resize(p_.n_owned);
-        for (std::size_t i = 0; i < p_.n_owned; ++i) ke_mass_[i] = 1.0 / double(p_.inv_mass[i]);
-        ke_mass_stale_ = false;
-      }
-      ke_local_ = kick_energy(p_, kick2_, ke_mass_.data());
+      ke_local_ = kick_energy(p_, kick2_);
       ke_fresh_ = true;
     } else {
       kick(p_, kick2_);

@@ -91,7 +91,6 @@ class Simulation {
   /// Mutable access (tests, set-up) drops the kinetic energy cached by the last step.
   Particles<Real>& particles() {
     ke_fresh_ = false;
-    ke_mass_stale_ = true;
     return p_;
   }
   const Bonds<Real>& bonds() const { return bonds_; }
@@ -191,11 +190,9 @@ class Simulation {
   double wall_work_in_ = 0;  ///< this rank's share of the positive work done by walls
   PhaseTimes times_;
   double ghost_wait_ = 0;
-  std::vector<double> ke_mass_;  ///< 1 / inv_mass of the owned particles, for kick_energy (only if saved)
-  bool ke_mass_stale_ = true;    ///< set when the owned particles change order or inverse mass
-  double ke_local_ = 0;          ///< this rank's kinetic energy, valid while ke_fresh_
-  bool ke_fresh_ = false;        ///< set when the second half-kick computed ke_local_ this step
-  bool forces_zeroed_ = false;   ///< set by the fused kick-zero-drift pass
+  double ke_local_ = 0;         ///< this rank's kinetic energy, valid while ke_fresh_
+  bool ke_fresh_ = false;       ///< set when the second half-kick computed ke_local_ this step
+  bool forces_zeroed_ = false;  ///< set by the fused kick-zero-drift pass
   StabilityReport stability_;
   OutputSink* output_ = nullptr;  ///< set during run(steps, OutputSink&)
   /// Owned positions at the last rebuild, exactly (x0 is only a float copy) and that rebuild's step:
