@@ -59,6 +59,21 @@ void Checkpoint::validate(const fs::path& source) const {
       throw FormatError(source, "/bonds/broken",
                         fmt::format("bond {}: flag must be 0, 1 or 2, got {}", k, bond_broken[k]));
   }
+  const std::size_t nc = contact_ids.size();
+  if (contact_model.size() != nc || contact_history.size() != nc * contact_width)
+    throw FormatError(source, "/contacts",
+                      fmt::format("{} contacts with {} model indices and {} history values ({} per contact)",
+                                  nc, contact_model.size(), contact_history.size(), contact_width));
+  for (std::size_t k = 0; k < nc; ++k) {
+    if (contact_model[k] < 0)
+      throw FormatError(source, "/contacts/model", fmt::format("contact {}: negative model index", k));
+    for (const auto pid : contact_ids[k])
+      if (geometry.index_of(pid) < 0)
+        throw FormatError(source, "/contacts/ids",
+                          fmt::format("contact {}: particle id {} does not exist", k, pid));
+  }
+  for (double v : contact_history)
+    if (!std::isfinite(v)) throw FormatError(source, "/contacts/history", "a history value is not finite");
   std::set<std::string> names;
   for (const auto& w : walls) {
     const auto where = "/walls/" + w.name;

@@ -82,6 +82,13 @@ void write_checkpoint(const Checkpoint& c, const fs::path& file) {
     w.scalar_attribute<std::int64_t>(g, "index", static_cast<std::int64_t>(i));
     for (int k = 0; k < 4; ++k) w.dataset(g + "/" + kWallVectors[k], wall_vector(wall, k).data(), 3);
   }
+  if (!s->contact_ids.empty()) {
+    w.group("/contacts");
+    w.scalar_attribute<std::int64_t>("/contacts", "width", static_cast<std::int64_t>(s->contact_width));
+    w.dataset("/contacts/ids", s->contact_ids.data()->data(), s->contact_ids.size(), 2);
+    w.dataset("/contacts/model", s->contact_model);
+    w.dataset("/contacts/history", s->contact_history.data(), s->contact_ids.size(), s->contact_width);
+  }
   w.scalar_attribute<std::int64_t>("/", "step", s->step);
   w.scalar_attribute<double>("/", "time", s->time);
   w.scalar_attribute<double>("/", "dt", s->dt);
@@ -134,6 +141,22 @@ Checkpoint read_checkpoint_unguarded(const fs::path& file) {
   if (brows != m) r.fail("/bonds/broken", fmt::format("{} values for {} bonds", brows, m));
   c.bond_broken = r.read<std::uint8_t>("/bonds/broken");
 
+  if (r.exists("/contacts/ids")) {
+    const auto nc = r.rows<std::int64_t>("/contacts/ids", 2);
+    c.contact_ids.resize(nc);
+    if (nc) r.read_into("/contacts/ids", c.contact_ids.data()->data());
+    if (r.rows<std::int32_t>("/contacts/model") != nc)
+      r.fail("/contacts/model", fmt::format("expected {} values", nc));
+    c.contact_model = r.read<std::int32_t>("/contacts/model");
+    const auto width = r.scalar_attribute<std::int64_t>("/contacts", "width");
+    if (width < 1 || width > 64)
+      r.fail("attribute 'width' of /contacts", fmt::format("{} is not in [1, 64]", width));
+    const auto w = static_cast<std::size_t>(width);
+    if (r.rows<double>("/contacts/history", w) != nc)
+      r.fail("/contacts/history", fmt::format("expected {} rows", nc));
+    c.contact_width = w;
+    c.contact_history = r.read<double>("/contacts/history", w);
+  }
   const auto names = r.members("/walls");
   c.walls.resize(names.size());
   std::vector<bool> seen(names.size(), false);

@@ -22,6 +22,7 @@
 #include "basalt/io/geometry.hpp"
 #include "basalt/io/io_ranks.hpp"
 #include "basalt/solver/core/errors.hpp"
+#include "basalt/solver/models/registry.hpp"
 #include "basalt/solver/parallel/communicator.hpp"
 #include "basalt/solver/scene/scene.hpp"
 #include "basalt/solver/simulation.hpp"
@@ -87,6 +88,25 @@ void prepare_output_folder(const fs::path& dir) {
 }
 
 std::string mb(std::uint64_t bytes) { return fmt::format("{:.2f} MB", double(bytes) * 1e-6); }
+
+/// "fields: position, velocity, ... = 112 B/particle" (and the contact history per contact): what the
+/// scene allocates.
+std::string fields_line(const Simulation<double>& sim) {
+  std::string names;
+  std::size_t bytes = 0;
+  for (const auto& [name, b] : sim.particles().field_bytes()) {
+    names += (names.empty() ? "" : ", ") + name;
+    bytes += b;
+  }
+  std::string line = fmt::format("fields: {} = {} B/particle", names, bytes);
+  std::string history;
+  for (const auto& c : sim.force_computes())
+    if (c->history_bytes() > 0)
+      history += fmt::format("{}{} {} B", history.empty() ? "" : ", ", c->model(), c->history_bytes());
+  line +=
+      history.empty() ? "; contact history: none" : fmt::format("; contact history: {} per contact", history);
+  return line;
+}
 
 void print_report(const io::OutputReport& r, int n_io) {
   auto kind = [](const char* name, const io::OutputKindReport& k) {
@@ -172,6 +192,7 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
     if (st.warn)
       fmt::print(stderr, "warning: dt = {} is {:.3g} x the critical time step, above the safe fraction {}\n",
                  scene.dt, st.fraction, scene.dt_safety);
+    fmt::print("{}\n", fields_line(*sim));
     if (sim->unassigned_bonds() > 0)
       fmt::print(stderr, "warning: {} bonds of the geometry match no bond interaction and exert no force\n",
                  sim->unassigned_bonds());
@@ -270,6 +291,13 @@ int run_world(int argc, char** argv) {
   app.add_flag("--quiet", cli.quiet, "no progress line");
   app.add_flag("--force-dt", cli.force_dt, "run even when dt exceeds the critical time step");
   app.set_version_flag("--version", std::string(basalt::kVersion));
+  app.add_flag_callback(
+      "--list-models",
+      [world_root] {
+        if (world_root) fmt::print("{}", describe_models());
+        throw CLI::Success();
+      },
+      "print every model this build knows (scene keys, particle fields, contact history) and exit");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -9,25 +9,11 @@ namespace basalt::solver {
 
 namespace {
 
-struct Migrant {
-  std::int64_t id;
-  std::int32_t tag;
-  std::int32_t pad;
-  double x, y, z, vx, vy, vz, r, inv_mass;
-};
-
 struct BondRecord {
   std::int64_t a, b;
   double r0;
   std::int32_t group;
   std::int32_t pad;
-};
-
-struct GhostRecord {
-  std::int64_t id;
-  std::int32_t tag;
-  std::int32_t pad;
-  double x, y, z, r;
 };
 
 /// Sends `out` to dest and receives from src (either may be MPI_PROC_NULL).
@@ -95,25 +81,49 @@ void settle_bonds(const Particles<Real>& p, Bonds<Real>& bonds, std::vector<std:
   bonds.permute(keep);
 }
 
+/// Copies the contact-history records that name a particle leaving to either side (ids sorted) to that
+/// side's neighbour, and appends what the neighbours send. Records stay here too: the pair may still
+/// be listed here (its other end owned here) and the next rebuild takes each pair's record by its ids.
+void send_history(MPI_Comm comm, ContactRecords& h, const std::array<std::vector<std::int64_t>, 2>& leaving,
+                  int lo_rank, int hi_rank) {
+  for (int side = 0; side < 2; ++side) {
+    const auto& ids = leaving[side];
+    ContactRecords out;
+    out.width = h.width;
+    if (!ids.empty())
+      for (std::size_t k = 0; k < h.size(); ++k)
+        if (std::binary_search(ids.begin(), ids.end(), h.a[k]) ||
+            std::binary_search(ids.begin(), ids.end(), h.b[k]))
+          out.push(h.a[k], h.b[k], h.at(k));
+    const int dest = side == 0 ? lo_rank : hi_rank, src = side == 0 ? hi_rank : lo_rank;
+    const auto a = sendrecv(comm, out.a, dest, src);
+    const auto b = sendrecv(comm, out.b, dest, src);
+    const auto v = sendrecv(comm, out.values, dest, src);
+    h.a.insert(h.a.end(), a.begin(), a.end());
+    h.b.insert(h.b.end(), b.begin(), b.end());
+    h.values.insert(h.values.end(), v.begin(), v.end());
+  }
+}
+
 }  // namespace
 
 template <class Real>
-std::optional<std::string> Halo<Real>::migrate(Particles<Real>& p, Bonds<Real>& bonds) {
+std::optional<std::string> Halo<Real>::migrate(Particles<Real>& p, Bonds<Real>& bonds,
+                                               const std::vector<ContactRecords*>& history) {
   const MPI_Comm comm = dec_.comm().raw();
   std::optional<std::string> error;
   std::vector<std::int64_t> migrants;  // ids that left or arrived here
+  const std::size_t record = p.record_bytes(false);
   for (int d = 0; d < 3; ++d) {
     if (dec_.dims()[d] == 1) continue;
     const auto& c = axis(p, d);
-    std::array<std::vector<Migrant>, 2> out;
+    std::array<std::vector<std::byte>, 2> out;
     std::array<std::vector<std::int64_t>, 2> leaving_ids;
     std::vector<std::size_t> leaving;
     for (std::size_t i = 0; i < p.n_owned; ++i) {
       const int side = c[i] < dec_.lo(d) ? 0 : (c[i] >= dec_.hi(d) ? 1 : -1);
       if (side < 0) continue;
-      out[side].push_back(Migrant{p.id[i], p.tag[i], 0, double(p.x[i]), double(p.y[i]), double(p.z[i]),
-                                  double(p.vx[i]), double(p.vy[i]), double(p.vz[i]), double(p.radius[i]),
-                                  double(p.inv_mass[i])});
+      p.pack(i, false, out[side]);
       leaving_ids[side].push_back(p.id[i]);
       leaving.push_back(i);
     }
@@ -127,6 +137,8 @@ std::optional<std::string> Halo<Real>::migrate(Particles<Real>& p, Bonds<Real>& 
             std::binary_search(ids.begin(), ids.end(), bonds.b[k]))
           bout[side].push_back(BondRecord{bonds.a[k], bonds.b[k], double(bonds.r0[k]), bonds.group_of(k), 0});
     }
+    for (auto* h : history)
+      if (h) send_history(comm, *h, leaving_ids, dec_.neighbor(d, 0), dec_.neighbor(d, 1));
     for (auto it = leaving.rbegin(); it != leaving.rend(); ++it) p.swap_remove_owned(*it);
     for (const auto& ids : leaving_ids) migrants.insert(migrants.end(), ids.begin(), ids.end());
 
@@ -134,16 +146,16 @@ std::optional<std::string> Halo<Real>::migrate(Particles<Real>& p, Bonds<Real>& 
       const int dest = dec_.neighbor(d, side), src = dec_.neighbor(d, 1 - side);
       const auto in = sendrecv(comm, out[side], dest, src);
       const auto bin = sendrecv(comm, bout[side], dest, src);
-      for (const auto& m : in) migrants.push_back(m.id);
-      for (const auto& m : in) {
-        const double v = d == 0 ? m.x : (d == 1 ? m.y : m.z);
+      for (std::size_t at = 0; at < in.size(); at += record) {
+        p.unpack(in.data() + at, false);
+        const std::size_t i = p.n_owned - 1;
+        migrants.push_back(p.id[i]);
+        const double v = double(axis(p, d)[i]);
         if (!(v >= dec_.lo(d) && v < dec_.hi(d)) && !error)
           error = fmt::format(
               "particle id {} at ({}, {}, {}) moved more than one rank's region between two neighbour-list "
               "rebuilds (arrived at rank {} owning [{}, {}) along axis {})",
-              m.id, m.x, m.y, m.z, dec_.comm().rank(), dec_.lo(d), dec_.hi(d), "xyz"[d]);
-        p.push_owned(m.id, Real(m.x), Real(m.y), Real(m.z), Real(m.r), m.tag, Real(m.inv_mass), Real(m.vx),
-                     Real(m.vy), Real(m.vz));
+              p.id[i], p.x[i], p.y[i], p.z[i], dec_.comm().rank(), dec_.lo(d), dec_.hi(d), "xyz"[d]);
       }
       for (const auto& b : bin) bonds.push(b.a, b.b, Real(b.r0), static_cast<std::uint8_t>(b.group));
     }
@@ -155,6 +167,7 @@ std::optional<std::string> Halo<Real>::migrate(Particles<Real>& p, Bonds<Real>& 
 template <class Real>
 void Halo<Real>::build_ghosts(Particles<Real>& p, double width) {
   const MPI_Comm comm = dec_.comm().raw();
+  const std::size_t record = p.record_bytes(true);
   for (int d = 0; d < 3; ++d) {
     for (int side = 0; side < 2; ++side) {
       send_[d][side].clear();
@@ -171,23 +184,14 @@ void Halo<Real>::build_ghosts(Particles<Real>& p, double width) {
       if (has_hi && c[i] >= hi) send_[d][1].push_back(static_cast<std::int32_t>(i));
     }
     for (int side = 0; side < 2; ++side) {
-      std::vector<GhostRecord> out;
-      out.reserve(send_[d][side].size());
-      for (auto i : send_[d][side])
-        out.push_back(GhostRecord{p.id[i], p.tag[i], 0, double(p.x[i]), double(p.y[i]), double(p.z[i]),
-                                  double(p.radius[i])});
+      std::vector<std::byte> out;
+      out.reserve(send_[d][side].size() * record);
+      for (auto i : send_[d][side]) p.pack(static_cast<std::size_t>(i), true, out);
       // Sending to side s means receiving from the other side.
       const auto in = sendrecv(comm, out, dec_.neighbor(d, side), dec_.neighbor(d, 1 - side));
       recv_begin_[d][1 - side] = p.size();
-      recv_count_[d][1 - side] = in.size();
-      for (const auto& g : in) {
-        p.x.push_back(Real(g.x));
-        p.y.push_back(Real(g.y));
-        p.z.push_back(Real(g.z));
-        p.radius.push_back(Real(g.r));
-        p.id.push_back(g.id);
-        p.tag.push_back(g.tag);
-      }
+      recv_count_[d][1 - side] = in.size() / record;
+      for (std::size_t at = 0; at < in.size(); at += record) p.unpack(in.data() + at, true);
     }
   }
 }

@@ -8,6 +8,8 @@
 #include <set>
 #include <sstream>
 
+#include "basalt/solver/models/registry.hpp"
+
 namespace basalt::solver {
 
 namespace fs = std::filesystem;
@@ -116,21 +118,20 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
   if (const auto* arr = top.table_array("interactions")) {
     for (std::size_t k = 0; k < arr->size(); ++k) {
       TableReader t(*(*arr)[k].as_table(), label, fmt::format("interactions[{}]", k));
-      const std::string type = t.choice_or("type", {"linear_bond", "linear_elastic"}, "");
-      if (type == "linear_bond") {
-        Group<LinearBond> g;
-        g.name = group_name(t, fmt::format("bonds{}", k), names);
-        g.params = LinearBond::parse(t);
-        g.tags = pair_tags(t);
-        if (t.has("bond_tag")) g.bond_tag = t.integer("bond_tag");
-        s.bonds.push_back(std::move(g));
-      } else {
-        Group<LinearElastic> g;
-        g.name = group_name(t, fmt::format("contacts{}", k), names);
-        g.params = LinearElastic::parse(t);
-        g.tags = pair_tags(t);
-        s.contacts.push_back(std::move(g));
-      }
+      auto types = model_names(ModelKind::bond);
+      for (auto& n : model_names(ModelKind::pair)) types.push_back(n);
+      const std::string type = t.choice_or("type", types, "");
+      const ModelEntry* m = find_model(type, ModelKind::bond);
+      if (!m) m = find_model(type, ModelKind::pair);
+      InteractionSpec g;
+      g.model = type;
+      g.kind = m->kind;
+      const bool bond = m->kind == ModelKind::bond;
+      g.name = group_name(t, fmt::format("{}{}", bond ? "bonds" : "contacts", k), names);
+      g.params = m->parse(t);
+      g.tags = pair_tags(t);
+      if (bond && t.has("bond_tag")) g.bond_tag = t.integer("bond_tag");
+      (bond ? s.bonds : s.contacts).push_back(std::move(g));
       t.finish();
     }
   }
@@ -142,8 +143,8 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
       w.name = group_name(t, fmt::format("wall{}", k), names);
       w.point = t.vec3("point");
       w.normal = unit(t, "normal");
-      t.choice_or("interaction", {"elastic"}, "elastic");
-      w.params = ElasticWall::parse(t);
+      w.model = t.choice_or("interaction", model_names(ModelKind::wall), "elastic");
+      w.params = find_model(w.model, ModelKind::wall)->parse(t);
       w.tags = t.integers_or("tags", {});
       if (const auto* m = t.subtable("motion")) {
         TableReader tm(*m, label, fmt::format("walls[{}].motion", k));

@@ -10,6 +10,7 @@
 
 #include "basalt/solver/core/errors.hpp"
 #include "basalt/solver/integrate/integrators.hpp"
+#include "basalt/solver/models/registry.hpp"
 
 namespace basalt::solver {
 
@@ -32,11 +33,9 @@ bool tags_match(const TagFilter& t, std::int64_t ta, std::int64_t tb) {
 
 template <class Real>
 Simulation<Real>::Simulation(const Scene& scene, io::Geometry g, MPI_Comm comm, const RunOptions& options)
-    : scene_(scene),
-      options_(options),
-      bond_driver_(scene.bonds),
-      pair_driver_(scene.contacts),
-      wall_driver_(scene.walls) {
+    : scene_(scene), options_(options), walls_(scene.walls) {
+  make_computes();
+  p_.with_exact_rebuild = scene.checkpoint_every > 0;
   if (g.size() == 0)
     throw InputError(fmt::format("{}: the geometry has no particles", scene.geometry.string()));
   if (scene.bonds.size() > 254) throw InputError("interactions: at most 254 bond groups");
@@ -49,6 +48,47 @@ Simulation<Real>::Simulation(const Scene& scene, io::Geometry g, MPI_Comm comm, 
   rebuild();
   const auto pe = compute_forces<true>();
   energy0_ = total_energy(pe);
+}
+
+template <class Real>
+void Simulation<Real>::make_computes() {
+  computes_ = make_force_computes<Real>(scene_);
+  for (auto& c : computes_) {
+    if (c->kind() == ModelKind::bond) bond_compute_ = c.get();
+    if (c->kind() == ModelKind::pair) pair_computes_.push_back(c.get());
+  }
+  for (const auto& g : scene_.contacts) {
+    std::size_t k = 0;
+    while (pair_computes_[k]->model() != g.model) ++k;
+    pair_group_compute_.push_back(static_cast<int>(k));
+  }
+  pairs_take_all_ = scene_.contacts.size() == 1 && scene_.contacts[0].tags.empty();
+  // Checkpoints store all contact histories in one table of one width.
+  std::size_t width = 0;
+  for (const auto* c : pair_computes_) {
+    const auto b = c->history_bytes();
+    if (b && width && b != width)
+      throw InputError(
+          "interactions: contact models with histories of different sizes in one scene are not supported "
+          "yet");
+    width = std::max(width, b);
+  }
+}
+
+template <class Real>
+int Simulation<Real>::pair_taker(std::int64_t ti, std::int64_t tj) const {
+  for (std::size_t g = 0; g < scene_.contacts.size(); ++g) {
+    const auto& t = scene_.contacts[g].tags;
+    if (t.empty() || (t[0] == ti && t[1] == tj) || (t[0] == tj && t[1] == ti)) return pair_group_compute_[g];
+  }
+  return -1;
+}
+
+template <class Real>
+std::vector<ContactRecords*> Simulation<Real>::pending_history() {
+  std::vector<ContactRecords*> r;
+  for (auto* c : pair_computes_) r.push_back(c->pending());
+  return r;
 }
 
 template <class Real>
@@ -77,8 +117,16 @@ std::array<double, 4> Simulation<Real>::energies() {
 }
 
 template <class Real>
+std::int64_t Simulation<Real>::local_bond_count() const {
+  auto c = static_cast<std::int64_t>(bonds_.n_both_owned);
+  for (std::size_t k = bonds_.n_both_owned; k < bonds_.size(); ++k)
+    c += p_.id[static_cast<std::size_t>(bonds_.ia[k])] < p_.id[static_cast<std::size_t>(bonds_.ib[k])];
+  return c;
+}
+
+template <class Real>
 std::int64_t Simulation<Real>::bond_count() const {
-  return comm().sum(static_cast<long long>(BondDriver<Real, LinearBond>::count(p_, bonds_)));
+  return comm().sum(static_cast<long long>(local_bond_count()));
 }
 
 template <class Real>
@@ -88,8 +136,8 @@ void Simulation<Real>::check_stability(const io::Geometry& g) {
     m_min = std::min(m_min, particle_mass(g, i, scene_.density));
     rmax = std::max(rmax, g.radius[i]);
   }
-  const double k_max = std::max({double(bond_driver_.max_stiffness()), double(pair_driver_.max_stiffness()),
-                                 double(wall_driver_.max_stiffness(Real(rmax)))});
+  double k_max = 0;
+  for (const auto& c : computes_) k_max = std::max(k_max, c->max_stiffness(rmax));
   stability_.m_min = m_min;
   stability_.k_max = k_max;
   if (k_max <= 0) return;
@@ -145,7 +193,7 @@ void Simulation<Real>::distribute(io::Geometry& g, MPI_Comm comm) {
     longest = std::max(longest, distance(g.position[ia], g.position[ib]));
   }
   unassigned_bonds_ = unassigned;
-  ghost_width_ = std::max(pair_driver_.empty() ? 0.0 : 2 * rmax, longest) + scene_.skin;
+  ghost_width_ = std::max(pair_computes_.empty() ? 0.0 : 2 * rmax, longest) + scene_.skin;
   contact_cutoff_ = 2 * rmax + scene_.skin;
   if (dec_->min_interior_width() < ghost_width_)
     throw InputError(fmt::format(
@@ -174,9 +222,8 @@ void Simulation<Real>::distribute(io::Geometry& g, MPI_Comm comm) {
     const auto& b = g.bonds[k];
     const auto ia = static_cast<std::size_t>(g.index_of(b.a)), ib = static_cast<std::size_t>(g.index_of(b.b));
     if (!owned[ia] && !owned[ib]) continue;
-    const auto& params = scene_.bonds[bond_group[k]].params;
-    const double r0 =
-        LinearBond::rest_length(params, g.radius[ia], g.radius[ib], distance(g.position[ia], g.position[ib]));
+    const double r0 = bond_compute_->rest_length(bond_group[k], g.radius[ia], g.radius[ib],
+                                                 distance(g.position[ia], g.position[ib]));
     bonds_.push(b.a, b.b, Real(r0), bond_group[k]);
   }
   std::vector<io::Bond>().swap(g.bonds);
@@ -290,9 +337,10 @@ void Simulation<Real>::rebuild() {
   const bool parallel = comm().size() > 1;
   if (parallel) error = comm().agree_error(error);
   if (error) stop(*error);
+  for (auto* c : pair_computes_) c->save_history(p_);  // before the ghosts (and the pairs' ids) go
   p_.drop_ghosts();
   if (parallel) {
-    error = halo_->migrate(p_, bonds_);
+    error = halo_->migrate(p_, bonds_, pending_history());
     error = comm().agree_error(error);
     if (error) stop(*error);
     const long long total = comm().sum(static_cast<long long>(p_.n_owned));
@@ -306,7 +354,7 @@ void Simulation<Real>::rebuild() {
   if (parallel) halo_->build_ghosts(p_, ghost_width_);
   times_.communication += sw.lap();
   resolve_bonds();
-  if (!pair_driver_.empty()) {
+  if (!pair_computes_.empty()) {
     // Cells half the longest cutoff: each particle searches only as far as it can reach (a third or a
     // quarter measured slower on the 30 mm cube: more rows to step through).
     grid_.size_to(p_.x, p_.y, p_.z, p_.size(), contact_cutoff_ / 2);
@@ -314,30 +362,32 @@ void Simulation<Real>::rebuild() {
     ghost_grid_.size_like(grid_);
     ghost_grid_.fill(p_.x, p_.y, p_.z, p_.n_owned, p_.size());
     exclusions_.bind(bond_bucket_end_, bonds_.ib, p_.n_owned);
-    if (pair_driver_.takes_all()) {
+    if (pairs_take_all_) {
       build_pair_lists(
           p_, grid_, ghost_grid_, scene_.skin, exclusions_, [](std::size_t, std::size_t) { return true; },
           own_, ghost_);
     } else {
-      auto accept = [this](std::size_t i, std::size_t j) {
-        return pair_driver_.group_of(p_.tag[i], p_.tag[j]) >= 0;
-      };
+      auto accept = [this](std::size_t i, std::size_t j) { return pair_taker(p_.tag[i], p_.tag[j]) >= 0; };
       build_pair_lists(p_, grid_, ghost_grid_, scene_.skin, exclusions_, accept, own_, ghost_);
     }
     std::vector<std::uint32_t>().swap(bond_bucket_end_);
+    const PairLists<Real> lists{
+        p_, own_, ghost_, pair_computes_.size(),
+        [this](std::size_t i, std::size_t j) { return pair_taker(p_.tag[i], p_.tag[j]); }};
+    for (std::size_t k = 0; k < pair_computes_.size(); ++k) pair_computes_[k]->rebuild(lists, k);
   }
   grid_.release();
   ghost_grid_.release();
-  if (!wall_driver_.empty()) wall_driver_.rebuild(p_, scene_.skin);
+  if (!walls_.empty()) walls_.rebuild(p_, scene_.skin);
   for (std::size_t i = 0; i < p_.n_owned; ++i) {
     p_.x0[i] = float(p_.x[i]);
     p_.y0[i] = float(p_.y[i]);
     p_.z0[i] = float(p_.z[i]);
   }
-  if (scene_.checkpoint_every > 0) {  // exact copies for the checkpoints (x0 is float); memory only then
-    xr_.assign(p_.x.begin(), p_.x.begin() + static_cast<std::ptrdiff_t>(p_.n_owned));
-    yr_.assign(p_.y.begin(), p_.y.begin() + static_cast<std::ptrdiff_t>(p_.n_owned));
-    zr_.assign(p_.z.begin(), p_.z.begin() + static_cast<std::ptrdiff_t>(p_.n_owned));
+  if (p_.with_exact_rebuild) {  // exact copies for the checkpoints (x0 is float); memory only then
+    p_.xr.assign(p_.x.begin(), p_.x.begin() + static_cast<std::ptrdiff_t>(p_.n_owned));
+    p_.yr.assign(p_.y.begin(), p_.y.begin() + static_cast<std::ptrdiff_t>(p_.n_owned));
+    p_.zr.assign(p_.z.begin(), p_.z.begin() + static_cast<std::ptrdiff_t>(p_.n_owned));
   }
   rebuild_step_ = step_;
   bond_broke_ = false;
@@ -351,30 +401,31 @@ void Simulation<Real>::rebuild() {
 
 template <class Real>
 template <bool Energy>
-std::array<double, 3> Simulation<Real>::compute_forces(bool ghosts_in_flight) {
+std::array<double, 3> Simulation<Real>::compute_forces(bool ghosts_in_flight, bool advance) {
   // Interactions among owned particles first: a ghost update still in flight overlaps them.
   if (!forces_zeroed_) zero_forces(p_);
   forces_zeroed_ = false;
   std::array<double, 3> pe{0, 0, 0};
   const std::size_t before = broken_.size();
-  const bool bonds = bonds_.size() > 0, pairs = !pair_driver_.empty();
-  if (bonds) pe[0] += bond_driver_.template compute_part<Energy, true>(p_, bonds_, broken_);
-  if (ghosts_in_flight) halo_->progress_ghosts();  // the neighbours' posts have arrived by now
-  if (pairs) pe[1] += pair_driver_.template compute<Energy, true>(p_, own_);
-  if (!wall_driver_.empty()) {
-    wall_driver_.move_to(time_);
-    pe[2] = wall_driver_.template compute<Energy>(p_);
+  if (!walls_.empty()) walls_.move_to(time_);
+  ForceState<Real> state{p_, bonds_, broken_, walls_};
+  // pe[kind]: bond, pair, wall energies. Bond models come first in the list: by the time the pair
+  // models start, the neighbours' ghost posts have arrived and one poke moves them along.
+  bool poked = !ghosts_in_flight;
+  for (auto& c : computes_) {
+    if (!poked && c->kind() != ModelKind::bond) {
+      halo_->progress_ghosts();
+      poked = true;
+    }
+    pe[static_cast<std::size_t>(c->kind())] += c->compute(state, Part::owned, Energy, advance);
   }
   if (ghosts_in_flight) {
     Stopwatch sw;
     halo_->end_update_ghosts(p_);
     ghost_wait_ += sw.lap();
   }
-  if (bonds) {
-    pe[0] += bond_driver_.template compute_part<Energy, false>(p_, bonds_, broken_);
-    bond_driver_.commit(bonds_);
-  }
-  if (pairs) pe[1] += pair_driver_.template compute<Energy, false>(p_, ghost_);
+  for (auto& c : computes_)
+    pe[static_cast<std::size_t>(c->kind())] += c->compute(state, Part::ghost, Energy, advance);
   if (broken_.size() != before) bond_broke_ = true;  // the lists must learn the pair is now unbonded
   for (std::size_t k = before; k < broken_.size(); ++k) broken_[k].step = step_;
   return pe;
@@ -407,10 +458,9 @@ void Simulation<Real>::step(FieldSink* sink) {
   forces_zeroed_ = true;
   times_.integration += sw.lap();
   const bool parallel = comm().size() > 1;
-  if (!wall_driver_.empty()) wall_driver_.move_to(double(step_ + 1) * scene_.dt);
-  double need = bond_broke_
-                    ? std::numeric_limits<double>::infinity()
-                    : std::max(moved2, wall_driver_.empty() ? 0.0 : wall_driver_.moved2_since_rebuild());
+  if (!walls_.empty()) walls_.move_to(double(step_ + 1) * scene_.dt);
+  double need = bond_broke_ ? std::numeric_limits<double>::infinity()
+                            : std::max(moved2, walls_.empty() ? 0.0 : walls_.moved2_since_rebuild());
   if (parallel) need = comm().max(need);
   times_.communication += sw.lap();
   bool in_flight = false;
@@ -427,7 +477,7 @@ void Simulation<Real>::step(FieldSink* sink) {
   time_ = double(step_) * scene_.dt;
   const bool energy = energy_due(step_);
   ghost_wait_ = 0;
-  const auto pe = energy ? compute_forces<true>(in_flight) : compute_forces<false>(in_flight);
+  const auto pe = energy ? compute_forces<true>(in_flight, true) : compute_forces<false>(in_flight, true);
   const double force_time = sw.lap();
   times_.forces += force_time - ghost_wait_;
   times_.communication += ghost_wait_;
@@ -440,7 +490,7 @@ void Simulation<Real>::step(FieldSink* sink) {
     }
   }
   times_.integration += sw.lap();
-  if (!wall_driver_.empty()) wall_work_in_ += std::max(0.0, wall_driver_.power(time_)) * scene_.dt;
+  if (!walls_.empty()) wall_work_in_ += std::max(0.0, walls_.power(time_)) * scene_.dt;
   save_fields(sink, pe);
   times_.output += sw.lap();
   if (scene_.energy_check_every > 0 && step_ % scene_.energy_check_every == 0) guard_energy(pe);
@@ -569,13 +619,7 @@ std::size_t Simulation<Real>::memory_bytes() const {
   auto add = [&](const auto& v) {
     b += v.capacity() * sizeof(typename std::decay_t<decltype(v)>::value_type);
   };
-  for (const auto* v :
-       {&p_.x, &p_.y, &p_.z, &p_.radius, &p_.vx, &p_.vy, &p_.vz, &p_.fx, &p_.fy, &p_.fz, &p_.inv_mass})
-    add(*v);
-  for (const auto* v : {&p_.x0, &p_.y0, &p_.z0}) add(*v);
-  for (const auto* v : {&xr_, &yr_, &zr_}) add(*v);
-  add(p_.id);
-  add(p_.tag);
+  b += p_.memory_bytes();
   add(bonds_.a);
   add(bonds_.b);
   add(bonds_.r0);
@@ -583,7 +627,8 @@ std::size_t Simulation<Real>::memory_bytes() const {
   add(bonds_.ia);
   add(bonds_.ib);
   b += own_.memory_bytes() + ghost_.memory_bytes() + ids_.memory_bytes() + halo_->memory_bytes() +
-       wall_driver_.memory_bytes();
+       walls_.memory_bytes();
+  for (const auto& c : computes_) b += c->memory_bytes();
   return b;
 }
 

@@ -17,7 +17,7 @@ SimulationFrame<Real>::SimulationFrame(const Simulation<Real>& sim, std::uint32_
   h.source_rank = sim.comm().rank();
   h.particles = p.n_owned;
   // Owned particles now are those of the last rebuild (only a rebuild migrates or reorders them).
-  h.with_rebuild = (kinds & io::kFrameCheckpoint) && sim.xr_.size() == p.n_owned;
+  h.with_rebuild = (kinds & io::kFrameCheckpoint) && p.with_exact_rebuild && p.xr.size() == p.n_owned;
   if (h.with_rebuild) {
     h.rebuild_step = sim.rebuild_step_;
     h.rebuild_pending = sim.bond_broke_;
@@ -25,8 +25,16 @@ SimulationFrame<Real>::SimulationFrame(const Simulation<Real>& sim, std::uint32_
   std::size_t m = bonds.n_both_owned + sim.broken_.size();
   for (std::size_t k = bonds.n_both_owned; k < bonds.size(); ++k) m += owns_ghost_bond(k) ? 1 : 0;
   h.bonds = m;
+  if (kinds & io::kFrameCheckpoint)
+    for (const auto* c : sim.pair_computes_)
+      if (c->history_bytes() > 0) {
+        history_.emplace_back();
+        c->history_records(p, history_.back());
+        h.contacts += history_.back().size();
+        h.contact_width = static_cast<std::uint32_t>(history_.back().width);
+      }
   // Walls: global; the force is summed over the ranks (collective), rank 0 carries them.
-  const auto& wd = sim.wall_driver_;
+  const auto& wd = sim.walls_;
   if (wd.size() > 0) {
     std::vector<double> f;
     for (std::size_t w = 0; w < wd.size(); ++w) f.insert(f.end(), wd.force(w).begin(), wd.force(w).end());
@@ -66,9 +74,9 @@ void SimulationFrame<Real>::write(io::FrameWriter& w) const {
   w.column(Column::radius, owned(p.radius));
   w.column(Column::mass, owned(p.inv_mass));
   if (header_.with_rebuild) {
-    w.column(Column::x_rebuild, sim_.xr_);
-    w.column(Column::y_rebuild, sim_.yr_);
-    w.column(Column::z_rebuild, sim_.zr_);
+    w.column(Column::x_rebuild, std::span(p.xr.data(), n));
+    w.column(Column::y_rebuild, std::span(p.yr.data(), n));
+    w.column(Column::z_rebuild, std::span(p.zr.data(), n));
   }
   // Bonds with both ends owned come first and go as they are; the bond tag carries the solver's
   // interaction group (restart).
@@ -100,6 +108,15 @@ void SimulationFrame<Real>::write(io::FrameWriter& w) const {
     w.set(Column::bond_group, at, broken.group);
     w.set(Column::bond_broken, at, broken.step == sim_.step_ ? 2 : 1);
     ++at;
+  }
+  std::size_t c = 0;
+  for (std::size_t model = 0; model < history_.size(); ++model) {
+    const auto& r = history_[model];
+    w.column(Column::contact_a, r.a, c);
+    w.column(Column::contact_b, r.b, c);
+    w.fill(Column::contact_model, c, r.size(), static_cast<std::int32_t>(model));
+    w.column(Column::contact_history, r.values, c * header_.contact_width);
+    c += r.size();
   }
   for (const auto& wall : walls_) w.wall(wall);
 }

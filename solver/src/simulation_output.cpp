@@ -43,12 +43,12 @@ bool Simulation<Real>::field_partials(const std::array<double, 3>& pe, std::vect
         local.push_back(pe[2]);
         break;
       case FieldSpec::Type::bond_count:
-        local.push_back(double(BondDriver<Real, LinearBond>::count(p_, bonds_)));
+        local.push_back(double(local_bond_count()));
         break;
       case FieldSpec::Type::wall_force: {
         std::size_t w = 0;
-        while (wall_driver_.spec(w).name != f.wall) ++w;
-        const auto& fw = wall_driver_.force(w);
+        while (walls_.spec(w).name != f.wall) ++w;
+        const auto& fw = walls_.force(w);
         local.insert(local.end(), fw.begin(), fw.end());
         break;
       }

@@ -16,11 +16,9 @@ namespace basalt::solver {
 template <class Real>
 Simulation<Real>::Simulation(const Scene& scene, const io::Checkpoint& c, const RestartLayout& layout,
                              MPI_Comm comm, const RunOptions& options)
-    : scene_(scene),
-      options_(options),
-      bond_driver_(scene.bonds),
-      pair_driver_(scene.contacts),
-      wall_driver_(scene.walls) {
+    : scene_(scene), options_(options), walls_(scene.walls) {
+  make_computes();
+  p_.with_exact_rebuild = scene.checkpoint_every > 0;
   if (c.size() == 0) throw InputError("the checkpoint has no particles");
   if (scene.bonds.size() > 254) throw InputError("interactions: at most 254 bond groups");
   if (c.dt != scene.dt)
@@ -41,7 +39,7 @@ Simulation<Real>::Simulation(const Scene& scene, const io::Checkpoint& c, const 
                  "older basalt-run): the lists are rebuilt at step {}, so the continuation agrees with the "
                  "uninterrupted run to rounding only\n",
                  step_);
-    if (!wall_driver_.empty()) wall_driver_.move_to(double(step_) * scene.dt);
+    if (!walls_.empty()) walls_.move_to(double(step_) * scene.dt);
     rebuild();
   }
   const auto pe = compute_forces<true>();
@@ -103,6 +101,25 @@ void Simulation<Real>::distribute_checkpoint(const io::Checkpoint& c, const Rest
                       b.a, b.b, b.tag, scene_.bonds.size()));
     bonds_.push(b.a, b.b, Real(c.bond_rest_length[k]), static_cast<std::uint8_t>(b.tag));
   }
+  // Contact history of the contacts with an owned end waits for the (replayed) rebuild to find
+  // their pairs in the lists.
+  std::vector<ContactRecords*> history;
+  for (auto* pc : pair_computes_)
+    if (pc->pending()) history.push_back(pc->pending());
+  for (std::size_t k = 0; k < c.contact_ids.size(); ++k) {
+    const auto model = static_cast<std::size_t>(c.contact_model[k]);
+    if (model >= history.size() || c.contact_width != history[model]->width)
+      throw InputError(fmt::format(
+          "the checkpoint's contact {}-{} has a history of {} values for contact model {}, but the scene's "
+          "contact models with history are {} ({} values)",
+          c.contact_ids[k][0], c.contact_ids[k][1], c.contact_width, model, history.size(),
+          history.empty() ? 0 : history.front()->width));
+    const auto ia = static_cast<std::size_t>(g.index_of(c.contact_ids[k][0]));
+    const auto ib = static_cast<std::size_t>(g.index_of(c.contact_ids[k][1]));
+    if (owned[ia] || owned[ib])
+      history[model]->push(c.contact_ids[k][0], c.contact_ids[k][1],
+                           c.contact_history.data() + k * c.contact_width);
+  }
   step_ = c.step;
   time_ = c.time;
 }
@@ -116,7 +133,7 @@ void Simulation<Real>::replay_rebuild(const io::Checkpoint& c) {
   const auto& g = c.geometry;
   const std::int64_t now = step_;
   step_ = c.rebuild_step;
-  if (!wall_driver_.empty()) wall_driver_.move_to(double(c.rebuild_step) * scene_.dt);
+  if (!walls_.empty()) walls_.move_to(double(c.rebuild_step) * scene_.dt);
   rebuild();
   step_ = now;
   // Back to the checkpoint's positions; the ghosts follow as after any step without a rebuild.

@@ -4,6 +4,8 @@
 #include <string>
 
 #include "basalt/solver/core/errors.hpp"
+#include "basalt/solver/models/elastic_wall.hpp"
+#include "basalt/solver/models/linear_bond.hpp"
 #include "basalt/solver/scene/scene.hpp"
 #include "solver_helpers.hpp"
 #include "test_support.hpp"
@@ -58,18 +60,18 @@ TEST(Scene, ShippedScenesParse) {
     EXPECT_EQ(field_columns(s), std::vector<std::string>{"kinetic_energy"});
   }
   const auto esys = parse_scene(basalt::test::source_dir() / "scenes" / "wave-esys.toml");
-  EXPECT_EQ(esys.bonds[0].params.rest_length, LinearBond::RestLength::sum_of_radii);
-  EXPECT_EQ(esys.walls[0].params.stiffness, ElasticWall::Stiffness::esys_pi_r);
+  EXPECT_EQ(esys.bonds[0].params_of<LinearBond>().rest_length, LinearBond::RestLength::sum_of_radii);
+  EXPECT_EQ(esys.walls[0].params_of<ElasticWall>().stiffness, ElasticWall::Stiffness::esys_pi_r);
   EXPECT_EQ(esys.integrator, Integrator::symplectic_euler);
   const auto wave = parse_scene(basalt::test::source_dir() / "scenes" / "wave.toml");
-  EXPECT_EQ(wave.bonds[0].params.rest_length, LinearBond::RestLength::initial_distance);
+  EXPECT_EQ(wave.bonds[0].params_of<LinearBond>().rest_length, LinearBond::RestLength::initial_distance);
   EXPECT_EQ(wave.geometry, basalt::test::source_dir() / "scenes" / "../out/cube.h5");
 }
 
 TEST(Scene, GoodSceneValues) {
   const auto s = basalt::test::scene_from(kGood);
   EXPECT_DOUBLE_EQ(s.walls[0].normal[2], 1.0);  // normalised
-  EXPECT_TRUE(std::isinf(s.bonds[0].params.break_strain));
+  EXPECT_TRUE(std::isinf(s.bonds[0].params_of<LinearBond>().break_strain));
   EXPECT_EQ(s.integrator, Integrator::velocity_verlet);
 }
 

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <numeric>
 #include <stdexcept>
+#include <tuple>
 #include <type_traits>
 
 namespace basalt::io {
@@ -79,6 +80,9 @@ void FramePiece::clear() {
   bonds.clear();
   bond_rest_length.clear();
   bond_broken.clear();
+  contact_ids.clear();
+  contact_model.clear();
+  contact_history.clear();
   walls.clear();
 }
 
@@ -95,6 +99,9 @@ FrameHeader PieceSource::header() const {
   const std::size_t m = p_.bonds.size();
   if (p_.bond_rest_length.size() != m || p_.bond_broken.size() != m)
     throw std::invalid_argument("frame piece: bond arrays differ in length");
+  const std::size_t nc = p_.contact_ids.size();
+  if (p_.contact_model.size() != nc || p_.contact_history.size() != nc * p_.contact_width)
+    throw std::invalid_argument("frame piece: contact arrays differ in length");
   FrameHeader h;
   h.kinds = p_.kinds;
   h.step = p_.step;
@@ -103,6 +110,8 @@ FrameHeader PieceSource::header() const {
   h.source_rank = p_.source_rank;
   h.particles = n;
   h.bonds = m;
+  h.contacts = nc;
+  h.contact_width = static_cast<std::uint32_t>(p_.contact_width);
   h.inverse_mass = !p_.inv_mass.empty();
   h.with_rebuild = !p_.position_at_rebuild.empty();
   h.rebuild_step = p_.rebuild_step;
@@ -134,6 +143,12 @@ void PieceSource::write(FrameWriter& w) const {
   }
   w.column(Column::bond_rest_length, p_.bond_rest_length);
   w.column(Column::bond_broken, p_.bond_broken);
+  for (std::size_t k = 0; k < p_.contact_ids.size(); ++k) {
+    w.set(Column::contact_a, k, p_.contact_ids[k][0]);
+    w.set(Column::contact_b, k, p_.contact_ids[k][1]);
+  }
+  w.column(Column::contact_model, p_.contact_model);
+  w.column(Column::contact_history, p_.contact_history);
   for (const auto& wall : p_.walls) w.wall(wall);
 }
 
@@ -218,6 +233,13 @@ FramePiece deserialize(std::span<const std::byte> bytes) {
                   col.at<std::int32_t>(Column::bond_group, k)};
   col.all(Column::bond_rest_length, p.bond_rest_length);
   col.all(Column::bond_broken, p.bond_broken);
+  p.contact_ids.resize(h.contacts);
+  for (std::size_t k = 0; k < h.contacts; ++k)
+    p.contact_ids[k] = {col.at<std::int64_t>(Column::contact_a, k),
+                        col.at<std::int64_t>(Column::contact_b, k)};
+  col.all(Column::contact_model, p.contact_model);
+  p.contact_width = h.contact_width;
+  col.all(Column::contact_history, p.contact_history);
 
   Reader r(bytes.subspan(layout.walls));
   const auto n_walls = r.value<std::uint64_t>();
@@ -350,6 +372,30 @@ Checkpoint assemble(std::vector<FramePiece>& pieces, const RunInfo& run) {
     g.bonds.push_back(row.b);
     c.bond_rest_length.push_back(row.rest);
     c.bond_broken.push_back(row.broken);
+  }
+
+  // Contacts sorted by (model, pair), whatever rank listed them.
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> contacts;
+  for (std::uint32_t k = 0; k < pieces.size(); ++k) {
+    const auto& p = pieces[k];
+    if (!p.contact_ids.empty() && c.contact_width != 0 && p.contact_width != c.contact_width)
+      throw std::runtime_error("assemble: pieces with different contact history widths");
+    if (!p.contact_ids.empty()) c.contact_width = p.contact_width;
+    for (std::uint32_t i = 0; i < p.contact_ids.size(); ++i) contacts.push_back({k, i});
+  }
+  const auto contact_key = [&](const std::pair<std::uint32_t, std::uint32_t>& e) {
+    const auto& p = pieces[e.first];
+    const auto& ids = p.contact_ids[e.second];
+    return std::tuple(p.contact_model[e.second], std::min(ids[0], ids[1]), std::max(ids[0], ids[1]));
+  };
+  std::sort(contacts.begin(), contacts.end(),
+            [&](const auto& x, const auto& y) { return contact_key(x) < contact_key(y); });
+  for (const auto& [k, i] : contacts) {
+    const auto& p = pieces[k];
+    c.contact_ids.push_back(p.contact_ids[i]);
+    c.contact_model.push_back(p.contact_model[i]);
+    const auto* v = p.contact_history.data() + i * p.contact_width;
+    c.contact_history.insert(c.contact_history.end(), v, v + p.contact_width);
   }
 
   for (const auto& p : pieces)

@@ -2,6 +2,7 @@
 // A checkpoint: the full restartable state of a run at one step, as written by the I/O layer
 // (schema "basalt-checkpoint" version 1, docs/formats.md). It extends the geometry schema:
 // the same /particles group (sorted by id) plus velocities, the bond state and the run's clock.
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -41,6 +42,16 @@ struct Checkpoint {
   std::vector<std::uint8_t> bond_broken;
 
   std::vector<WallState> walls;
+
+  /// Per-contact history of the contact models that keep one (/contacts, optional): one row per
+  /// contact whose history differs from a new contact's, each contact once. contact_ids[k] is the pair
+  /// (the history belongs to the orientation first -> second), contact_model[k] the index of the pair
+  /// model among the scene's pair models that keep history, contact_history the model's History as
+  /// contact_width float64 values per contact.
+  std::vector<std::array<std::int64_t, 2>> contact_ids;
+  std::vector<std::int32_t> contact_model;
+  std::size_t contact_width = 0;
+  std::vector<double> contact_history;
 
   std::int64_t step = 0;
   double time = 0;

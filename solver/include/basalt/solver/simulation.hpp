@@ -16,9 +16,8 @@
 #include "basalt/solver/core/bonds.hpp"
 #include "basalt/solver/core/id_map.hpp"
 #include "basalt/solver/core/particles.hpp"
-#include "basalt/solver/interactions/bond_driver.hpp"
-#include "basalt/solver/interactions/pair_driver.hpp"
-#include "basalt/solver/interactions/wall_driver.hpp"
+#include "basalt/solver/interactions/force_compute.hpp"
+#include "basalt/solver/interactions/walls.hpp"
 #include "basalt/solver/neighbor/verlet_list.hpp"
 #include "basalt/solver/output/field_sink.hpp"
 #include "basalt/solver/output/output_sink.hpp"
@@ -105,6 +104,9 @@ class Simulation {
   std::int64_t last_rebuild_step() const { return rebuild_step_; }
   std::int64_t total_particles() const { return n_global_; }
   double ghost_width() const { return ghost_width_; }
+  /// The force computes, one per model the scene uses (bond, pair, wall models in that order).
+  const std::vector<std::unique_ptr<ForceCompute<Real>>>& force_computes() const { return computes_; }
+  const Walls& walls() const { return walls_; }
   /// Geometry bonds that no bond group takes (they exert no force).
   std::size_t unassigned_bonds() const { return unassigned_bonds_; }
   const std::vector<BrokenBond>& broken_bonds() const { return broken_; }
@@ -128,6 +130,8 @@ class Simulation {
   void report_frame_times(std::vector<double> seconds) const;
   void distribute(io::Geometry& g, MPI_Comm comm);
   double kinetic_energy_local() const;
+  /// Bonds of this rank counted once across ranks (a bond to a ghost by the rank owning the lower id).
+  std::int64_t local_bond_count() const;
   double total_energy(const std::array<double, 3>& pe) const;
   void progress(std::int64_t done, std::int64_t total, double seconds) const;
   void check_stability(const io::Geometry& g);
@@ -137,8 +141,15 @@ class Simulation {
   std::optional<std::string> check_finite() const;
   /// Forces at the current positions; ghosts_in_flight: a ghost update was begun and is completed
   /// after the owned-only interactions.
+  /// advance: a real step (contact history moves on); forces computed outside steps only read it.
   template <bool Energy>
-  std::array<double, 3> compute_forces(bool ghosts_in_flight = false);
+  std::array<double, 3> compute_forces(bool ghosts_in_flight = false, bool advance = false);
+  void make_computes();
+  /// Which pair compute takes a pair of particles with these tags (the first pair group that takes
+  /// them, in scene order), or -1.
+  int pair_taker(std::int64_t ti, std::int64_t tj) const;
+  /// History records of the force computes waiting for a rebuild (null entries: no history).
+  std::vector<ContactRecords*> pending_history();
   void save_fields(FieldSink* sink, const std::array<double, 3>& pe);
   bool field_partials(const std::array<double, 3>& pe, std::vector<double>& local,
                       std::vector<char>& due) const;
@@ -167,9 +178,12 @@ class Simulation {
   Particles<Real> p_;
   Bonds<Real> bonds_;
   IdMap ids_;
-  BondDriver<Real, LinearBond> bond_driver_;
-  PairDriver<Real, LinearElastic> pair_driver_;
-  WallDriver<Real, ElasticWall> wall_driver_;
+  Walls walls_;
+  std::vector<std::unique_ptr<ForceCompute<Real>>> computes_;
+  ForceCompute<Real>* bond_compute_ = nullptr;  ///< the bond model's compute (rest lengths), if any
+  std::vector<ForceCompute<Real>*> pair_computes_;
+  std::vector<int> pair_group_compute_;  ///< for each scene pair group, its compute in pair_computes_
+  bool pairs_take_all_ = false;          ///< one pair group, every tag
   PairList own_, ghost_;
   CellGrid grid_, ghost_grid_;  ///< owned and ghost particles in the same cells (rebuilds only)
   Exclusions exclusions_;
@@ -194,11 +208,8 @@ class Simulation {
   bool ke_fresh_ = false;       ///< set when the second half-kick computed ke_local_ this step
   bool forces_zeroed_ = false;  ///< set by the fused kick-zero-drift pass
   StabilityReport stability_;
-  OutputSink* output_ = nullptr;  ///< set during run(steps, OutputSink&)
-  /// Owned positions at the last rebuild, exactly (x0 is only a float copy) and that rebuild's step:
-  /// checkpoints store them so that a restart can replay the rebuild.
-  std::vector<Real> xr_, yr_, zr_;
-  std::int64_t rebuild_step_ = 0;
+  OutputSink* output_ = nullptr;   ///< set during run(steps, OutputSink&)
+  std::int64_t rebuild_step_ = 0;  ///< step of the last rebuild (checkpoints store it with p_.xr, yr, zr)
 };
 
 extern template class Simulation<double>;

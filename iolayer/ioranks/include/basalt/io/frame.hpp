@@ -45,6 +45,12 @@ struct FramePiece {
   std::vector<double> bond_rest_length;
   std::vector<std::uint8_t> bond_broken;
 
+  // Contact history this rank is responsible for (each contact in exactly one piece).
+  std::vector<std::array<std::int64_t, 2>> contact_ids;
+  std::vector<std::int32_t> contact_model;
+  std::size_t contact_width = 0;
+  std::vector<double> contact_history;
+
   // Global, identical on every rank; only the piece of compute rank 0 needs to carry them.
   std::vector<WallState> walls;
 

@@ -31,9 +31,11 @@ struct FrameHeader {
   std::int64_t step = 0;
   double time = 0;
   double dt = 0;
-  std::int32_t source_rank = 0;  ///< compute rank that wrote it
-  std::uint64_t particles = 0;   ///< length of the particle columns
-  std::uint64_t bonds = 0;       ///< length of the bond columns
+  std::int32_t source_rank = 0;     ///< compute rank that wrote it
+  std::uint64_t particles = 0;      ///< length of the particle columns
+  std::uint64_t bonds = 0;          ///< length of the bond columns
+  std::uint64_t contacts = 0;       ///< length of the contact columns (contacts with a history)
+  std::uint32_t contact_width = 0;  ///< float64 values of history per contact
   /// true: Column::mass holds 1 / mass as the solver holds it (the reader derives the mass, and a
   /// restart gets the same bits); false: it holds the mass and there is no inverse mass.
   bool inverse_mass = true;
@@ -65,12 +67,16 @@ enum class Column : std::uint8_t {
   bond_rest_length,
   bond_group,   ///< the bond's tag (the solver's interaction group)
   bond_broken,  ///< 0 or 1
+  contact_a,    ///< contact history: the pair (history oriented a -> b)
+  contact_b,
+  contact_model,    ///< index of the pair model (among those with history)
+  contact_history,  ///< contact_width values per contact
 };
-inline constexpr std::size_t kColumns = static_cast<std::size_t>(Column::bond_broken) + 1;
+inline constexpr std::size_t kColumns = static_cast<std::size_t>(Column::contact_history) + 1;
 
 namespace wire {
 
-inline constexpr std::uint64_t kFrameMagic = 0x42534c5446524d32ULL;  // "BSLTFRM2"
+inline constexpr std::uint64_t kFrameMagic = 0x42534c5446524d33ULL;  // "BSLTFRM3"
 
 /// The header as it travels (all fields 8-byte slots: no padding).
 struct Header {
@@ -85,8 +91,10 @@ struct Header {
   std::uint32_t flags = 0;
   std::uint32_t rebuild_pending = 0;
   std::int64_t rebuild_step = -1;
+  std::uint64_t contacts = 0;
+  std::uint64_t contact_width = 0;
 };
-static_assert(sizeof(Header) == 72 && std::is_trivially_copyable_v<Header>);
+static_assert(sizeof(Header) == 88 && std::is_trivially_copyable_v<Header>);
 inline constexpr std::uint32_t kInverseMass = 1u << 0;
 inline constexpr std::uint32_t kWithRebuild = 1u << 1;
 
@@ -97,9 +105,12 @@ constexpr Type type_of(Column c) {
     case Column::id:
     case Column::bond_a:
     case Column::bond_b:
+    case Column::contact_a:
+    case Column::contact_b:
       return Type::i64;
     case Column::tag:
     case Column::bond_group:
+    case Column::contact_model:
       return Type::i32;
     case Column::bond_broken:
       return Type::u8;
@@ -108,7 +119,8 @@ constexpr Type type_of(Column c) {
   }
 }
 constexpr std::size_t size_of(Type t) { return t == Type::u8 ? 1 : t == Type::i32 ? 4 : 8; }
-constexpr bool is_bond(Column c) { return c >= Column::bond_a; }
+constexpr bool is_bond(Column c) { return c >= Column::bond_a && c <= Column::bond_broken; }
+constexpr bool is_contact(Column c) { return c >= Column::contact_a; }
 constexpr bool is_rebuild(Column c) { return c >= Column::x_rebuild && c <= Column::z_rebuild; }
 constexpr std::size_t align8(std::size_t n) { return (n + 7) & ~std::size_t(7); }
 
@@ -122,13 +134,17 @@ struct Layout {
   explicit Layout(const Header& h) {
     // A frame never comes near 2^40 entries; larger counts are a damaged buffer.
     constexpr std::uint64_t kMax = std::uint64_t(1) << 40;
-    if (h.particles > kMax || h.bonds > kMax)
-      throw std::runtime_error("frame: impossible particle or bond count");
+    if (h.particles > kMax || h.bonds > kMax || h.contacts > kMax || h.contact_width > 64)
+      throw std::runtime_error("frame: impossible particle, bond or contact count");
     std::size_t at = sizeof(Header);
     for (std::size_t k = 0; k < kColumns; ++k) {
       const auto c = static_cast<Column>(k);
       const bool present = !is_rebuild(c) || (h.flags & kWithRebuild);
-      length[k] = present ? (is_bond(c) ? h.bonds : h.particles) : 0;
+      length[k] = !present                       ? 0
+                  : is_bond(c)                   ? h.bonds
+                  : c == Column::contact_history ? h.contacts * h.contact_width
+                  : is_contact(c)                ? h.contacts
+                                                 : h.particles;
       offset[k] = at;
       at += align8(length[k] * size_of(type_of(c)));
     }
@@ -211,6 +227,8 @@ class FrameWriter {
     wire_.dt = h.dt;
     wire_.particles = h.particles;
     wire_.bonds = h.bonds;
+    wire_.contacts = h.contacts;
+    wire_.contact_width = h.contact_width;
     wire_.flags = (h.inverse_mass ? wire::kInverseMass : 0u) | (h.with_rebuild ? wire::kWithRebuild : 0u);
     wire_.rebuild_pending = h.rebuild_pending ? 1u : 0u;
     wire_.rebuild_step = h.rebuild_step;

@@ -3,11 +3,29 @@
 // (copies of other ranks' particles near this rank's faces) follow. Interactions work on these local
 // indices; global ids travel with the particles. Real is the floating-point type of positions,
 // velocities and forces (double by default).
+//
+// One list of arrays, for_each_array(), says what each array is: the field it belongs to, whether
+// ghosts have it too, whether it travels with a migrating particle, whether the scene may leave it
+// out. Growing, reordering and removing particles, migration and ghost records, the memory report
+// and the "fields:" line at start are all derived from that list: a new per-particle array is one
+// member plus one line there.
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
+#include <string>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 namespace basalt::solver {
+
+/// What an array of Particles is (for_each_array()).
+struct ArrayInfo {
+  std::string_view field;  ///< the field it is (part of): "position" for x, y and z
+  bool ghosts;             ///< owned and ghost particles have it (else owned only)
+  bool migrates;           ///< travels with a particle that changes rank (else recomputed there)
+  bool optional;           ///< only allocated when the scene asks (Particles::with_exact_rebuild)
+};
 
 template <class Real>
 struct Particles {
@@ -23,6 +41,20 @@ struct Particles {
   std::vector<Real> inv_mass;     ///< 1 / mass (the mass itself is mass(i))
   std::vector<float> x0, y0, z0;  ///< positions at the last neighbour-list rebuild (float: only
                                   ///< compared with half the skin)
+  /// Optional (with_exact_rebuild, i.e. checkpoints on): the same positions exactly, which a
+  /// checkpoint stores so that a restart can replay that rebuild (docs/ARCHITECTURE.md).
+  std::vector<Real> xr, yr, zr;
+  bool with_exact_rebuild = false;
+
+  /// Calls f(ArrayInfo, vector&) for every array, in a fixed order.
+  template <class F>
+  void for_each_array(F&& f) {
+    for_each(*this, f);
+  }
+  template <class F>
+  void for_each_array(F&& f) const {
+    for_each(*this, f);
+  }
 
   Real mass(std::size_t i) const { return Real(1) / inv_mass[i]; }
 
@@ -31,74 +63,128 @@ struct Particles {
 
   /// Resizes the arrays every particle has (owned + ghosts).
   void resize_all(std::size_t n) {
-    x.resize(n);
-    y.resize(n);
-    z.resize(n);
-    radius.resize(n);
-    id.resize(n);
-    tag.resize(n);
+    for_each_array([&](const ArrayInfo& a, auto& v) {
+      if (a.ghosts) v.resize(n);
+    });
   }
   /// Capacity for n owned particles (exact: no growth slack).
   void reserve_owned(std::size_t n) {
-    for (auto* v : {&x, &y, &z, &radius, &vx, &vy, &vz, &fx, &fy, &fz, &inv_mass}) v->reserve(n);
-    for (auto* v : {&x0, &y0, &z0}) v->reserve(n);
-    id.reserve(n);
-    tag.reserve(n);
-  }
-  /// Resizes the owned-only arrays.
-  void resize_owned(std::size_t n) {
-    for (auto* v : {&vx, &vy, &vz, &fx, &fy, &fz, &inv_mass}) v->resize(n);
-    for (auto* v : {&x0, &y0, &z0}) v->resize(n);
+    for_each_array([&](const ArrayInfo& a, auto& v) {
+      if (enabled(a)) v.reserve(n);
+    });
   }
   /// Drops ghosts, keeps owned particles.
   void drop_ghosts() { resize_all(n_owned); }
 
+  /// Appends an owned particle with every value zero and returns its index; requires no ghosts.
+  std::size_t append_owned() {
+    for_each_array([&](const ArrayInfo& a, auto& v) {
+      if (enabled(a)) v.emplace_back();
+    });
+    return n_owned++;
+  }
+
   /// Appends an owned particle (im = 1 / mass); requires that there are no ghosts.
   void push_owned(std::int64_t gid, Real px, Real py, Real pz, Real r, std::int32_t t, Real im, Real pvx = 0,
                   Real pvy = 0, Real pvz = 0) {
-    x.push_back(px);
-    y.push_back(py);
-    z.push_back(pz);
-    radius.push_back(r);
-    id.push_back(gid);
-    tag.push_back(t);
-    vx.push_back(pvx);
-    vy.push_back(pvy);
-    vz.push_back(pvz);
-    fx.push_back(0);
-    fy.push_back(0);
-    fz.push_back(0);
-    inv_mass.push_back(im);
-    x0.push_back(float(px));
-    y0.push_back(float(py));
-    z0.push_back(float(pz));
-    ++n_owned;
+    const std::size_t i = append_owned();
+    x[i] = px;
+    y[i] = py;
+    z[i] = pz;
+    radius[i] = r;
+    id[i] = gid;
+    tag[i] = t;
+    vx[i] = pvx;
+    vy[i] = pvy;
+    vz[i] = pvz;
+    inv_mass[i] = im;
+    x0[i] = float(px);
+    y0[i] = float(py);
+    z0[i] = float(pz);
   }
 
   /// Reorders the owned particles: new index k holds old index order[k]. Requires no ghosts.
   void permute_owned(const std::vector<std::uint32_t>& order) {
-    auto apply = [&](auto& v) {
+    for_each_array([&](const ArrayInfo& a, auto& v) {
+      if (!enabled(a) || v.empty()) return;
       auto copy = v;
       for (std::size_t k = 0; k < order.size(); ++k) v[k] = copy[order[k]];
-    };
-    for (auto* v : {&x, &y, &z, &radius, &vx, &vy, &vz, &fx, &fy, &fz, &inv_mass}) apply(*v);
-    for (auto* v : {&x0, &y0, &z0}) apply(*v);
-    apply(id);
-    apply(tag);
+    });
   }
 
   /// Removes owned particle i by moving the last owned one into its place. Requires no ghosts.
   void swap_remove_owned(std::size_t i) {
     const std::size_t last = n_owned - 1;
-    auto mv = [&](auto& v) {
+    for_each_array([&](const ArrayInfo& a, auto& v) {
+      if (!enabled(a) || v.empty()) return;
       v[i] = v[last];
       v.pop_back();
-    };
-    for (auto* v : {&x, &y, &z, &radius, &vx, &vy, &vz, &fx, &fy, &fz, &inv_mass}) mv(*v);
-    for (auto* v : {&x0, &y0, &z0}) mv(*v);
-    mv(id);
-    mv(tag);
+    });
     --n_owned;
+  }
+
+  /// Bytes of one particle's record in migration (migrating arrays) or ghost records (ghost arrays).
+  std::size_t record_bytes(bool ghost) const {
+    std::size_t b = 0;
+    for_each_array([&](const ArrayInfo& a, const auto& v) {
+      if (ghost ? a.ghosts : a.migrates) b += sizeof(v[0]);
+    });
+    return b;
+  }
+  /// Appends particle i's record (migration or ghost) to `out`.
+  void pack(std::size_t i, bool ghost, std::vector<std::byte>& out) const {
+    for_each_array([&](const ArrayInfo& a, const auto& v) {
+      if (!(ghost ? a.ghosts : a.migrates)) return;
+      const auto* p = reinterpret_cast<const std::byte*>(&v[i]);
+      out.insert(out.end(), p, p + sizeof(v[i]));
+    });
+  }
+  /// Appends a particle from a record: an owned one (migration; requires no ghosts) or a ghost.
+  void unpack(const std::byte* rec, bool ghost) {
+    std::size_t i = ghost ? size() : append_owned();
+    for_each_array([&](const ArrayInfo& a, auto& v) {
+      if (!(ghost ? a.ghosts : a.migrates)) return;
+      if (ghost) v.emplace_back();
+      std::memcpy(static_cast<void*>(&v[i]), rec, sizeof(v[i]));
+      rec += sizeof(v[i]);
+    });
+  }
+
+  /// Bytes per particle of each field the scene allocates, in list order: ("position", 24), ...
+  std::vector<std::pair<std::string, std::size_t>> field_bytes() const {
+    std::vector<std::pair<std::string, std::size_t>> out;
+    for_each_array([&](const ArrayInfo& a, const auto& v) {
+      if (!enabled(a)) return;
+      if (out.empty() || out.back().first != a.field) out.emplace_back(std::string(a.field), 0);
+      out.back().second += sizeof(v[0]);
+    });
+    return out;
+  }
+  /// Bytes held by the arrays (capacity).
+  std::size_t memory_bytes() const {
+    std::size_t b = 0;
+    for_each_array([&](const ArrayInfo&, const auto& v) { b += v.capacity() * sizeof(v[0]); });
+    return b;
+  }
+
+ private:
+  bool enabled(const ArrayInfo& a) const { return !a.optional || with_exact_rebuild; }
+
+  template <class P, class F>
+  static void for_each(P& p, F& f) {
+    constexpr ArrayInfo pos{"position", true, true, false}, rad{"radius", true, true, false},
+        ident{"id", true, true, false}, tg{"tag", true, true, false}, vel{"velocity", false, true, false},
+        frc{"force", false, false, false}, im{"inverse_mass", false, true, false},
+        ref{"skin_reference", false, false, false}, exact{"position_at_rebuild", false, false, true};
+    f(pos, p.x), f(pos, p.y), f(pos, p.z);
+    f(rad, p.radius);
+    f(ident, p.id);
+    f(tg, p.tag);
+    f(vel, p.vx), f(vel, p.vy), f(vel, p.vz);
+    f(frc, p.fx), f(frc, p.fy), f(frc, p.fz);
+    f(im, p.inv_mass);
+    f(ref, p.x0), f(ref, p.y0), f(ref, p.z0);
+    f(exact, p.xr), f(exact, p.yr), f(exact, p.zr);
   }
 };
 

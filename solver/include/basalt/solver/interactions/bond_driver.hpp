@@ -2,81 +2,72 @@
 // Loops a bond model over the rank's bonds. Bonds with both ends owned apply Newton's third law once;
 // bonds to a ghost apply the force to the owned end only (the ghost's owner computes the same bond
 // from identical positions, so both ranks also agree when it breaks). Energies and counts are tallied
-// by the rank owning the smaller global id, so sums over ranks count each bond once.
+// by the rank owning the smaller global id, so sums over ranks count each bond once. A bond's rest
+// length is its history, kept by the bond store (Bonds::r0).
 #include <cmath>
 #include <cstdint>
+#include <string_view>
 #include <vector>
 
-#include "basalt/solver/core/bonds.hpp"
-#include "basalt/solver/core/particles.hpp"
-#include "basalt/solver/scene/scene.hpp"
+#include "basalt/solver/interactions/force_compute.hpp"
 
 namespace basalt::solver {
 
-struct BrokenBond {
-  std::int64_t a, b;
-  double length, rest_length;
-  std::int64_t step = -1;  ///< the step it broke at (set by the simulation)
-  std::uint8_t group = 0;  ///< its interaction group: a restart at that very step restores the bond
-};
-
 template <class Real, class Model>
-class BondDriver {
+class BondDriver final : public ForceCompute<Real> {
  public:
-  explicit BondDriver(const std::vector<Group<Model>>& groups) {
+  using Coeffs = typename Model::template Coeffs<Real>;
+
+  /// Takes the scene's bond groups (all of model Model: Bonds::group indexes them).
+  explicit BondDriver(const std::vector<InteractionSpec>& groups) {
     for (const auto& g : groups) {
-      K_.push_back(Real(g.params.K));
-      eps_.push_back(std::isfinite(g.params.break_strain) ? Real(g.params.break_strain)
-                                                          : std::numeric_limits<Real>::infinity());
-      breakable_ = breakable_ || std::isfinite(g.params.break_strain);
+      params_.push_back(g.template params_of<Model>());
+      coeffs_.push_back(Model::template coeffs<Real>(params_.back()));
+      breakable_ = breakable_ || Model::breakable(params_.back());
     }
   }
 
-  /// Adds bond forces to p.f*; returns the bond potential energy (when Energy) and appends bonds
-  /// that broke (they are removed at once).
-  template <bool Energy>
-  double compute(Particles<Real>& p, Bonds<Real>& bonds, std::vector<BrokenBond>& broken) {
-    const double e =
-        compute_part<Energy, true>(p, bonds, broken) + compute_part<Energy, false>(p, bonds, broken);
-    commit(bonds);
+  std::string_view model() const override { return Model::name; }
+  ModelKind kind() const override { return ModelKind::bond; }
+  double max_stiffness(double rmax) const override {
+    double m = 0;
+    for (const auto& p : params_) m = std::max(m, Model::max_stiffness(p, rmax));
+    return m;
+  }
+  double rest_length(std::size_t g, double ri, double rj, double r) const override {
+    return Model::rest_length(params_[g], ri, rj, r);
+  }
+
+  /// The owned part (bonds with both ends owned) comes first; the ghost part ends the step's bond
+  /// work and removes the bonds that broke in either part.
+  double compute(ForceState<Real>& s, Part part, bool energy, bool) override {
+    if (s.bonds.size() == 0) return 0;
+    double e = 0;
+    if (part == Part::owned) {
+      gone_.clear();
+      e = energy ? dispatch<true, true>(s) : dispatch<false, true>(s);
+    } else {
+      e = energy ? dispatch<true, false>(s) : dispatch<false, false>(s);
+      if (!gone_.empty()) remove(s.bonds, gone_);
+      gone_.clear();
+    }
     return e;
   }
 
-  /// Bonds with both ends owned (BothOwned) or with a ghost end; call commit() after both parts.
-  template <bool Energy, bool BothOwned>
-  double compute_part(Particles<Real>& p, const Bonds<Real>& bonds, std::vector<BrokenBond>& broken) {
-    if (BothOwned) gone_.clear();
-    const std::size_t b = BothOwned ? 0 : bonds.n_both_owned,
-                      e = BothOwned ? bonds.n_both_owned : bonds.size();
-    if (K_.size() == 1 && !breakable_) return loop<Energy, true, false, BothOwned>(p, bonds, broken, b, e);
-    if (K_.size() == 1) return loop<Energy, true, true, BothOwned>(p, bonds, broken, b, e);
-    return loop<Energy, false, true, BothOwned>(p, bonds, broken, b, e);
-  }
-
-  /// Removes the bonds that broke in this step's compute_part() calls.
-  void commit(Bonds<Real>& bonds) {
-    if (!gone_.empty()) remove(bonds, gone_);
-    gone_.clear();
-  }
-
-  /// Bonds counted once across ranks.
-  static std::int64_t count(const Particles<Real>& p, const Bonds<Real>& bonds) {
-    std::int64_t c = static_cast<std::int64_t>(bonds.n_both_owned);
-    for (std::size_t k = bonds.n_both_owned; k < bonds.size(); ++k)
-      c += p.id[static_cast<std::size_t>(bonds.ia[k])] < p.id[static_cast<std::size_t>(bonds.ib[k])];
-    return c;
-  }
-
-  Real max_stiffness() const {
-    Real m = 0;
-    for (auto k : K_) m = std::max(m, k);
-    return m;
-  }
-
  private:
+  template <bool Energy, bool BothOwned>
+  double dispatch(ForceState<Real>& s) {
+    const std::size_t b = BothOwned ? 0 : s.bonds.n_both_owned,
+                      e = BothOwned ? s.bonds.n_both_owned : s.bonds.size();
+    if (coeffs_.size() == 1 && !breakable_) return loop<Energy, true, false, BothOwned>(s, b, e);
+    if (coeffs_.size() == 1) return loop<Energy, true, true, BothOwned>(s, b, e);
+    return loop<Energy, false, true, BothOwned>(s, b, e);
+  }
+
   template <bool Energy, bool Uniform, bool Breakable, bool BothOwned>
-  double loop(Particles<Real>& p, const Bonds<Real>& bonds, std::vector<BrokenBond>& broken,
-              std::size_t begin, std::size_t end) {
+  double loop(ForceState<Real>& s, std::size_t begin, std::size_t end) {
+    auto& p = s.p;
+    const auto& bonds = s.bonds;
     double energy = 0;
     const Real* __restrict x = p.x.data();
     const Real* __restrict y = p.y.data();
@@ -87,33 +78,32 @@ class BondDriver {
     const std::int32_t* __restrict ia = bonds.ia.data();
     const std::int32_t* __restrict ib = bonds.ib.data();
     const Real* __restrict r0s = bonds.r0.data();
-    const Real K0 = K_[0], eps0 = eps_[0];
+    const Coeffs c0 = coeffs_[0];
     for (std::size_t k = begin; k < end; ++k) {
       const auto i = static_cast<std::size_t>(ia[k]), j = static_cast<std::size_t>(ib[k]);
       const Real dx = x[i] - x[j], dy = y[i] - y[j], dz = z[i] - z[j];
       const Real r = std::sqrt(dx * dx + dy * dy + dz * dz);
       const Real r0 = r0s[k];
-      const std::size_t g = Uniform ? 0 : bonds.group[k];
-      const Real K = Uniform ? K0 : K_[g];
+      const Coeffs& c = Uniform ? c0 : coeffs_[bonds.group[k]];
       if constexpr (Breakable) {
-        if (Model::broken(Uniform ? eps0 : eps_[g], r0, r)) [[unlikely]] {
+        if (Model::broken(c, r0, r)) [[unlikely]] {
           gone_.push_back(k);
           if (BothOwned || p.id[i] < p.id[j])
-            broken.push_back({bonds.a[k], bonds.b[k], double(r), double(r0), -1, bonds.group_of(k)});
+            s.broken.push_back({bonds.a[k], bonds.b[k], double(r), double(r0), -1, bonds.group_of(k)});
           continue;
         }
       }
-      const Real s = Model::force(K, r0, r) / r;
-      fx[i] += s * dx;
-      fy[i] += s * dy;
-      fz[i] += s * dz;
+      const Real f = Model::force(c, r0, r) / r;
+      fx[i] += f * dx;
+      fy[i] += f * dy;
+      fz[i] += f * dz;
       if constexpr (BothOwned) {
-        fx[j] -= s * dx;
-        fy[j] -= s * dy;
-        fz[j] -= s * dz;
+        fx[j] -= f * dx;
+        fy[j] -= f * dy;
+        fz[j] -= f * dz;
       }
       if constexpr (Energy)
-        if (BothOwned || p.id[i] < p.id[j]) energy += double(Model::energy(K, r0, r));
+        if (BothOwned || p.id[i] < p.id[j]) energy += double(Model::energy(c, r0, r));
     }
     return energy;
   }
@@ -134,7 +124,8 @@ class BondDriver {
     bonds.n_both_owned = n2;
   }
 
-  std::vector<Real> K_, eps_;
+  std::vector<typename Model::Params> params_;
+  std::vector<Coeffs> coeffs_;
   bool breakable_ = false;
   std::vector<std::size_t> gone_;
 };

@@ -1,58 +1,127 @@
 #pragma once
 // Loops a contact model over the Verlet pair lists. Owned-owned pairs apply Newton's third law once;
-// owned-ghost pairs give force to the owned particle only. Energies are tallied by the rank owning the
-// smaller global id. With one group that takes every tag the per-pair group lookup is skipped.
+// owned-ghost pairs give force to the owned particle only (the ghost's owner computes the same pair).
+// Energies are tallied by the rank owning the smaller global id. With one group that takes every tag
+// the per-pair group lookup is skipped. A model with per-contact History gets it stored beside the
+// list (one entry per listed pair), carried across rebuilds by the pair's ids (contact_history.hpp),
+// and advanced only on real steps: Model::advance updates it for touching pairs, Model::apart for
+// listed pairs that do not touch, and Model::force reads it.
 #include <cmath>
 #include <cstdint>
+#include <cstring>
+#include <string_view>
 #include <vector>
 
-#include "basalt/solver/core/particles.hpp"
-#include "basalt/solver/neighbor/verlet_list.hpp"
-#include "basalt/solver/scene/scene.hpp"
+#include "basalt/solver/interactions/force_compute.hpp"
 
 namespace basalt::solver {
 
 template <class Real, class Model>
-class PairDriver {
+class PairDriver final : public ForceCompute<Real> {
  public:
-  explicit PairDriver(const std::vector<Group<Model>>& groups) : groups_(groups) {
-    for (const auto& g : groups) K_.push_back(Real(g.params.K));
-    uniform_ = groups.size() == 1 && groups[0].tags.empty();
+  using Coeffs = typename Model::template Coeffs<Real>;
+  using History = typename Model::History;
+  static constexpr bool kHistory = basalt::solver::history_bytes<Model>() > 0;
+
+  /// Takes the scene's pair groups of model Model.
+  explicit PairDriver(const std::vector<InteractionSpec>& groups) {
+    for (const auto& g : groups) {
+      if (g.model != Model::name) continue;
+      params_.push_back(g.template params_of<Model>());
+      coeffs_.push_back(Model::template coeffs<Real>(params_.back()));
+      tags_.push_back(g.tags);
+    }
+    uniform_ = tags_.size() == 1 && tags_[0].empty();
+    pending_.width = history_width<Model>();
   }
 
-  bool empty() const { return groups_.empty(); }
-  /// One group for every pair of tags.
-  bool takes_all() const { return uniform_; }
-
-  /// Group index taking a pair of particles with these tags, or -1.
+  std::string_view model() const override { return Model::name; }
+  ModelKind kind() const override { return ModelKind::pair; }
+  double max_stiffness(double rmax) const override {
+    double m = 0;
+    for (const auto& p : params_) m = std::max(m, Model::max_stiffness(p, rmax));
+    return m;
+  }
+  /// Group taking a pair of particles with these tags, or -1.
   int group_of(std::int64_t ti, std::int64_t tj) const {
-    for (std::size_t g = 0; g < groups_.size(); ++g) {
-      const auto& t = groups_[g].tags;
+    for (std::size_t g = 0; g < tags_.size(); ++g) {
+      const auto& t = tags_[g];
       if (t.empty() || (t[0] == ti && t[1] == tj) || (t[0] == tj && t[1] == ti)) return static_cast<int>(g);
     }
     return -1;
   }
+  /// One group for every pair of tags.
+  bool takes_all() const { return uniform_; }
 
-  /// Owned-owned pairs (Newton's third law) when Newton, owned-ghost pairs (owned end only) otherwise.
-  template <bool Energy, bool Newton>
-  double compute(Particles<Real>& p, const PairList& list) const {
-    if (uniform_) return loop<Energy, true, Newton>(p, list);
-    return loop<Energy, false, Newton>(p, list);
-  }
-  template <bool Energy>
-  double compute(Particles<Real>& p, const PairList& own, const PairList& ghost) const {
-    return compute<Energy, true>(p, own) + compute<Energy, false>(p, ghost);
+  double compute(ForceState<Real>& s, Part part, bool energy, bool advance) override {
+    const bool own = part == Part::owned;
+    const PairList& list = own ? *own_ : *ghost_;
+    History* h = own ? hist_own_.data() : hist_ghost_.data();
+    if (own) return dispatch<true>(s.p, list, h, energy, advance);
+    return dispatch<false>(s.p, list, h, energy, advance);
   }
 
-  Real max_stiffness() const {
-    Real m = 0;
-    for (auto k : K_) m = std::max(m, k);
-    return m;
+  void rebuild(const PairLists<Real>& l, std::size_t index) override {
+    if (l.computes == 1) {
+      own_ = &l.own;
+      ghost_ = &l.ghost;
+    } else {
+      filter(l, l.own, index, own_sub_);
+      filter(l, l.ghost, index, ghost_sub_);
+      own_ = &own_sub_;
+      ghost_ = &ghost_sub_;
+    }
+    if constexpr (kHistory) {
+      restore(l.p, *own_, hist_own_);
+      restore(l.p, *ghost_, hist_ghost_);
+      pending_.clear();
+    }
+  }
+
+  void save_history(const Particles<Real>& p) override {
+    if constexpr (kHistory) {
+      if (own_ == nullptr) return;
+      collect(p, *own_, hist_own_, false, pending_);
+      collect(p, *ghost_, hist_ghost_, false, pending_);
+    }
+  }
+  ContactRecords* pending() override { return kHistory ? &pending_ : nullptr; }
+  void history_records(const Particles<Real>& p, ContactRecords& out) const override {
+    if constexpr (kHistory) {
+      if (own_ == nullptr) return;
+      collect(p, *own_, hist_own_, false, out);
+      collect(p, *ghost_, hist_ghost_, true, out);
+    }
+  }
+  std::size_t history_bytes() const override { return basalt::solver::history_bytes<Model>(); }
+  std::size_t contacts() const override { return own_ ? own_->pairs() + ghost_->pairs() : 0; }
+  std::size_t memory_bytes() const override {
+    std::size_t b = (hist_own_.capacity() + hist_ghost_.capacity()) * basalt::solver::history_bytes<Model>();
+    if (own_ == &own_sub_) b += own_sub_.memory_bytes() + ghost_sub_.memory_bytes();
+    return b;
   }
 
  private:
-  template <bool Energy, bool Uniform, bool Newton>
-  double loop(Particles<Real>& p, const PairList& list) const {
+  template <bool Newton>
+  double dispatch(Particles<Real>& p, const PairList& list, History* h, bool energy, bool advance) const {
+    if constexpr (kHistory) {
+      if (advance) {
+        if (uniform_)
+          return energy ? loop<true, true, Newton, true>(p, list, h)
+                        : loop<false, true, Newton, true>(p, list, h);
+        return energy ? loop<true, false, Newton, true>(p, list, h)
+                      : loop<false, false, Newton, true>(p, list, h);
+      }
+    }
+    if (uniform_)
+      return energy ? loop<true, true, Newton, false>(p, list, h)
+                    : loop<false, true, Newton, false>(p, list, h);
+    return energy ? loop<true, false, Newton, false>(p, list, h)
+                  : loop<false, false, Newton, false>(p, list, h);
+  }
+
+  template <bool Energy, bool Uniform, bool Newton, bool Advance>
+  double loop(Particles<Real>& p, const PairList& list, [[maybe_unused]] History* hist) const {
     double energy = 0;
     const std::size_t n = p.n_owned;
     const Real* __restrict x = p.x.data();
@@ -64,7 +133,7 @@ class PairDriver {
     Real* __restrict fz = p.fz.data();
     const std::uint32_t* __restrict off = list.offset.data();
     const std::int32_t* __restrict nb = list.neigh.data();
-    const Real K0 = K_.empty() ? Real(0) : K_[0];
+    const Coeffs c0 = coeffs_.empty() ? Coeffs{} : coeffs_[0];
     for (std::size_t i = 0; i < n; ++i) {
       const Real xi = x[i], yi = y[i], zi = z[i], ri = rad[i];
       Real fxi = 0, fyi = 0, fzi = 0;
@@ -73,11 +142,18 @@ class PairDriver {
         const Real dx = xi - x[j], dy = yi - y[j], dz = zi - z[j];
         const Real r2 = dx * dx + dy * dy + dz * dz;
         const Real rsum = ri + rad[j];
-        if (!Model::touching(r2, rsum)) continue;
-        Real K = K0;
-        if constexpr (!Uniform) K = K_[static_cast<std::size_t>(group_of(p.tag[i], p.tag[j]))];
+        if (!(r2 < rsum * rsum)) {
+          if constexpr (kHistory && Advance) Model::apart(hist[k]);
+          continue;
+        }
+        const Coeffs& c = Uniform ? c0 : coeffs_[static_cast<std::size_t>(group_of(p.tag[i], p.tag[j]))];
         const Real r = std::sqrt(r2);
-        const Real s = Model::force(K, rsum, r) / r;
+        History none{};
+        History* hp = &none;
+        if constexpr (kHistory) hp = &hist[k];
+        History& h = *hp;
+        if constexpr (kHistory && Advance) Model::advance(c, h, rsum, r);
+        const Real s = Model::force(c, h, rsum, r) / r;
         fxi += s * dx;
         fyi += s * dy;
         fzi += s * dz;
@@ -87,7 +163,7 @@ class PairDriver {
           fz[j] -= s * dz;
         }
         if constexpr (Energy)
-          if (Newton || p.id[i] < p.id[j]) energy += double(Model::energy(K, rsum, r));
+          if (Newton || p.id[i] < p.id[j]) energy += double(Model::energy(c, h, rsum, r));
       }
       fx[i] += fxi;
       fy[i] += fyi;
@@ -96,9 +172,62 @@ class PairDriver {
     return energy;
   }
 
-  std::vector<Group<Model>> groups_;
-  std::vector<Real> K_;
+  /// The pairs of `in` that pair compute `index` takes.
+  static void filter(const PairLists<Real>& l, const PairList& in, std::size_t index, PairList& out) {
+    const std::size_t n = in.offset.empty() ? 0 : in.offset.size() - 1;
+    out.offset.assign(n + 1, 0);
+    out.neigh.clear();
+    for (std::size_t i = 0; i < n; ++i) {
+      for (auto k = in.offset[i]; k < in.offset[i + 1]; ++k)
+        if (l.taker(i, static_cast<std::size_t>(in.neigh[k])) == static_cast<int>(index))
+          out.neigh.push_back(in.neigh[k]);
+      out.offset[i + 1] = static_cast<std::uint32_t>(out.neigh.size());
+    }
+  }
+
+  static bool is_default(const History& h) {
+    static const History zero{};
+    return std::memcmp(&h, &zero, sizeof(History)) == 0;
+  }
+
+  /// Records of the listed contacts whose history is not the default; once across ranks: the pairs
+  /// to a ghost only from the rank owning the lower id.
+  static void collect(const Particles<Real>& p, const PairList& list, const std::vector<History>& hist,
+                      bool lower_id_only, ContactRecords& out) {
+    out.width = history_width<Model>();
+    for (std::size_t i = 0; i + 1 < list.offset.size(); ++i)
+      for (auto k = list.offset[i]; k < list.offset[i + 1]; ++k) {
+        const auto j = static_cast<std::size_t>(list.neigh[k]);
+        if (is_default(hist[k]) || (lower_id_only && p.id[j] < p.id[i])) continue;
+        out.push(p.id[i], p.id[j], reinterpret_cast<const double*>(&hist[k]));
+      }
+  }
+
+  /// History for each listed pair from the pending records (default when none).
+  void restore(const Particles<Real>& p, const PairList& list, std::vector<History>& hist) const {
+    hist.assign(list.pairs(), History{});
+    if (pending_.empty()) return;
+    std::vector<std::uint32_t> order;
+    pending_.index(order);
+    for (std::size_t i = 0; i + 1 < list.offset.size(); ++i)
+      for (auto k = list.offset[i]; k < list.offset[i + 1]; ++k) {
+        const auto j = static_cast<std::size_t>(list.neigh[k]);
+        const auto r = pending_.find(order, p.id[i], p.id[j]);
+        if (r < 0) continue;
+        std::memcpy(static_cast<void*>(&hist[k]), pending_.at(static_cast<std::size_t>(r)), sizeof(History));
+        if (pending_.a[static_cast<std::size_t>(r)] != p.id[i]) hist[k] = Model::flip(hist[k]);
+      }
+  }
+
+  std::vector<typename Model::Params> params_;
+  std::vector<Coeffs> coeffs_;
+  std::vector<TagFilter> tags_;
   bool uniform_ = false;
+  const PairList* own_ = nullptr;
+  const PairList* ghost_ = nullptr;
+  PairList own_sub_, ghost_sub_;  ///< with several pair models: this model's share of the lists
+  std::vector<History> hist_own_, hist_ghost_;
+  ContactRecords pending_;
 };
 
 }  // namespace basalt::solver

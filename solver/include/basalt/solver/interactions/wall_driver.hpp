@@ -1,130 +1,75 @@
 #pragma once
-// Planar walls with prescribed motion acting on owned particles through a wall model.
-// Tallies the force on each wall (minus the sum of forces it puts on particles), the wall energy and
-// the work walls do on the particles (the energy source the stability guard allows for).
-#include <algorithm>
-#include <array>
-#include <cmath>
-#include <cstdint>
+// Loops a wall model over the walls of the scene that use it and the owned particles within reach of
+// each (Walls::candidates). Tallies the force on each wall (minus the sum of forces it puts on
+// particles) and the wall energy; walls act on owned particles only, so there is no ghost part.
+#include <string_view>
 #include <vector>
 
-#include "basalt/solver/core/particles.hpp"
-#include "basalt/solver/scene/scene.hpp"
+#include "basalt/solver/interactions/force_compute.hpp"
 
 namespace basalt::solver {
 
 template <class Real, class Model>
-class WallDriver {
+class WallDriver final : public ForceCompute<Real> {
  public:
-  explicit WallDriver(const std::vector<WallSpec>& walls)
-      : walls_(walls), point_(walls.size()), force_(walls.size()) {
-    for (std::size_t w = 0; w < walls.size(); ++w) point_[w] = walls[w].point;
-  }
+  using Coeffs = typename Model::template Coeffs<Real>;
 
-  bool empty() const { return walls_.empty(); }
-  std::size_t size() const { return walls_.size(); }
-  const WallSpec& spec(std::size_t w) const { return walls_[w]; }
-  const std::array<double, 3>& point(std::size_t w) const { return point_[w]; }
-  /// Force the particles put on wall w at the last compute() (this rank's share).
-  const std::array<double, 3>& force(std::size_t w) const { return force_[w]; }
-
-  /// Moves the walls to their positions at time t.
-  void move_to(double t) {
-    for (std::size_t w = 0; w < walls_.size(); ++w) {
-      const auto u = walls_[w].motion.displacement_at(t);
-      for (int d = 0; d < 3; ++d) point_[w][d] = walls_[w].point[d] + u[d];
+  /// Takes the scene's walls whose model is Model.
+  explicit WallDriver(const std::vector<WallSpec>& walls) {
+    for (std::size_t w = 0; w < walls.size(); ++w) {
+      if (walls[w].model != Model::name) continue;
+      index_.push_back(w);
+      params_.push_back(walls[w].template params_of<Model>());
+      coeffs_.push_back(Model::template coeffs<Real>(params_.back()));
     }
   }
 
-  /// Power the walls put into the particles at time t (this rank's share): -F_wall . v_wall.
-  double power(double t) const {
-    double pw = 0;
-    for (std::size_t w = 0; w < walls_.size(); ++w) {
-      const auto v = walls_[w].motion.velocity_at(t);
-      pw -= force_[w][0] * v[0] + force_[w][1] * v[1] + force_[w][2] * v[2];
-    }
-    return pw;
-  }
-
-  /// At a rebuild: the owned particles within reach of each wall (centre closer than radius + skin,
-  /// taking the wall's tags), so that steps loop over those only.
-  void rebuild(const Particles<Real>& p, double skin) {
-    candidates_.resize(walls_.size());
-    point_at_rebuild_ = point_;
-    for (std::size_t w = 0; w < walls_.size(); ++w) {
-      const auto& spec = walls_[w];
-      auto& c = candidates_[w];
-      c.clear();
-      for (std::size_t i = 0; i < p.n_owned; ++i) {
-        const double d = (p.x[i] - point_[w][0]) * spec.normal[0] + (p.y[i] - point_[w][1]) * spec.normal[1] +
-                         (p.z[i] - point_[w][2]) * spec.normal[2];
-        if (d >= double(p.radius[i]) + skin) continue;
-        if (!spec.tags.empty() && std::find(spec.tags.begin(), spec.tags.end(), p.tag[i]) == spec.tags.end())
-          continue;
-        c.push_back(static_cast<std::int32_t>(i));
-      }
-    }
-  }
-
-  /// Squared distance the walls moved towards their particles since the last rebuild (the same on
-  /// every rank): with particle displacements, it decides the next rebuild.
-  double moved2_since_rebuild() const {
+  std::string_view model() const override { return Model::name; }
+  ModelKind kind() const override { return ModelKind::wall; }
+  double max_stiffness(double rmax) const override {
     double m = 0;
-    for (std::size_t w = 0; w < walls_.size() && w < point_at_rebuild_.size(); ++w) {
-      const auto& n = walls_[w].normal;
-      const double u = (point_[w][0] - point_at_rebuild_[w][0]) * n[0] +
-                       (point_[w][1] - point_at_rebuild_[w][1]) * n[1] +
-                       (point_[w][2] - point_at_rebuild_[w][2]) * n[2];
-      if (u > 0) m = std::max(m, u * u);
-    }
+    for (const auto& p : params_) m = std::max(m, Model::max_stiffness(p, rmax));
     return m;
   }
 
+  double compute(ForceState<Real>& s, Part part, bool energy, bool) override {
+    if (part != Part::owned) return 0;
+    return energy ? loop<true>(s.p, s.walls) : loop<false>(s.p, s.walls);
+  }
+
+ private:
   template <bool Energy>
-  double compute(Particles<Real>& p) {
+  double loop(Particles<Real>& p, Walls& walls) const {
     double energy = 0;
-    for (std::size_t w = 0; w < walls_.size(); ++w) {
-      const auto& spec = walls_[w];
+    for (std::size_t k = 0; k < index_.size(); ++k) {
+      const std::size_t w = index_[k];
+      const auto& spec = walls.spec(w);
+      const auto& c = coeffs_[k];
       const Real nx = Real(spec.normal[0]), ny = Real(spec.normal[1]), nz = Real(spec.normal[2]);
-      const Real px = Real(point_[w][0]), py = Real(point_[w][1]), pz = Real(point_[w][2]);
+      const auto& at = walls.point(w);
+      const Real px = Real(at[0]), py = Real(at[1]), pz = Real(at[2]);
       double wfx = 0, wfy = 0, wfz = 0;
-      for (const auto i : candidates_[w]) {
+      for (const auto i : walls.candidates(w)) {
         const Real d = (p.x[i] - px) * nx + (p.y[i] - py) * ny + (p.z[i] - pz) * nz;
         const Real o = p.radius[i] - d;
         if (o <= 0) continue;
-        const Real k = Model::stiffness(spec.params, p.radius[i]);
-        const Real f = Model::force(k, o);
+        const Real f = Model::force(c, p.radius[i], o);
         p.fx[i] += f * nx;
         p.fy[i] += f * ny;
         p.fz[i] += f * nz;
         wfx -= double(f * nx);
         wfy -= double(f * ny);
         wfz -= double(f * nz);
-        if constexpr (Energy) energy += double(Model::energy(k, o));
+        if constexpr (Energy) energy += double(Model::energy(c, p.radius[i], o));
       }
-      force_[w] = {wfx, wfy, wfz};
+      walls.force(w) = {wfx, wfy, wfz};
     }
     return energy;
   }
 
-  std::size_t memory_bytes() const {
-    std::size_t b = 0;
-    for (const auto& c : candidates_) b += c.capacity() * sizeof(std::int32_t);
-    return b;
-  }
-
-  Real max_stiffness(Real rmax) const {
-    Real m = 0;
-    for (const auto& w : walls_) m = std::max(m, Model::stiffness(w.params, rmax));
-    return m;
-  }
-
- private:
-  std::vector<WallSpec> walls_;
-  std::vector<std::array<double, 3>> point_;
-  std::vector<std::array<double, 3>> force_;
-  std::vector<std::array<double, 3>> point_at_rebuild_;
-  std::vector<std::vector<std::int32_t>> candidates_;
+  std::vector<std::size_t> index_;  ///< the walls this model acts through
+  std::vector<typename Model::Params> params_;
+  std::vector<Coeffs> coeffs_;
 };
 
 }  // namespace basalt::solver

@@ -28,6 +28,8 @@ class SimulationFrame final : public io::FrameSource {
   const Simulation<Real>& sim_;
   io::FrameHeader header_;
   std::vector<io::WallState> walls_;
+  /// Checkpoints: history of the pair models that keep one ([k] of the k-th such model).
+  std::vector<ContactRecords> history_;
 };
 
 extern template class SimulationFrame<double>;

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "basalt/solver/core/bonds.hpp"
+#include "basalt/solver/core/contact_history.hpp"
 #include "basalt/solver/core/particles.hpp"
 #include "basalt/solver/parallel/decomposition.hpp"
 
@@ -18,10 +19,13 @@ class Halo {
  public:
   explicit Halo(const Decomposition& dec) : dec_(dec) {}
 
-  /// Sends owned particles that left this rank's region (with every bond touching them) to the
-  /// neighbour in that direction. Requires no ghosts. Returns an error message (not thrown: the caller
-  /// agrees on errors across ranks) when a particle arrives outside its new owner's region.
-  std::optional<std::string> migrate(Particles<Real>& p, Bonds<Real>& bonds);
+  /// Sends owned particles that left this rank's region (with every bond touching them, and a copy of
+  /// every contact-history record naming them: `history`, one set per pair model, null entries for
+  /// models without history) to the neighbour in that direction. Requires no ghosts. Returns an error
+  /// message (not thrown: the caller agrees on errors across ranks) when a particle arrives outside its
+  /// new owner's region.
+  std::optional<std::string> migrate(Particles<Real>& p, Bonds<Real>& bonds,
+                                     const std::vector<ContactRecords*>& history = {});
 
   /// Appends as ghosts copies of the neighbours' particles within `width` of this rank's faces and
   /// remembers the lists for update_ghosts(). Requires no ghosts.

@@ -2,6 +2,7 @@
 // A run as the scene file (TOML, docs/scenes.md) describes it. parse_scene() checks every key:
 // an unknown or misspelled key, a wrong type, a missing file or an impossible value is an InputError
 // naming the file, line and key.
+#include <any>
 #include <array>
 #include <cstdint>
 #include <filesystem>
@@ -9,9 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "basalt/solver/interactions/elastic_wall.hpp"
-#include "basalt/solver/interactions/linear_bond.hpp"
-#include "basalt/solver/interactions/linear_elastic.hpp"
+#include "basalt/solver/models/model.hpp"
 #include "basalt/solver/scene/wall_motion.hpp"
 
 namespace basalt::solver {
@@ -20,21 +19,35 @@ namespace basalt::solver {
 /// with one end tagged a and the other b (either order).
 using TagFilter = std::vector<std::int64_t>;
 
-template <class Model>
-struct Group {
+/// One [[interactions]] group: a registered model (models/registry.hpp), its parameters as the model
+/// parsed them, and what it applies to.
+struct InteractionSpec {
   std::string name;
-  typename Model::Params params;
+  std::string model;  ///< the registry name (type = "...")
+  ModelKind kind = ModelKind::pair;
+  std::any params;  ///< Model::Params
   TagFilter tags;
   std::optional<std::int64_t> bond_tag;  ///< bonds only: the geometry's bond tag this group takes
+
+  template <class Model>
+  const typename Model::Params& params_of() const {
+    return std::any_cast<const typename Model::Params&>(params);
+  }
 };
 
 struct WallSpec {
   std::string name;
   std::array<double, 3> point{0, 0, 0};
   std::array<double, 3> normal{0, 0, 1};  ///< unit length after parsing
-  ElasticWall::Params params;
-  TagFilter tags;  ///< particle tags the wall touches (empty: all)
+  std::string model = "elastic";          ///< the registry name of its wall model (interaction = "...")
+  std::any params;                        ///< Model::Params
+  TagFilter tags;                         ///< particle tags the wall touches (empty: all)
   WallMotion motion;
+
+  template <class Model>
+  const typename Model::Params& params_of() const {
+    return std::any_cast<const typename Model::Params&>(params);
+  }
 };
 
 struct FieldSpec {
@@ -68,8 +81,8 @@ struct Scene {
   bool force_dt = false;
   double dt_safety = 0.2;                 ///< warn when dt > dt_safety * critical step
   std::int64_t energy_check_every = 100;  ///< 0: no energy-growth guard
-  std::vector<Group<LinearBond>> bonds;
-  std::vector<Group<LinearElastic>> contacts;
+  std::vector<InteractionSpec> bonds;     ///< bond groups, in scene order (a bond's group indexes these)
+  std::vector<InteractionSpec> contacts;  ///< pair (contact) groups, in scene order
   std::vector<WallSpec> walls;
   std::filesystem::path output_dir = "out";
   std::vector<FieldSpec> fields;

@@ -1,0 +1,56 @@
+#pragma once
+// Per-contact history in transit: the state a contact model keeps for a pair (e.g. a tangential spring),
+// keyed by the global ids of the pair, as it travels across a neighbour-list rebuild (the lists are
+// rebuilt, the pairs are found again by id), with migrating particles to their new rank, and to and
+// from checkpoints. Values belong to the orientation a -> b in which they were saved; a model whose
+// history changes sign with the orientation says so (Model::flip), the driver applies it.
+#include <algorithm>
+#include <cstdint>
+#include <cstring>
+#include <vector>
+
+namespace basalt::solver {
+
+struct ContactRecords {
+  std::size_t width = 0;  ///< doubles per record (the model's History)
+  std::vector<std::int64_t> a, b;
+  std::vector<double> values;  ///< width per record
+
+  std::size_t size() const { return a.size(); }
+  bool empty() const { return a.empty(); }
+  void clear() {
+    a.clear();
+    b.clear();
+    values.clear();
+  }
+  void push(std::int64_t ia, std::int64_t ib, const double* v) {
+    a.push_back(ia);
+    b.push_back(ib);
+    values.insert(values.end(), v, v + width);
+  }
+  const double* at(std::size_t k) const { return values.data() + k * width; }
+
+  /// Index for find(): records ordered by their unordered pair (lower id, higher id).
+  void index(std::vector<std::uint32_t>& order) const {
+    order.resize(size());
+    for (std::uint32_t k = 0; k < order.size(); ++k) order[k] = k;
+    std::sort(order.begin(), order.end(), [&](std::uint32_t i, std::uint32_t j) {
+      const auto ki = key(i), kj = key(j);
+      return ki != kj ? ki < kj : i < j;
+    });
+  }
+  /// The record of the pair {ia, ib} (either orientation) through an index(), or -1.
+  std::int64_t find(const std::vector<std::uint32_t>& order, std::int64_t ia, std::int64_t ib) const {
+    const std::pair<std::int64_t, std::int64_t> want{std::min(ia, ib), std::max(ia, ib)};
+    const auto it = std::lower_bound(order.begin(), order.end(), want,
+                                     [&](std::uint32_t k, const auto& w) { return key(k) < w; });
+    return it != order.end() && key(*it) == want ? std::int64_t(*it) : -1;
+  }
+
+ private:
+  std::pair<std::int64_t, std::int64_t> key(std::size_t k) const {
+    return {std::min(a[k], b[k]), std::max(a[k], b[k])};
+  }
+};
+
+}  // namespace basalt::solver

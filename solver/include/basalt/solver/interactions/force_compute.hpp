@@ -1,0 +1,86 @@
+#pragma once
+// One interaction model of a scene, looped by its driver (bond_driver.hpp, pair_driver.hpp,
+// wall_driver.hpp): what Simulation holds a list of, one per model the scene uses. The step calls
+// each compute twice: first over what involves owned particles only (overlapping the ghost refresh
+// in flight), then over what involves ghosts. Virtual calls happen a few times per step, never per
+// pair: the loops inside are templates over the model.
+#include <cstdint>
+#include <functional>
+#include <string_view>
+#include <vector>
+
+#include "basalt/solver/core/bonds.hpp"
+#include "basalt/solver/core/contact_history.hpp"
+#include "basalt/solver/core/particles.hpp"
+#include "basalt/solver/interactions/walls.hpp"
+#include "basalt/solver/models/model.hpp"
+#include "basalt/solver/neighbor/verlet_list.hpp"
+
+namespace basalt::solver {
+
+struct BrokenBond {
+  std::int64_t a, b;
+  double length, rest_length;
+  std::int64_t step = -1;  ///< the step it broke at (set by the simulation)
+  std::uint8_t group = 0;  ///< its interaction group: a restart at that very step restores the bond
+};
+
+/// What the force computes act on during a step.
+template <class Real>
+struct ForceState {
+  Particles<Real>& p;
+  Bonds<Real>& bonds;
+  std::vector<BrokenBond>& broken;
+  Walls& walls;
+};
+
+/// The rank's candidate pair lists after a rebuild (every pair some pair model takes) and which pair
+/// model takes a pair (index among the scene's pair computes).
+template <class Real>
+struct PairLists {
+  const Particles<Real>& p;
+  const PairList& own;
+  const PairList& ghost;
+  std::size_t computes = 1;                            ///< number of pair computes
+  std::function<int(std::size_t, std::size_t)> taker;  ///< pair compute taking (i, j) (computes > 1)
+};
+
+enum class Part { owned, ghost };
+
+template <class Real>
+class ForceCompute {
+ public:
+  virtual ~ForceCompute() = default;
+  virtual std::string_view model() const = 0;
+  virtual ModelKind kind() const = 0;
+  /// Largest spring constant for particles up to radius rmax (critical time step).
+  virtual double max_stiffness(double rmax) const = 0;
+  /// Adds forces of one part; returns the potential energy when `energy`. `advance`: a real step, so
+  /// contact history moves on (a force evaluation outside the step, e.g. at start or restart, reads it).
+  virtual double compute(ForceState<Real>& s, Part part, bool energy, bool advance) = 0;
+
+  // Pair models: the lists after a rebuild, and the contact history across it.
+  /// Pair compute number `index` takes its pairs from the rebuilt lists and their history from pending().
+  virtual void rebuild(const PairLists<Real>&, std::size_t /*index*/) {}
+  /// Before a rebuild (ghosts still present): the history of listed contacts into pending().
+  virtual void save_history(const Particles<Real>&) {}
+  /// Records waiting for the next rebuild (carried by migration, filled by a restart); null: no history.
+  virtual ContactRecords* pending() { return nullptr; }
+  /// This rank's history records for output: each contact once across ranks (owned-owned pairs, and
+  /// owned-ghost pairs by the rank owning the lower id); nothing without history.
+  virtual void history_records(const Particles<Real>&, ContactRecords&) const {}
+  /// Bytes of history per contact (0: none).
+  virtual std::size_t history_bytes() const { return 0; }
+  /// Contacts in the lists this compute loops (for the memory report).
+  virtual std::size_t contacts() const { return 0; }
+
+  // Bond models.
+  /// Rest length of a bond of group g created between radii ri, rj at distance r.
+  virtual double rest_length(std::size_t /*group*/, double /*ri*/, double /*rj*/, double r) const {
+    return r;
+  }
+
+  virtual std::size_t memory_bytes() const { return 0; }
+};
+
+}  // namespace basalt::solver

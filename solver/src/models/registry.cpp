@@ -1,0 +1,126 @@
+// The model registry: one line per model in model_registry(). A model header (models/*.hpp) plus its
+// line here is all a new model takes (docs/ARCHITECTURE.md, "How to add a model").
+#include "basalt/solver/models/registry.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <set>
+
+#include "basalt/solver/core/errors.hpp"
+#include "basalt/solver/interactions/bond_driver.hpp"
+#include "basalt/solver/interactions/pair_driver.hpp"
+#include "basalt/solver/interactions/wall_driver.hpp"
+#include "basalt/solver/models/contact_age.hpp"
+#include "basalt/solver/models/elastic_wall.hpp"
+#include "basalt/solver/models/linear_bond.hpp"
+#include "basalt/solver/models/linear_elastic.hpp"
+
+namespace basalt::solver {
+
+namespace {
+
+template <class Real, class Model>
+std::unique_ptr<ForceCompute<Real>> make(const Scene& s) {
+  if constexpr (Model::kind == ModelKind::bond) return std::make_unique<BondDriver<Real, Model>>(s.bonds);
+  if constexpr (Model::kind == ModelKind::pair) return std::make_unique<PairDriver<Real, Model>>(s.contacts);
+  if constexpr (Model::kind == ModelKind::wall) return std::make_unique<WallDriver<Real, Model>>(s.walls);
+}
+
+template <class Model>
+ModelEntry entry() {
+  return {Model::name,
+          Model::kind,
+          Model::summary,
+          Model::keys,
+          Model::reads,
+          Model::writes,
+          history_bytes<Model>(),
+          [](TableReader& t) { return std::any(Model::parse(t)); },
+          &make<double, Model>,
+          &make<float, Model>};
+}
+
+}  // namespace
+
+const std::vector<ModelEntry>& model_registry() {
+  static const std::vector<ModelEntry> models{
+      entry<LinearBond>(),     // bond
+      entry<LinearElastic>(),  // pair
+      entry<ContactAge>(),     // pair, test model for contact history
+      entry<ElasticWall>(),    // wall
+  };
+  return models;
+}
+
+const ModelEntry* find_model(std::string_view name, ModelKind kind) {
+  for (const auto& m : model_registry())
+    if (m.name == name && m.kind == kind) return &m;
+  return nullptr;
+}
+
+std::vector<std::string> model_names(ModelKind kind) {
+  std::vector<std::string> names;
+  for (const auto& m : model_registry())
+    if (m.kind == kind) names.emplace_back(m.name);
+  return names;
+}
+
+std::string field_names(Fields f) {
+  static constexpr std::pair<Fields, const char*> kNames[] = {{kPosition, "position"},
+                                                              {kVelocity, "velocity"},
+                                                              {kForce, "force"},
+                                                              {kRadius, "radius"},
+                                                              {kInverseMass, "inverse_mass"},
+                                                              {kId, "id"},
+                                                              {kTag, "tag"}};
+  std::string s;
+  for (const auto& [bit, name] : kNames)
+    if (f & bit) s += (s.empty() ? "" : ", ") + std::string(name);
+  return s.empty() ? "none" : s;
+}
+
+std::string describe_models() {
+  std::string s;
+  for (const auto kind : {ModelKind::bond, ModelKind::pair, ModelKind::wall}) {
+    s += fmt::format("{} models ({}):\n", kind_name(kind),
+                     kind == ModelKind::wall ? "[[walls]] interaction = \"<name>\""
+                                             : "[[interactions]] type = \"<name>\"");
+    for (const auto& m : model_registry()) {
+      if (m.kind != kind) continue;
+      s += fmt::format("  {}\n    {}\n", m.name, m.summary);
+      for (const auto& k : m.keys) s += fmt::format("    {:<14} {}\n", k.key, k.doc);
+      s += fmt::format("    reads: {}; writes: {}; per-contact history: {}\n", field_names(m.reads),
+                       field_names(m.writes),
+                       m.history_bytes ? fmt::format("{} B", m.history_bytes) : std::string("none"));
+    }
+  }
+  return s;
+}
+
+template <class Real>
+std::vector<std::unique_ptr<ForceCompute<Real>>> make_force_computes(const Scene& scene) {
+  std::vector<std::unique_ptr<ForceCompute<Real>>> out;
+  const auto add = [&](std::string_view name, ModelKind kind, std::set<std::string_view>& made) {
+    if (!made.insert(name).second) return;
+    const auto* m = find_model(name, kind);
+    if (!m) throw InputError(fmt::format("no {} model \"{}\" in this build", kind_name(kind), name));
+    if constexpr (std::is_same_v<Real, double>)
+      out.push_back(m->make_double(scene));
+    else
+      out.push_back(m->make_float(scene));
+  };
+  std::set<std::string_view> bonds, pairs, walls;
+  for (const auto& g : scene.bonds) add(g.model, ModelKind::bond, bonds);
+  // Bond groups index one driver's parameters (Bonds::group); a second bond model needs a driver that
+  // skips the other's groups: refused until a second bond model exists.
+  if (bonds.size() > 1) throw InputError("interactions: all bond groups must use the same bond model");
+  for (const auto& g : scene.contacts) add(g.model, ModelKind::pair, pairs);
+  for (const auto& w : scene.walls) add(w.model, ModelKind::wall, walls);
+  return out;
+}
+
+template std::vector<std::unique_ptr<ForceCompute<double>>> make_force_computes<double>(const Scene&);
+template std::vector<std::unique_ptr<ForceCompute<float>>> make_force_computes<float>(const Scene&);
+
+}  // namespace basalt::solver
