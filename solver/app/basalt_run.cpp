@@ -140,6 +140,7 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
     info.attributes = basalt::run::restart_attributes(sim->restart_layout());
     info.attributes["code_version"] = std::string(basalt::kVersion);
     info.scene_text = scene.text;
+    info.dt = scene.dt;  // constant for the run: sent once to the I/O ranks, stored in every checkpoint
   } catch (const std::exception& e) {
     setup_error = e.what();
   }
