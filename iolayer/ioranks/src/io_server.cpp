@@ -57,178 +57,194 @@ void split_pieces(std::span<const std::byte> bytes, std::vector<FramePiece>& out
   }
 }
 
-}  // namespace
+/// One I/O rank's run: what IoServer::run does, with its state.
+class Server {
+ public:
+  Server(const RankLayout& layout, const OutputConfig& config, const VtkFrameWriter& vtk)
+      : L_(layout), cfg_(config), vtk_(vtk), io_index_(layout.world_rank - layout.n_compute) {}
 
-IoServer::IoServer(const RankLayout& layout, OutputConfig config, VtkFrameWriter vtk)
-    : layout_(layout), config_(std::move(config)), vtk_(std::move(vtk)) {}
+  OutputReport run() {
+    const double wall0 = MPI_Wtime();
+    const double cpu0 = process_cpu_seconds();
+    // The run's fixed information, from compute rank 0.
+    receive_without_spinning(0, kTagInfo, L_.bridge, buffer_);
+    info_ = deserialize_run_info(buffer_);
+    open_fields();
 
-OutputReport IoServer::run() {
-  const RankLayout& L = layout_;
-  const int io_index = L.world_rank - L.n_compute;
-  OutputReport local;
-  const double wall0 = MPI_Wtime();
-  const double cpu0 = process_cpu_seconds();
-  int errors_sent = 0;
-
-  auto report_error = [&](const std::string& text) {
-    if (local.error) return;  // one error message per compute rank at most
-    local.error = text;
-    for (int c = 0; c < L.n_compute; ++c) {
-      MPI_Send(text.data(), static_cast<int>(text.size()), MPI_CHAR, c, kTagError, L.bridge);
+    int done = 0;
+    Backoff backoff;
+    while (done < L_.n_compute) {
+      int flag = 0;
+      MPI_Message msg;
+      MPI_Status st;
+      MPI_Improbe(MPI_ANY_SOURCE, MPI_ANY_TAG, L_.bridge, &flag, &msg, &st);
+      if (!flag) {
+        backoff.sleep();  // an idle I/O rank must not burn a core
+        continue;
+      }
+      backoff.reset();
+      int n = 0;
+      MPI_Get_count(&st, MPI_BYTE, &n);
+      buffer_.resize(n);
+      MPI_Mrecv(buffer_.data(), n, MPI_BYTE, &msg, MPI_STATUS_IGNORE);
+      switch (st.MPI_TAG) {
+        case kTagFrame:
+          add_piece(deserialize(buffer_));
+          break;
+        case kTagFields:
+          add_field_batch();
+          break;
+        case kTagDone:
+          ++done;
+          break;
+        default:
+          report_error(fmt::format("I/O rank {}: unexpected message tag {} from rank {}", io_index_,
+                                   st.MPI_TAG, st.MPI_SOURCE));
+      }
     }
-    errors_sent = 1;
-  };
-
-  // The run's fixed information, from compute rank 0.
-  RunInfo info;
-  {
-    std::vector<std::byte> bytes;
-    receive_without_spinning(0, kTagInfo, L.bridge, bytes);
-    info = deserialize_run_info(bytes);
+    if (!pending_.empty())
+      report_error(fmt::format("I/O rank {}: step {} is missing pieces from some compute ranks", io_index_,
+                               pending_.begin()->first));
+    if (csv_) {
+      local_.fields.files = 1;
+      local_.fields.bytes = csv_->bytes();
+      local_.fields.write_seconds = csv_->seconds();
+    }
+    local_.io_cpu_seconds = process_cpu_seconds() - cpu0;
+    local_.io_wall_seconds = MPI_Wtime() - wall0;
+    OutputReport all = reduce_report(L_.bridge, local_);
+    int expected = 0;
+    MPI_Allreduce(&errors_sent_, &expected, 1, MPI_INT, MPI_SUM, L_.bridge);
+    return all;
   }
 
-  std::unique_ptr<detail::FieldSeriesWriter> csv;
-  if (io_index == 0 && config_.fields_every > 0 && !config_.field_names.empty()) {
+ private:
+  /// Tells every compute rank (once: one error message per compute rank at most).
+  void report_error(const std::string& text) {
+    if (local_.error) return;
+    local_.error = text;
+    for (int c = 0; c < L_.n_compute; ++c)
+      MPI_Send(text.data(), static_cast<int>(text.size()), MPI_CHAR, c, kTagError, L_.bridge);
+    errors_sent_ = 1;
+  }
+
+  /// I/O rank 0 writes fields.csv.
+  void open_fields() {
+    if (io_index_ == 0 && cfg_.fields_every > 0 && !cfg_.field_names.empty()) {
+      try {
+        csv_ = std::make_unique<FieldSeriesWriter>(cfg_.dir / "fields.csv", cfg_.field_names,
+                                                   cfg_.append_fields);
+      } catch (const std::exception& e) {
+        report_error(e.what());
+      }
+    }
+    fields_failed_ = !csv_ && io_index_ == 0 && cfg_.fields_every > 0;
+  }
+
+  /// Sums a batch of rows [step, time, partials...] into the rows of their steps; appends the rows
+  /// every compute rank has sent, in step order (every rank sends its rows in order).
+  void add_field_batch() {
+    const std::size_t n_fields = cfg_.field_names.size();
+    const std::size_t width = 2 + n_fields;
+    const std::size_t count = buffer_.size() / sizeof(double);
+    std::vector<double> values(count);
+    std::memcpy(values.data(), buffer_.data(), buffer_.size());
+    for (std::size_t r = 0; r + width <= count; r += width) {
+      const auto step = static_cast<std::int64_t>(values[r]);
+      auto& row = rows_[step];
+      if (row.sum.empty()) row.sum.assign(n_fields, 0.0);
+      row.time = values[r + 1];
+      for (std::size_t k = 0; k < n_fields; ++k) row.sum[k] += values[r + 2 + k];
+      ++row.count;
+    }
+    while (!rows_.empty() && rows_.begin()->second.count == L_.n_compute) {
+      if (csv_ && !fields_failed_)
+        csv_->append(rows_.begin()->first, rows_.begin()->second.time, rows_.begin()->second.sum);
+      rows_.erase(rows_.begin());
+    }
+    if (csv_ && !fields_failed_) try {
+        csv_->flush();
+      } catch (const std::exception& e) {
+        fields_failed_ = true;
+        report_error(e.what());
+      }
+  }
+
+  /// Writes a step once every compute rank this I/O rank serves has sent its piece.
+  void add_piece(FramePiece piece) {
+    const auto step = piece.step;
+    auto& list = pending_[step];
+    list.push_back(std::move(piece));
+    if (list.size() != L_.served.size()) return;
+    const auto kinds = list.front().kinds;
+    if (kinds & kFrameVtk) write_vtk(list, step);
+    if (kinds & kFrameCheckpoint) write_checkpoint(list);
+    pending_.erase(step);
+  }
+
+  /// This I/O rank's piece of the VTK frame (and, on I/O rank 0, the frame's index and the series).
+  void write_vtk(const std::vector<FramePiece>& pieces, std::int64_t step) {
+    if (!vtk_ || frames_failed_) return;
     try {
-      csv = std::make_unique<detail::FieldSeriesWriter>(config_.dir / "fields.csv", config_.field_names,
-                                                        config_.append_fields);
+      const double t0 = MPI_Wtime();
+      const auto bytes = vtk_(pieces, step, pieces.front().time, io_index_, L_.n_io, cfg_.dir);
+      throttle(cfg_.throttle_mb_per_s, bytes, MPI_Wtime() - t0);
+      local_.frames.files += 1;
+      local_.frames.bytes += bytes;
+      local_.frames.write_seconds += MPI_Wtime() - t0;
     } catch (const std::exception& e) {
+      frames_failed_ = true;
       report_error(e.what());
     }
   }
-  const std::size_t n_fields = config_.field_names.size();
+
+  /// One file per checkpoint: the other I/O ranks hand their pieces to I/O rank 0, which writes it.
+  void write_checkpoint(std::vector<FramePiece>& pieces) {
+    if (io_index_ != 0) {
+      concat_pieces(pieces, gathered_);
+      MPI_Request req;
+      MPI_Isend(gathered_.data(), checked_count(gathered_.size()), MPI_BYTE, 0, kTagGather, L_.io, &req);
+      wait_without_spinning(req);
+      return;
+    }
+    for (int q = 1; q < L_.n_io; ++q) {
+      receive_without_spinning(q, kTagGather, L_.io, gathered_);
+      split_pieces(gathered_, pieces);
+    }
+    if (checkpoints_failed_) return;
+    try {
+      write_checkpoint_step(pieces, info_, cfg_, local_.checkpoints);
+    } catch (const std::exception& e) {
+      checkpoints_failed_ = true;
+      report_error(e.what());
+    }
+  }
+
   struct Row {
     double time = 0;
     std::vector<double> sum;
     int count = 0;
   };
-  std::map<std::int64_t, Row> rows;
-  bool fields_failed = !csv && io_index == 0 && config_.fields_every > 0;
-  bool checkpoints_failed = false, frames_failed = false;
 
-  std::map<std::int64_t, std::vector<FramePiece>> pending;
-  std::vector<std::byte> buffer, gathered;
+  const RankLayout& L_;
+  const OutputConfig& cfg_;
+  const VtkFrameWriter& vtk_;
+  const int io_index_;
+  RunInfo info_;
+  OutputReport local_;
+  int errors_sent_ = 0;
+  std::unique_ptr<FieldSeriesWriter> csv_;
+  std::map<std::int64_t, Row> rows_;  // field rows not yet complete
+  bool fields_failed_ = false, checkpoints_failed_ = false, frames_failed_ = false;
+  std::map<std::int64_t, std::vector<FramePiece>> pending_;  // pieces of steps not yet complete
+  std::vector<std::byte> buffer_, gathered_;
+};
 
-  auto process_step = [&](std::int64_t step) {
-    auto& pieces = pending[step];
-    const auto kinds = pieces.front().kinds;
-    if ((kinds & kFrameVtk) && vtk_ && !frames_failed) {
-      try {
-        const double t0 = MPI_Wtime();
-        const auto bytes = vtk_(pieces, step, pieces.front().time, io_index, L.n_io, config_.dir);
-        throttle(config_.throttle_mb_per_s, bytes, MPI_Wtime() - t0);
-        local.frames.files += 1;
-        local.frames.bytes += bytes;
-        local.frames.write_seconds += MPI_Wtime() - t0;
-      } catch (const std::exception& e) {
-        frames_failed = true;
-        report_error(e.what());
-      }
-    }
-    if (kinds & kFrameCheckpoint) {
-      if (L.n_io == 1) {
-        if (!checkpoints_failed) try {
-            write_checkpoint_step(pieces, info, config_, local.checkpoints);
-          } catch (const std::exception& e) {
-            checkpoints_failed = true;
-            report_error(e.what());
-          }
-      } else if (io_index != 0) {
-        // One file per checkpoint: hand the pieces to I/O rank 0, which writes it.
-        concat_pieces(pieces, gathered);
-        MPI_Request req;
-        MPI_Isend(gathered.data(), checked_count(gathered.size()), MPI_BYTE, 0, kTagGather, L.io, &req);
-        wait_without_spinning(req);
-      } else {
-        for (int q = 1; q < L.n_io; ++q) {
-          receive_without_spinning(q, kTagGather, L.io, gathered);
-          split_pieces(gathered, pieces);
-        }
-        if (!checkpoints_failed) try {
-            write_checkpoint_step(pieces, info, config_, local.checkpoints);
-          } catch (const std::exception& e) {
-            checkpoints_failed = true;
-            report_error(e.what());
-          }
-      }
-    }
-    pending.erase(step);
-  };
+}  // namespace
 
-  int done = 0;
-  Backoff backoff;
-  while (done < L.n_compute) {
-    int flag = 0;
-    MPI_Message msg;
-    MPI_Status st;
-    MPI_Improbe(MPI_ANY_SOURCE, MPI_ANY_TAG, L.bridge, &flag, &msg, &st);
-    if (!flag) {
-      backoff.sleep();  // an idle I/O rank must not burn a core
-      continue;
-    }
-    backoff.reset();
-    int n = 0;
-    MPI_Get_count(&st, MPI_BYTE, &n);
-    buffer.resize(n);
-    MPI_Mrecv(buffer.data(), n, MPI_BYTE, &msg, MPI_STATUS_IGNORE);
-    switch (st.MPI_TAG) {
-      case kTagFrame: {
-        FramePiece piece = deserialize(buffer);
-        const auto step = piece.step;
-        auto& list = pending[step];
-        list.push_back(std::move(piece));
-        if (list.size() == L.served.size()) process_step(step);
-        break;
-      }
-      case kTagFields: {
-        const std::size_t width = 2 + n_fields;
-        const std::size_t count = buffer.size() / sizeof(double);
-        std::vector<double> values(count);
-        std::memcpy(values.data(), buffer.data(), buffer.size());
-        for (std::size_t r = 0; r + width <= count; r += width) {
-          const auto step = static_cast<std::int64_t>(values[r]);
-          auto& row = rows[step];
-          if (row.sum.empty()) row.sum.assign(n_fields, 0.0);
-          row.time = values[r + 1];
-          for (std::size_t k = 0; k < n_fields; ++k) row.sum[k] += values[r + 2 + k];
-          ++row.count;
-        }
-        // Rows complete in step order (every rank sends its rows in order).
-        while (!rows.empty() && rows.begin()->second.count == L.n_compute) {
-          if (csv && !fields_failed)
-            csv->append(rows.begin()->first, rows.begin()->second.time, rows.begin()->second.sum);
-          rows.erase(rows.begin());
-        }
-        if (csv && !fields_failed) try {
-            csv->flush();
-          } catch (const std::exception& e) {
-            fields_failed = true;
-            report_error(e.what());
-          }
-        break;
-      }
-      case kTagDone:
-        ++done;
-        break;
-      default:
-        report_error(fmt::format("I/O rank {}: unexpected message tag {} from rank {}", io_index, st.MPI_TAG,
-                                 st.MPI_SOURCE));
-    }
-  }
-  if (!pending.empty())
-    report_error(fmt::format("I/O rank {}: step {} is missing pieces from some compute ranks", io_index,
-                             pending.begin()->first));
-  if (csv) {
-    local.fields.files = 1;
-    local.fields.bytes = csv->bytes();
-    local.fields.write_seconds = csv->seconds();
-  }
-  local.io_cpu_seconds = process_cpu_seconds() - cpu0;
-  local.io_wall_seconds = MPI_Wtime() - wall0;
-  OutputReport all = reduce_report(L.bridge, local);
-  int expected = 0;
-  MPI_Allreduce(&errors_sent, &expected, 1, MPI_INT, MPI_SUM, L.bridge);
-  return all;
-}
+IoServer::IoServer(const RankLayout& layout, OutputConfig config, VtkFrameWriter vtk)
+    : layout_(layout), config_(std::move(config)), vtk_(std::move(vtk)) {}
+
+OutputReport IoServer::run() { return Server(layout_, config_, vtk_).run(); }
 
 }  // namespace basalt::io
