@@ -14,7 +14,6 @@ find_package(CGAL REQUIRED)
 find_package(tomlplusplus REQUIRED)
 find_package(CLI11 REQUIRED)
 find_package(fmt REQUIRED)
-find_package(spdlog REQUIRED)
 find_package(VTK 9.1 REQUIRED COMPONENTS
   CommonCore CommonDataModel CommonColor IOXML IOParallelXML IOImage
   FiltersCore FiltersSources FiltersGeneral FiltersExtraction

@@ -10,7 +10,7 @@ PACKAGES=(
   libcgal-dev libeigen3-dev libgmp-dev libmpfr-dev
   libvtk9-dev
   libgtest-dev libgmock-dev
-  libtomlplusplus-dev libcli11-dev libfmt-dev libspdlog-dev
+  libtomlplusplus-dev libcli11-dev libfmt-dev
   xvfb xauth
   python3-h5py python3-matplotlib python3-numpy
 )

@@ -21,6 +21,7 @@
 #include "basalt/io/checkpoint.hpp"
 #include "basalt/io/geometry.hpp"
 #include "basalt/io/io_ranks.hpp"
+#include "basalt/io/vtk_frame_writer.hpp"
 #include "basalt/solver/core/errors.hpp"
 #include "basalt/solver/models/registry.hpp"
 #include "basalt/solver/parallel/communicator.hpp"
@@ -29,7 +30,6 @@
 #include "basalt/version.hpp"
 #include "client_sink.hpp"
 #include "restart_support.hpp"
-#include "vtk_frame_writer.hpp"
 
 namespace fs = std::filesystem;
 using namespace basalt::solver;
@@ -160,6 +160,7 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
     info.attributes = basalt::run::restart_attributes(sim->restart_layout());
     info.attributes["code_version"] = std::string(basalt::kVersion);
     info.scene_text = scene.text;
+    info.dt = scene.dt;  // constant for the run: sent once to the I/O ranks, stored in every checkpoint
   } catch (const std::exception& e) {
     setup_error = e.what();
   }
@@ -348,7 +349,7 @@ int run_world(int argc, char** argv) {
   cfg.continue_on_error = scene.output_continue_on_error;
   cfg.throttle_mb_per_s = cli.throttle_mbps;
   cfg.append_fields = ckpt.has_value();
-  const auto vtk = basalt::run::make_vtk_frame_writer(
+  const auto vtk = io::make_vtk_frame_writer(
       io::Units{scene.units.length, scene.units.time, scene.units.force, io::Units{}.mass},
       ckpt ? ckpt->time : -1.0);
 

@@ -13,7 +13,6 @@ SimulationFrame<Real>::SimulationFrame(const Simulation<Real>& sim, std::uint32_
   h.kinds = kinds;
   h.step = sim.step_;
   h.time = sim.time_;
-  h.dt = sim.scene_.dt;
   h.source_rank = sim.comm().rank();
   h.particles = p.n_owned;
   // Owned particles now are those of the last rebuild (only a rebuild migrates or reorders them).

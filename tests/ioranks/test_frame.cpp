@@ -16,7 +16,6 @@ FramePiece make_piece(int rank, int n, std::int64_t step) {
   p.kinds = kFrameCheckpoint;
   p.step = step;
   p.time = step * 1e-3;
-  p.dt = 1e-3;
   p.source_rank = rank;
   for (int k = 0; k < n; ++k) {
     const std::int64_t id = 100 - (rank + 2 * k);  // descending on purpose
@@ -103,6 +102,7 @@ TEST(Frame, AssembleSortsByIdAndKeepsState) {
   RunInfo info;
   info.box_max = {15, 15, 15};
   info.scene_text = "dt = 1e-3";
+  info.dt = 1e-3;
   const auto c = assemble(pieces, info);
   ASSERT_EQ(c.size(), 8u);
   EXPECT_TRUE(std::is_sorted(c.geometry.id.begin(), c.geometry.id.end()));
@@ -117,7 +117,32 @@ TEST(Frame, AssembleSortsByIdAndKeepsState) {
   EXPECT_EQ(c.walls.size(), 1u);
   EXPECT_EQ(c.step, 7);
   EXPECT_EQ(c.scene_text, "dt = 1e-3");
+  EXPECT_EQ(c.dt, 1e-3);  // from the run's information, not from the frames
   EXPECT_EQ(c.geometry.box_max[2], 15);
+}
+
+TEST(Frame, RunInfoRoundTripsWithTheTimeStep) {
+  // Sent once at start: what is constant for the run, dt included (frames do not carry it).
+  RunInfo info;
+  info.dt = 1.0 / 3.0 * 1e-3;
+  info.box_min = {-1, -2, -3};
+  info.box_max = {15, 15, 15.5};
+  info.periodic = {true, false, true};
+  info.units.length = "mm";
+  info.attributes["code_version"] = "test";
+  info.scene_text = "[run]\ndt = 1e-3\n";
+  std::vector<std::byte> bytes;
+  serialize(info, bytes);
+  const RunInfo back = deserialize_run_info(bytes);
+  EXPECT_EQ(back.dt, info.dt);
+  EXPECT_EQ(back.box_min, info.box_min);
+  EXPECT_EQ(back.box_max, info.box_max);
+  EXPECT_EQ(back.periodic, info.periodic);
+  EXPECT_EQ(back.units.length, "mm");
+  EXPECT_EQ(back.attributes, info.attributes);
+  EXPECT_EQ(back.scene_text, info.scene_text);
+  bytes[0] = std::byte{0};
+  EXPECT_THROW(deserialize_run_info(bytes), std::runtime_error);
 }
 
 TEST(Frame, AssembleRefusesDuplicateIdsAndMixedSteps) {

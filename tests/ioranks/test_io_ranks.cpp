@@ -26,7 +26,6 @@ FramePiece piece_for(int c, int n_compute, std::int64_t step, std::uint32_t kind
   p.kinds = kinds;
   p.step = step;
   p.time = step * 0.5;
-  p.dt = 0.5;
   p.source_rank = c;
   for (int k = 0; k < per_rank; ++k) {
     const std::int64_t id = c + std::int64_t(k) * n_compute;
@@ -57,6 +56,7 @@ RunResult run_fake_solver(const OutputConfig& cfg, int steps, int per_rank = kPe
   RunInfo info;
   info.box_max = {10, 10, 10};
   info.scene_text = "# test scene";
+  info.dt = 0.5;  // sent once, stored in every checkpoint
   if (res.layout.is_io) {
     res.report = IoServer(res.layout, cfg).run();
     return res;
@@ -121,6 +121,7 @@ TEST(IoRanks, FieldSeriesAndCheckpointsFromEveryRank) {
     ASSERT_TRUE(is_complete_checkpoint(path)) << path;
     const auto c = read_checkpoint(path);
     EXPECT_EQ(c.step, step);
+    EXPECT_EQ(c.dt, 0.5);
     ASSERT_EQ(c.size(), std::size_t(kPerRank * P));
     for (std::size_t i = 0; i < c.size(); ++i) {
       EXPECT_EQ(c.geometry.id[i], std::int64_t(i));

@@ -232,7 +232,8 @@ FramePiece frame_piece(int source_rank, int n, std::int64_t first_id) {
 }
 }  // namespace
 
-TEST(VtkFrames, IoRankFrameWriterWritesPiecesPvtpAndResumableSeries) {
+TEST(VtkFrames, FrameWriterWritesPiecesPvtpAndResumableSeries) {
+  // basalt-run's frame writer (the I/O ranks', and compute rank 0's with --io-ranks 0).
   const fs::path dir = basalt::test::scratch_dir("vtk-ioranks");
   // Two writers (I/O ranks), each serving two compute ranks; the second writer's share is empty at step 200.
   VtkFrameWriter w0 = make_vtk_frame_writer(Units{}), w1 = make_vtk_frame_writer(Units{});
@@ -244,7 +245,7 @@ TEST(VtkFrames, IoRankFrameWriterWritesPiecesPvtpAndResumableSeries) {
   EXPECT_GT(w0(a, 200, 0.2, 0, 2, dir), 0u);
 
   auto reader = vtkSmartPointer<vtkXMLPPolyDataReader>::New();
-  reader->SetFileName((dir / "frames" / "frame_00000100.pvtp").c_str());
+  reader->SetFileName((dir / "frame_00000100.pvtp").c_str());
   reader->Update();
   vtkPolyData* pd = reader->GetOutput();
   ASSERT_EQ(pd->GetNumberOfPoints(), 22);
@@ -253,16 +254,25 @@ TEST(VtkFrames, IoRankFrameWriterWritesPiecesPvtpAndResumableSeries) {
   EXPECT_EQ(id->GetTuple1(10), 100);  // second compute rank of writer 0
   EXPECT_EQ(id->GetTuple1(15), 200);  // first particle of writer 1
   EXPECT_EQ(pd->GetPoint(16)[1], 1.0 / 3.0 * 2);
-  auto step200 = read_polydata(dir / "frames" / "frame_00000200.pvtp");
+  for (const char* name : {"radius", "tag", "mass", "velocity", "speed"})
+    EXPECT_NE(array(pd, name), nullptr) << name;
+  auto step200 = read_polydata(dir / "frame_00000200.pvtp");
   EXPECT_EQ(step200->GetNumberOfPoints(), 15);  // writer 1 wrote an empty piece
+  EXPECT_EQ(info_of(*step200).step, 200);
+  EXPECT_EQ(info_of(*step200).time, 0.2);
 
   ASSERT_EQ(PvdSeries(dir / "frames.pvd", true).entries().size(), 2u);
-  EXPECT_EQ(PvdSeries(dir / "frames.pvd", true).entries()[1].file, "frames/frame_00000200.pvtp");
-  // A restart at step 200 (a new writer) replaces the frame at t = 0.2 rather than listing it twice.
-  VtkFrameWriter restarted = make_vtk_frame_writer(Units{});
+  EXPECT_EQ(PvdSeries(dir / "frames.pvd", true).entries()[1].file, "frame_00000200.pvtp");
+  // A restart from the checkpoint at t = 0.1 (a new writer) drops the later frame and writes it again,
+  // rather than listing it twice.
+  VtkFrameWriter restarted = make_vtk_frame_writer(Units{}, 0.1);
   restarted(a, 200, 0.2, 0, 1, dir);
   const PvdSeries after(dir / "frames.pvd", true);
   ASSERT_EQ(after.entries().size(), 2u);
   EXPECT_EQ(after.entries()[0].time, 0.1);
   EXPECT_EQ(after.entries()[1].time, 0.2);
+  // A new run (no restart) starts a new series.
+  VtkFrameWriter fresh = make_vtk_frame_writer(Units{});
+  fresh(a, 300, 0.3, 0, 1, dir);
+  ASSERT_EQ(PvdSeries(dir / "frames.pvd", true).entries().size(), 1u);
 }

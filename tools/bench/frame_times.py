@@ -4,8 +4,9 @@ basalt-run itself (BASALT_FRAME_TIMES=1 prints each rank's median per run), for 
 basalt-run binaries run interleaved on the same machine state. Prints the median over repeats of
 compute rank 0's per-run median, and the ratio new / baseline.
 
+  tools/bench/make_inputs.sh      # bench-inputs/cube30.geo and cube60.h5 (once)
   tools/bench/frame_times.py --basalt-run build/bin/basalt-run --baseline-run OTHER/bin/basalt-run \
-      --geometry /work/data/cube30.geo --steps 600 --checkpoint-every 100 --repeats 5 [--io-ranks 1]
+      --geometry bench-inputs/cube30.geo --steps 600 --checkpoint-every 100 --repeats 5 [--io-ranks 1]
 """
 import argparse
 import os

@@ -4,7 +4,8 @@ checkpoint every 100 steps; both) with --io-ranks 0 (1 rank computes and writes)
 (1 compute + 1 I/O rank), and the slow-storage experiment (--throttle-io-mbps). Prints Markdown
 tables of medians over repeats and ratios against "none" with the same Q measured in the same run.
 
-  tools/bench/output_bench.py --basalt-run build/bin/basalt-run --geometry /work/data/cube30.geo \
+  tools/bench/make_inputs.sh      # bench-inputs/cube30.geo and cube60.h5 (once)
+  tools/bench/output_bench.py --basalt-run build/bin/basalt-run --geometry bench-inputs/cube30.geo \
       --steps 300 --repeats 3 [--throttle 0,50,20,10,5] [--baseline-run OTHER/bin/basalt-run]
 With --baseline-run, "none" and "checkpoint every 100" also run with that binary (e.g. the previous
 commit built in another folder), interleaved with the others: a before/after comparison in one session.

@@ -2,8 +2,9 @@
 """Driver of tools/bench/wave_benchmark.sh: runs the wave benchmark and writes docs/bench/wave.md
 (docs/BENCHMARKS.md quotes its table).
 
-Cases: the 15 mm GenGeo cube (cube1.geo, 8,948 particles) and a 30 mm cube (/work/data/cube30.geo when
-present, else cube1.geo tiled 2x2x2 = 71,584 particles), each at 1 and 2 ranks. Every repeat runs
+Cases: the 15 mm GenGeo cube (cube1.geo, 8,948 particles) and a 30 mm cube (INPUTS/cube30-gengeo.geo, the
+GenGeo cube, when present, else INPUTS/cube30.geo, basalt-pack's; both from tools/bench/make_inputs.sh,
+which this driver runs when neither exists), each at 1 and 2 ranks. Every repeat runs
 Basalt and then each peer code (LAMMPS, ESyS-Particle) on the same case, so the ratios compare runs
 made under the same machine load; the report gives medians over repeats. Peers run when their
 executables exist and their drivers (tools/lammps/wave_benchmark.sh, tools/esys/wave_benchmark.py) are
@@ -94,20 +95,24 @@ def main():
     p.add_argument("--lammps-skin", type=float, default=0.1, help="LAMMPS neighbour skin (Basalt's scene uses 0.1)")
     p.add_argument("--no-memory", action="store_true")
     p.add_argument("--output", default=None, help="report (default ROOT/docs/bench/wave.md)")
+    p.add_argument("--inputs", default=None, help="folder of tools/bench/make_inputs.sh (default ROOT/bench-inputs)")
     a = p.parse_args()
     a.build = a.build or os.path.join(a.root, "build")
     a.peer_dir = a.peer_dir or a.root
     a.output = a.output or os.path.join(a.root, "docs", "bench", "wave.md")
+    a.inputs = a.inputs or os.path.join(a.root, "bench-inputs")
     ref = os.environ.get("BASALT_REFERENCE_DIR") or os.path.join(a.root, "..", "shared", "reference")
     cube15 = os.path.join(ref, "cube1.geo")
     work = tempfile.mkdtemp(prefix="basalt-bench-")
     tile = os.path.join(a.root, "tools", "bench", "wave_tile_geo.py")
-    cube30 = "/work/data/cube30.geo"
-    cube30_note = "GenGeo 30 mm cube (/work/data/cube30.geo)"
+    cube30 = os.path.join(a.inputs, "cube30-gengeo.geo")
+    cube30_note = "GenGeo 30 mm cube (bench-inputs/cube30-gengeo.geo: tools/bench/make_inputs.sh --gengeo)"
     if not os.path.exists(cube30):
-        cube30 = os.path.join(work, "cube30.geo")
-        sh(["/usr/bin/python3", tile, cube15, "2", cube30])
-        cube30_note = "cube1.geo tiled 2x2x2 (tools/bench/wave_tile_geo.py; no bonds across tiles)"
+        cube30 = os.path.join(a.inputs, "cube30.geo")
+        cube30_note = "basalt-pack 30 mm cube (bench-inputs/cube30.geo: tools/bench/make_inputs.sh)"
+        if not os.path.exists(cube30):
+            subprocess.run(["bash", os.path.join(a.root, "tools", "bench", "make_inputs.sh"), a.inputs], check=True,
+                           env=dict(os.environ, BASALT_PACK=os.path.join(a.build, "bin", "basalt-pack")))
     cases = [("cube15", cube15, a.steps), ("cube30", cube30, a.steps30)]
     peers = []
     if not a.no_peers:

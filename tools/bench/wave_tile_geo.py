@@ -3,7 +3,7 @@
 bigger benchmark geometries from GenGeo's cube1.geo: n = 2 gives a 30 mm cube (71,584 particles, the
 size of the paper's 30 mm case), n = 5 about 1.1 M particles for the memory measurement.
 
-    /usr/bin/python3 tools/bench/wave_tile_geo.py ../shared/reference/cube1.geo 2 /tmp/cube30.geo
+    /usr/bin/python3 tools/bench/wave_tile_geo.py $BASALT_REFERENCE_DIR/cube1.geo 2 out/cube1-tiled2.geo
 """
 import sys
 

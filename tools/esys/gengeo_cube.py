@@ -1,9 +1,9 @@
 #!/usr/bin/python3
 """Packs a bonded cube of side L with GenGeo (python3-gengeo) and writes it as an LSMGeometry .geo file.
 
-    /usr/bin/python3 tools/esys/gengeo_cube.py --side 30 --output /work/data/cube30.geo
+    /usr/bin/python3 tools/esys/gengeo_cube.py --side 30 --output bench-inputs/cube30-gengeo.geo   (or: tools/bench/make_inputs.sh --gengeo)
 
-Same recipe as /work/shared/reference/cube1.geo (see its README.md): InsertGenerator3D with radii
+Same recipe as the paper's reference cube1.geo (BASALT_REFERENCE_DIR; see its README.md): InsertGenerator3D with radii
 0.2-1.0 mm, insertFails 1000, maxIterations 1000, tolerance 1e-6, planes on all six faces, particle
 tag 1; bonds between pairs closer than 1e-5 (bond tag 0). The 30 mm cube takes tens of minutes.
 The file is written to a temporary name and renamed when complete.

@@ -2,7 +2,7 @@
 """Times the peer codes on the wave benchmark: particle-steps/s of the stepping loop, median of repeats.
 
     /usr/bin/python3 tools/esys/measure_throughput.py --geometry G.geo --steps 2000 --repeats 3 \
-        --ranks 1,2 --codes esys,lammps --output /tmp/timing [--markdown docs/data/x.md]
+        --ranks 1,2 --codes esys,lammps --output out/timing [--markdown docs/data/x.md]
 
 Runs are interleaved (esys 1, esys 2, lammps 1, lammps 2, then again) so that other load on the
 machine falls on every configuration alike; the 1-minute load average is recorded before each run.
@@ -44,7 +44,10 @@ def run_one(code, ranks, args, rundir):
 
 def main():
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    p.add_argument("--geometry", default="/work/shared/reference/cube1.geo")
+    p.add_argument("--geometry", default=os.path.join(os.environ.get("BASALT_REFERENCE_DIR") or
+                                                     os.path.join(HERE, "..", "..", "..", "shared", "reference"),
+                                                     "cube1.geo"),
+                   help="default $BASALT_REFERENCE_DIR/cube1.geo (../shared/reference next to the checkout)")
     p.add_argument("--steps", type=int, default=2000)
     p.add_argument("--repeats", type=int, default=3)
     p.add_argument("--ranks", default="1,2", help="comma list: ESyS workers / LAMMPS ranks")

@@ -4,7 +4,7 @@
 Run it with the system Python; it checks that ESyS-Particle is installed and re-launches itself as
 `mpirun -np W+1 esysparticle wave_benchmark.py ...` (one master + W workers):
 
-    /usr/bin/python3 tools/esys/wave_benchmark.py --steps 2000 --fieldsaver --output /tmp/esys1
+    /usr/bin/python3 tools/esys/wave_benchmark.py --steps 2000 --fieldsaver --output out/esys1
 
 Physics (ESyS conventions, verified in docs/reference-runs.md):
   * particles from a .geo file, mass = 4/3 pi r^3 (density 1), no rotation (NRotSphere);
@@ -30,8 +30,10 @@ import sys
 import time
 
 CHILD_ENV = "BASALT_ESYS_CHILD"
-DEFAULT_GEOMETRY = "/work/shared/reference/cube1.geo"
 HERE = os.path.dirname(os.path.abspath(__file__))
+# The paper's reference cube: BASALT_REFERENCE_DIR (as for the tests), default ../shared/reference next to the checkout.
+DEFAULT_GEOMETRY = os.path.join(os.environ.get("BASALT_REFERENCE_DIR") or os.path.join(HERE, "..", "..", "..", "shared", "reference"),
+                                "cube1.geo")
 sys.path.insert(0, HERE)  # esysparticle's embedded interpreter does not add the script's folder
 
 from geofile import GeoError, read_geo  # noqa: E402

@@ -12,7 +12,7 @@
 set -euo pipefail
 
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
-geometry=/work/shared/reference/cube1.geo
+geometry="${BASALT_REFERENCE_DIR:-$here/../../../shared/reference}/cube1.geo"
 steps=10000
 ranks=1
 ke=0

@@ -13,7 +13,7 @@ namespace basalt::io {
 
 namespace {
 
-constexpr std::uint64_t kInfoMagic = 0x42534c54494e4631ULL;  // "BSLTINF1"
+constexpr std::uint64_t kInfoMagic = 0x42534c54494e4632ULL;  // "BSLTINF2"
 
 class Writer {
  public:
@@ -106,7 +106,6 @@ FrameHeader PieceSource::header() const {
   h.kinds = p_.kinds;
   h.step = p_.step;
   h.time = p_.time;
-  h.dt = p_.dt;
   h.source_rank = p_.source_rank;
   h.particles = n;
   h.bonds = m;
@@ -209,7 +208,6 @@ FramePiece deserialize(std::span<const std::byte> bytes) {
   p.kinds = h.kinds;
   p.step = h.step;
   p.time = h.time;
-  p.dt = h.dt;
   p.source_rank = h.source_rank;
   p.rebuild_step = h.rebuild_step;
   p.rebuild_pending = h.rebuild_pending != 0 ? 1 : 0;
@@ -259,6 +257,7 @@ FramePiece deserialize(std::span<const std::byte> bytes) {
 void serialize(const RunInfo& info, std::vector<std::byte>& out) {
   Writer w(out);
   w.value(kInfoMagic);
+  w.value(info.dt);
   w.value(info.box_min);
   w.value(info.box_max);
   w.value(info.periodic);
@@ -278,6 +277,7 @@ RunInfo deserialize_run_info(std::span<const std::byte> bytes) {
   Reader r(bytes);
   if (r.value<std::uint64_t>() != kInfoMagic) throw std::runtime_error("run info: bad magic number");
   RunInfo info;
+  info.dt = r.value<double>();
   info.box_min = r.value<Vec3>();
   info.box_max = r.value<Vec3>();
   info.periodic = r.value<std::array<bool, 3>>();
@@ -410,7 +410,7 @@ Checkpoint assemble(std::vector<FramePiece>& pieces, const RunInfo& run) {
   g.attributes = run.attributes;
   c.step = step;
   c.time = pieces.front().time;
-  c.dt = pieces.front().dt;
+  c.dt = run.dt;
   c.scene_text = run.scene_text;
   return c;
 }

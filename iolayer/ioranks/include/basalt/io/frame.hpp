@@ -20,7 +20,6 @@ struct FramePiece {
   std::uint32_t kinds = 0;  ///< FrameKind bits
   std::int64_t step = 0;
   double time = 0;
-  double dt = 0;
   std::int32_t source_rank = 0;  ///< compute rank that packed it
 
   // Owned particles of the source rank (any order).
@@ -78,8 +77,10 @@ void serialize(const FramePiece& piece, std::vector<std::byte>& out);
 /// Throws std::runtime_error on a malformed buffer (bad magic, sizes that overrun the buffer).
 FramePiece deserialize(std::span<const std::byte> bytes);
 
-/// What a checkpoint needs besides the per-rank pieces: fixed for the whole run.
+/// What a checkpoint needs besides the per-rank pieces: fixed for the whole run, so it travels once
+/// (at start, to every I/O rank), not in every frame.
 struct RunInfo {
+  double dt = 0;  ///< the time step (checkpoints store it)
   Vec3 box_min{0, 0, 0};
   Vec3 box_max{0, 0, 0};
   std::array<bool, 3> periodic{false, false, false};

@@ -25,12 +25,12 @@ enum FrameKind : std::uint32_t {
   kFrameVtk = 1u << 1,         ///< write a VTK frame of this step
 };
 
-/// What a frame holds besides its columns' contents: sizes, clock, flags.
+/// What a frame holds besides its columns' contents: sizes, clock, flags. What is constant for a run
+/// (dt, the box, units, the scene) is not in frames: it travels once, in RunInfo (frame.hpp).
 struct FrameHeader {
   std::uint32_t kinds = 0;  ///< FrameKind bits
   std::int64_t step = 0;
   double time = 0;
-  double dt = 0;
   std::int32_t source_rank = 0;     ///< compute rank that wrote it
   std::uint64_t particles = 0;      ///< length of the particle columns
   std::uint64_t bonds = 0;          ///< length of the bond columns
@@ -76,7 +76,7 @@ inline constexpr std::size_t kColumns = static_cast<std::size_t>(Column::contact
 
 namespace wire {
 
-inline constexpr std::uint64_t kFrameMagic = 0x42534c5446524d33ULL;  // "BSLTFRM3"
+inline constexpr std::uint64_t kFrameMagic = 0x42534c5446524d34ULL;  // "BSLTFRM4"
 
 /// The header as it travels (all fields 8-byte slots: no padding).
 struct Header {
@@ -85,7 +85,6 @@ struct Header {
   std::int32_t source_rank = 0;
   std::int64_t step = 0;
   double time = 0;
-  double dt = 0;
   std::uint64_t particles = 0;
   std::uint64_t bonds = 0;
   std::uint32_t flags = 0;
@@ -94,7 +93,7 @@ struct Header {
   std::uint64_t contacts = 0;
   std::uint64_t contact_width = 0;
 };
-static_assert(sizeof(Header) == 88 && std::is_trivially_copyable_v<Header>);
+static_assert(sizeof(Header) == 80 && std::is_trivially_copyable_v<Header>);
 inline constexpr std::uint32_t kInverseMass = 1u << 0;
 inline constexpr std::uint32_t kWithRebuild = 1u << 1;
 
@@ -224,7 +223,6 @@ class FrameWriter {
     wire_.source_rank = h.source_rank;
     wire_.step = h.step;
     wire_.time = h.time;
-    wire_.dt = h.dt;
     wire_.particles = h.particles;
     wire_.bonds = h.bonds;
     wire_.contacts = h.contacts;

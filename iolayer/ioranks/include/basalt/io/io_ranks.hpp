@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -21,6 +22,10 @@
 #include "basalt/io/frame.hpp"
 
 namespace basalt::io {
+
+namespace detail {
+class OutputClientImpl;  // the asynchronous client (Q >= 1) or the synchronous writer (Q = 0)
+}
 
 /// Which ranks compute and which write. Only start-up passes MPI_COMM_WORLD here.
 struct RankLayout {
@@ -109,8 +114,7 @@ class OutputClient {
   OutputReport finish();
 
  private:
-  struct Impl;
-  Impl* impl_;
+  std::unique_ptr<detail::OutputClientImpl> impl_;
   std::optional<std::string> error_;
 };
 

@@ -1,0 +1,44 @@
+#include "checkpoint_step.hpp"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <thread>
+
+namespace basalt::io::detail {
+
+namespace {
+
+std::uint64_t file_size_or_zero(const std::filesystem::path& p) {
+  std::error_code ec;
+  auto s = std::filesystem::file_size(p, ec);
+  return ec ? 0 : s;
+}
+
+std::filesystem::path checkpoint_path(const std::filesystem::path& dir, std::int64_t step) {
+  return dir / fmt::format("ckpt_{:06d}.h5", step);
+}
+
+}  // namespace
+
+void throttle(double mb_per_s, std::uint64_t bytes, double elapsed) {
+  if (mb_per_s <= 0) return;
+  const double want = static_cast<double>(bytes) / (mb_per_s * 1e6);
+  if (want > elapsed) std::this_thread::sleep_for(std::chrono::duration<double>(want - elapsed));
+}
+
+std::uint64_t write_checkpoint_step(std::vector<FramePiece>& pieces, const RunInfo& info,
+                                    const OutputConfig& cfg, OutputKindReport& rep) {
+  const double t0 = MPI_Wtime();
+  Checkpoint c = assemble(pieces, info);
+  const auto path = checkpoint_path(cfg.dir, c.step);
+  write_checkpoint(c, path);
+  const auto bytes = file_size_or_zero(path);
+  throttle(cfg.throttle_mb_per_s, bytes, MPI_Wtime() - t0);
+  rep.files += 1;
+  rep.bytes += bytes;
+  rep.write_seconds += MPI_Wtime() - t0;
+  return bytes;
+}
+
+}  // namespace basalt::io::detail

@@ -1,0 +1,250 @@
+// The I/O-rank side: IoServer::run receives frames and field batches from the compute ranks it
+// serves, assembles the pieces of a step and writes checkpoints (I/O rank 0 writes one file per
+// step; the others forward their pieces), VTK pieces and fields.csv; it sleeps while idle.
+#include <fmt/format.h>
+#include <sys/resource.h>
+
+#include <cstring>
+#include <map>
+#include <memory>
+#include <stdexcept>
+
+#include "basalt/io/io_ranks.hpp"
+#include "checkpoint_step.hpp"
+#include "field_series.hpp"
+#include "messages.hpp"
+#include "report_reduction.hpp"
+
+namespace basalt::io {
+
+using namespace detail;
+
+namespace {
+
+/// CPU time (user + system) of this process so far: shows that an idle I/O rank sleeps.
+double process_cpu_seconds() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
+/// The pieces of one step in one buffer (length-prefixed), for I/O rank 0 to write them.
+void concat_pieces(const std::vector<FramePiece>& pieces, std::vector<std::byte>& out) {
+  out.clear();
+  std::vector<std::byte> one;
+  for (const auto& p : pieces) {
+    serialize(p, one);
+    const std::uint64_t n = one.size();
+    const std::size_t at = out.size();
+    out.resize(at + sizeof(n) + one.size());
+    std::memcpy(out.data() + at, &n, sizeof(n));
+    std::memcpy(out.data() + at + sizeof(n), one.data(), one.size());
+  }
+}
+
+/// The inverse of concat_pieces: appends the pieces in `bytes` to `out`.
+void split_pieces(std::span<const std::byte> bytes, std::vector<FramePiece>& out) {
+  std::size_t pos = 0;
+  while (pos < bytes.size()) {
+    std::uint64_t n = 0;
+    if (bytes.size() - pos < sizeof(n)) throw std::runtime_error("gathered frame: truncated length");
+    std::memcpy(&n, bytes.data() + pos, sizeof(n));
+    pos += sizeof(n);
+    if (n > bytes.size() - pos) throw std::runtime_error("gathered frame: truncated piece");
+    out.push_back(deserialize(bytes.subspan(pos, n)));
+    pos += n;
+  }
+}
+
+/// One I/O rank's run: what IoServer::run does, with its state.
+class Server {
+ public:
+  Server(const RankLayout& layout, const OutputConfig& config, const VtkFrameWriter& vtk)
+      : L_(layout), cfg_(config), vtk_(vtk), io_index_(layout.world_rank - layout.n_compute) {}
+
+  OutputReport run() {
+    const double wall0 = MPI_Wtime();
+    const double cpu0 = process_cpu_seconds();
+    // The run's fixed information, from compute rank 0.
+    receive_without_spinning(0, kTagInfo, L_.bridge, buffer_);
+    info_ = deserialize_run_info(buffer_);
+    open_fields();
+
+    int done = 0;
+    Backoff backoff;
+    while (done < L_.n_compute) {
+      int flag = 0;
+      MPI_Message msg;
+      MPI_Status st;
+      MPI_Improbe(MPI_ANY_SOURCE, MPI_ANY_TAG, L_.bridge, &flag, &msg, &st);
+      if (!flag) {
+        backoff.sleep();  // an idle I/O rank must not burn a core
+        continue;
+      }
+      backoff.reset();
+      int n = 0;
+      MPI_Get_count(&st, MPI_BYTE, &n);
+      buffer_.resize(n);
+      MPI_Mrecv(buffer_.data(), n, MPI_BYTE, &msg, MPI_STATUS_IGNORE);
+      switch (st.MPI_TAG) {
+        case kTagFrame:
+          add_piece(deserialize(buffer_));
+          break;
+        case kTagFields:
+          add_field_batch();
+          break;
+        case kTagDone:
+          ++done;
+          break;
+        default:
+          report_error(fmt::format("I/O rank {}: unexpected message tag {} from rank {}", io_index_,
+                                   st.MPI_TAG, st.MPI_SOURCE));
+      }
+    }
+    if (!pending_.empty())
+      report_error(fmt::format("I/O rank {}: step {} is missing pieces from some compute ranks", io_index_,
+                               pending_.begin()->first));
+    if (csv_) {
+      local_.fields.files = 1;
+      local_.fields.bytes = csv_->bytes();
+      local_.fields.write_seconds = csv_->seconds();
+    }
+    local_.io_cpu_seconds = process_cpu_seconds() - cpu0;
+    local_.io_wall_seconds = MPI_Wtime() - wall0;
+    OutputReport all = reduce_report(L_.bridge, local_);
+    int expected = 0;
+    MPI_Allreduce(&errors_sent_, &expected, 1, MPI_INT, MPI_SUM, L_.bridge);
+    return all;
+  }
+
+ private:
+  /// Tells every compute rank (once: one error message per compute rank at most).
+  void report_error(const std::string& text) {
+    if (local_.error) return;
+    local_.error = text;
+    for (int c = 0; c < L_.n_compute; ++c)
+      MPI_Send(text.data(), static_cast<int>(text.size()), MPI_CHAR, c, kTagError, L_.bridge);
+    errors_sent_ = 1;
+  }
+
+  /// I/O rank 0 writes fields.csv.
+  void open_fields() {
+    if (io_index_ == 0 && cfg_.fields_every > 0 && !cfg_.field_names.empty()) {
+      try {
+        csv_ = std::make_unique<FieldSeriesWriter>(cfg_.dir / "fields.csv", cfg_.field_names,
+                                                   cfg_.append_fields);
+      } catch (const std::exception& e) {
+        report_error(e.what());
+      }
+    }
+    fields_failed_ = !csv_ && io_index_ == 0 && cfg_.fields_every > 0;
+  }
+
+  /// Sums a batch of rows [step, time, partials...] into the rows of their steps; appends the rows
+  /// every compute rank has sent, in step order (every rank sends its rows in order).
+  void add_field_batch() {
+    const std::size_t n_fields = cfg_.field_names.size();
+    const std::size_t width = 2 + n_fields;
+    const std::size_t count = buffer_.size() / sizeof(double);
+    std::vector<double> values(count);
+    std::memcpy(values.data(), buffer_.data(), buffer_.size());
+    for (std::size_t r = 0; r + width <= count; r += width) {
+      const auto step = static_cast<std::int64_t>(values[r]);
+      auto& row = rows_[step];
+      if (row.sum.empty()) row.sum.assign(n_fields, 0.0);
+      row.time = values[r + 1];
+      for (std::size_t k = 0; k < n_fields; ++k) row.sum[k] += values[r + 2 + k];
+      ++row.count;
+    }
+    while (!rows_.empty() && rows_.begin()->second.count == L_.n_compute) {
+      if (csv_ && !fields_failed_)
+        csv_->append(rows_.begin()->first, rows_.begin()->second.time, rows_.begin()->second.sum);
+      rows_.erase(rows_.begin());
+    }
+    if (csv_ && !fields_failed_) try {
+        csv_->flush();
+      } catch (const std::exception& e) {
+        fields_failed_ = true;
+        report_error(e.what());
+      }
+  }
+
+  /// Writes a step once every compute rank this I/O rank serves has sent its piece.
+  void add_piece(FramePiece piece) {
+    const auto step = piece.step;
+    auto& list = pending_[step];
+    list.push_back(std::move(piece));
+    if (list.size() != L_.served.size()) return;
+    const auto kinds = list.front().kinds;
+    if (kinds & kFrameVtk) write_vtk(list, step);
+    if (kinds & kFrameCheckpoint) write_checkpoint(list);
+    pending_.erase(step);
+  }
+
+  /// This I/O rank's piece of the VTK frame (and, on I/O rank 0, the frame's index and the series).
+  void write_vtk(const std::vector<FramePiece>& pieces, std::int64_t step) {
+    if (!vtk_ || frames_failed_) return;
+    try {
+      const double t0 = MPI_Wtime();
+      const auto bytes = vtk_(pieces, step, pieces.front().time, io_index_, L_.n_io, cfg_.dir);
+      throttle(cfg_.throttle_mb_per_s, bytes, MPI_Wtime() - t0);
+      local_.frames.files += 1;
+      local_.frames.bytes += bytes;
+      local_.frames.write_seconds += MPI_Wtime() - t0;
+    } catch (const std::exception& e) {
+      frames_failed_ = true;
+      report_error(e.what());
+    }
+  }
+
+  /// One file per checkpoint: the other I/O ranks hand their pieces to I/O rank 0, which writes it.
+  void write_checkpoint(std::vector<FramePiece>& pieces) {
+    if (io_index_ != 0) {
+      concat_pieces(pieces, gathered_);
+      MPI_Request req;
+      MPI_Isend(gathered_.data(), checked_count(gathered_.size()), MPI_BYTE, 0, kTagGather, L_.io, &req);
+      wait_without_spinning(req);
+      return;
+    }
+    for (int q = 1; q < L_.n_io; ++q) {
+      receive_without_spinning(q, kTagGather, L_.io, gathered_);
+      split_pieces(gathered_, pieces);
+    }
+    if (checkpoints_failed_) return;
+    try {
+      write_checkpoint_step(pieces, info_, cfg_, local_.checkpoints);
+    } catch (const std::exception& e) {
+      checkpoints_failed_ = true;
+      report_error(e.what());
+    }
+  }
+
+  struct Row {
+    double time = 0;
+    std::vector<double> sum;
+    int count = 0;
+  };
+
+  const RankLayout& L_;
+  const OutputConfig& cfg_;
+  const VtkFrameWriter& vtk_;
+  const int io_index_;
+  RunInfo info_;
+  OutputReport local_;
+  int errors_sent_ = 0;
+  std::unique_ptr<FieldSeriesWriter> csv_;
+  std::map<std::int64_t, Row> rows_;  // field rows not yet complete
+  bool fields_failed_ = false, checkpoints_failed_ = false, frames_failed_ = false;
+  std::map<std::int64_t, std::vector<FramePiece>> pending_;  // pieces of steps not yet complete
+  std::vector<std::byte> buffer_, gathered_;
+};
+
+}  // namespace
+
+IoServer::IoServer(const RankLayout& layout, OutputConfig config, VtkFrameWriter vtk)
+    : layout_(layout), config_(std::move(config)), vtk_(std::move(vtk)) {}
+
+OutputReport IoServer::run() { return Server(layout_, config_, vtk_).run(); }
+
+}  // namespace basalt::io
