@@ -74,6 +74,23 @@ case $case_name in
     cmp "$W/straight/ckpt_000300.h5" "$W/split/ckpt_000300.h5" || fail "final checkpoint files differ in their bytes"
     echo "np 3 (1x1x3), migration before the checkpoint: step-300 checkpoints identical"
     ;;
+  restart_history)
+    # Contacts with history (the test model test_contact_age: stiffness grows with the steps in
+    # contact) while particles migrate (1x1x3, stronger pulse): the checkpoint stores every contact's
+    # age (/contacts), the restart gives each back to its pair, and the continuation is bit for bit.
+    sed -e 's/^skin = .*/skin = 0.005/' -e 's/amplitude = 0.1,/amplitude = 0.5,/' \
+        -e 's/^type = "linear_elastic"/type = "test_contact_age"\ngrowth = 0.5\nsaturation = 20/' "$SCENE" >"$W/history.toml"
+    grep -q '^type = "test_contact_age"' "$W/history.toml" || fail "could not set the contact model in $W/history.toml"
+    SCENE=$W/history.toml
+    must_run 3 --dims 1,1,3 --steps 300 --checkpoint-every 150 --output "$W/straight"
+    grep -q "contact history: test_contact_age 8 B per contact" "$W/last.log" || fail "the fields line does not show the contact history"
+    must_run 3 --dims 1,1,3 --steps 150 --checkpoint-every 150 --output "$W/split"
+    $CHECK contacts "$W/split/ckpt_000150.h5" 100 || fail "the step-150 checkpoint holds too few aged contacts"
+    must_run 3 --dims 1,1,3 --steps 150 --checkpoint-every 150 --output "$W/split" --restart "$W/split"
+    $CHECK same "$W/straight/ckpt_000300.h5" "$W/split/ckpt_000300.h5" || fail "final checkpoints differ"
+    cmp "$W/straight/ckpt_000300.h5" "$W/split/ckpt_000300.h5" || fail "final checkpoint files differ in their bytes"
+    echo "np 3 (1x1x3), aging contacts and migration: step-300 checkpoints identical"
+    ;;
   restart_old_checkpoint)
     # A checkpoint without the positions at the last rebuild (older basalt-run): the restart warns
     # and rebuilds plainly; the continuation agrees to rounding.

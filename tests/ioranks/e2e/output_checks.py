@@ -7,6 +7,8 @@
                               position_at_rebuild differs from position
   strip_rebuild FILE          removes position_at_rebuild, rebuild_step and rebuild_pending (an older
                               basalt-run's checkpoint)
+  contacts FILE N             the checkpoint holds at least N contacts with a history (/contacts), each pair
+                              once, with positive ages, and some contacts with an age below the step
   pvd DIR                     every frame of DIR/frames.pvd, read with vtkXMLPPolyDataReader, has the
                               positions of DIR/ckpt_<step>.h5 (same ids), when that checkpoint exists
 """
@@ -61,6 +63,20 @@ def old_lists(f):
         moved = not np.array_equal(h["particles/position_at_rebuild"][()], h["particles/position"][()])
         print(f"step {step}: last rebuild at step {rb}; positions moved since: {moved}")
         return 0 < rb < step and moved
+
+
+def contacts(f, n):
+    with h5py.File(f, "r") as h:
+        if "contacts" not in h:
+            print("no /contacts group")
+            return False
+        ids, hist = h["contacts/ids"][()], h["contacts/history"][()]
+        step = int(h.attrs["step"])
+        pairs = {(min(a, b), max(a, b)) for a, b in ids}
+        print(f"{len(ids)} contacts with history ({len(pairs)} pairs), ages {hist.min():g} .. {hist.max():g}, "
+              f"step {step}")
+        return (len(ids) >= n and len(pairs) == len(ids) and hist.min() > 0 and hist.max() <= step
+                and hist.min() < step)
 
 
 def break_overlap(f):
@@ -124,6 +140,7 @@ if __name__ == "__main__":
     cmd, args = sys.argv[1], sys.argv[2:]
     ok = {"same": lambda: same(*args), "close": lambda: close(args[0], args[1], float(args[2])),
           "complete": lambda: complete(args[0]),
+          "contacts": lambda: contacts(args[0], int(args[1])),
           "old_lists": lambda: old_lists(args[0]), "break_overlap": lambda: break_overlap(args[0]),
           "strip_rebuild": lambda: strip_rebuild(args[0]), "pvd": lambda: pvd(args[0])}[cmd]()
     sys.exit(0 if ok else 1)

@@ -1,0 +1,187 @@
+// Per-contact history (the pair driver's History, carried by the pair's ids across rebuilds, migration
+// and ranks), checked with the test model test_contact_age, whose force depends on the history (the
+// steps a pair has been touching):
+// - two spheres colliding while crossing from one rank to the other, with rebuilds forced during the
+//   contact: the recorded age equals the number of touching steps the test counts itself, every step;
+// - the wave cube with aging contacts and a pulse strong enough to migrate particles: the same
+//   kinetic energies (1e-9) and the same contact ages on any number of ranks as in a serial run.
+// Restart with history (bit for bit) is io_e2e.restart_history.
+#include <gtest/gtest.h>
+#include <mpi.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <tuple>
+
+#include "basalt/solver/simulation.hpp"
+#include "solver_helpers.hpp"
+#include "test_support.hpp"
+
+using namespace basalt::solver;
+
+namespace {
+
+using Age = std::tuple<std::int64_t, std::int64_t, double>;  // lower id, higher id, steps in contact
+
+/// Collective: every contact's age across ranks, sorted, on every rank.
+std::vector<Age> contact_ages(const Simulation<double>& sim, MPI_Comm comm) {
+  std::vector<double> mine;  // (a, b, age) triples as doubles (ids are small)
+  for (const auto& c : sim.force_computes()) {
+    if (c->history_bytes() == 0) continue;
+    ContactRecords r;
+    c->history_records(sim.particles(), r);
+    for (std::size_t k = 0; k < r.size(); ++k)
+      mine.insert(mine.end(),
+                  {double(std::min(r.a[k], r.b[k])), double(std::max(r.a[k], r.b[k])), r.at(k)[0]});
+  }
+  int size = 1;
+  MPI_Comm_size(comm, &size);
+  int n = static_cast<int>(mine.size());
+  std::vector<int> counts(static_cast<std::size_t>(size)), displs(static_cast<std::size_t>(size), 0);
+  MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, comm);
+  for (int r = 1; r < size; ++r) displs[r] = displs[r - 1] + counts[r - 1];
+  std::vector<double> all(static_cast<std::size_t>(displs.back() + counts.back()));
+  MPI_Allgatherv(mine.data(), n, MPI_DOUBLE, all.data(), counts.data(), displs.data(), MPI_DOUBLE, comm);
+  std::vector<Age> ages;
+  for (std::size_t k = 0; k + 2 < all.size(); k += 3)
+    ages.emplace_back(std::int64_t(all[k]), std::int64_t(all[k + 1]), all[k + 2]);
+  std::sort(ages.begin(), ages.end());
+  return ages;
+}
+
+/// Collective: position x and whether particle `id` is owned here (sums over ranks).
+double position_x(const Simulation<double>& sim, std::int64_t id, MPI_Comm comm) {
+  const auto& p = sim.particles();
+  double x = 0;
+  for (std::size_t i = 0; i < p.n_owned; ++i)
+    if (p.id[i] == id) x = p.x[i];
+  double sum = 0;
+  MPI_Allreduce(&x, &sum, 1, MPI_DOUBLE, MPI_SUM, comm);
+  return sum;
+}
+
+}  // namespace
+
+TEST(ContactHistory, AgeCountsTouchingStepsAcrossRebuildsAndRanks) {
+  const int n = basalt::test::size();
+  if (n > 2) GTEST_SKIP() << "two spheres fill at most two ranks";
+  // Two spheres of radius 0.5 drifting along +x, the left one faster: they touch at t = 0.5 and stay
+  // in contact for about pi sqrt(m/2 / K) = 1.6 time units, while the left one crosses the ranks'
+  // boundary (x = -0.55 on two ranks); a soft K keeps the overlap small.
+  const auto scene = basalt::test::scene_from(R"(
+[run]
+dt = 0.01
+steps = 0
+skin = 0.02
+[[interactions]]
+type = "test_contact_age"
+K = 1.0
+growth = 1.0
+saturation = 50
+)");
+  basalt::io::Geometry g;
+  g.add_particle(1, {-1.1, 0, 0}, 0.5);
+  g.add_particle(2, {0.0, 0, 0}, 0.5);
+  RunOptions opt;
+  opt.quiet = true;
+  opt.dims = {n, 1, 1};
+  Simulation<double> sim(scene, g, basalt::test::world(), opt);
+  auto& p = sim.particles();
+  for (std::size_t i = 0; i < p.n_owned; ++i) p.vx[i] = p.id[i] == 1 ? 0.7 : 0.5;
+  sim.state_changed();
+
+  double expected = 0;  // steps in contact, counted here from the positions
+  int touching_steps = 0, crossed_while_touching = 0;
+  double last_x1 = position_x(sim, 1, basalt::test::world());
+  for (int step = 1; step <= 400; ++step) {
+    sim.step();
+    if (step % 7 == 0) sim.force_rebuild();  // history must survive any rebuild
+    const double x1 = position_x(sim, 1, basalt::test::world()),
+                 x2 = position_x(sim, 2, basalt::test::world());
+    const bool touching = std::abs(x2 - x1) < 1.0;
+    expected = touching ? expected + 1 : 0;
+    touching_steps += touching;
+    if (touching && n == 2 && (last_x1 < -0.55) != (x1 < -0.55)) ++crossed_while_touching;
+    last_x1 = x1;
+    const auto ages = contact_ages(sim, basalt::test::world());
+    double age = 0;
+    for (const auto& [a, b, s] : ages) {
+      EXPECT_EQ(a, 1);
+      EXPECT_EQ(b, 2);
+      age = s;
+    }
+    EXPECT_LE(ages.size(), 1u) << "step " << step << ": a contact recorded twice";
+    ASSERT_EQ(age, expected) << "step " << step;
+  }
+  EXPECT_GT(touching_steps, 100) << "the spheres must have collided";
+  if (n == 2) {
+    EXPECT_EQ(crossed_while_touching, 1) << "sphere 1 must change rank during the contact";
+  }
+  // The contact ended: both move apart, the faster one is now the right one.
+  EXPECT_GT(position_x(sim, 2, basalt::test::world()) - position_x(sim, 1, basalt::test::world()), 1.0);
+}
+
+TEST(ContactHistory, AgingContactsAreDecompositionInvariant) {
+  // The wave cube with aging contacts instead of linear elastic ones and a 5x pulse: contacts form and
+  // age while particles migrate (rebuilds with migration from step ~150 at np > 1).
+  auto scene = parse_scene(basalt::test::source_dir() / "scenes" / "wave.toml");
+  const auto with_age = basalt::test::scene_from(R"(
+[run]
+dt = 1.0e-3
+steps = 0
+skin = 0.02
+[[interactions]]
+type = "test_contact_age"
+K = 1000.0
+growth = 0.5
+saturation = 20
+)");
+  scene.contacts = with_age.contacts;
+  scene.skin = 0.02;
+  scene.walls[0].motion.amplitude = 0.5;
+  const auto g = basalt::io::read_geometry(basalt::test::reference_dir() / "cube1.geo");
+  constexpr int kSteps = 400;
+  const auto run = [&](MPI_Comm comm, std::array<int, 3> dims) {
+    RunOptions opt;
+    opt.dims = dims;
+    opt.quiet = true;
+    Simulation<double> sim(scene, g, comm, opt);
+    basalt::test::MemorySink sink;
+    sink.begin(field_columns(scene));
+    sim.run(kSteps, &sink);
+    return std::make_tuple(sink.column(0), contact_ages(sim, comm), sim.rebuilds());
+  };
+  const int n = basalt::test::size();
+  std::vector<double> ref_ke(kSteps);
+  std::vector<Age> ref_ages;
+  if (basalt::test::rank() == 0) {
+    auto [ke, ages, rebuilds] = run(MPI_COMM_SELF, {1, 1, 1});
+    ref_ke = ke;
+    ref_ages = ages;
+    double total = 0;
+    for (const auto& a : ages) total += std::get<2>(a);
+    std::printf("serial: %zu aged contacts at step %d (total age %.0f), %lld rebuilds\n", ages.size(), kSteps,
+                total, static_cast<long long>(rebuilds));
+    EXPECT_GT(ages.size(), 50u) << "contacts must have formed";
+    EXPECT_GT(rebuilds, 5);
+  }
+  MPI_Bcast(ref_ke.data(), kSteps, MPI_DOUBLE, 0, basalt::test::world());
+  if (n == 1) return;
+  std::vector<std::array<int, 3>> grids{{1, 1, n}};
+  if (n == 4) grids.push_back({1, 2, 2});
+  for (const auto& dims : grids) {
+    const auto [ke, ages, rebuilds] = run(basalt::test::world(), dims);
+    if (basalt::test::rank() != 0) continue;
+    double worst = 0;
+    for (std::size_t k = 0; k < ke.size(); ++k)
+      for (std::size_t s = 0; s < ke.size(); ++s) {
+        if (ref_ke[s] > 1e-9 * ref_ke.back())
+          worst = std::max(worst, std::abs(ke[s] - ref_ke[s]) / ref_ke[s]);
+      }
+    EXPECT_LT(worst, 1e-9) << "dims " << dims[0] << "," << dims[1] << "," << dims[2];
+    EXPECT_EQ(ages, ref_ages) << "dims " << dims[0] << "," << dims[1] << "," << dims[2];
+    std::printf("np %d dims %d,%d,%d: max relative KE difference %.3g, %zu aged contacts\n", n, dims[0],
+                dims[1], dims[2], worst, ages.size());
+  }
+}
