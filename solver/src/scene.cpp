@@ -155,6 +155,20 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
     }
   }
 
+  if (const auto* arr = top.table_array("body_forces")) {
+    for (std::size_t k = 0; k < arr->size(); ++k) {
+      TableReader t(*(*arr)[k].as_table(), label, fmt::format("body_forces[{}]", k));
+      InteractionSpec b;
+      b.model = t.choice_or("type", model_names(ModelKind::body), "");
+      b.kind = ModelKind::body;
+      b.name = group_name(t, fmt::format("{}{}", b.model, k), names);
+      b.params = find_model(b.model, ModelKind::body)->parse(t);
+      b.tags = t.integers_or("tags", {});
+      t.finish();
+      s.body_forces.push_back(std::move(b));
+    }
+  }
+
   if (const auto* o = top.subtable("output")) {
     TableReader t(*o, label, "output");
     if (t.has("directory")) {
@@ -177,17 +191,18 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
     if (const auto* arr = t.table_array("fields")) {
       for (std::size_t k = 0; k < arr->size(); ++k) {
         TableReader tf(*(*arr)[k].as_table(), label, fmt::format("output.fields[{}]", k));
-        static const std::map<std::string, FieldSpec::Type> kTypes{
-            {"kinetic_energy", FieldSpec::Type::kinetic_energy},
-            {"bond_potential_energy", FieldSpec::Type::bond_potential_energy},
-            {"contact_potential_energy", FieldSpec::Type::contact_potential_energy},
-            {"wall_potential_energy", FieldSpec::Type::wall_potential_energy},
-            {"bond_count", FieldSpec::Type::bond_count},
-            {"wall_force", FieldSpec::Type::wall_force}};
-        std::vector<std::string> allowed;
-        for (const auto& [n, _] : kTypes) allowed.push_back(n);
+        // An energy term of the ledger (those every scene has, and the body forces'), or another saver.
+        std::vector<std::string> allowed = standard_energy_terms();
+        for (const auto& m : model_registry())
+          if (!m.energy_term.empty()) allowed.emplace_back(m.energy_term);
+        for (const char* other : {"total_energy", "bond_count", "wall_force"}) allowed.emplace_back(other);
         FieldSpec f;
-        f.type = kTypes.at(tf.choice_or("type", allowed, ""));
+        const std::string type = tf.choice_or("type", allowed, "");
+        f.type = type == "total_energy" ? FieldSpec::Type::total_energy
+                 : type == "bond_count" ? FieldSpec::Type::bond_count
+                 : type == "wall_force" ? FieldSpec::Type::wall_force
+                                        : FieldSpec::Type::energy;
+        if (f.type == FieldSpec::Type::energy) f.term = type;
         f.every = tf.integer_or("every", 1);
         if (f.every < 1) tf.fail("every", fmt::format("must be >= 1, got {}", f.every));
         if (f.type == FieldSpec::Type::wall_force) {
@@ -219,26 +234,11 @@ Scene parse_scene(const fs::path& file) {
 std::vector<std::string> field_columns(const Scene& scene) {
   std::vector<std::string> cols;
   for (const auto& f : scene.fields) {
-    switch (f.type) {
-      case FieldSpec::Type::kinetic_energy:
-        cols.push_back("kinetic_energy");
-        break;
-      case FieldSpec::Type::bond_potential_energy:
-        cols.push_back("bond_potential_energy");
-        break;
-      case FieldSpec::Type::contact_potential_energy:
-        cols.push_back("contact_potential_energy");
-        break;
-      case FieldSpec::Type::wall_potential_energy:
-        cols.push_back("wall_potential_energy");
-        break;
-      case FieldSpec::Type::bond_count:
-        cols.push_back("bond_count");
-        break;
-      case FieldSpec::Type::wall_force:
-        for (const char* c : {"x", "y", "z"}) cols.push_back(fmt::format("wall_force_{}_{}", f.wall, c));
-        break;
+    if (f.type != FieldSpec::Type::wall_force) {
+      cols.push_back(f.name());
+      continue;
     }
+    for (const char* c : {"x", "y", "z"}) cols.push_back(fmt::format("wall_force_{}_{}", f.wall, c));
   }
   return cols;
 }

@@ -46,8 +46,7 @@ Simulation<Real>::Simulation(const Scene& scene, io::Geometry g, MPI_Comm comm, 
   check_stability(g);
   distribute(g, comm);
   rebuild();
-  const auto pe = compute_forces<true>();
-  energy0_ = total_energy(pe);
+  start_ledger(compute_forces<true>());
 }
 
 template <class Real>
@@ -63,6 +62,28 @@ void Simulation<Real>::make_computes() {
     pair_group_compute_.push_back(static_cast<int>(k));
   }
   pairs_take_all_ = scene_.contacts.size() == 1 && scene_.contacts[0].tags.empty();
+  // The ledger: every scene has the standard terms (a saver of one nothing fills saves zeros); body
+  // forces add theirs.
+  for (const auto& name : standard_energy_terms())
+    ledger_.add(name, name == "kinetic_energy" ? Ledger::Kind::kinetic
+                      : name == "wall_work_in" ? Ledger::Kind::work
+                                               : Ledger::Kind::potential);
+  kinetic_term_ = static_cast<std::size_t>(ledger_.find("kinetic_energy"));
+  wall_work_term_ = static_cast<std::size_t>(ledger_.find("wall_work_in"));
+  for (const auto& c : computes_)
+    compute_term_.push_back(ledger_.add(c->energy_term(), Ledger::Kind::potential));
+  body_term_.assign(ledger_.size(), 0);
+  for (std::size_t k = 0; k < computes_.size(); ++k)
+    if (computes_[k]->kind() == ModelKind::body) body_term_[compute_term_[k]] = 1;
+  pe_.assign(ledger_.size(), 0.0);
+  for (std::size_t k = 0; k < scene_.fields.size(); ++k) {
+    const auto& f = scene_.fields[k];
+    if (f.type == FieldSpec::Type::energy && ledger_.find(f.term) < 0)
+      throw InputError(
+          fmt::format("output.fields[{}]: type = \"{}\": no model of this scene has that energy term "
+                      "(add the body force that owns it)",
+                      k, f.term));
+  }
   // Checkpoints store all contact histories in one table of one width.
   std::size_t width = 0;
   for (const auto* c : pair_computes_) {
@@ -97,10 +118,29 @@ double Simulation<Real>::kinetic_energy_local() const {
 }
 
 template <class Real>
-double Simulation<Real>::total_energy(const std::array<double, 3>& pe) const {
-  std::vector<double> v{kinetic_energy_local(), pe[0], pe[1], pe[2]};
+double Simulation<Real>::term_value(std::size_t t, const std::vector<double>& pe) const {
+  if (t == kinetic_term_) return kinetic_energy_local();
+  if (t == wall_work_term_) return wall_work_in_;
+  return pe[t];
+}
+
+template <class Real>
+std::vector<double> Simulation<Real>::ledger_totals(const std::vector<double>& pe) const {
+  std::vector<double> v(ledger_.size());
+  for (std::size_t t = 0; t < v.size(); ++t) v[t] = term_value(t, pe);
   comm().sum_all(v);
-  return v[0] + v[1] + v[2] + v[3];
+  return v;
+}
+
+template <class Real>
+void Simulation<Real>::start_ledger(const std::vector<double>& pe) {
+  ledger0_ = ledger_totals(pe);
+  energy0_ = ledger_.mechanical(ledger0_);
+}
+
+template <class Real>
+std::vector<double> Simulation<Real>::ledger_values() {
+  return ledger_totals(compute_forces<true>());
 }
 
 template <class Real>
@@ -110,10 +150,10 @@ double Simulation<Real>::kinetic_energy() const {
 
 template <class Real>
 std::array<double, 4> Simulation<Real>::energies() {
-  const auto pe = compute_forces<true>();
-  std::vector<double> v{kinetic_energy_local(), pe[0], pe[1], pe[2]};
-  comm().sum_all(v);
-  return {v[0], v[1], v[2], v[3]};
+  const auto v = ledger_values();
+  const auto term = [&](std::string_view name) { return v[static_cast<std::size_t>(ledger_.find(name))]; };
+  return {term("kinetic_energy"), term("bond_potential_energy"), term("contact_potential_energy"),
+          term("wall_potential_energy")};
 }
 
 template <class Real>
@@ -401,41 +441,43 @@ void Simulation<Real>::rebuild() {
 
 template <class Real>
 template <bool Energy>
-std::array<double, 3> Simulation<Real>::compute_forces(bool ghosts_in_flight, bool advance) {
+const std::vector<double>& Simulation<Real>::compute_forces(bool ghosts_in_flight, bool advance) {
   // Interactions among owned particles first: a ghost update still in flight overlaps them.
   if (!forces_zeroed_) zero_forces(p_);
   forces_zeroed_ = false;
-  std::array<double, 3> pe{0, 0, 0};
+  if (Energy) std::fill(pe_.begin(), pe_.end(), 0.0);
   const std::size_t before = broken_.size();
   if (!walls_.empty()) walls_.move_to(time_);
   ForceState<Real> state{p_, bonds_, broken_, walls_};
-  // pe[kind]: bond, pair, wall energies. Bond models come first in the list: by the time the pair
-  // models start, the neighbours' ghost posts have arrived and one poke moves them along.
+  // Bond models come first in the list: by the time the pair models start, the neighbours' ghost
+  // posts have arrived and one poke moves them along.
   bool poked = !ghosts_in_flight;
-  for (auto& c : computes_) {
-    if (!poked && c->kind() != ModelKind::bond) {
+  for (std::size_t k = 0; k < computes_.size(); ++k) {
+    if (!poked && computes_[k]->kind() != ModelKind::bond) {
       halo_->progress_ghosts();
       poked = true;
     }
-    pe[static_cast<std::size_t>(c->kind())] += c->compute(state, Part::owned, Energy, advance);
+    pe_[compute_term_[k]] += computes_[k]->compute(state, Part::owned, Energy, advance);
   }
   if (ghosts_in_flight) {
     Stopwatch sw;
     halo_->end_update_ghosts(p_);
     ghost_wait_ += sw.lap();
   }
-  for (auto& c : computes_)
-    pe[static_cast<std::size_t>(c->kind())] += c->compute(state, Part::ghost, Energy, advance);
+  for (std::size_t k = 0; k < computes_.size(); ++k)
+    pe_[compute_term_[k]] += computes_[k]->compute(state, Part::ghost, Energy, advance);
   if (broken_.size() != before) bond_broke_ = true;  // the lists must learn the pair is now unbonded
   for (std::size_t k = before; k < broken_.size(); ++k) broken_[k].step = step_;
-  return pe;
+  return pe_;
 }
 
 template <class Real>
 bool Simulation<Real>::energy_due(std::int64_t s) const {
   for (const auto& f : scene_.fields)
-    if (s % f.every == 0 && f.type != FieldSpec::Type::kinetic_energy &&
-        f.type != FieldSpec::Type::bond_count && f.type != FieldSpec::Type::wall_force)
+    if (s % f.every == 0 &&
+        (f.type == FieldSpec::Type::total_energy ||
+         (f.type == FieldSpec::Type::energy &&
+          ledger_[static_cast<std::size_t>(ledger_.find(f.term))].kind == Ledger::Kind::potential)))
       return true;
   return scene_.energy_check_every > 0 && s % scene_.energy_check_every == 0;
 }
@@ -443,7 +485,9 @@ bool Simulation<Real>::energy_due(std::int64_t s) const {
 template <class Real>
 bool Simulation<Real>::kinetic_due(std::int64_t s) const {
   for (const auto& f : scene_.fields)
-    if (s % f.every == 0 && f.type == FieldSpec::Type::kinetic_energy) return true;
+    if (s % f.every == 0 && (f.type == FieldSpec::Type::total_energy ||
+                             (f.type == FieldSpec::Type::energy && f.term == "kinetic_energy")))
+      return true;
   return scene_.energy_check_every > 0 && s % scene_.energy_check_every == 0;
 }
 
@@ -497,7 +541,7 @@ void Simulation<Real>::step(FieldSink* sink) {
 }
 
 template <class Real>
-void Simulation<Real>::save_fields(FieldSink* sink, const std::array<double, 3>& pe) {
+void Simulation<Real>::save_fields(FieldSink* sink, const std::vector<double>& pe) {
   if (output_) return output_fields(pe);
   std::vector<double> local;
   std::vector<char> due;
@@ -539,12 +583,19 @@ void Simulation<Real>::finish_row(FieldSink* sink) {
 }
 
 template <class Real>
-void Simulation<Real>::guard_energy(const std::array<double, 3>& pe) {
-  std::vector<double> v{kinetic_energy_local(), pe[0], pe[1], pe[2], wall_work_in_};
-  comm().sum_all(v);
-  const double e = v[0] + v[1] + v[2] + v[3];
-  const double allowed = 2 * (energy0_ + v[4]);
-  if (!(e > allowed && e > 0) && std::isfinite(e)) return;
+void Simulation<Real>::guard_energy(const std::vector<double>& pe) {
+  // The ledger's balance: mechanical energy + dissipated - work put in stays at the start's
+  // mechanical energy E0. Allowed growth: |E0| + the work put in + what was dissipated + how far each
+  // body force's potential moved (energy it released): an error of 100 % of every source at once.
+  // Without body forces or dissipation this is E > 2 (E0 + W).
+  const auto v = ledger_totals(pe);
+  const double e = ledger_.mechanical(v), w = ledger_.sum(v, Ledger::Kind::work),
+               d = ledger_.sum(v, Ledger::Kind::dissipated);
+  double released = 0;
+  for (std::size_t t = 0; t < v.size(); ++t)
+    if (body_term_[t]) released += std::abs(v[t] - ledger0_[t]);
+  const double imbalance = e + d - w - energy0_, allowed = std::abs(energy0_) + w + d + released;
+  if (imbalance <= allowed && std::isfinite(e)) return;
   // Name the fastest particle.
   double best = -1;
   std::size_t bi = 0;
@@ -558,15 +609,21 @@ void Simulation<Real>::guard_energy(const std::array<double, 3>& pe) {
   }
   const auto [top, who] = comm().max_loc(std::isfinite(best) ? best : std::numeric_limits<double>::max());
   std::string msg;
-  if (comm().rank() == who && p_.n_owned > 0)
+  if (comm().rank() == who && p_.n_owned > 0) {
+    std::string terms;
+    for (std::size_t t = 0; t < v.size(); ++t)
+      terms += fmt::format("{}{} {:.6g}", t ? ", " : "", ledger_[t].name, v[t]);
     msg = fmt::format(
-        "step {}: the energy grows without a source: total {:.6g} (kinetic {:.6g}, bonds {:.6g}, contacts "
-        "{:.6g}, walls {:.6g}) > 2 x (initial {:.6g} + work done by walls {:.6g}). Fastest particle: id {} "
-        "with kinetic energy {:.6g}, velocity ({:.6g}, {:.6g}, {:.6g}) at ({:.6g}, {:.6g}, {:.6g}). dt = {} "
-        "is "
-        "{:.3g} x the critical time step {:.6g}",
-        step_, e, v[0], v[1], v[2], v[3], energy0_, v[4], p_.id[bi], best, p_.vx[bi], p_.vy[bi], p_.vz[bi],
+        "step {}: the energy grows without a source: mechanical energy {:.6g} + dissipated {:.6g} - work put "
+        "in "
+        "{:.6g} exceeds the initial {:.6g} by {:.6g}, more than allowed ({:.6g}); ledger: {}. Fastest "
+        "particle: "
+        "id {} with kinetic energy {:.6g}, velocity ({:.6g}, {:.6g}, {:.6g}) at ({:.6g}, {:.6g}, {:.6g}). dt "
+        "= {} "
+        "is {:.3g} x the critical time step {:.6g}",
+        step_, e, d, w, energy0_, imbalance, allowed, terms, p_.id[bi], best, p_.vx[bi], p_.vy[bi], p_.vz[bi],
         p_.x[bi], p_.y[bi], p_.z[bi], scene_.dt, stability_.fraction, stability_.dt_critical);
+  }
   stop(comm().broadcast(msg, who));
 }
 
@@ -602,8 +659,8 @@ void Simulation<Real>::run(std::int64_t steps, FieldSink* sink) {
 template <class Real>
 void Simulation<Real>::state_changed() {
   ke_fresh_ = false;
-  energy0_ = total_energy(compute_forces<true>());
   wall_work_in_ = 0;
+  start_ledger(compute_forces<true>());
 }
 
 template <class Real>

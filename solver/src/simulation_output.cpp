@@ -15,7 +15,7 @@
 namespace basalt::solver {
 
 template <class Real>
-bool Simulation<Real>::field_partials(const std::array<double, 3>& pe, std::vector<double>& local,
+bool Simulation<Real>::field_partials(const std::vector<double>& pe, std::vector<double>& local,
                                       std::vector<char>& due) const {
   local.clear();
   due.clear();
@@ -30,18 +30,17 @@ bool Simulation<Real>::field_partials(const std::array<double, 3>& pe, std::vect
       continue;
     }
     switch (f.type) {
-      case FieldSpec::Type::kinetic_energy:
-        local.push_back(kinetic_energy_local());
+      case FieldSpec::Type::energy:
+        local.push_back(term_value(static_cast<std::size_t>(ledger_.find(f.term)), pe));
         break;
-      case FieldSpec::Type::bond_potential_energy:
-        local.push_back(pe[0]);
+      case FieldSpec::Type::total_energy: {
+        double e = 0;
+        for (std::size_t t = 0; t < ledger_.size(); ++t)
+          if (ledger_[t].kind == Ledger::Kind::kinetic || ledger_[t].kind == Ledger::Kind::potential)
+            e += term_value(t, pe);
+        local.push_back(e);
         break;
-      case FieldSpec::Type::contact_potential_energy:
-        local.push_back(pe[1]);
-        break;
-      case FieldSpec::Type::wall_potential_energy:
-        local.push_back(pe[2]);
-        break;
+      }
       case FieldSpec::Type::bond_count:
         local.push_back(double(local_bond_count()));
         break;
@@ -58,7 +57,7 @@ bool Simulation<Real>::field_partials(const std::array<double, 3>& pe, std::vect
 }
 
 template <class Real>
-void Simulation<Real>::output_fields(const std::array<double, 3>& pe) {
+void Simulation<Real>::output_fields(const std::vector<double>& pe) {
   // No reduction here: the sink sums the ranks' partials (on an I/O rank, or reduced with Q = 0).
   thread_local std::vector<double> local;
   thread_local std::vector<char> due;
@@ -146,12 +145,12 @@ void Simulation<Real>::report_frame_times(std::vector<double> seconds) const {
              comm().rank(), seconds.size(), 1e3 * median, 1e3 * seconds.front(), 1e3 * seconds.back());
 }
 
-#define BASALT_INSTANTIATE(R)                                                                     \
-  template bool Simulation<R>::field_partials(const std::array<double, 3>&, std::vector<double>&, \
-                                              std::vector<char>&) const;                          \
-  template void Simulation<R>::output_fields(const std::array<double, 3>&);                       \
-  template RestartLayout Simulation<R>::restart_layout() const;                                   \
-  template void Simulation<R>::report_frame_times(std::vector<double>) const;                     \
+#define BASALT_INSTANTIATE(R)                                                                   \
+  template bool Simulation<R>::field_partials(const std::vector<double>&, std::vector<double>&, \
+                                              std::vector<char>&) const;                        \
+  template void Simulation<R>::output_fields(const std::vector<double>&);                       \
+  template RestartLayout Simulation<R>::restart_layout() const;                                 \
+  template void Simulation<R>::report_frame_times(std::vector<double>) const;                   \
   template void Simulation<R>::run(std::int64_t, OutputSink&);
 BASALT_INSTANTIATE(double)
 BASALT_INSTANTIATE(float)

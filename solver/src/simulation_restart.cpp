@@ -42,8 +42,7 @@ Simulation<Real>::Simulation(const Scene& scene, const io::Checkpoint& c, const 
     if (!walls_.empty()) walls_.move_to(double(step_) * scene.dt);
     rebuild();
   }
-  const auto pe = compute_forces<true>();
-  energy0_ = total_energy(pe);
+  start_ledger(compute_forces<true>());
 }
 
 template <class Real>

@@ -8,11 +8,13 @@
 #include <set>
 
 #include "basalt/solver/core/errors.hpp"
+#include "basalt/solver/interactions/body_driver.hpp"
 #include "basalt/solver/interactions/bond_driver.hpp"
 #include "basalt/solver/interactions/pair_driver.hpp"
 #include "basalt/solver/interactions/wall_driver.hpp"
 #include "basalt/solver/models/contact_age.hpp"
 #include "basalt/solver/models/elastic_wall.hpp"
+#include "basalt/solver/models/gravity.hpp"
 #include "basalt/solver/models/linear_bond.hpp"
 #include "basalt/solver/models/linear_elastic.hpp"
 
@@ -25,6 +27,16 @@ std::unique_ptr<ForceCompute<Real>> make(const Scene& s) {
   if constexpr (Model::kind == ModelKind::bond) return std::make_unique<BondDriver<Real, Model>>(s.bonds);
   if constexpr (Model::kind == ModelKind::pair) return std::make_unique<PairDriver<Real, Model>>(s.contacts);
   if constexpr (Model::kind == ModelKind::wall) return std::make_unique<WallDriver<Real, Model>>(s.walls);
+  if constexpr (Model::kind == ModelKind::body)
+    return std::make_unique<BodyDriver<Real, Model>>(s.body_forces);
+}
+
+template <class Model>
+constexpr std::string_view energy_term_of() {
+  if constexpr (requires { Model::energy_term; })
+    return Model::energy_term;
+  else
+    return {};
 }
 
 template <class Model>
@@ -36,6 +48,7 @@ ModelEntry entry() {
           Model::reads,
           Model::writes,
           history_bytes<Model>(),
+          energy_term_of<Model>(),
           [](TableReader& t) { return std::any(Model::parse(t)); },
           &make<double, Model>,
           &make<float, Model>};
@@ -49,6 +62,7 @@ const std::vector<ModelEntry>& model_registry() {
       entry<LinearElastic>(),  // pair
       entry<ContactAge>(),     // pair, test model for contact history
       entry<ElasticWall>(),    // wall
+      entry<Gravity>(),        // body force
   };
   return models;
 }
@@ -82,14 +96,16 @@ std::string field_names(Fields f) {
 
 std::string describe_models() {
   std::string s;
-  for (const auto kind : {ModelKind::bond, ModelKind::pair, ModelKind::wall}) {
+  for (const auto kind : {ModelKind::bond, ModelKind::pair, ModelKind::wall, ModelKind::body}) {
     s += fmt::format("{} models ({}):\n", kind_name(kind),
-                     kind == ModelKind::wall ? "[[walls]] interaction = \"<name>\""
-                                             : "[[interactions]] type = \"<name>\"");
+                     kind == ModelKind::wall   ? "[[walls]] interaction = \"<name>\""
+                     : kind == ModelKind::body ? "[[body_forces]] type = \"<name>\""
+                                               : "[[interactions]] type = \"<name>\"");
     for (const auto& m : model_registry()) {
       if (m.kind != kind) continue;
       s += fmt::format("  {}\n    {}\n", m.name, m.summary);
       for (const auto& k : m.keys) s += fmt::format("    {:<14} {}\n", k.key, k.doc);
+      if (!m.energy_term.empty()) s += fmt::format("    energy term: {}\n", m.energy_term);
       s += fmt::format("    reads: {}; writes: {}; per-contact history: {}\n", field_names(m.reads),
                        field_names(m.writes),
                        m.history_bytes ? fmt::format("{} B", m.history_bytes) : std::string("none"));
@@ -117,6 +133,8 @@ std::vector<std::unique_ptr<ForceCompute<Real>>> make_force_computes(const Scene
   if (bonds.size() > 1) throw InputError("interactions: all bond groups must use the same bond model");
   for (const auto& g : scene.contacts) add(g.model, ModelKind::pair, pairs);
   for (const auto& w : scene.walls) add(w.model, ModelKind::wall, walls);
+  std::set<std::string_view> bodies;
+  for (const auto& b : scene.body_forces) add(b.model, ModelKind::body, bodies);
   return out;
 }
 

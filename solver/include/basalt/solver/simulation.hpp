@@ -15,6 +15,7 @@
 #include "basalt/io/geometry.hpp"
 #include "basalt/solver/core/bonds.hpp"
 #include "basalt/solver/core/id_map.hpp"
+#include "basalt/solver/core/ledger.hpp"
 #include "basalt/solver/core/particles.hpp"
 #include "basalt/solver/interactions/force_compute.hpp"
 #include "basalt/solver/interactions/walls.hpp"
@@ -114,6 +115,9 @@ class Simulation {
   double kinetic_energy() const;
   /// Collective: {kinetic, bond, contact, wall} energies (recomputes forces' energies; forces unchanged).
   std::array<double, 4> energies();
+  /// The energy ledger's terms, and (collective) their values now (recomputes the potentials).
+  const Ledger& ledger() const { return ledger_; }
+  std::vector<double> ledger_values();
   /// Collective: number of bonds.
   std::int64_t bond_count() const;
   /// Collective: call after changing particle state from outside (e.g. initial velocities): recomputes
@@ -132,7 +136,10 @@ class Simulation {
   double kinetic_energy_local() const;
   /// Bonds of this rank counted once across ranks (a bond to a ghost by the rank owning the lower id).
   std::int64_t local_bond_count() const;
-  double total_energy(const std::array<double, 3>& pe) const;
+  /// Collective: the ledger's values summed over ranks, from this rank's potentials pe.
+  std::vector<double> ledger_totals(const std::vector<double>& pe) const;
+  /// This rank's value of ledger term t (potentials from pe).
+  double term_value(std::size_t t, const std::vector<double>& pe) const;
   void progress(std::int64_t done, std::int64_t total, double seconds) const;
   void check_stability(const io::Geometry& g);
   void rebuild();
@@ -142,18 +149,19 @@ class Simulation {
   /// Forces at the current positions; ghosts_in_flight: a ghost update was begun and is completed
   /// after the owned-only interactions.
   /// advance: a real step (contact history moves on); forces computed outside steps only read it.
+  /// Returns this rank's potential energies by ledger term (valid when Energy).
   template <bool Energy>
-  std::array<double, 3> compute_forces(bool ghosts_in_flight = false, bool advance = false);
+  const std::vector<double>& compute_forces(bool ghosts_in_flight = false, bool advance = false);
   void make_computes();
   /// Which pair compute takes a pair of particles with these tags (the first pair group that takes
   /// them, in scene order), or -1.
   int pair_taker(std::int64_t ti, std::int64_t tj) const;
   /// History records of the force computes waiting for a rebuild (null entries: no history).
   std::vector<ContactRecords*> pending_history();
-  void save_fields(FieldSink* sink, const std::array<double, 3>& pe);
-  bool field_partials(const std::array<double, 3>& pe, std::vector<double>& local,
+  void save_fields(FieldSink* sink, const std::vector<double>& pe);
+  bool field_partials(const std::vector<double>& pe, std::vector<double>& local,
                       std::vector<char>& due) const;
-  void output_fields(const std::array<double, 3>& pe);
+  void output_fields(const std::vector<double>& pe);
   void distribute_checkpoint(const io::Checkpoint& c, const RestartLayout& layout, MPI_Comm comm);
   /// Restart: the lists of the uninterrupted run's last rebuild (see the restart constructor).
   void replay_rebuild(const io::Checkpoint& c);
@@ -161,7 +169,9 @@ class Simulation {
   void finish_row(FieldSink* sink);
   /// Collective: delivers pending output, then throws RunError(message).
   [[noreturn]] void stop(const std::string& message);
-  void guard_energy(const std::array<double, 3>& pe);
+  void guard_energy(const std::vector<double>& pe);
+  /// The ledger's balance at the start (global): set by start_ledger().
+  void start_ledger(const std::vector<double>& pe);
   bool energy_due(std::int64_t s) const;
   /// Whether step s needs the kinetic energy (a saver or the energy guard).
   bool kinetic_due(std::int64_t s) const;
@@ -184,6 +194,12 @@ class Simulation {
   std::vector<ForceCompute<Real>*> pair_computes_;
   std::vector<int> pair_group_compute_;  ///< for each scene pair group, its compute in pair_computes_
   bool pairs_take_all_ = false;          ///< one pair group, every tag
+  Ledger ledger_;
+  std::vector<std::size_t> compute_term_;  ///< the ledger term of each force compute's potential
+  std::size_t kinetic_term_ = 0, wall_work_term_ = 0;
+  std::vector<double> pe_;       ///< this rank's potentials by ledger term (last computation with energy)
+  std::vector<double> ledger0_;  ///< the ledger's global values at the start (the guard's reference)
+  std::vector<char> body_term_;  ///< terms of body forces (their change since the start counts as a source)
   PairList own_, ghost_;
   CellGrid grid_, ghost_grid_;  ///< owned and ghost particles in the same cells (rebuilds only)
   Exclusions exclusions_;

@@ -53,6 +53,19 @@ class ForceCompute {
   virtual ~ForceCompute() = default;
   virtual std::string_view model() const = 0;
   virtual ModelKind kind() const = 0;
+  /// The energy-ledger term its potential energy goes to.
+  virtual std::string_view energy_term() const {
+    switch (kind()) {
+      case ModelKind::bond:
+        return "bond_potential_energy";
+      case ModelKind::pair:
+        return "contact_potential_energy";
+      case ModelKind::wall:
+        return "wall_potential_energy";
+      default:
+        return "body_potential_energy";
+    }
+  }
   /// Largest spring constant for particles up to radius rmax (critical time step).
   virtual double max_stiffness(double rmax) const = 0;
   /// Adds forces of one part; returns the potential energy when `energy`. `advance`: a real step, so

@@ -26,10 +26,14 @@
 
 namespace basalt::solver {
 
-enum class ModelKind { bond, pair, wall };
+/// Which driver loops a model: bonds, pairs in contact, planar walls, or a force on each particle
+/// from its own state (body forces: gravity).
+enum class ModelKind { bond, pair, wall, body };
 
 constexpr std::string_view kind_name(ModelKind k) {
-  return k == ModelKind::bond ? "bond" : (k == ModelKind::pair ? "pair" : "wall");
+  return k == ModelKind::bond
+             ? "bond"
+             : (k == ModelKind::pair ? "pair" : (k == ModelKind::wall ? "wall" : "body force"));
 }
 
 /// One scene key of a model: its name and what it means (units, range, default).

@@ -22,7 +22,8 @@ struct ModelEntry {
   std::string_view summary;
   std::span<const KeyDoc> keys;
   Fields reads, writes;
-  std::size_t history_bytes;  ///< per contact (0: none)
+  std::size_t history_bytes;     ///< per contact (0: none)
+  std::string_view energy_term;  ///< body forces: the ledger term of its potential energy ("" otherwise)
   std::any (*parse)(TableReader&);
   std::unique_ptr<ForceCompute<double>> (*make_double)(const Scene&);
   std::unique_ptr<ForceCompute<float>> (*make_float)(const Scene&);
@@ -40,7 +41,8 @@ std::string describe_models();
 std::string field_names(Fields f);
 
 /// One force compute per model the scene uses: bond models first, then pair models (in the order the
-/// scene first names them), then wall models. Throws InputError for combinations not supported.
+/// scene first names them), then wall models, then body forces. Throws InputError for combinations not
+/// supported.
 template <class Real>
 std::vector<std::unique_ptr<ForceCompute<Real>>> make_force_computes(const Scene& scene);
 

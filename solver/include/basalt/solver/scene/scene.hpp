@@ -50,19 +50,31 @@ struct WallSpec {
   }
 };
 
+/// One field saver ([[output.fields]]): a term of the energy ledger (kinetic_energy, the potentials,
+/// wall_work_in, a body force's potential), the total mechanical energy, the bond count, or a wall's
+/// force.
 struct FieldSpec {
-  enum class Type {
-    kinetic_energy,
-    bond_potential_energy,
-    contact_potential_energy,
-    wall_potential_energy,
-    bond_count,
-    wall_force
-  };
-  Type type = Type::kinetic_energy;
+  enum class Type { energy, total_energy, bond_count, wall_force };
+  Type type = Type::energy;
+  std::string term = "kinetic_energy";  ///< energy only: the ledger term
   std::int64_t every = 1;
   std::string wall;  ///< wall_force only
+  /// The column name (wall_force: the prefix of three columns).
+  std::string name() const {
+    return type == Type::energy         ? term
+           : type == Type::total_energy ? "total_energy"
+           : type == Type::bond_count   ? "bond_count"
+                                        : "wall_force";
+  }
 };
+
+/// Ledger terms every scene has (a saver of one the scene's models do not fill saves zeros).
+inline const std::vector<std::string>& standard_energy_terms() {
+  static const std::vector<std::string> t{"kinetic_energy", "bond_potential_energy",
+                                          "contact_potential_energy", "wall_potential_energy",
+                                          "wall_work_in"};
+  return t;
+}
 
 enum class Integrator { velocity_verlet, symplectic_euler };
 
@@ -84,6 +96,7 @@ struct Scene {
   std::vector<InteractionSpec> bonds;     ///< bond groups, in scene order (a bond's group indexes these)
   std::vector<InteractionSpec> contacts;  ///< pair (contact) groups, in scene order
   std::vector<WallSpec> walls;
+  std::vector<InteractionSpec> body_forces;  ///< [[body_forces]]: tags = the particle tags it acts on
   std::filesystem::path output_dir = "out";
   std::vector<FieldSpec> fields;
   // [output] frames and checkpoints (written by the I/O layer; docs/io-ranks.md)

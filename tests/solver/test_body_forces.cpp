@@ -1,0 +1,131 @@
+// Body forces and the energy ledger: gravity against the closed form of free fall (velocity Verlet is
+// exact for a constant force), the ledger's balance (kinetic + gravity's potential conserved), a pile
+// starting at rest under gravity that the energy guard lets run, and an unstable run under gravity
+// that it still stops.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <string>
+
+#include "basalt/solver/core/errors.hpp"
+#include "basalt/solver/simulation.hpp"
+#include "solver_helpers.hpp"
+#include "test_support.hpp"
+
+using namespace basalt::solver;
+
+namespace {
+
+double mass_of(double r) { return 4.0 / 3.0 * std::numbers::pi * r * r * r; }
+
+double term(const Simulation<double>& sim, const std::vector<double>& v, const std::string& name) {
+  const int t = sim.ledger().find(name);
+  EXPECT_GE(t, 0) << name;
+  return t < 0 ? 0 : v[static_cast<std::size_t>(t)];
+}
+
+}  // namespace
+
+TEST(Gravity, FreeFallFollowsTheClosedFormAndConservesTheLedger) {
+  // g = -9.81e-3 mm/ms^2 along z, two spheres far apart (no contact), one tagged 1 that gravity skips.
+  const auto scene = basalt::test::scene_from(R"(
+[run]
+dt = 0.1
+steps = 0
+skin = 0.1
+energy_check_every = 1
+[[body_forces]]
+type = "gravity"
+acceleration = [0.0, 0.0, -9.81e-3]
+tags = [0]
+[[output.fields]]
+type = "gravity_potential_energy"
+)");
+  basalt::io::Geometry g;
+  g.add_particle(1, {0, 0, 10}, 0.5, 0);
+  g.add_particle(2, {5, 0, 10}, 0.5, 1);
+  Simulation<double> sim(scene, g, MPI_COMM_SELF);
+  const double m = mass_of(0.5), gz = -9.81e-3;
+  const auto v0 = sim.ledger_values();
+  EXPECT_NEAR(term(sim, v0, "gravity_potential_energy"), -m * gz * 10, 1e-15);
+  sim.run(500);
+  const auto& p = sim.particles();
+  const double t = 500 * 0.1;
+  for (std::size_t i = 0; i < p.n_owned; ++i) {
+    const double want = p.id[i] == 1 ? 10 + 0.5 * gz * t * t : 10;  // tag 1 is not pulled
+    EXPECT_NEAR(p.z[i], want, 1e-9 * std::abs(want)) << "id " << p.id[i];
+    EXPECT_NEAR(p.vz[i], p.id[i] == 1 ? gz * t : 0.0, 1e-12) << "id " << p.id[i];
+  }
+  const auto v = sim.ledger_values();
+  const double e0 = term(sim, v0, "kinetic_energy") + term(sim, v0, "gravity_potential_energy");
+  const double e = term(sim, v, "kinetic_energy") + term(sim, v, "gravity_potential_energy");
+  EXPECT_GT(term(sim, v, "kinetic_energy"), 0.5 * m * 0.24);  // it really fell: v = 0.49 mm/ms
+  EXPECT_NEAR(e, e0, 1e-12 * std::abs(e0));
+}
+
+TEST(Gravity, PileAtRestUnderGravityRunsAndTheGuardStillStopsABlowUp) {
+  // A column of spheres on an elastic floor, starting at rest under gravity: they fall and settle. The
+  // column is centred on z = 0, so the mechanical energy starts near zero and the guard's margin is
+  // the potential energy gravity released; the guard (every 10 steps) must not mistake the kinetic
+  // energy the fall produces for energy from nowhere.
+  const std::string body = R"(
+[run]
+dt = 0.002
+steps = 0
+skin = 0.05
+energy_check_every = 10
+[[interactions]]
+type = "linear_elastic"
+K = 1000.0
+[[walls]]
+name = "floor"
+point = [0.0, 0.0, -3.0]
+normal = [0.0, 0.0, 1.0]
+K = 1000.0
+[[body_forces]]
+type = "gravity"
+acceleration = [0.0, 0.0, -1.0]
+)";
+  basalt::io::Geometry g;
+  for (int k = 0; k < 5; ++k) g.add_particle(k + 1, {0.01 * k, 0, -2.4 + 1.2 * k}, 0.5);
+  Simulation<double> sim(basalt::test::scene_from(body), g, MPI_COMM_SELF);
+  EXPECT_NO_THROW(sim.run(3000));
+  const auto v = sim.ledger_values();
+  // The spheres close gaps of 0.1 (floor) and 4 x 0.2: their heights drop by 2.5 in total.
+  EXPECT_LT(term(sim, v, "gravity_potential_energy"), -0.8 * mass_of(0.5) * 1.0 * 2.5)
+      << "the column must have come down";
+
+  // The same column with dt above the critical step (forced): energy appears from nowhere; stopped.
+  std::string fast = body;
+  fast.replace(fast.find("dt = 0.002"), 10, "dt = 0.06");
+  RunOptions forced;
+  forced.force_dt = true;
+  Simulation<double> unstable(basalt::test::scene_from(fast), g, MPI_COMM_SELF, forced);
+  try {
+    unstable.run(3000);
+    ADD_FAILURE() << "an unstable run under gravity went on";
+  } catch (const RunError& e) {
+    EXPECT_NE(std::string(e.what()).find("gravity_potential_energy"), std::string::npos) << e.what();
+  }
+  EXPECT_LT(unstable.current_step(), 3000);
+}
+
+TEST(Gravity, SaverOfATermNoModelFillsIsRefused) {
+  const auto scene = basalt::test::scene_from(R"(
+[run]
+dt = 0.1
+steps = 0
+skin = 0.1
+[[output.fields]]
+type = "gravity_potential_energy"
+)");
+  basalt::io::Geometry g;
+  g.add_particle(1, {0, 0, 0}, 0.5);
+  try {
+    Simulation<double> sim(scene, g, MPI_COMM_SELF);
+    ADD_FAILURE() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("output.fields[0]"), std::string::npos) << e.what();
+  }
+}
