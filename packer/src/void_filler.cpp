@@ -131,6 +131,9 @@ class Filler {
   /// 0.15 % of the bounding box is found with probability 95 %.
   static constexpr int kFillProbes = 2000;
   static constexpr int kRadiusProbes = 100;  ///< power-law mode, per radius that found no void
+  /// Pieces a sphere is mirrored across: a box's six faces; a finely faceted mesh near a sphere could
+  /// offer dozens, each a vertex more.
+  static constexpr int kMaxMirrorPieces = 6;
 
   /// Room the triangulation did not offer. The filler sees a void only in a cell whose four vertices
   /// stand for four distinct objects; where the seeds are too few for such cells (a volume only a few
@@ -214,11 +217,11 @@ class Filler {
     Cell near = v != Rt::Vertex_handle() ? v->cell() : hint;
     pieces_.clear();
     vol_.pieces_near(c, r + ghost_reach_, pieces_);
-    // Mirror images across every combination of up to three pieces (a corner of a box is three), and
-    // single images across any further piece: in a volume only a few rmax across a sphere is within
+    // Mirror images across every combination of the first three pieces (a corner of a box is three), and
+    // single images across up to three further pieces: in a volume only a few rmax across a sphere is within
     // reach of opposite faces too, and a face without its image leaves the cells along it to the frame
     // points, where the filler sees no void (a 2 x 2 x 2 box with rmax 0.5 got 2 spheres).
-    const int n = static_cast<int>(pieces_.size());
+    const int n = std::min(static_cast<int>(pieces_.size()), kMaxMirrorPieces);
     const int m = std::min(n, 3);
     const int masks = (1 << m) - 1 + (n - m);
     for (int j = 1; j <= masks; ++j) {
