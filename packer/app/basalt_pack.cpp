@@ -5,13 +5,17 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -68,6 +72,70 @@ void check_output(const fs::path& out) {
         fmt::format("{}: cannot write the output: folder '{}' is not writable", out.string(), dir.string()));
 }
 
+/// --seed: a whole number in [0, 2^64). CLI11 would store -1 as 2^64 - 1 without a word.
+std::uint64_t parse_seed(const std::string& text) {
+  const auto bad = [&](const char* why) {
+    return PackError(fmt::format("--seed '{}': {}; give a whole number from 0 to {}", text, why,
+                                 std::numeric_limits<std::uint64_t>::max()));
+  };
+  if (text.empty()) throw bad("empty");
+  if (text[0] == '-') throw bad("a seed cannot be negative");
+  for (char ch : text)
+    if (ch < '0' || ch > '9') throw bad("not a whole number");
+  errno = 0;
+  const unsigned long long v = std::strtoull(text.c_str(), nullptr, 10);
+  if (errno == ERANGE) throw bad("too large");
+  return v;
+}
+
+const char* const kShapes[] = {"box", "cylinder", "sphere", "mesh"};
+
+/// The shape is the first word that is not an option: CLI11 says only "A subcommand is required" for
+/// `basalt-pack torus ...`. Returns an error message, or empty when the shape is known (or asked --help).
+std::string check_shape(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "-h" || arg == "--help" || arg == "--version") return {};
+    if (!arg.empty() && arg[0] == '-') continue;
+    for (const char* s : kShapes)
+      if (arg == s) return {};
+    return fmt::format(
+        "unknown shape '{}' (the first word names the shape): basalt-pack fills a box, "
+        "cylinder, sphere or mesh, e.g. "
+        "basalt-pack box --size 15,15,15 --rmin 0.2 --rmax 1.0 -o cube.h5",
+        arg);
+  }
+  return "no shape given: basalt-pack fills a box, cylinder, sphere or mesh, e.g. "
+         "basalt-pack box --size 15,15,15 --rmin 0.2 --rmax 1.0 -o cube.h5";
+}
+
+std::string human_bytes(double bytes) {
+  const char* units[] = {"B", "KiB", "MiB", "GiB", "TiB", "PiB", "EiB"};
+  int u = 0;
+  while (bytes >= 1024 && u < 6) {
+    bytes /= 1024;
+    ++u;
+  }
+  return fmt::format("{:.3g} {}", bytes, units[u]);
+}
+
+/// Refuses, before any work, a pack whose expected sphere count is beyond `limit` (memory grows about
+/// 1 KiB per sphere): --size 1e6,1e6,1e6 ran until std::bad_alloc.
+void check_expected_count(const basalt::packer::Volume& volume, const basalt::packer::PackOptions& o,
+                          double limit, bool allowed) {
+  const double n = basalt::packer::expected_sphere_count(volume.measure(), o);
+  if (n <= limit || allowed) return;
+  const double bytes = n * basalt::packer::kBytesPerSphere;
+  const double ram =
+      static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGESIZE));
+  throw PackError(fmt::format(
+      "{} with radii {} .. {} would take about {:.3g} spheres and {} of memory{}, at about 1 KiB and "
+      "20 us of CPU per sphere; that is beyond the {:.3g} spheres basalt-pack packs without asking "
+      "(--max-spheres): pass --allow-large to pack it anyway, or give larger radii or a smaller volume",
+      volume.description(), o.rmin, o.rmax, n, human_bytes(bytes),
+      ram > 0 ? fmt::format(" (this machine has {})", human_bytes(ram)) : std::string(), limit));
+}
+
 class ProgressBar {
  public:
   explicit ProgressBar(bool enabled) : enabled_(enabled && isatty(fileno(stderr))) {}
@@ -105,6 +173,10 @@ int main(int argc, char** argv) {
       "(Basalt " +
       std::string(basalt::kVersion) + ")"};
   app.require_subcommand(1);
+  if (const std::string why = check_shape(argc, argv); !why.empty()) {
+    std::fprintf(stderr, "basalt-pack: error: %s\n", why.c_str());
+    return 2;
+  }
   app.set_version_flag("--version", std::string(basalt::kVersion));
 
   std::string size, origin = "0,0,0", centre = "0,0,0", mesh_file, output;
@@ -113,7 +185,9 @@ int main(int argc, char** argv) {
   basalt::packer::AssemblyOptions aopt;
   std::optional<double> exponent;
   std::vector<std::string> tag_texts;
-  bool no_bonds = false, record_time = false, quiet = false;
+  bool no_bonds = false, record_time = false, quiet = false, allow_large = false, allow_low = false;
+  std::string seed_text = "1";
+  double max_spheres = 1e7;
 
   auto* box = app.add_subcommand("box", "an axis-aligned box from --origin to --origin + --size");
   box->add_option("--size", size, "edge lengths X,Y,Z")->required();
@@ -133,7 +207,15 @@ int main(int argc, char** argv) {
     sub->add_option("--rmax", popt.rmax, "largest radius")->required();
     sub->add_option("-o,--output", output, "output geometry: .h5 (Basalt) or .geo (ESyS-Particle)")
         ->required();
-    sub->add_option("--seed", popt.seed, "random seed (same seed, same file)")->capture_default_str();
+    sub->add_option("--seed", seed_text, "random seed, 0 .. 2^64-1 (same seed, same file)")
+        ->capture_default_str();
+    sub->add_flag("--allow-large", allow_large,
+                  "pack even when more than --max-spheres spheres are expected (about 1 KiB of memory each)");
+    sub->add_option("--max-spheres", max_spheres,
+                    "expected sphere count above which basalt-pack refuses without --allow-large")
+        ->capture_default_str();
+    sub->add_flag("--allow-low-fraction", allow_low,
+                  "write the packing with a warning even when its solid fraction is far below the mode's");
     sub->add_option("--exponent", exponent,
                     "follow the power law N(>r) ~ r^-EXPONENT instead of filling as densely as possible");
     sub->add_option("--target-fraction", popt.target_fraction,
@@ -165,6 +247,8 @@ int main(int argc, char** argv) {
 
   try {
     popt.exponent = exponent;
+    popt.seed = parse_seed(seed_text);
+    if (!(max_spheres >= 1)) throw PackError(fmt::format("--max-spheres must be >= 1, got {}", max_spheres));
     aopt.bonds = !no_bonds;
     if (!(aopt.bond_tolerance >= 0) || !std::isfinite(aopt.bond_tolerance))
       throw PackError(fmt::format("--bond-tolerance must be >= 0, got {}", aopt.bond_tolerance));
@@ -187,6 +271,7 @@ int main(int argc, char** argv) {
     }
     // Unknown tag faces fail now, not after packing.
     (void)basalt::packer::region_tags(*volume, {}, {}, aopt.tags);
+    check_expected_count(*volume, popt, max_spheres, allow_large);
 
     ProgressBar bar(!quiet);
     popt.progress = [&](double f) { bar.update(f); };
@@ -210,6 +295,10 @@ int main(int argc, char** argv) {
       if (arg == "-q" || arg == "--quiet") continue;  // changes nothing in the file
       command += " " + arg;
     }
+    const auto low = basalt::packer::low_fraction_report(*volume, popt, packing, st.solid_fraction);
+    if (low.far_below && !allow_low)
+      throw PackError(low.text + "; nothing written (--allow-low-fraction writes it anyway)");
+
     geometry.attributes["creator"] = fmt::format("basalt-pack {}", basalt::kVersion);
     geometry.attributes["command_line"] = command;
     if (record_time) {
@@ -247,6 +336,13 @@ int main(int argc, char** argv) {
                  st.largest_overlap, std::max(0.0, st.largest_boundary_overlap));
       fmt::print("  time                 {:.3f} s ({:.3f} s packing)\n", total_seconds, pack_seconds);
       fmt::print("  written              {}\n", output);
+    }
+    if (!low.text.empty()) {
+      if (low.far_below)
+        std::fprintf(stderr, "basalt-pack: warning: %s (written as --allow-low-fraction asks)\n",
+                     low.text.c_str());
+      else if (!quiet)
+        fmt::print("  note: {}\n", low.text);
     }
     return 0;
   } catch (const std::exception& e) {

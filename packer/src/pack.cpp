@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <string>
+#include <vector>
 
 #include "basalt/packer/error.hpp"
 #include "basalt/packer/random.hpp"
@@ -67,6 +69,12 @@ void check_options(const PackOptions& o) {
   if (o.exponent) {
     if (!(*o.exponent > 0) || !std::isfinite(*o.exponent))
       throw PackError(fmt::format("power-law exponent must be > 0 (N(>r) ~ r^-alpha), got {}", *o.exponent));
+    if (*o.exponent > kMaxExponent)
+      throw PackError(fmt::format(
+          "power-law exponent {} is beyond the useful range (0, {}]: at exponent A only a share 2^-A of the "
+          "spheres is larger than 2 rmin (one in a million at 20), so the packing would be spheres of radius "
+          "rmin with no visible power law; for equal spheres give --rmax {}",
+          *o.exponent, kMaxExponent, o.rmin));
     if (!(o.target_fraction > 0 && o.target_fraction < 0.8))
       throw PackError(fmt::format("target solid fraction must be in (0, 0.8), got {}", o.target_fraction));
   }
@@ -75,28 +83,93 @@ void check_options(const PackOptions& o) {
     throw PackError(fmt::format("seed fraction must be in [0.05, 0.35), got {}", o.seed_fraction));
 }
 
+namespace {
+
+/// log(e^x - 1) for x > 0, without overflow for large x.
+double log_expm1(double x) { return x > 30 ? x + std::log1p(-std::exp(-x)) : std::log(std::expm1(x)); }
+
+/// The power law in units of rmax, so that nothing overflows for any exponent: with R = rmax / rmin,
+/// L = ln R and x = r / rmax, N(>r) = C' (x^-alpha - 1) and the spheres' volume is
+/// (4/3) pi rmax^3 C' alpha I, I = integral of x^(2 - alpha) over [1/R, 1] = expm1((alpha - 3) L) / (alpha -
+/// 3). Returns ln I.
+double log_volume_integral(double alpha, double L) {
+  if (std::abs(alpha - 3) < 1e-12) return std::log(L);
+  if (alpha > 3) return log_expm1((alpha - 3) * L) - std::log(alpha - 3);
+  return std::log(-std::expm1((alpha - 3) * L)) - std::log(3 - alpha);
+}
+
+}  // namespace
+
 std::vector<double> power_law_radii(double rmin, double rmax, double alpha, double solid_volume,
                                     std::uint64_t seed) {
-  // Number of spheres larger than r: N(>r) = C (r^-alpha - rmax^-alpha), rmin <= r <= rmax.
-  // Their volume: (4/3) pi C alpha * integral of r^(2 - alpha) dr over [rmin, rmax].
-  const double integral = std::abs(alpha - 3) < 1e-12
-                              ? std::log(rmax / rmin)
-                              : (std::pow(rmax, 3 - alpha) - std::pow(rmin, 3 - alpha)) / (3 - alpha);
   std::vector<double> radii;
   if (rmax == rmin) {
     radii.assign(static_cast<std::size_t>(solid_volume / ball_volume(rmax)), rmax);
     return radii;
   }
-  const double c = solid_volume / (4.0 / 3.0 * std::numbers::pi * alpha * integral);
-  const double top = std::pow(rmax, -alpha);
+  // The k-th largest radius solves N(>r) = k + u, u uniform in [0, 1) (stratified draws):
+  // x^-alpha = 1 + (k + u) / C', C' = S / (alpha I), S = solid_volume / ((4/3) pi rmax^3); so
+  // ln x = -log1p((k + u) alpha I / S) / alpha, which neither overflows nor loses the small alphas.
+  // (Written as r^-alpha, rmin^-alpha overflowed for alpha ln(1/rmin) > 709: no radius was drawn and
+  // the seeding fell back on popping the last radius of an empty list.)
+  const double L = std::log(rmax / rmin);
+  const double per_count =
+      alpha * std::exp(log_volume_integral(alpha, L)) / (solid_volume / ball_volume(rmax));
   Random rng(seed ^ 0x5eedc0ffee123457ULL);
-  // Stratified draws: the k-th largest radius solves N(>r) = k + u, u uniform in [0, 1).
   for (std::size_t k = 0;; ++k) {
-    const double r = std::pow(top + (static_cast<double>(k) + rng.uniform()) / c, -1.0 / alpha);
-    if (r < rmin) break;
-    radii.push_back(std::min(r, rmax));
+    const double log_x = -std::log1p((static_cast<double>(k) + rng.uniform()) * per_count) / alpha;
+    if (!(log_x >= -L)) break;  // r < rmin (or not a number: never loop on it)
+    radii.push_back(std::min(rmax * std::exp(log_x), rmax));
   }
   return radii;
+}
+
+double expected_sphere_count(double measure, const PackOptions& o) {
+  const double fraction = o.exponent ? o.target_fraction : 0.72;
+  const double alpha = o.exponent ? *o.exponent : kDenseCountExponent;
+  const double solid = fraction * measure / ball_volume(o.rmax);
+  const double L = std::log(o.rmax / o.rmin);
+  if (!(L > 0)) return solid;
+  // N(>rmin) = C' expm1(alpha L), C' = S / (alpha I), in logarithms.
+  return std::exp(std::log(solid) + log_expm1(alpha * L) - std::log(alpha) - log_volume_integral(alpha, L));
+}
+
+LowFractionReport low_fraction_report(const Volume& volume, const PackOptions& o, const Packing& p,
+                                      double solid_fraction) {
+  const bool dense = !o.exponent || o.fill_after;
+  const double aim = dense ? 0.70 : o.target_fraction;
+  LowFractionReport rep;
+  if (solid_fraction >= 0.85 * aim) return rep;
+  rep.far_below = solid_fraction < 0.5 * aim;
+  const Bounds b = volume.bounds();
+  const double narrowest = std::min({b.hi[0] - b.lo[0], b.hi[1] - b.lo[1], b.hi[2] - b.lo[2]});
+  const double across = narrowest / (2 * o.rmax);
+  const double ratio = o.rmax / o.rmin;
+  std::vector<std::string> why;
+  if (across < 8)
+    why.push_back(
+        fmt::format("the volume is only {:.3g} spheres of radius rmax across at its narrowest, and the "
+                    "layer next to a wall is about 0.5 solid (0.70 is for volumes 15 across)",
+                    across));
+  if (ratio < 2.5)
+    why.push_back(
+        fmt::format("the radius range is narrow (rmax / rmin = {:.3g}): smaller radii fill the gaps "
+                    "between large ones, equal spheres saturate near 0.35",
+                    ratio));
+  if (o.exponent && p.not_placed > 0)
+    why.push_back(fmt::format("{} of the {} radii drawn found no room", p.not_placed, p.requested));
+  if (why.empty()) why.push_back("none of the known limits applies: please report the command line");
+  std::string reasons;
+  for (std::size_t i = 0; i < why.size(); ++i) reasons += (i ? "; " : "") + why[i];
+  rep.text = fmt::format(
+      "solid fraction {:.3f} is {}below the {}'s {:.2f}{}: {}", solid_fraction, rep.far_below ? "far " : "",
+      dense ? "dense mode" : "power-law target", aim,
+      dense ? fmt::format(" although no room is left for another sphere of radius rmin = {} (2000 random "
+                          "probes in a row found none)",
+                          o.rmin)
+            : "",
+      reasons);
+  return rep;
 }
 
 Packing pack(const Volume& volume, const PackOptions& opt) {
@@ -111,6 +184,7 @@ Packing pack(const Volume& volume, const PackOptions& opt) {
   Random rng(opt.seed);
   std::vector<double> radii;
   detail::FillContext ctx{volume, opt, grid, out};
+  ctx.rng = &rng;
   if (opt.exponent) {
     radii =
         power_law_radii(opt.rmin, opt.rmax, *opt.exponent, opt.target_fraction * volume.measure(), opt.seed);
@@ -134,8 +208,8 @@ Packing pack(const Volume& volume, const PackOptions& opt) {
     if (out.seeds == 0)
       throw PackError(fmt::format("the volume ({}) is too small for one sphere of radius rmin = {}",
                                   volume.description(), opt.rmin));
-    if (opt.exponent) {  // the small sphere replaces the smallest drawn radius
-      radii.pop_back();
+    if (opt.exponent) {  // the small sphere replaces the smallest drawn radius (if any was drawn)
+      if (!radii.empty()) radii.pop_back();
       out.requested = radii.size() + 1;
     }
   }

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "basalt/packer/pack.hpp"
+#include "basalt/packer/random.hpp"
 #include "basalt/packer/vec3.hpp"
 #include "basalt/packer/volume.hpp"
 
@@ -38,6 +39,30 @@ class SphereGrid {
             if (dx * dx + dy * dy + dz * dz < lim * lim && lim > 0) return true;
           }
     return false;
+  }
+
+  /// True when c lies inside a sphere stored in c's own cell (a cheap first test for random probes).
+  bool inside_home_cell(const Vec3& c) const {
+    for (const auto& e : cells_[index(coord(c[0], 0), coord(c[1], 1), coord(c[2], 2))]) {
+      const double dx = c[0] - e.x, dy = c[1] - e.y, dz = c[2] - e.z;
+      if (dx * dx + dy * dy + dz * dz < e.r * e.r) return true;
+    }
+    return false;
+  }
+
+  /// Distance from c to the surface of the nearest placed sphere, or `reach` when none is nearer.
+  double clearance(const Vec3& c, double reach) const {
+    int a[3], z[3];
+    range(c, reach + reach_, a, z);
+    double best = reach;
+    for (int k = a[2]; k <= z[2]; ++k)
+      for (int j = a[1]; j <= z[1]; ++j)
+        for (int i = a[0]; i <= z[0]; ++i)
+          for (const auto& e : cells_[index(i, j, k)]) {
+            const double dx = c[0] - e.x, dy = c[1] - e.y, dz = c[2] - e.z;
+            best = std::min(best, std::sqrt(dx * dx + dy * dy + dz * dz) - e.r);
+          }
+    return best;
   }
 
   void add(const Vec3& c, double r) {
@@ -77,7 +102,9 @@ struct FillContext {
   std::size_t next = 0;                        ///< first radius of `radii` not yet placed
   double expected_solid = 1;                   ///< for progress: solid volume expected at the end
   double placed_solid = 0;
-  std::size_t not_placed = 0;  ///< power-law mode: radii for which no void was left
+  std::size_t not_placed = 0;      ///< power-law mode: radii for which no void was left
+  Random* rng = nullptr;           ///< for the room probes after filling (the seeding's stream)
+  std::size_t probed_spheres = 0;  ///< spheres placed where a probe found room the triangulation missed
 };
 
 /// Places spheres into the voids left between out's spheres until none of radius >= rmin is left

@@ -85,9 +85,9 @@ class Filler {
     if (std::getenv("BASALT_PACK_DEBUG"))
       std::fprintf(stderr,
                    "evaluate %zu place %zu placed %zu vertices %zu cells %zu voids left %zu fail cap %zu "
-                   "fail three %zu\n",
+                   "fail three %zu probes %zu probed spheres %zu\n",
                    n_eval_, n_place_, ctx_.out.size(), rt_.number_of_vertices(), rt_.number_of_cells(),
-                   voids_.size(), n_fail_cap_, n_fail_three_);
+                   voids_.size(), n_fail_cap_, n_fail_three_, n_probe_, ctx_.probed_spheres);
   }
 
   void run() {
@@ -99,7 +99,7 @@ class Filler {
         for (;;) {
           auto it = voids_.lower_bound(Void{rho * (1 - 1e-12), 0, {}, {}});
           if (it == voids_.end()) {
-            ++ctx_.not_placed;
+            if (!probe(rho, kRadiusProbes, true)) ++ctx_.not_placed;
             break;
           }
           const Void v = take(it);
@@ -108,20 +108,66 @@ class Filler {
       }
     }
     if (!ctx_.radii) {
-      while (!queue_.empty()) {
-        const Void v = queue_.top().v;
-        queue_.pop();
-        if (v.cell->info().serial != v.serial) continue;  // the cell died
-        place(v, std::min(v.cap, rmax_));
-      }
+      do {
+        while (!queue_.empty()) {
+          const Void v = queue_.top().v;
+          queue_.pop();
+          if (v.cell->info().serial != v.serial) continue;  // the cell died
+          place(v, std::min(v.cap, rmax_));
+        }
+      } while (probe(rmin_, kFillProbes, false));
     } else if (ctx_.options.fill_after) {
-      while (!voids_.empty()) {
-        const Void v = take(std::prev(voids_.end()));
-        place(v, std::min(v.cap, rmax_));
-      }
+      do {
+        while (!voids_.empty()) {
+          const Void v = take(std::prev(voids_.end()));
+          place(v, std::min(v.cap, rmax_));
+        }
+      } while (probe(rmin_, kFillProbes, false));
     }
   }
 
+ private:
+  /// Misses in a row after which the volume counts as full: a region of room for a sphere that covers
+  /// 0.15 % of the bounding box is found with probability 95 %.
+  static constexpr int kFillProbes = 2000;
+  static constexpr int kRadiusProbes = 100;  ///< power-law mode, per radius that found no void
+  /// Pieces a sphere is mirrored across: a box's six faces; a finely faceted mesh near a sphere could
+  /// offer dozens, each a vertex more.
+  static constexpr int kMaxMirrorPieces = 6;
+
+  /// Room the triangulation did not offer. The filler sees a void only in a cell whose four vertices
+  /// stand for four distinct objects; where the seeds are too few for such cells (a volume only a few
+  /// rmax across: 2 seeds in a 2 x 2 x 2 box with rmax 0.5, 1 in a ball of radius 1.2) it saw nothing and
+  /// stopped. A probe takes a random point of the bounding box; where a sphere of radius >= `at_least`
+  /// fits, it places the largest that fits there (at most rmax), or with `exact` one of radius `at_least`
+  /// (the power-law mode's next radius), whose new cells give the filling its start. True when one was
+  /// placed.
+  bool probe(double at_least, int tries, bool exact) {
+    if (!ctx_.rng) return false;
+    Random& rng = *ctx_.rng;
+    for (int t = 0; t < tries; ++t) {
+      ++n_probe_;
+      Vec3 c;
+      for (int k = 0; k < 3; ++k) c[k] = bounds_.lo[k] + (bounds_.hi[k] - bounds_.lo[k]) * rng.uniform();
+      // Most probes land inside a sphere: look in the probe's own grid cell first, then let the overlap
+      // test (which stops at the first overlap) rule out the rest before measuring the room (4x less
+      // probe time than measuring it for every probe: 0.49 -> 0.12 s of 7.5 s on a 60 mm cube).
+      if (ctx_.grid.inside_home_cell(c)) continue;
+      const double wall = vol_.signed_distance(c);
+      if (!(wall >= at_least)) continue;
+      if (ctx_.grid.overlaps(c, at_least, tol_)) continue;
+      const double room = std::min(wall, ctx_.grid.clearance(c, rmax_));
+      if (!(room >= at_least)) continue;
+      const double r = exact ? at_least : std::min(room, rmax_);
+      if (ctx_.grid.overlaps(c, r, tol_)) continue;  // rounding
+      commit({c, r}, Cell());
+      ++ctx_.probed_spheres;
+      return true;
+    }
+    return false;
+  }
+
+ public:
  private:
   // ---- triangulation upkeep -------------------------------------------------------------------
   void build() {
@@ -176,13 +222,20 @@ class Filler {
     Cell near = v != Rt::Vertex_handle() ? v->cell() : hint;
     pieces_.clear();
     vol_.pieces_near(c, r + ghost_reach_, pieces_);
-    const int m = std::min<int>(static_cast<int>(pieces_.size()), 3);
-    for (int mask = 1; mask < (1 << m); ++mask) {
+    // Mirror images across every combination of the first three pieces (a corner of a box is three), and
+    // single images across up to three further pieces: in a volume only a few rmax across a sphere is within
+    // reach of opposite faces too, and a face without its image leaves the cells along it to the frame
+    // points, where the filler sees no void (a 2 x 2 x 2 box with rmax 0.5 got 2 spheres).
+    const int n = std::min(static_cast<int>(pieces_.size()), kMaxMirrorPieces);
+    const int m = std::min(n, 3);
+    const int masks = (1 << m) - 1 + (n - m);
+    for (int j = 1; j <= masks; ++j) {
+      const int mask = j < (1 << m) ? j : 0;
       Vec3 g = c;
       int piece = -1;
       int count = 0;
-      for (int k = 0; k < m; ++k)
-        if (mask & (1 << k)) {
+      for (int k = 0; k < n; ++k)
+        if (mask ? (k < m && (mask & (1 << k))) : k == m + (j - (1 << m))) {
           g = pieces_[k].plane.mirror(g);
           piece = pieces_[k].id;
           if (piece_flat_.size() <= static_cast<std::size_t>(piece)) piece_flat_.resize(piece + 1, true);
@@ -371,7 +424,7 @@ class Filler {
       ctx_.options.progress(std::min(0.99, ctx_.placed_solid / ctx_.expected_solid));
   }
 
-  std::size_t n_eval_ = 0, n_place_ = 0, n_fail_cap_ = 0, n_fail_three_ = 0;
+  std::size_t n_eval_ = 0, n_place_ = 0, n_fail_cap_ = 0, n_fail_three_ = 0, n_probe_ = 0;
   FillContext& ctx_;
   const Volume& vol_;
   const double tol_, rmin_, rmax_, ghost_reach_;

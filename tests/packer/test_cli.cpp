@@ -159,3 +159,85 @@ TEST(Cli, AFailedRunKeepsTheFileAlreadyThere) {
   EXPECT_NE(run("box --size 4,4,4 --rmin 2 --rmax 1 -q -o " + out.string()).status, 0);
   EXPECT_TRUE(slurp(out) == before) << "a failed run changed the existing file";
 }
+
+// ---- issue 16 (docs/reliability.md) ----------------------------------------------------------------
+
+TEST(Cli, SteepExponentsAndHugeVolumesAreRefusedBeforeAnyWork) {
+  const auto dir = basalt::test::scratch_dir("packer-cli-absurd");
+  const std::string o = " -o " + (dir / "x.h5").string();
+  // Exponent 600 segfaulted; 1e4 and 1e308 grew memory until std::bad_alloc.
+  for (const char* a : {"600", "500", "800", "1e4", "1e308"}) {
+    const auto r = run(std::string("box --size 3,3,3 --rmin 0.2 --rmax 0.5 --exponent ") + a + o);
+    EXPECT_EQ(r.status, 1) << a << ": " << r.output;
+    EXPECT_TRUE(contains(r.output, "beyond the useful range (0, 20]")) << r.output;
+  }
+  // --size 1e6,1e6,1e6 grew memory without bound: refused with the estimate and its memory.
+  auto r = run("box --size 1e6,1e6,1e6 --rmin 0.2 --rmax 0.5" + o);
+  EXPECT_EQ(r.status, 1) << r.output;
+  for (const char* w : {"would take about 5.", "e+18 spheres", "EiB of memory", "--allow-large"})
+    EXPECT_TRUE(contains(r.output, w)) << w << " missing from: " << r.output;
+  r = run("sphere --radius 1e5 --rmin 0.01 --rmax 0.02 --exponent 2" + o);
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, "--allow-large")) << r.output;
+  EXPECT_FALSE(fs::exists(dir / "x.h5"));
+  // The limit is a limit: --allow-large packs beyond it.
+  r = run("box --size 6,6,6 --rmin 0.2 --rmax 1 --max-spheres 100 -q" + o);
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, "beyond the 100 spheres")) << r.output;
+  r = run("box --size 6,6,6 --rmin 0.2 --rmax 1 --max-spheres 100 --allow-large -q" + o);
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_GT(basalt::io::read_geometry(dir / "x.h5").size(), 100u);
+}
+
+TEST(Cli, SmallVolumesAreFilledOrTheReasonIsGiven) {
+  const auto dir = basalt::test::scratch_dir("packer-cli-small");
+  // 2 x 2 x 2 with radii up to 0.5 wrote 2 spheres (solid fraction 0.13) and exit 0.
+  auto r = run("box --size 2,2,2 --rmin 0.2 --rmax 0.5 -o " + (dir / "a.h5").string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_GE(basalt::io::read_geometry(dir / "a.h5").size(), 10u);
+  EXPECT_TRUE(contains(r.output, "note: solid fraction")) << r.output;  // the wall layer, said
+  r = run("sphere --radius 1.2 --rmin 0.2 --rmax 0.5 -q -o " + (dir / "b.h5").string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_GE(basalt::io::read_geometry(dir / "b.h5").size(), 15u);
+  // Where nothing more fits, the fraction is far below the mode's: an error that says why, no file ...
+  r = run("box --size 1.2,1.2,1.2 --rmin 0.5 --rmax 0.5 -o " + (dir / "c.h5").string());
+  EXPECT_EQ(r.status, 1) << r.output;
+  for (const char* w : {"far below the dense mode's 0.70", "no room is left", "--allow-low-fraction"})
+    EXPECT_TRUE(contains(r.output, w)) << w << " missing from: " << r.output;
+  EXPECT_FALSE(fs::exists(dir / "c.h5"));
+  // ... unless asked: then a warning, and the file.
+  r = run("box --size 1.2,1.2,1.2 --rmin 0.5 --rmax 0.5 --allow-low-fraction -q -o " +
+          (dir / "c.h5").string());
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "warning: solid fraction 0.303")) << r.output;
+  EXPECT_EQ(basalt::io::read_geometry(dir / "c.h5").size(), 1u);
+}
+
+TEST(Cli, AnUnknownShapeOrANegativeSeedIsNamed) {
+  const auto dir = basalt::test::scratch_dir("packer-cli-names");
+  const std::string o = " -o " + (dir / "x.h5").string();
+  auto r = run("torus --rmin 0.2 --rmax 0.5" + o);
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_TRUE(contains(r.output, "unknown shape 'torus'")) << r.output;
+  EXPECT_TRUE(contains(r.output, "box, cylinder, sphere or mesh")) << r.output;
+  r = run("");
+  EXPECT_NE(r.status, 0);
+  EXPECT_TRUE(contains(r.output, "no shape given")) << r.output;
+  EXPECT_EQ(run("--help").status, 0);
+  struct Case {
+    const char* seed;
+    const char* words;
+  };
+  for (const Case& c : {Case{"-1", "a seed cannot be negative"}, Case{"-0", "a seed cannot be negative"},
+                        Case{"1.5", "not a whole number"}, Case{"7x", "not a whole number"},
+                        Case{"18446744073709551616", "too large"}}) {
+    r = run(std::string("box --size 3,3,3 --rmin 0.2 --rmax 0.5 --seed ") + c.seed + o);
+    EXPECT_EQ(r.status, 1) << c.seed << ": " << r.output;
+    EXPECT_TRUE(contains(r.output, std::string("--seed '") + c.seed + "': " + c.words)) << r.output;
+  }
+  EXPECT_FALSE(fs::exists(dir / "x.h5"));
+  // The largest seed is a seed, stored as given.
+  r = run("box --size 3,3,3 --rmin 0.2 --rmax 0.5 -q --seed 18446744073709551615" + o);
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(basalt::io::read_geometry(dir / "x.h5").attributes.at("seed"), "18446744073709551615");
+}

@@ -459,3 +459,111 @@ TEST(BasaltView, StartsItsOwnXServerAlsoForConcurrentCommands) {
   EXPECT_NE(r.code, 0);
   EXPECT_NE(r.out.find("Xvfb is not installed"), std::string::npos) << r.out;
 }
+
+// ---- issue 16: plots that drew nothing, renders far from the origin (docs/reliability.md) ------------
+
+TEST(BasaltView, PlotsTheFinitePointsAndSaysWhatWasLeftOut) {
+  const fs::path dir = basalt::test::scratch_dir("view-plot-nonfinite");
+  const Rgb kLine{31, 119, 180};
+  {
+    std::ofstream csv(dir / "inf.csv");  // an empty chart, exit 0
+    csv << "step,time,kinetic_energy\n";
+    for (int s = 0; s <= 100; ++s)
+      csv << s << "," << s * 1e-3 << ","
+          << (s % 25 == 7 ? "inf"
+              : s == 50   ? "nan"
+                          : std::to_string(s * s))
+          << "\n";
+  }
+  Outcome r = basalt_view(
+      fmt_args("plot", (dir / "inf.csv").string(), "-o", (dir / "inf.png").string(), "--size 400x300"), dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  for (const char* w :
+       {"inf.csv: column \"kinetic_energy\": 5 of 101 rows not drawn", "line 9: inf", "(5 in all)"})
+    EXPECT_NE(r.out.find(w), std::string::npos) << w << " missing from: " << r.out;
+  EXPECT_GT(read_png(dir / "inf.png").count(kLine, 40), 150) << "no line drawn";
+
+  // +-1e308: the axis was 2e308 long (infinite), and VTK draws in single precision.
+  {
+    std::ofstream csv(dir / "big.csv");
+    csv << "step,time,kinetic_energy\n";
+    for (int s = 0; s <= 40; ++s) csv << s << "," << s << "," << (s % 2 ? "-1e308" : "1e308") << "\n";
+  }
+  r = basalt_view(
+      fmt_args("plot", (dir / "big.csv").string(), "-o", (dir / "big.png").string(), "--size 400x300"), dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_GT(read_png(dir / "big.png").count(kLine, 40), 500) << "no line drawn";
+  {
+    std::ofstream csv(dir / "tiny.csv");
+    csv << "step,time,kinetic_energy\n0,0,1e-310\n1,1e-40,3e-310\n2,2e-40,2e-310\n";
+  }
+  r = basalt_view(
+      fmt_args("plot", (dir / "tiny.csv").string(), "-o", (dir / "tiny.png").string(), "--size 400x300"),
+      dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_GT(read_png(dir / "tiny.png").count(kLine, 40), 150) << "no line drawn";
+
+  // One row: a line needs two points; the lone one is a marker (the axes get a length).
+  {
+    std::ofstream csv(dir / "one.csv");
+    csv << "step,time,kinetic_energy\n100,0.1,2.5\n";
+  }
+  r = basalt_view(
+      fmt_args("plot", (dir / "one.csv").string(), "-o", (dir / "one.png").string(), "--size 400x300"), dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_EQ(r.out.find("ERR"), std::string::npos) << r.out;
+  EXPECT_GT(read_png(dir / "one.png").count(kLine, 40), 20) << "no point drawn";
+}
+
+TEST(BasaltView, RefusesAChartWithNothingToDraw) {
+  const fs::path dir = basalt::test::scratch_dir("view-plot-nothing");
+  {
+    std::ofstream csv(dir / "none.csv");
+    csv << "step,time,kinetic_energy,wall_force\n0,0,inf,\n1,0.001,nan,\n2,inf,1,\n";
+  }
+  Outcome r =
+      basalt_view(fmt_args("plot", (dir / "none.csv").string(), "-o", (dir / "none.png").string()), dir);
+  EXPECT_EQ(r.code, 1) << r.out;
+  for (const char* w : {"basalt-view: error: ", "none.csv: column \"kinetic_energy\": nothing to draw",
+                        "line 2: inf", "line 4: time inf", "column \"wall_force\": nothing to draw",
+                        "saver was never due", "no chart written"})
+    EXPECT_NE(r.out.find(w), std::string::npos) << w << " missing from: " << r.out;
+  EXPECT_FALSE(fs::exists(dir / "none.png"));
+  r = basalt_view(fmt_args("plot", (dir / "none.csv").string(), "-o", (dir / "some.png").string(),
+                           "--columns kinetic_energy,wall_force"),
+                  dir);
+  EXPECT_EQ(r.code, 1) << r.out;  // the same columns named: still nothing to draw
+  EXPECT_NE(r.out.find("nothing to draw"), std::string::npos) << r.out;
+  // One column with nothing beside one with points: drawn, the empty one named.
+  {
+    std::ofstream csv(dir / "half.csv");
+    csv << "step,time,kinetic_energy,wall_force\n0,0,1,inf\n1,0.001,2,nan\n2,0.002,1.5,inf\n";
+  }
+  r = basalt_view(fmt_args("plot", (dir / "half.csv").string(), "-o", (dir / "half.png").string()), dir);
+  EXPECT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("column \"wall_force\": nothing to draw"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("left out of the chart"), std::string::npos) << r.out;
+  EXPECT_TRUE(fs::exists(dir / "half.png"));
+}
+
+TEST(BasaltView, RendersParticlesFarFromTheOrigin) {
+  // Positions 1e9 from the origin rendered blank (single-precision OpenGL); now drawn relative to the
+  // frame's centre.
+  for (double offset : {1e9, 1e12}) {
+    const fs::path dir = basalt::test::scratch_dir(fmt::format("view-render-offset-{:g}", offset));
+    basalt::io::Checkpoint c = lattice_checkpoint();
+    for (auto& p : c.geometry.position) p = {p[0] + offset, p[1] - offset, p[2] + offset};
+    basalt::io::write_checkpoint(c, dir / "ckpt.h5");
+    const Outcome r = basalt_view(fmt_args("render", (dir / "ckpt.h5").string(), "-o",
+                                           (dir / "far.png").string(), "--size 400x300 --view -y"),
+                                  dir);
+    ASSERT_EQ(r.code, 0) << r.out;
+    const Image img = read_png(dir / "far.png");
+    ASSERT_EQ(img.width, 400);
+    const int scene_pixels = static_cast<int>(kSceneFraction * img.width) * img.height;
+    EXPECT_GT(scene_pixels - img.count(kBackground, 3, kSceneFraction), scene_pixels / 5)
+        << "almost blank at offset " << offset;
+    EXPECT_GT(img.count(kLow, 30, kSceneFraction), 30) << offset;
+    EXPECT_GT(img.count(kHigh, 30, kSceneFraction), 30) << offset;
+  }
+}

@@ -5,7 +5,9 @@
 #include <vtkSmartPointer.h>
 
 #include <algorithm>
+#include <cmath>
 #include <fstream>
+#include <limits>
 
 #include "basalt/io/geometry.hpp"
 #include "field_series.hpp"
@@ -104,8 +106,13 @@ TEST(FieldSeriesCsv, MalformedLinesAreNamedByNumber) {
   EXPECT_NE(err.find("no data rows"), std::string::npos) << err;
   err = error_of(write_file(dir, "g.csv", ""));
   EXPECT_NE(err.find("empty file"), std::string::npos) << err;
-  err = error_of(write_file(dir, "h.csv", header + "0,0,nan\n"));
+  // A field may be nan or inf (the solver writes them so; plot skips them), step and time may not.
+  err = error_of(write_file(dir, "h.csv", header + "0,nan,1\n"));
   EXPECT_NE(err.find("h.csv: line 2"), std::string::npos) << err;
+  err = error_of(write_file(dir, "i.csv", header + "0,0,1\n1,0.1,1e999\n"));  // beyond double: not inf
+  EXPECT_NE(err.find("i.csv: line 3"), std::string::npos) << err;
+  err = error_of(write_file(dir, "j.csv", header + "0,,1\n"));  // only a field's cell may be empty
+  EXPECT_NE(err.find("j.csv: line 2"), std::string::npos) << err;
   err = error_of(dir / "missing.csv");
   EXPECT_NE(err.find("missing.csv: no such file"), std::string::npos) << err;
 }
@@ -159,4 +166,23 @@ TEST(ParticleSelection, BuriedParticlesAreDroppedAndTheSurfaceKept) {
   EXPECT_EQ(half.size(), 4000u);
   for (vtkIdType i : half) EXPECT_LE(pd->GetPoint(i)[0], 9.5);
   EXPECT_EQ(select_points(*pd, half)->GetNumberOfVerts(), 4000);
+}
+
+TEST(FieldSeriesCsv, NonFiniteValuesAndSaversNotDueAreRead) {
+  // Issue 16: a CSV with inf made an empty chart; nan was refused although the solver writes it for a
+  // non-finite sum; an empty cell (a saver not due, docs/scenes.md) was refused as "not a number".
+  const fs::path dir = basalt::test::scratch_dir("view-csv-nonfinite");
+  const auto f =
+      write_file(dir, "fields.csv",
+                 "step,time,kinetic_energy,wall_force\n0,0,inf,1\n\n1,0.1,-inf,\n2,0.2,nan,3\n3,inf,4,5\n");
+  const FieldSeries s = read_field_series(f);
+  ASSERT_EQ(s.rows(), 4u);
+  EXPECT_EQ(s.columns[2][0], std::numeric_limits<double>::infinity());
+  EXPECT_EQ(s.columns[2][1], -std::numeric_limits<double>::infinity());
+  EXPECT_TRUE(std::isnan(s.columns[2][2]));
+  EXPECT_FALSE(s.blank[2][2]);
+  EXPECT_TRUE(std::isnan(s.columns[3][1]));
+  EXPECT_TRUE(s.blank[3][1]);
+  EXPECT_EQ(s.columns[1][3], std::numeric_limits<double>::infinity());
+  EXPECT_EQ(s.lines, (std::vector<int>{2, 4, 5, 6}));  // the blank line 3 is skipped
 }

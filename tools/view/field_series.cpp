@@ -5,6 +5,7 @@
 #include <charconv>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <system_error>
 
 #include "basalt/io/geometry.hpp"
@@ -60,6 +61,7 @@ FieldSeries read_field_series(const fs::path& file) {
         if (c.empty()) throw io::FormatError(file, where, "empty column name in header");
       s.names = cells;
       s.columns.resize(cells.size());
+      s.blank.resize(cells.size());
       continue;
     }
     if (cells.size() != s.names.size())
@@ -67,14 +69,23 @@ FieldSeries read_field_series(const fs::path& file) {
           file, where,
           fmt::format("{} values, expected {} ({})", cells.size(), s.names.size(), fmt::join(s.names, ",")));
     for (std::size_t i = 0; i < cells.size(); ++i) {
-      double v = 0;
+      double v = std::numeric_limits<double>::quiet_NaN();
       const std::string& c = cells[i];
+      if (c.empty() && i >= 2) {  // a saver not due on this row
+        s.columns[i].push_back(v);
+        s.blank[i].push_back(true);
+        continue;
+      }
+      // from_chars reads nan, inf and infinity (any case); a number beyond the double range (1e999) is
+      // an error, refused as not a number rather than read as inf.
       const auto [ptr, err] = std::from_chars(c.data(), c.data() + c.size(), v);
-      if (c.empty() || err != std::errc() || ptr != c.data() + c.size() || std::isnan(v))
+      if (c.empty() || err != std::errc() || ptr != c.data() + c.size() || (i < 2 && std::isnan(v)))
         throw io::FormatError(file, where,
                               fmt::format("column \"{}\": \"{}\" is not a number", s.names[i], c));
       s.columns[i].push_back(v);
+      s.blank[i].push_back(false);
     }
+    s.lines.push_back(number);
   }
   if (s.names.empty())
     throw io::FormatError(file, "line 1", "empty file: expected a header \"step,time,...\"");

@@ -8,6 +8,8 @@
 #include <vtkLookupTable.h>
 #include <vtkOpenGLSphereMapper.h>
 #include <vtkPointData.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
 #include <vtkProperty.h>
 #include <vtkRenderWindow.h>
 #include <vtkRenderer.h>
@@ -61,6 +63,23 @@ vtkSmartPointer<vtkLookupTable> cool_to_warm(const Range& r) {
     lut->SetTableValue(i, rgb[0], rgb[1], rgb[2], 1.0);
   }
   return lut;
+}
+
+/// The same particles and arrays, positions less `centre` (in double precision).
+vtkSmartPointer<vtkPolyData> relative_to(vtkPolyData& in, const double centre[3]) {
+  auto out = vtkSmartPointer<vtkPolyData>::New();
+  out->ShallowCopy(&in);
+  auto points = vtkSmartPointer<vtkPoints>::New();
+  points->SetDataTypeToDouble();
+  const vtkIdType n = in.GetNumberOfPoints();
+  points->SetNumberOfPoints(n);
+  for (vtkIdType i = 0; i < n; ++i) {
+    double p[3];
+    in.GetPoint(i, p);
+    points->SetPoint(i, p[0] - centre[0], p[1] - centre[1], p[2] - centre[2]);
+  }
+  out->SetPoints(points);
+  return out;
 }
 
 std::string describe_clock(const io::FrameInfo& info, const std::string& kind) {
@@ -118,6 +137,11 @@ void render(const RenderOptions& o) {
   vtkSmartPointer<vtkPolyData> shown =
       static_cast<vtkIdType>(kept.size()) == total ? frame.polydata : select_points(full, kept);
   shown->GetPointData()->SetActiveScalars(color_array.c_str());
+  // Drawn relative to the frame's centre: OpenGL works in single precision, so particles 1e9 from the
+  // origin (1e12: nothing at all) collapsed onto a few positions and the picture was blank.
+  const double centre[3] = {0.5 * (full_bounds[0] + full_bounds[1]), 0.5 * (full_bounds[2] + full_bounds[3]),
+                            0.5 * (full_bounds[4] + full_bounds[5])};
+  shown = relative_to(*shown, centre);
   const double read_s = seconds_since(t0);
 
   Range range;
@@ -229,10 +253,9 @@ void render(const RenderOptions& o) {
   text->SetDisplayPosition(font / 2, h - font / 2);
   scene->AddActor2D(text);
 
-  // Camera: look at the centre of the whole frame from the requested side.
+  // Camera: look at the centre of the whole frame (now the origin) from the requested side.
   auto* cam = scene->GetActiveCamera();
-  const double c[3] = {0.5 * (full_bounds[0] + full_bounds[1]), 0.5 * (full_bounds[2] + full_bounds[3]),
-                       0.5 * (full_bounds[4] + full_bounds[5])};
+  const double c[3] = {0, 0, 0};
   cam->SetFocalPoint(c);
   cam->SetPosition(c[0] + o.view.toward_camera[0], c[1] + o.view.toward_camera[1],
                    c[2] + o.view.toward_camera[2]);
@@ -242,8 +265,9 @@ void render(const RenderOptions& o) {
   double rr[2];
   full.GetPointData()->GetArray("radius")->GetRange(rr);
   const double pad = rr[1];
-  const double fit[6] = {full_bounds[0] - pad, full_bounds[1] + pad, full_bounds[2] - pad,
-                         full_bounds[3] + pad, full_bounds[4] - pad, full_bounds[5] + pad};
+  const double fit[6] = {full_bounds[0] - centre[0] - pad, full_bounds[1] - centre[0] + pad,
+                         full_bounds[2] - centre[1] - pad, full_bounds[3] - centre[1] + pad,
+                         full_bounds[4] - centre[2] - pad, full_bounds[5] - centre[2] + pad};
   scene->ResetCamera(fit);
   cam->Zoom(1.25);
   scene->ResetCameraClippingRange(fit);

@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "basalt/packer/vec3.hpp"
@@ -47,12 +48,35 @@ struct Packing {
   std::size_t size() const { return radius.size(); }
 };
 
+/// Largest power-law exponent accepted: beyond it the radii are all but equal to rmin (docs/packer.md).
+inline constexpr double kMaxExponent = 20;
+/// The dense mode's size distribution, for estimates only: counts per log-radius bin ~ r^-1.5 (1.42 is
+/// measured on the 15 mm cube with radii 0.2-1.0; wider radius ranges fill more small voids).
+inline constexpr double kDenseCountExponent = 1.5;
+/// Memory the packer needs per sphere at its peak, for estimates (measured 0.83-0.93 KiB, docs/packer.md).
+inline constexpr double kBytesPerSphere = 1024;
+
 /// Throws PackError on impossible options (rmin <= 0, rmin > rmax, non-finite values ...).
 void check_options(const PackOptions& options);
 
 /// Packs the volume. Deterministic: the same volume and options give the same spheres in the same order.
 /// Throws PackError when not even one sphere of radius rmin fits.
 Packing pack(const Volume& volume, const PackOptions& options);
+
+/// About how many spheres a pack of a volume of this measure makes: the power law's count at the target
+/// fraction, or for the dense mode a power law of exponent kDenseCountExponent at solid fraction 0.72.
+/// Within a factor of two of the real count for ordinary radius ranges; may be inf for absurd requests.
+double expected_sphere_count(double measure, const PackOptions& options);
+
+/// A solid fraction far below the mode's, and why. The dense mode (and --fill) aims at 0.70 (a 15 mm cube
+/// with radii 0.2-1.0); the power-law mode at its target fraction. Below half of it is "far below"; below
+/// 0.85 of it a note says why (a volume few rmax across, a narrow radius range, radii left unplaced).
+struct LowFractionReport {
+  bool far_below = false;
+  std::string text;  ///< empty when the fraction is as expected
+};
+LowFractionReport low_fraction_report(const Volume& volume, const PackOptions& options,
+                                      const Packing& packing, double solid_fraction);
 
 /// The radii the power-law mode draws for a volume, largest first (exposed for tests).
 std::vector<double> power_law_radii(double rmin, double rmax, double alpha, double solid_volume,
