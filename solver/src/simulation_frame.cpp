@@ -25,7 +25,7 @@ SimulationFrame<Real>::SimulationFrame(const Simulation<Real>& sim, std::uint32_
   for (std::size_t k = bonds.n_both_owned; k < bonds.size(); ++k) m += owns_ghost_bond(k) ? 1 : 0;
   h.bonds = m;
   if (kinds & io::kFrameCheckpoint)
-    for (const auto* c : sim.pair_computes_)
+    for (const auto* c : sim.forces_.pair_computes())
       if (c->history_bytes() > 0) {
         history_.emplace_back();
         c->history_records(p, history_.back());
@@ -33,7 +33,7 @@ SimulationFrame<Real>::SimulationFrame(const Simulation<Real>& sim, std::uint32_
         h.contact_width = static_cast<std::uint32_t>(history_.back().width);
       }
   // Walls: global; the force is summed over the ranks (collective), rank 0 carries them.
-  const auto& wd = sim.walls_;
+  const auto& wd = sim.forces_.walls();
   if (wd.size() > 0) {
     std::vector<double> f;
     for (std::size_t w = 0; w < wd.size(); ++w) f.insert(f.end(), wd.force(w).begin(), wd.force(w).end());

@@ -31,12 +31,13 @@ bool Simulation<Real>::field_partials(const std::vector<double>& pe, std::vector
     }
     switch (f.type) {
       case FieldSpec::Type::energy:
-        local.push_back(term_value(static_cast<std::size_t>(ledger_.find(f.term)), pe));
+        local.push_back(term_value(static_cast<std::size_t>(forces_.ledger().find(f.term)), pe));
         break;
       case FieldSpec::Type::total_energy: {
         double e = 0;
-        for (std::size_t t = 0; t < ledger_.size(); ++t)
-          if (ledger_[t].kind == Ledger::Kind::kinetic || ledger_[t].kind == Ledger::Kind::potential)
+        for (std::size_t t = 0; t < forces_.ledger().size(); ++t)
+          if (forces_.ledger()[t].kind == Ledger::Kind::kinetic ||
+              forces_.ledger()[t].kind == Ledger::Kind::potential)
             e += term_value(t, pe);
         local.push_back(e);
         break;
@@ -46,8 +47,8 @@ bool Simulation<Real>::field_partials(const std::vector<double>& pe, std::vector
         break;
       case FieldSpec::Type::wall_force: {
         std::size_t w = 0;
-        while (walls_.spec(w).name != f.wall) ++w;
-        const auto& fw = walls_.force(w);
+        while (forces_.walls().spec(w).name != f.wall) ++w;
+        const auto& fw = forces_.walls().force(w);
         local.insert(local.end(), fw.begin(), fw.end());
         break;
       }

@@ -16,8 +16,7 @@ namespace basalt::solver {
 template <class Real>
 Simulation<Real>::Simulation(const Scene& scene, const io::Checkpoint& c, const RestartLayout& layout,
                              MPI_Comm comm, const RunOptions& options)
-    : scene_(scene), options_(options), walls_(scene.walls) {
-  make_computes();
+    : scene_(scene), options_(options), forces_(scene) {
   p_.with_exact_rebuild = scene.checkpoint_every > 0;
   if (c.size() == 0) throw InputError("the checkpoint has no particles");
   if (scene.bonds.size() > 254) throw InputError("interactions: at most 254 bond groups");
@@ -39,7 +38,7 @@ Simulation<Real>::Simulation(const Scene& scene, const io::Checkpoint& c, const 
                  "older basalt-run): the lists are rebuilt at step {}, so the continuation agrees with the "
                  "uninterrupted run to rounding only\n",
                  step_);
-    if (!walls_.empty()) walls_.move_to(double(step_) * scene.dt);
+    if (!forces_.walls().empty()) forces_.walls().move_to(double(step_) * scene.dt);
     rebuild();
   }
   start_ledger(compute_forces<true>());
@@ -103,7 +102,7 @@ void Simulation<Real>::distribute_checkpoint(const io::Checkpoint& c, const Rest
   // Contact history of the contacts with an owned end waits for the (replayed) rebuild to find
   // their pairs in the lists.
   std::vector<ContactRecords*> history;
-  for (auto* pc : pair_computes_)
+  for (auto* pc : forces_.pair_computes())
     if (pc->pending()) history.push_back(pc->pending());
   for (std::size_t k = 0; k < c.contact_ids.size(); ++k) {
     const auto model = static_cast<std::size_t>(c.contact_model[k]);
@@ -132,7 +131,7 @@ void Simulation<Real>::replay_rebuild(const io::Checkpoint& c) {
   const auto& g = c.geometry;
   const std::int64_t now = step_;
   step_ = c.rebuild_step;
-  if (!walls_.empty()) walls_.move_to(double(c.rebuild_step) * scene_.dt);
+  if (!forces_.walls().empty()) forces_.walls().move_to(double(c.rebuild_step) * scene_.dt);
   rebuild();
   step_ = now;
   // Back to the checkpoint's positions; the ghosts follow as after any step without a rebuild.

@@ -17,8 +17,7 @@
 #include "basalt/solver/core/id_map.hpp"
 #include "basalt/solver/core/ledger.hpp"
 #include "basalt/solver/core/particles.hpp"
-#include "basalt/solver/interactions/force_compute.hpp"
-#include "basalt/solver/interactions/walls.hpp"
+#include "basalt/solver/interactions/force_field.hpp"
 #include "basalt/solver/neighbor/verlet_list.hpp"
 #include "basalt/solver/output/field_sink.hpp"
 #include "basalt/solver/output/output_sink.hpp"
@@ -94,8 +93,8 @@ class Simulation {
     return p_;
   }
   const Bonds<Real>& bonds() const { return bonds_; }
-  const PairList& own_pairs() const { return own_; }
-  const PairList& ghost_pairs() const { return ghost_; }
+  const PairList& own_pairs() const { return forces_.own_pairs(); }
+  const PairList& ghost_pairs() const { return forces_.ghost_pairs(); }
   const Decomposition& decomposition() const { return *dec_; }
   const Comm& comm() const { return dec_->comm(); }
   const PhaseTimes& times() const { return times_; }
@@ -106,8 +105,10 @@ class Simulation {
   std::int64_t total_particles() const { return n_global_; }
   double ghost_width() const { return ghost_width_; }
   /// The force computes, one per model the scene uses (bond, pair, wall models in that order).
-  const std::vector<std::unique_ptr<ForceCompute<Real>>>& force_computes() const { return computes_; }
-  const Walls& walls() const { return walls_; }
+  const std::vector<std::unique_ptr<ForceCompute<Real>>>& force_computes() const {
+    return forces_.computes();
+  }
+  const Walls& walls() const { return forces_.walls(); }
   /// Geometry bonds that no bond group takes (they exert no force).
   std::size_t unassigned_bonds() const { return unassigned_bonds_; }
   const std::vector<BrokenBond>& broken_bonds() const { return broken_; }
@@ -116,7 +117,7 @@ class Simulation {
   /// Collective: {kinetic, bond, contact, wall} energies (recomputes forces' energies; forces unchanged).
   std::array<double, 4> energies();
   /// The energy ledger's terms, and (collective) their values now (recomputes the potentials).
-  const Ledger& ledger() const { return ledger_; }
+  const Ledger& ledger() const { return forces_.ledger(); }
   std::vector<double> ledger_values();
   /// Collective: number of bonds.
   std::int64_t bond_count() const;
@@ -143,7 +144,8 @@ class Simulation {
   void progress(std::int64_t done, std::int64_t total, double seconds) const;
   void check_stability(const io::Geometry& g);
   void rebuild();
-  void resolve_bonds();
+  /// Bonds to local indices, in canonical order; returns the bond buckets (Bonds::order_canonically).
+  std::vector<std::uint32_t> resolve_bonds();
   void spatial_sort();
   std::optional<std::string> check_finite() const;
   /// Forces at the current positions; ghosts_in_flight: a ghost update was begun and is completed
@@ -152,12 +154,6 @@ class Simulation {
   /// Returns this rank's potential energies by ledger term (valid when Energy).
   template <bool Energy>
   const std::vector<double>& compute_forces(bool ghosts_in_flight = false, bool advance = false);
-  void make_computes();
-  /// Which pair compute takes a pair of particles with these tags (the first pair group that takes
-  /// them, in scene order), or -1.
-  int pair_taker(std::int64_t ti, std::int64_t tj) const;
-  /// History records of the force computes waiting for a rebuild (null entries: no history).
-  std::vector<ContactRecords*> pending_history();
   void save_fields(FieldSink* sink, const std::vector<double>& pe);
   bool field_partials(const std::vector<double>& pe, std::vector<double>& local,
                       std::vector<char>& due) const;
@@ -188,22 +184,8 @@ class Simulation {
   Particles<Real> p_;
   Bonds<Real> bonds_;
   IdMap ids_;
-  Walls walls_;
-  std::vector<std::unique_ptr<ForceCompute<Real>>> computes_;
-  ForceCompute<Real>* bond_compute_ = nullptr;  ///< the bond model's compute (rest lengths), if any
-  std::vector<ForceCompute<Real>*> pair_computes_;
-  std::vector<int> pair_group_compute_;  ///< for each scene pair group, its compute in pair_computes_
-  bool pairs_take_all_ = false;          ///< one pair group, every tag
-  Ledger ledger_;
-  std::vector<std::size_t> compute_term_;  ///< the ledger term of each force compute's potential
-  std::size_t kinetic_term_ = 0, wall_work_term_ = 0;
-  std::vector<double> pe_;       ///< this rank's potentials by ledger term (last computation with energy)
-  std::vector<double> ledger0_;  ///< the ledger's global values at the start (the guard's reference)
-  std::vector<char> body_term_;  ///< terms of body forces (their change since the start counts as a source)
-  PairList own_, ghost_;
-  CellGrid grid_, ghost_grid_;  ///< owned and ghost particles in the same cells (rebuilds only)
-  Exclusions exclusions_;
-  std::vector<std::uint32_t> bond_bucket_end_;  ///< bonds per owned end, kept during a rebuild only
+  ForceField<Real> forces_;  ///< the models, their lists and the energy ledger
+  CellGrid grid_;            ///< the owned particles' cells for the canonical sort (rebuilds only)
   std::vector<BrokenBond> broken_;
   bool bond_broke_ = false;
 
@@ -217,7 +199,8 @@ class Simulation {
   double time_ = 0;
   std::int64_t rebuilds_ = 0;
   double energy0_ = 0;
-  double wall_work_in_ = 0;  ///< this rank's share of the positive work done by walls
+  std::vector<double> ledger0_;  ///< the ledger's global values at the start (the guard's reference)
+  double wall_work_in_ = 0;      ///< this rank's share of the positive work done by walls
   PhaseTimes times_;
   double ghost_wait_ = 0;
   double ke_local_ = 0;         ///< this rank's kinetic energy, valid while ke_fresh_

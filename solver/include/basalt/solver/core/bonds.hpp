@@ -3,6 +3,7 @@
 // ids of their ends; at each neighbour-list rebuild the ids are resolved to local indices (ia, ib)
 // and the bonds are ordered so that those with both ends owned come first ([0, n_both_owned)); in
 // the others ia is the owned end and ib a ghost.
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -55,6 +56,32 @@ struct Bonds {
     apply(group);
     apply(ia);
     apply(ib);
+  }
+
+  /// Puts the bonds in their canonical order, a function of their local ends alone (ia the owned end,
+  /// ib the other; both owned: ia < ib): both ends owned first, each part in memory order of its owned
+  /// end (a counting sort, O(bonds)), then by the other end within a bucket. So the bond order, and
+  /// with it the force summation order, is canonical like the particles'. Sets n_both_owned; returns
+  /// the end of each bucket: bucket i holds owned particle i's bonds to owned particles, bucket
+  /// n_owned + i those to ghosts (the pair-list build excludes bonded pairs through them).
+  std::vector<std::uint32_t> order_canonically(std::size_t n_owned) {
+    const std::size_t nb = size(), n = n_owned;
+    std::vector<std::uint32_t> start(2 * n + 1, 0);
+    auto key = [&](std::size_t k) {
+      return (static_cast<std::size_t>(ib[k]) >= n ? n : 0) + static_cast<std::size_t>(ia[k]);
+    };
+    for (std::size_t k = 0; k < nb; ++k) ++start[key(k) + 1];
+    for (std::size_t c = 0; c < 2 * n; ++c) start[c + 1] += start[c];
+    std::vector<std::uint32_t> order(nb);
+    for (std::size_t k = 0; k < nb; ++k) order[start[key(k)]++] = static_cast<std::uint32_t>(k);
+    for (std::size_t c = 0, first = 0; c < 2 * n; first = start[c], ++c)
+      if (start[c] - first > 1)
+        std::sort(order.begin() + static_cast<std::ptrdiff_t>(first), order.begin() + start[c],
+                  [&](std::uint32_t i, std::uint32_t j) { return ib[i] < ib[j]; });
+    permute(order);
+    n_both_owned = 0;
+    while (n_both_owned < nb && static_cast<std::size_t>(ib[n_both_owned]) < n) ++n_both_owned;
+    return start;  // start[c] is now the end of bucket c
   }
 
  private:

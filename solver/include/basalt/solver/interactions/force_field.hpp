@@ -1,0 +1,105 @@
+#pragma once
+// The scene's interactions on one rank: one force compute per model the scene uses (built through the
+// registry, models/registry.hpp), the walls they act through, the contact candidate lists they share,
+// and the energy ledger their potentials fill. Simulation drives it: rebuild_lists() at each
+// neighbour-list rebuild, add() twice per step (owned part, then ghost part).
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "basalt/solver/core/bonds.hpp"
+#include "basalt/solver/core/ledger.hpp"
+#include "basalt/solver/core/particles.hpp"
+#include "basalt/solver/interactions/force_compute.hpp"
+#include "basalt/solver/interactions/walls.hpp"
+#include "basalt/solver/neighbor/cell_grid.hpp"
+#include "basalt/solver/neighbor/verlet_list.hpp"
+#include "basalt/solver/scene/scene.hpp"
+
+namespace basalt::solver {
+
+template <class Real>
+class ForceField {
+ public:
+  /// Builds the computes and the ledger; throws InputError for a field saver of a term nothing fills or
+  /// a combination of models not supported.
+  explicit ForceField(const Scene& scene);
+
+  const std::vector<std::unique_ptr<ForceCompute<Real>>>& computes() const { return computes_; }
+  const std::vector<ForceCompute<Real>*>& pair_computes() const { return pair_computes_; }
+  bool has_pairs() const { return !pair_computes_.empty(); }
+  /// Largest spring constant over the models for radii up to rmax.
+  double max_stiffness(double rmax) const;
+  /// Rest length of a new bond of group g (the bond model's rule); r without bond models.
+  double rest_length(std::size_t g, double ri, double rj, double r) const {
+    return bond_compute_ ? bond_compute_->rest_length(g, ri, rj, r) : r;
+  }
+  Walls& walls() { return walls_; }
+  const Walls& walls() const { return walls_; }
+  const PairList& own_pairs() const { return own_; }
+  const PairList& ghost_pairs() const { return ghost_; }
+
+  // Energy ledger.
+  const Ledger& ledger() const { return ledger_; }
+  std::size_t kinetic_term() const { return kinetic_term_; }
+  std::size_t wall_work_term() const { return wall_work_term_; }
+  /// Whether ledger term t is a body force's potential.
+  bool body_term(std::size_t t) const { return body_term_[t] != 0; }
+  /// This rank's potentials by ledger term, from the last add() with energy since zero_energies().
+  const std::vector<double>& potentials() const { return pe_; }
+  void zero_energies() { std::fill(pe_.begin(), pe_.end(), 0.0); }
+
+  /// Adds the forces of one part (Part::owned, then Part::ghost) and, with `energy`, the potentials.
+  /// In the owned part `poke()` is called once between the bond models and the others (the ghost
+  /// refresh in flight moves along while pairs are computed).
+  template <class Poke>
+  void add(ForceState<Real>& s, Part part, bool energy, bool advance, Poke&& poke) {
+    bool poked = part != Part::owned;
+    for (std::size_t k = 0; k < computes_.size(); ++k) {
+      if (!poked && computes_[k]->kind() != ModelKind::bond) {
+        poke();
+        poked = true;
+      }
+      pe_[compute_term_[k]] += computes_[k]->compute(s, part, energy, advance);
+    }
+  }
+
+  // Rebuilds.
+  /// Before a rebuild (ghosts still present): contact histories into the pending records.
+  void save_history(const Particles<Real>& p) {
+    for (auto* c : pair_computes_) c->save_history(p);
+  }
+  /// The pending records of each pair compute (null: no history), for migration and restarts.
+  std::vector<ContactRecords*> pending_history() const;
+  /// After migration, ghosts and bonds: the contact lists (bonded pairs excluded through the bonds'
+  /// buckets, see Exclusions), each pair model's share with its history, the walls' candidates.
+  void rebuild_lists(const Particles<Real>& p, const std::vector<std::uint32_t>& bond_bucket_end,
+                     const Bonds<Real>& bonds, double skin, double contact_cutoff);
+
+  std::size_t memory_bytes() const;
+
+ private:
+  /// The pair compute taking a pair with these tags (first pair group that takes them), or -1.
+  int pair_taker(std::int64_t ti, std::int64_t tj) const;
+
+  std::vector<std::unique_ptr<ForceCompute<Real>>> computes_;
+  ForceCompute<Real>* bond_compute_ = nullptr;
+  std::vector<ForceCompute<Real>*> pair_computes_;
+  std::vector<TagFilter> pair_group_tags_;  ///< each scene pair group's tags
+  std::vector<int> pair_group_compute_;     ///< each scene pair group's compute in pair_computes_
+  bool pairs_take_all_ = false;             ///< one pair group, every tag
+  Walls walls_;
+  PairList own_, ghost_;
+  CellGrid grid_, ghost_grid_;  ///< owned and ghost particles in the same cells (rebuilds only)
+  Exclusions exclusions_;
+  Ledger ledger_;
+  std::vector<std::size_t> compute_term_;  ///< the ledger term of each compute's potential
+  std::size_t kinetic_term_ = 0, wall_work_term_ = 0;
+  std::vector<char> body_term_;
+  std::vector<double> pe_;
+};
+
+extern template class ForceField<double>;
+extern template class ForceField<float>;
+
+}  // namespace basalt::solver
