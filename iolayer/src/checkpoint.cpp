@@ -3,12 +3,20 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 #include <string>
 #include <utility>
 
 namespace basalt::io {
+
+bool is_fixed_particle_dataset(const std::string& name) {
+  for (const char* fixed :
+       {"id", "position", "radius", "tag", "mass", "velocity", "inverse_mass", "position_at_rebuild"})
+    if (name == fixed) return true;
+  return false;
+}
 
 namespace fs = std::filesystem;
 
@@ -59,16 +67,30 @@ void Checkpoint::validate(const fs::path& source) const {
       throw FormatError(source, "/bonds/broken",
                         fmt::format("bond {}: flag must be 0, 1 or 2, got {}", k, bond_broken[k]));
   }
+  for (const auto& [name, values] : particle_fields) {
+    const auto where = "/particles/" + name;
+    if (name.empty() || name.find('/') != std::string::npos || name == "." || is_fixed_particle_dataset(name))
+      throw FormatError(source, where, "a particle field needs a name of its own, without '/'");
+    if (values.size() != n)
+      throw FormatError(source, where, fmt::format("{} values for {} particles", values.size(), n));
+    for (double v : values)
+      if (!std::isfinite(v)) throw FormatError(source, where, "a value is not finite");
+  }
   const std::size_t nc = contact_ids.size();
   if (contact_model.size() != nc || contact_history.size() != nc * contact_width)
     throw FormatError(source, "/contacts",
                       fmt::format("{} contacts with {} model indices and {} history values ({} per contact)",
                                   nc, contact_model.size(), contact_history.size(), contact_width));
+  std::vector<std::int64_t> ids;  // sorted (the particles need not be yet)
+  if (nc > 0) {
+    ids = geometry.id;
+    std::sort(ids.begin(), ids.end());
+  }
   for (std::size_t k = 0; k < nc; ++k) {
     if (contact_model[k] < 0)
       throw FormatError(source, "/contacts/model", fmt::format("contact {}: negative model index", k));
     for (const auto pid : contact_ids[k])
-      if (geometry.index_of(pid) < 0)
+      if (!std::binary_search(ids.begin(), ids.end(), pid))
         throw FormatError(source, "/contacts/ids",
                           fmt::format("contact {}: particle id {} does not exist", k, pid));
   }

@@ -58,6 +58,9 @@ void write_checkpoint(const Checkpoint& c, const fs::path& file) {
     if (!c.position_at_rebuild.empty())
       for (std::size_t k = 0; k < order.size(); ++k)
         storage.position_at_rebuild[k] = c.position_at_rebuild[order[k]];
+    for (std::size_t f = 0; f < c.particle_fields.size(); ++f)
+      for (std::size_t k = 0; k < order.size(); ++k)
+        storage.particle_fields[f].second[k] = c.particle_fields[f].second[order[k]];
     s = &storage;
   }
 
@@ -72,6 +75,7 @@ void write_checkpoint(const Checkpoint& c, const fs::path& file) {
     w.scalar_attribute<std::int64_t>("/", "rebuild_step", s->rebuild_step);
     w.scalar_attribute<std::uint8_t>("/", "rebuild_pending", s->rebuild_pending ? 1 : 0);
   }
+  for (const auto& [name, values] : s->particle_fields) w.dataset("/particles/" + name, values);
   w.dataset("/bonds/rest_length", s->bond_rest_length);
   w.dataset("/bonds/broken", s->bond_broken);
   w.group("/walls");
@@ -133,6 +137,12 @@ Checkpoint read_checkpoint_unguarded(const fs::path& file) {
     c.rebuild_step = r.scalar_attribute<std::int64_t>("/", "rebuild_step");
     c.rebuild_pending = r.has_attribute("/", "rebuild_pending") &&
                         r.scalar_attribute<std::uint8_t>("/", "rebuild_pending") != 0;
+  }
+  for (const auto& name : r.members("/particles")) {
+    if (is_fixed_particle_dataset(name)) continue;
+    const auto ds = "/particles/" + name;
+    if (r.rows<double>(ds) != n) r.fail(ds, fmt::format("expected {} values (one per particle)", n));
+    c.particle_fields.emplace_back(name, r.read<double>(ds));
   }
   const auto lrows = r.rows<double>("/bonds/rest_length");
   if (lrows != m) r.fail("/bonds/rest_length", fmt::format("{} values for {} bonds", lrows, m));

@@ -35,6 +35,7 @@ template <class Real>
 Simulation<Real>::Simulation(const Scene& scene, io::Geometry g, MPI_Comm comm, const RunOptions& options)
     : scene_(scene), options_(options), forces_(scene) {
   p_.with_exact_rebuild = scene.checkpoint_every > 0;
+  p_.with_damage = forces_.bonds_can_break();
   if (g.size() == 0)
     throw InputError(fmt::format("{}: the geometry has no particles", scene.geometry.string()));
   if (scene.bonds.size() > 254) throw InputError("interactions: at most 254 bond groups");
@@ -158,6 +159,8 @@ void Simulation<Real>::distribute(io::Geometry& g, MPI_Comm comm) {
                  owned[static_cast<std::size_t>(g.index_of(g.bonds[k].b))];
   bonds_.grouped = scene_.bonds.size() > 1;
   bonds_.reserve(n_bonds);
+  std::vector<std::int32_t> initial;  // bonds of each particle (with breakable bonds: damage)
+  if (p_.with_damage) initial.assign(g.size(), 0);
   for (std::size_t k = 0; k < g.bonds.size(); ++k) {
     if (bond_group[k] == kNone) continue;
     const auto& b = g.bonds[k];
@@ -166,6 +169,10 @@ void Simulation<Real>::distribute(io::Geometry& g, MPI_Comm comm) {
     const double r0 = forces_.rest_length(bond_group[k], g.radius[ia], g.radius[ib],
                                           distance(g.position[ia], g.position[ib]));
     bonds_.push(b.a, b.b, Real(r0), bond_group[k]);
+    if (p_.with_damage) {
+      ++initial[ia];
+      ++initial[ib];
+    }
   }
   std::vector<io::Bond>().swap(g.bonds);
   std::vector<std::uint8_t>().swap(bond_group);
@@ -175,6 +182,7 @@ void Simulation<Real>::distribute(io::Geometry& g, MPI_Comm comm) {
     const auto& x = g.position[i];
     p_.push_owned(g.id[i], Real(x[0]), Real(x[1]), Real(x[2]), Real(g.radius[i]), g.tag[i],
                   Real(1.0 / particle_mass(g, i, scene_.density)));
+    if (p_.with_damage) p_.bonds_initial.back() = initial[i];
   }
   std::vector<io::Vec3>().swap(g.position);
   std::vector<double>().swap(g.radius);

@@ -32,6 +32,8 @@ SimulationFrame<Real>::SimulationFrame(const Simulation<Real>& sim, std::uint32_
         h.contacts += history_.back().size();
         h.contact_width = static_cast<std::uint32_t>(history_.back().width);
       }
+  // The scene's optional particle fields that frames carry (Particles' array list).
+  p.for_each_array([&](const ArrayInfo& a, const auto&) { h.fields += !a.output.empty() && p.enabled(a); });
   // Walls: global; the force is summed over the ranks (collective), rank 0 carries them.
   const auto& wd = sim.forces_.walls();
   if (wd.size() > 0) {
@@ -118,6 +120,9 @@ void SimulationFrame<Real>::write(io::FrameWriter& w) const {
     c += r.size();
   }
   for (const auto& wall : walls_) w.wall(wall);
+  p.for_each_array([&](const ArrayInfo& a, const auto& v) {
+    if (!a.output.empty() && p.enabled(a)) w.field(a.output, std::span(v.data(), n));
+  });
 }
 
 template class SimulationFrame<double>;

@@ -6,6 +6,7 @@
 // ranks both runs continue bit for bit, and the uninterrupted run needs no extra rebuild.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "basalt/solver/core/errors.hpp"
@@ -18,6 +19,7 @@ Simulation<Real>::Simulation(const Scene& scene, const io::Checkpoint& c, const 
                              MPI_Comm comm, const RunOptions& options)
     : scene_(scene), options_(options), forces_(scene) {
   p_.with_exact_rebuild = scene.checkpoint_every > 0;
+  p_.with_damage = forces_.bonds_can_break();
   if (c.size() == 0) throw InputError("the checkpoint has no particles");
   if (scene.bonds.size() > 254) throw InputError("interactions: at most 254 bond groups");
   if (c.dt != scene.dt)
@@ -63,10 +65,12 @@ void Simulation<Real>::distribute_checkpoint(const io::Checkpoint& c, const Rest
   // (replay_rebuild restores the current ones), or by the current ones for an old checkpoint.
   const auto& at = c.position_at_rebuild.empty() ? g.position : c.position_at_rebuild;
   std::vector<char> owned(g.size(), 0);
+  std::vector<std::size_t> mine;  // geometry index of each owned particle, in local order
   for (std::size_t i = 0; i < g.size(); ++i) {
     const auto& x = at[i];
     if (!dec_->owns(x[0], x[1], x[2])) continue;
     owned[i] = 1;
+    mine.push_back(i);
     const double im = c.inv_mass.empty() ? 1.0 / g.mass[i] : c.inv_mass[i];
     const auto& v = c.velocity[i];
     p_.push_owned(g.id[i], Real(x[0]), Real(x[1]), Real(x[2]), Real(g.radius[i]), g.tag[i], Real(im),
@@ -76,6 +80,7 @@ void Simulation<Real>::distribute_checkpoint(const io::Checkpoint& c, const Rest
   // replayed: the uninterrupted run's lists, built before it broke, excluded its pair from contacts,
   // and the restart's first force computation breaks it again from the same positions.
   const bool replay = !c.position_at_rebuild.empty();
+  restore_particle_fields(c, mine, replay);
   for (std::size_t k = 0; k < g.bonds.size(); ++k) {
     const auto& b = g.bonds[k];
     const auto ia = static_cast<std::size_t>(g.index_of(b.a)), ib = static_cast<std::size_t>(g.index_of(b.b));
@@ -123,6 +128,49 @@ void Simulation<Real>::distribute_checkpoint(const io::Checkpoint& c, const Rest
 }
 
 template <class Real>
+void Simulation<Real>::restore_particle_fields(const io::Checkpoint& c, const std::vector<std::size_t>& mine,
+                                               bool replay) {
+  // The scene's optional fields that checkpoints store, by name (Particles' array list).
+  std::vector<std::string_view> missing;
+  p_.for_each_array([&](const ArrayInfo& a, auto& v) {
+    if (a.output.empty() || !p_.enabled(a)) return;
+    const auto it = std::find_if(c.particle_fields.begin(), c.particle_fields.end(),
+                                 [&](const auto& f) { return f.first == a.output; });
+    if (it == c.particle_fields.end()) {
+      missing.push_back(a.output);
+      return;
+    }
+    using T = std::decay_t<decltype(v[0])>;
+    for (std::size_t k = 0; k < mine.size(); ++k) v[k] = static_cast<T>(it->second[mine[k]]);
+  });
+  if (!p_.with_damage) return;
+  const auto& g = c.geometry;
+  const auto local_of = [&](std::int64_t id) {
+    const auto gi = static_cast<std::size_t>(g.index_of(id));
+    const auto at = std::lower_bound(mine.begin(), mine.end(), gi);
+    return at != mine.end() && *at == gi ? static_cast<std::int64_t>(at - mine.begin()) : std::int64_t(-1);
+  };
+  // A checkpoint without the damage counters (written by a scene without breakable bonds or an older
+  // basalt-run): count them from its bonds, broken ones included.
+  const bool derive = !missing.empty();
+  for (std::size_t k = 0; k < g.bonds.size(); ++k) {
+    const auto flag = c.bond_broken[k];
+    for (const auto id : {g.bonds[k].a, g.bonds[k].b}) {
+      const auto i = local_of(id);
+      if (i < 0) continue;
+      const auto li = static_cast<std::size_t>(i);
+      if (derive) {
+        ++p_.bonds_initial[li];
+        p_.bonds_broken[li] += flag == 1 || flag == 2;
+      }
+      // A bond that broke at the checkpoint's step is restored intact for the replay, whose first force
+      // computation breaks (and counts) it again.
+      if (flag == 2 && replay) --p_.bonds_broken[li];
+    }
+  }
+}
+
+template <class Real>
 void Simulation<Real>::replay_rebuild(const io::Checkpoint& c) {
   // The particles sit at their positions at the last rebuild (distribute_checkpoint), the walls go
   // where that rebuild saw them (step() moves them before rebuilding); the rebuild then reproduces
@@ -152,7 +200,9 @@ void Simulation<Real>::replay_rebuild(const io::Checkpoint& c) {
   template Simulation<R>::Simulation(const Scene&, const io::Checkpoint&, const RestartLayout&, MPI_Comm,    \
                                      const RunOptions&);                                                     \
   template void Simulation<R>::distribute_checkpoint(const io::Checkpoint&, const RestartLayout&, MPI_Comm); \
-  template void Simulation<R>::replay_rebuild(const io::Checkpoint&);
+  template void Simulation<R>::replay_rebuild(const io::Checkpoint&);                                        \
+  template void Simulation<R>::restore_particle_fields(const io::Checkpoint&,                                \
+                                                       const std::vector<std::size_t>&, bool);
 BASALT_INSTANTIATE(double)
 BASALT_INSTANTIATE(float)
 #undef BASALT_INSTANTIATE

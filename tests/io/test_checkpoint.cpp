@@ -302,3 +302,40 @@ TEST(Checkpoint, EmptyStateRoundTrips) {
   expect_same(read_checkpoint(dir / "ckpt_0.h5"), c);
   EXPECT_EQ(latest_complete_checkpoint(dir), dir / "ckpt_0.h5");
 }
+
+TEST(Checkpoint, ParticleFieldsAndContactHistoryRoundTripSortedWithTheIds) {
+  const auto dir = basalt::test::scratch_dir("ckpt-fields");
+  Checkpoint c = sample_checkpoint();
+  std::vector<double> broken;
+  for (std::size_t i = 0; i < c.size(); ++i) broken.push_back(double(c.geometry.id[i] % 4));
+  c.particle_fields.emplace_back("bonds_broken", broken);
+  const auto a = c.geometry.id.front(), b = c.geometry.id.back();
+  c.contact_ids = {{b, a}, {a, b}};
+  c.contact_model = {0, 1};
+  c.contact_width = 2;
+  c.contact_history = {1.5, -2.0, 3.0, 0.25};
+  write_checkpoint(c, dir / "ckpt_1700.h5");
+  const Checkpoint back = read_checkpoint(dir / "ckpt_1700.h5");
+  ASSERT_EQ(back.particle_fields.size(), 1u);
+  EXPECT_EQ(back.particle_fields[0].first, "bonds_broken");
+  for (std::size_t i = 0; i < back.size(); ++i)  // the values followed their ids through the sort
+    EXPECT_EQ(back.particle_fields[0].second[i], double(back.geometry.id[i] % 4));
+  EXPECT_EQ(back.contact_ids, c.contact_ids);
+  EXPECT_EQ(back.contact_model, c.contact_model);
+  EXPECT_EQ(back.contact_width, 2u);
+  EXPECT_EQ(back.contact_history, c.contact_history);
+  // Bad ones are refused, naming the dataset: a field of the wrong length, one that takes a fixed
+  // dataset's name, a contact naming no particle, a non-finite history value.
+  Checkpoint bad = c;
+  bad.particle_fields[0].second.pop_back();
+  expect_format_error([&] { write_checkpoint(bad, dir / "bad.h5"); }, {"/particles/bonds_broken", "values"});
+  bad = c;
+  bad.particle_fields[0].first = "velocity";
+  expect_format_error([&] { write_checkpoint(bad, dir / "bad.h5"); }, {"/particles/velocity"});
+  bad = c;
+  bad.contact_ids[1][1] = 999999;
+  expect_format_error([&] { write_checkpoint(bad, dir / "bad.h5"); }, {"/contacts/ids", "999999"});
+  bad = c;
+  bad.contact_history[3] = std::nan("");
+  expect_format_error([&] { write_checkpoint(bad, dir / "bad.h5"); }, {"/contacts/history"});
+}

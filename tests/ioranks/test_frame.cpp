@@ -271,3 +271,36 @@ TEST(Frame, ImpossibleCountsAreRejected) {
   std::memcpy(more.data() + 40, &six, sizeof(six));
   EXPECT_THROW(deserialize(more), std::runtime_error);
 }
+
+TEST(Frame, ParticleFieldsAndContactsTravelAndAssemble) {
+  std::vector<FramePiece> pieces{make_piece(1, 4, 7), make_piece(0, 3, 7)};
+  for (auto& p : pieces) {
+    std::vector<double> v;
+    for (const auto id : p.id) v.push_back(0.5 * double(id));
+    p.fields.emplace_back("bonds_broken", v);
+    p.contact_width = 1;
+    p.contact_ids.push_back({p.id[1], p.id[0]});
+    p.contact_model.push_back(0);
+    p.contact_history.push_back(double(p.source_rank) + 0.25);
+  }
+  std::vector<FramePiece> back;
+  for (const auto& p : pieces) {
+    std::vector<std::byte> bytes;
+    serialize(p, bytes);
+    back.push_back(deserialize(bytes));
+    EXPECT_EQ(back.back().fields, p.fields);
+    EXPECT_EQ(back.back().contact_ids, p.contact_ids);
+    EXPECT_EQ(back.back().contact_history, p.contact_history);
+  }
+  RunInfo info;
+  const auto c = assemble(back, info);
+  ASSERT_EQ(c.particle_fields.size(), 1u);
+  for (std::size_t i = 0; i < c.size(); ++i)
+    EXPECT_EQ(c.particle_fields[0].second[i], 0.5 * double(c.geometry.id[i]));
+  ASSERT_EQ(c.contact_ids.size(), 2u);  // sorted by (model, lower id, higher id)
+  EXPECT_LT(std::min(c.contact_ids[0][0], c.contact_ids[0][1]),
+            std::min(c.contact_ids[1][0], c.contact_ids[1][1]));
+  // A piece that lacks a field the others have cannot be assembled.
+  back[0].fields.clear();
+  EXPECT_THROW(assemble(back, info), std::runtime_error);
+}

@@ -123,6 +123,11 @@ type = "bond_count"
     }
   }
   ASSERT_GT(broke_at, 0) << "the bond never broke";
+  // Each end keeps its damage: one bond at the start, one broken.
+  for (std::size_t i = 0; i < p.n_owned; ++i) {
+    EXPECT_EQ(p.bonds_initial[i], 1) << "particle " << p.id[i];
+    EXPECT_EQ(p.bonds_broken[i], 1) << "particle " << p.id[i];
+  }
   // It broke at the first step whose positions stretch it beyond 5 %.
   EXPECT_LE(strain_before, 0.05);
   EXPECT_GT((separation(p) - r0) / r0, 0.05);

@@ -55,13 +55,13 @@ class Reader {
     return s;
   }
   bool at_end() const { return pos_ == in_.size(); }
-
- private:
   void raw(void* p, std::size_t n) {
     if (n > in_.size() - pos_) throw std::runtime_error("frame: buffer too short");
     std::memcpy(p, in_.data() + pos_, n);
     pos_ += n;
   }
+
+ private:
   std::span<const std::byte> in_;
   std::size_t pos_ = 0;
 };
@@ -83,6 +83,7 @@ void FramePiece::clear() {
   contact_ids.clear();
   contact_model.clear();
   contact_history.clear();
+  fields.clear();
   walls.clear();
 }
 
@@ -102,6 +103,9 @@ FrameHeader PieceSource::header() const {
   const std::size_t nc = p_.contact_ids.size();
   if (p_.contact_model.size() != nc || p_.contact_history.size() != nc * p_.contact_width)
     throw std::invalid_argument("frame piece: contact arrays differ in length");
+  for (const auto& f : p_.fields)
+    if (f.second.size() != n)
+      throw std::invalid_argument("frame piece: particle field " + f.first + " of the wrong length");
   FrameHeader h;
   h.kinds = p_.kinds;
   h.step = p_.step;
@@ -111,6 +115,7 @@ FrameHeader PieceSource::header() const {
   h.bonds = m;
   h.contacts = nc;
   h.contact_width = static_cast<std::uint32_t>(p_.contact_width);
+  h.fields = p_.fields.size();
   h.inverse_mass = !p_.inv_mass.empty();
   h.with_rebuild = !p_.position_at_rebuild.empty();
   h.rebuild_step = p_.rebuild_step;
@@ -149,6 +154,7 @@ void PieceSource::write(FrameWriter& w) const {
   w.column(Column::contact_model, p_.contact_model);
   w.column(Column::contact_history, p_.contact_history);
   for (const auto& wall : p_.walls) w.wall(wall);
+  for (const auto& [name, values] : p_.fields) w.field(name, std::span<const double>(values));
 }
 
 std::size_t serialize(const FrameSource& source, std::vector<std::byte>& out) {
@@ -250,7 +256,16 @@ FramePiece deserialize(std::span<const std::byte> bytes) {
     wall.velocity = r.value<Vec3>();
     wall.force = r.value<Vec3>();
   }
-  if (!r.at_end()) throw std::runtime_error("frame: trailing bytes after the walls");
+  if (h.fields > bytes.size()) throw std::runtime_error("frame: particle field count overruns the buffer");
+  p.fields.resize(h.fields);
+  for (auto& [name, values] : p.fields) {
+    name = r.string();
+    if (p.id.size() > (bytes.size() / sizeof(double)))
+      throw std::runtime_error("frame: particle field overruns the buffer");
+    values.resize(p.id.size());
+    r.raw(values.data(), values.size() * sizeof(double));
+  }
+  if (!r.at_end()) throw std::runtime_error("frame: trailing bytes after the particle fields");
   return p;
 }
 
@@ -347,6 +362,20 @@ Checkpoint assemble(std::vector<FramePiece>& pieces, const RunInfo& run) {
     c.velocity[i] = p.velocity[j];
     if (inv) c.inv_mass[i] = p.inv_mass[j];
     if (at_rebuild) c.position_at_rebuild[i] = p.position_at_rebuild[j];
+  }
+  // Optional particle fields: every piece names the same ones (the solver's list), in the same order.
+  for (const auto& p : pieces)
+    if (p.fields.size() != pieces.front().fields.size())
+      throw std::runtime_error("assemble: pieces with different particle fields");
+  for (std::size_t f = 0; f < pieces.front().fields.size(); ++f) {
+    const auto& name = pieces.front().fields[f].first;
+    for (const auto& p : pieces)
+      if (p.fields[f].first != name)
+        throw std::runtime_error(fmt::format("assemble: particle field {} missing from a piece", name));
+    std::vector<double> values(n);
+    for (std::size_t i = 0; i < n; ++i)
+      values[i] = pieces[order[i].second.first].fields[f].second[order[i].second.second];
+    c.particle_fields.emplace_back(name, std::move(values));
   }
 
   struct BondRow {

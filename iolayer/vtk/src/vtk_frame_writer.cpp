@@ -29,6 +29,7 @@ VtkFrameWriter make_vtk_frame_writer(Units units, double resume_after_time) {
     std::vector<Vec3> position, velocity;
     std::vector<double> radius, mass;
     std::vector<std::int32_t> tag;
+    std::vector<std::pair<std::string, std::vector<double>>> fields;
   };
   auto state = std::make_shared<State>();
   return
@@ -41,7 +42,14 @@ VtkFrameWriter make_vtk_frame_writer(Units units, double resume_after_time) {
         s.radius.clear();
         s.mass.clear();
         s.tag.clear();
+        // The optional particle fields: the same names in every piece of every rank (the solver's list).
+        s.fields.clear();
+        if (!pieces.empty())
+          for (const auto& f : pieces.front().fields) s.fields.emplace_back(f.first, std::vector<double>{});
         for (const auto& p : pieces) {
+          for (std::size_t f = 0; f < s.fields.size() && f < p.fields.size(); ++f)
+            s.fields[f].second.insert(s.fields[f].second.end(), p.fields[f].second.begin(),
+                                      p.fields[f].second.end());
           s.id.insert(s.id.end(), p.id.begin(), p.id.end());
           s.position.insert(s.position.end(), p.position.begin(), p.position.end());
           s.velocity.insert(s.velocity.end(), p.velocity.begin(), p.velocity.end());
@@ -56,6 +64,10 @@ VtkFrameWriter make_vtk_frame_writer(Units units, double resume_after_time) {
         a.tag = s.tag;
         a.velocity = s.velocity;
         a.mass = s.mass;
+        for (const auto& [name, values] : s.fields) a.fields.emplace_back(name, values);
+        // Every piece of a frame announces the same arrays, also a piece with no particles.
+        s.layout = frame_layout(/*mass=*/true, /*velocity=*/true, /*displacement=*/false);
+        for (const auto& f : s.fields) s.layout.push_back({f.first, "Float64", 1});
         FrameInfo info;
         info.step = step;
         info.time = time;

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <vtkXMLPolyDataWriter.h>
 
+#include <algorithm>
 #include <fstream>
 #include <stdexcept>
 #include <system_error>
@@ -19,7 +20,8 @@ void ParticleArrays::check() const {
   const std::size_t n = id.size();
   auto bad = [n](std::size_t m, bool optional) { return optional ? (m != 0 && m != n) : m != n; };
   if (bad(position.size(), false) || bad(radius.size(), false) || bad(tag.size(), false) ||
-      bad(velocity.size(), true) || bad(mass.size(), true) || bad(displacement.size(), true))
+      bad(velocity.size(), true) || bad(mass.size(), true) || bad(displacement.size(), true) ||
+      std::any_of(fields.begin(), fields.end(), [&](const auto& f) { return f.second.size() != n; }))
     throw std::invalid_argument(fmt::format(
         "particle arrays differ in length: id {}, position {}, radius {}, tag {}, velocity {}, mass {}, "
         "displacement {}",
@@ -40,6 +42,7 @@ ParticleArrays arrays_of(const Geometry& g, std::span<const Vec3> displacement) 
 ParticleArrays arrays_of(const Checkpoint& c, std::span<const Vec3> displacement) {
   ParticleArrays a = arrays_of(c.geometry, displacement);
   a.velocity = c.velocity;
+  for (const auto& [name, values] : c.particle_fields) a.fields.emplace_back(name, values);
   return a;
 }
 
@@ -79,7 +82,9 @@ std::vector<ArrayLayout> frame_layout(bool mass, bool velocity, bool displacemen
 }
 
 std::vector<ArrayLayout> layout_of(const ParticleArrays& a) {
-  return frame_layout(!a.mass.empty(), !a.velocity.empty(), !a.displacement.empty());
+  auto l = frame_layout(!a.mass.empty(), !a.velocity.empty(), !a.displacement.empty());
+  for (const auto& f : a.fields) l.push_back({f.first, "Float64", 1});
+  return l;
 }
 
 void write_vtp(const ParticleArrays& a, const FrameInfo& info, const fs::path& file,

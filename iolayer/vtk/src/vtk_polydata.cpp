@@ -114,6 +114,8 @@ vtkSmartPointer<vtkPolyData> to_polydata(const ParticleArrays& a, const FrameInf
     p->AddArray(speed);
   }
   if (!a.displacement.empty()) p->AddArray(vec3_array("displacement", a.displacement));
+  for (const auto& [name, values] : a.fields)
+    p->AddArray(make_array<vtkDoubleArray>(name.c_str(), values, 1));
   if (layout != nullptr) conform(*p, a, *layout);
   p->SetActiveScalars("radius");
 

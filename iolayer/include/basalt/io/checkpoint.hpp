@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "basalt/io/geometry.hpp"
@@ -43,6 +44,11 @@ struct Checkpoint {
 
   std::vector<WallState> walls;
 
+  /// Optional per-particle fields of the scene beyond the fixed ones (e.g. broken_bonds): name and one
+  /// value per particle, same order as geometry.id, as /particles/<name> float64 (N). The solver
+  /// decides which of its fields go here (Particles' array list) and restores them on restart.
+  std::vector<std::pair<std::string, std::vector<double>>> particle_fields;
+
   /// Per-contact history of the contact models that keep one (/contacts, optional): one row per
   /// contact whose history differs from a new contact's, each contact once. contact_ids[k] is the pair
   /// (the history belongs to the orientation first -> second), contact_model[k] the index of the pair
@@ -62,6 +68,9 @@ struct Checkpoint {
   /// Geometry invariants plus: one velocity per particle, one state per bond, finite values.
   void validate(const std::filesystem::path& source) const;
 };
+
+/// Whether /particles/<name> is one of the schema's fixed datasets (not a particle field).
+bool is_fixed_particle_dataset(const std::string& name);
 
 /// Writes atomically: to "<file>.partial", then renames; the file carries the attribute
 /// /complete = 1 written last. A failure throws FormatError naming the path and leaves no file

@@ -159,6 +159,9 @@ class Simulation {
                       std::vector<char>& due) const;
   void output_fields(const std::vector<double>& pe);
   void distribute_checkpoint(const io::Checkpoint& c, const RestartLayout& layout, MPI_Comm comm);
+  /// Restart: the optional particle fields the checkpoint stores (by name), for the owned particles
+  /// (`mine`: their geometry indices in local order); bond damage counters adjusted for the replay.
+  void restore_particle_fields(const io::Checkpoint& c, const std::vector<std::size_t>& mine, bool replay);
   /// Restart: the lists of the uninterrupted run's last rebuild (see the restart constructor).
   void replay_rebuild(const io::Checkpoint& c);
   /// Writes the row whose reduction is still in flight (ranks > 1), if any.

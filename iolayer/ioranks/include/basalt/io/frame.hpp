@@ -50,6 +50,9 @@ struct FramePiece {
   std::size_t contact_width = 0;
   std::vector<double> contact_history;
 
+  /// Optional particle fields (Checkpoint::particle_fields): name, one value per particle (id order).
+  std::vector<std::pair<std::string, std::vector<double>>> fields;
+
   // Global, identical on every rank; only the piece of compute rank 0 needs to carry them.
   std::vector<WallState> walls;
 

@@ -13,6 +13,7 @@
 #include <span>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <type_traits>
 #include <vector>
 
@@ -36,6 +37,7 @@ struct FrameHeader {
   std::uint64_t bonds = 0;          ///< length of the bond columns
   std::uint64_t contacts = 0;       ///< length of the contact columns (contacts with a history)
   std::uint32_t contact_width = 0;  ///< float64 values of history per contact
+  std::uint64_t fields = 0;         ///< optional particle fields after the walls (FrameWriter::field)
   /// true: Column::mass holds 1 / mass as the solver holds it (the reader derives the mass, and a
   /// restart gets the same bits); false: it holds the mass and there is no inverse mass.
   bool inverse_mass = true;
@@ -76,7 +78,7 @@ inline constexpr std::size_t kColumns = static_cast<std::size_t>(Column::contact
 
 namespace wire {
 
-inline constexpr std::uint64_t kFrameMagic = 0x42534c5446524d34ULL;  // "BSLTFRM4"
+inline constexpr std::uint64_t kFrameMagic = 0x42534c5446524d35ULL;  // "BSLTFRM5"
 
 /// The header as it travels (all fields 8-byte slots: no padding).
 struct Header {
@@ -92,8 +94,9 @@ struct Header {
   std::int64_t rebuild_step = -1;
   std::uint64_t contacts = 0;
   std::uint64_t contact_width = 0;
+  std::uint64_t fields = 0;
 };
-static_assert(sizeof(Header) == 80 && std::is_trivially_copyable_v<Header>);
+static_assert(sizeof(Header) == 88 && std::is_trivially_copyable_v<Header>);
 inline constexpr std::uint32_t kInverseMass = 1u << 0;
 inline constexpr std::uint32_t kWithRebuild = 1u << 1;
 
@@ -197,8 +200,22 @@ class FrameWriter {
   void set(Column c, std::size_t k, T value) {
     put(c, slot(c, k, 1), value);
   }
+  /// Appends an optional particle field (after every wall): its name and one value per particle,
+  /// sent as float64. header.fields of them must follow the walls.
+  template <class T>
+  void field(std::string_view name, std::span<const T> v) {
+    if (v.size() != layout_.length[0])
+      throw std::logic_error("frame writer: a particle field of the wrong length");
+    append(std::uint64_t(name.size()));
+    append_raw(name.data(), name.size());
+    const std::size_t at = out_.size();
+    out_.resize(at + v.size() * sizeof(double));
+    store<double>(out_.data() + at, v.data(), v.size());
+    ++fields_;
+  }
   /// Appends a wall (walls are global: one compute rank's frame carries them).
   void wall(const WallState& w) {
+    if (fields_ > 0) throw std::logic_error("frame writer: walls must come before the particle fields");
     append(std::uint64_t(w.name.size()));
     append_raw(w.name.data(), w.name.size());
     for (const Vec3* v : {&w.position, &w.normal, &w.velocity, &w.force}) append(*v);
@@ -212,6 +229,9 @@ class FrameWriter {
         throw std::logic_error("frame writer: column " + std::to_string(k) + " filled with " +
                                std::to_string(filled_[k]) + " of " + std::to_string(layout_.length[k]) +
                                " entries");
+    if (fields_ != header_.fields)
+      throw std::logic_error("frame writer: " + std::to_string(fields_) + " particle fields written, " +
+                             std::to_string(header_.fields) + " announced");
     std::memcpy(out_.data() + layout_.walls, &walls_, sizeof(walls_));
     return out_.size();
   }
@@ -227,6 +247,7 @@ class FrameWriter {
     wire_.bonds = h.bonds;
     wire_.contacts = h.contacts;
     wire_.contact_width = h.contact_width;
+    wire_.fields = h.fields;
     wire_.flags = (h.inverse_mass ? wire::kInverseMass : 0u) | (h.with_rebuild ? wire::kWithRebuild : 0u);
     wire_.rebuild_pending = h.rebuild_pending ? 1u : 0u;
     wire_.rebuild_step = h.rebuild_step;
@@ -281,6 +302,7 @@ class FrameWriter {
   wire::Layout layout_;
   std::array<std::size_t, kColumns> filled_{};
   std::uint64_t walls_ = 0;
+  std::uint64_t fields_ = 0;
 };
 
 /// Something that can write a frame: the solver's state (solver/output/simulation_frame.hpp) or

@@ -25,6 +25,8 @@ struct ParticleArrays {
   std::span<const Vec3> velocity;      ///< optional; also gives the "speed" array
   std::span<const double> mass;        ///< optional
   std::span<const Vec3> displacement;  ///< optional: position minus the reference (initial) position
+  /// Optional particle fields (Checkpoint::particle_fields), one Float64 array each.
+  std::vector<std::pair<std::string, std::span<const double>>> fields;
 
   std::size_t size() const { return id.size(); }
   /// Throws std::invalid_argument when the lengths disagree.

@@ -19,12 +19,18 @@
 
 namespace basalt::solver {
 
+/// Groups of arrays a scene may leave out (Particles::enabled()).
+enum class FieldGroup { core, exact_rebuild, damage };
+
 /// What an array of Particles is (for_each_array()).
 struct ArrayInfo {
   std::string_view field;  ///< the field it is (part of): "position" for x, y and z
   bool ghosts;             ///< owned and ghost particles have it (else owned only)
   bool migrates;           ///< travels with a particle that changes rank (else recomputed there)
-  bool optional;           ///< only allocated when the scene asks (Particles::with_exact_rebuild)
+  FieldGroup group;        ///< core (always) or an optional group
+  /// Written to frames and checkpoints as the particle field of this name (/particles/<name>) and
+  /// restored from it on restart ("" for the core arrays, which have fixed places in the schema).
+  std::string_view output = {};
 };
 
 template <class Real>
@@ -45,6 +51,16 @@ struct Particles {
   /// checkpoint stores so that a restart can replay that rebuild (docs/ARCHITECTURE.md).
   std::vector<Real> xr, yr, zr;
   bool with_exact_rebuild = false;
+  /// Optional (with_damage: the scene has breakable bonds): each particle's bonds at the start and
+  /// how many of them broke; damage = bonds_broken / bonds_initial (frames, checkpoints).
+  std::vector<std::int32_t> bonds_initial, bonds_broken;
+  bool with_damage = false;
+
+  /// Whether the arrays of a group are allocated.
+  bool enabled(const ArrayInfo& a) const {
+    return a.group == FieldGroup::core || (a.group == FieldGroup::exact_rebuild && with_exact_rebuild) ||
+           (a.group == FieldGroup::damage && with_damage);
+  }
 
   /// Calls f(ArrayInfo, vector&) for every array, in a fixed order.
   template <class F>
@@ -127,14 +143,14 @@ struct Particles {
   std::size_t record_bytes(bool ghost) const {
     std::size_t b = 0;
     for_each_array([&](const ArrayInfo& a, const auto& v) {
-      if (ghost ? a.ghosts : a.migrates) b += sizeof(v[0]);
+      if (enabled(a) && (ghost ? a.ghosts : a.migrates)) b += sizeof(v[0]);
     });
     return b;
   }
   /// Appends particle i's record (migration or ghost) to `out`.
   void pack(std::size_t i, bool ghost, std::vector<std::byte>& out) const {
     for_each_array([&](const ArrayInfo& a, const auto& v) {
-      if (!(ghost ? a.ghosts : a.migrates)) return;
+      if (!enabled(a) || !(ghost ? a.ghosts : a.migrates)) return;
       const auto* p = reinterpret_cast<const std::byte*>(&v[i]);
       out.insert(out.end(), p, p + sizeof(v[i]));
     });
@@ -143,7 +159,7 @@ struct Particles {
   void unpack(const std::byte* rec, bool ghost) {
     std::size_t i = ghost ? size() : append_owned();
     for_each_array([&](const ArrayInfo& a, auto& v) {
-      if (!(ghost ? a.ghosts : a.migrates)) return;
+      if (!enabled(a) || !(ghost ? a.ghosts : a.migrates)) return;
       if (ghost) v.emplace_back();
       std::memcpy(static_cast<void*>(&v[i]), rec, sizeof(v[i]));
       rec += sizeof(v[i]);
@@ -168,14 +184,16 @@ struct Particles {
   }
 
  private:
-  bool enabled(const ArrayInfo& a) const { return !a.optional || with_exact_rebuild; }
-
   template <class P, class F>
   static void for_each(P& p, F& f) {
-    constexpr ArrayInfo pos{"position", true, true, false}, rad{"radius", true, true, false},
-        ident{"id", true, true, false}, tg{"tag", true, true, false}, vel{"velocity", false, true, false},
-        frc{"force", false, false, false}, im{"inverse_mass", false, true, false},
-        ref{"skin_reference", false, false, false}, exact{"position_at_rebuild", false, false, true};
+    using G = FieldGroup;
+    constexpr ArrayInfo pos{"position", true, true, G::core}, rad{"radius", true, true, G::core},
+        ident{"id", true, true, G::core}, tg{"tag", true, true, G::core},
+        vel{"velocity", false, true, G::core}, frc{"force", false, false, G::core},
+        im{"inverse_mass", false, true, G::core}, ref{"skin_reference", false, false, G::core},
+        exact{"position_at_rebuild", false, false, G::exact_rebuild},
+        initial{"bond_damage", false, true, G::damage, "bonds_initial"},
+        broken{"bond_damage", false, true, G::damage, "bonds_broken"};
     f(pos, p.x), f(pos, p.y), f(pos, p.z);
     f(rad, p.radius);
     f(ident, p.id);
@@ -185,6 +203,7 @@ struct Particles {
     f(im, p.inv_mass);
     f(ref, p.x0), f(ref, p.y0), f(ref, p.z0);
     f(exact, p.xr), f(exact, p.yr), f(exact, p.zr);
+    f(initial, p.bonds_initial), f(broken, p.bonds_broken);
   }
 };
 

@@ -34,6 +34,7 @@ class BondDriver final : public ForceCompute<Real> {
     for (const auto& p : params_) m = std::max(m, Model::max_stiffness(p, rmax));
     return m;
   }
+  bool can_break() const override { return breakable_; }
   double rest_length(std::size_t g, double ri, double rj, double r) const override {
     return Model::rest_length(params_[g], ri, rj, r);
   }
@@ -88,6 +89,10 @@ class BondDriver final : public ForceCompute<Real> {
       if constexpr (Breakable) {
         if (Model::broken(c, r0, r)) [[unlikely]] {
           gone_.push_back(k);
+          if (p.with_damage) {  // each rank counts the break for its own particles
+            ++p.bonds_broken[i];
+            if constexpr (BothOwned) ++p.bonds_broken[j];
+          }
           if (BothOwned || p.id[i] < p.id[j])
             s.broken.push_back({bonds.a[k], bonds.b[k], double(r), double(r0), -1, bonds.group_of(k)});
           continue;

@@ -88,6 +88,8 @@ class ForceCompute {
   virtual std::size_t contacts() const { return 0; }
 
   // Bond models.
+  /// Whether a bond of this model can break.
+  virtual bool can_break() const { return false; }
   /// Rest length of a bond of group g created between radii ri, rj at distance r.
   virtual double rest_length(std::size_t /*group*/, double /*ri*/, double /*rj*/, double r) const {
     return r;

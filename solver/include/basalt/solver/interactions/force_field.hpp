@@ -34,6 +34,8 @@ class ForceField {
   double rest_length(std::size_t g, double ri, double rj, double r) const {
     return bond_compute_ ? bond_compute_->rest_length(g, ri, rj, r) : r;
   }
+  /// Whether some bond can break (the scene then keeps each particle's bond damage).
+  bool bonds_can_break() const { return bond_compute_ && bond_compute_->can_break(); }
   Walls& walls() { return walls_; }
   const Walls& walls() const { return walls_; }
   const PairList& own_pairs() const { return own_; }
