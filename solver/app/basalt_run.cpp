@@ -40,7 +40,7 @@ namespace {
 struct Cli {
   std::string scene_file, geometry, output, dims_text, restart;
   std::int64_t steps = -1;
-  bool quiet = false, force_dt = false;
+  bool quiet = false, force_dt = false, force_overlap = false;
   int io_ranks = 0;
   std::int64_t checkpoint_every = -1, frames_every = -1, fields_every = -1;
   double throttle_mbps = 0;
@@ -131,6 +131,7 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
   options.dims = parse_dims(cli.dims_text);
   options.quiet = cli.quiet;
   options.force_dt = cli.force_dt;
+  options.force_overlap = cli.force_overlap;
 
   const auto t0 = std::chrono::steady_clock::now();
   std::unique_ptr<Simulation<double>> sim;
@@ -291,6 +292,8 @@ int run_world(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   app.add_flag("--quiet", cli.quiet, "no progress line");
   app.add_flag("--force-dt", cli.force_dt, "run even when dt exceeds the critical time step");
+  app.add_flag("--force-overlap", cli.force_overlap,
+               "start even when particles overlap by more than half a radius (each other or a wall)");
   app.set_version_flag("--version", std::string(basalt::kVersion));
   app.add_flag_callback(
       "--list-models",

@@ -105,6 +105,7 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
                        ? Integrator::symplectic_euler
                        : Integrator::velocity_verlet;
     s.force_dt = t.boolean_or("force_dt", false);
+    s.force_overlap = t.boolean_or("force_overlap", false);
     if (t.has("dt_safety")) {
       s.dt_safety = t.positive("dt_safety");
       if (s.dt_safety > 1) t.fail("dt_safety", "must be <= 1 (a fraction of the critical time step)");

@@ -46,6 +46,7 @@ Simulation<Real>::Simulation(const Scene& scene, io::Geometry g, MPI_Comm comm, 
   check_stability(g);
   distribute(g, comm);
   rebuild();
+  check_start(true);
   start_ledger(compute_forces<true>());
 }
 

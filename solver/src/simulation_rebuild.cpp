@@ -125,11 +125,78 @@ void Simulation<Real>::rebuild() {
   times_.neighbor += sw.lap();
 }
 
+template <class Real>
+void Simulation<Real>::check_start(bool fresh) {
+  std::optional<std::string> error;
+  double worst = 0;  // deepest overlap relative to the smaller radius (unbonded pairs, walls)
+  std::string where;
+  const auto pair = [&](std::size_t i, std::size_t j, bool bonded) {
+    const double dx = double(p_.x[i] - p_.x[j]), dy = double(p_.y[i] - p_.y[j]),
+                 dz = double(p_.z[i] - p_.z[j]);
+    const double r = std::sqrt(dx * dx + dy * dy + dz * dz), ri = double(p_.radius[i]),
+                 rj = double(p_.radius[j]);
+    if (!(r > 1e-9 * (ri + rj))) {
+      if (!error)
+        error = fmt::format(
+            "particles id {} and id {} are {:.3g} apart (radii {:.6g} and {:.6g}): coincident particles (a "
+            "particle "
+            "doubled in the geometry or checkpoint?) would make the first force infinite",
+            p_.id[i], p_.id[j], r, ri, rj);
+      return;
+    }
+    const double overlap = (ri + rj - r) / std::min(ri, rj);
+    if (!bonded && overlap > worst) {
+      worst = overlap;
+      where = fmt::format(
+          "particles id {} and id {} overlap by {:.3g} of the smaller radius ({:.6g} apart, radii "
+          "{:.6g} and {:.6g})",
+          p_.id[i], p_.id[j], overlap, r, ri, rj);
+    }
+  };
+  for (const PairList* list : {&forces_.own_pairs(), &forces_.ghost_pairs()})
+    for (std::size_t i = 0; i + 1 < list->offset.size(); ++i)
+      for (auto k = list->offset[i]; k < list->offset[i + 1]; ++k)
+        pair(i, static_cast<std::size_t>(list->neigh[k]), false);
+  for (std::size_t k = 0; k < bonds_.size(); ++k)
+    pair(static_cast<std::size_t>(bonds_.ia[k]), static_cast<std::size_t>(bonds_.ib[k]), true);
+  const auto& walls = forces_.walls();
+  for (std::size_t w = 0; w < walls.size(); ++w) {
+    const auto& n = walls.spec(w).normal;
+    const auto& at = walls.point(w);
+    for (const auto i : walls.candidates(w)) {
+      const double d = (double(p_.x[i]) - at[0]) * n[0] + (double(p_.y[i]) - at[1]) * n[1] +
+                       (double(p_.z[i]) - at[2]) * n[2];
+      const double overlap = (double(p_.radius[i]) - d) / double(p_.radius[i]);
+      if (overlap > worst) {
+        worst = overlap;
+        where = fmt::format(
+            "particle id {} overlaps wall \"{}\" by {:.3g} of its radius (centre {:.6g} from the plane)",
+            p_.id[i], walls.spec(w).name, overlap, d);
+      }
+    }
+  }
+  if (comm().size() > 1) error = comm().agree_error(error);
+  if (error) throw InputError(*error);
+  const auto [top, who] = comm().max_loc(worst);
+  if (top <= 0.1) return;
+  const std::string deepest = comm().broadcast(where, who);
+  if (fresh && top > 0.5 && !(scene_.force_overlap || options_.force_overlap))
+    throw InputError(
+        fmt::format("the geometry starts with deep overlaps: {}; the repulsion would launch them at "
+                    "speeds far beyond the scene's. Fix the geometry, or set run.force_overlap = true "
+                    "/ --force-overlap to start anyway",
+                    deepest));
+  if (comm().rank() == 0)
+    fmt::print(stderr, "basalt-run: warning: the deepest overlap at {}: {}\n", fresh ? "start" : "restart",
+               deepest);
+}
+
 #define BASALT_INSTANTIATE(R)                                              \
   template std::optional<std::string> Simulation<R>::check_finite() const; \
   template void Simulation<R>::spatial_sort();                             \
   template std::vector<std::uint32_t> Simulation<R>::resolve_bonds();      \
-  template void Simulation<R>::rebuild();
+  template void Simulation<R>::rebuild();                                  \
+  template void Simulation<R>::check_start(bool);
 BASALT_INSTANTIATE(double)
 BASALT_INSTANTIATE(float)
 #undef BASALT_INSTANTIATE

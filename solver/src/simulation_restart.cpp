@@ -43,6 +43,7 @@ Simulation<Real>::Simulation(const Scene& scene, const io::Checkpoint& c, const 
     if (!forces_.walls().empty()) forces_.walls().move_to(double(step_) * scene.dt);
     rebuild();
   }
+  check_start(false);
   start_ledger(compute_forces<true>());
 }
 

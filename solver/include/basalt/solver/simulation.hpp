@@ -31,6 +31,7 @@ namespace basalt::solver {
 struct RunOptions {
   std::array<int, 3> dims{0, 0, 0};  ///< {0,0,0}: MPI_Dims_create chooses
   bool force_dt = false;             ///< run even above the critical time step
+  bool force_overlap = false;        ///< start even when particles overlap deeply
   bool quiet = false;                ///< no progress line
   double progress_seconds = 2.0;     ///< time between progress lines
 };
@@ -143,6 +144,10 @@ class Simulation {
   double term_value(std::size_t t, const std::vector<double>& pe) const;
   void progress(std::int64_t done, std::int64_t total, double seconds) const;
   void check_stability(const io::Geometry& g);
+  /// Collective, after the first rebuild: refuses coincident particles (naming both ids and their
+  /// distance) and, at a fresh start unless forced, overlaps deeper than half the smaller radius
+  /// between unbonded particles or into a wall; warns (rank 0) of the deepest overlap above 10 %.
+  void check_start(bool fresh);
   void rebuild();
   /// Bonds to local indices, in canonical order; returns the bond buckets (Bonds::order_canonically).
   std::vector<std::uint32_t> resolve_bonds();

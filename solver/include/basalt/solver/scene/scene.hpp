@@ -91,6 +91,7 @@ struct Scene {
   double skin = 0;
   Integrator integrator = Integrator::velocity_verlet;
   bool force_dt = false;
+  bool force_overlap = false;             ///< start even when particles overlap deeply (each other or a wall)
   double dt_safety = 0.2;                 ///< warn when dt > dt_safety * critical step
   std::int64_t energy_check_every = 100;  ///< 0: no energy-growth guard
   std::vector<InteractionSpec> bonds;     ///< bond groups, in scene order (a bond's group indexes these)
