@@ -639,8 +639,8 @@ TEST(BasaltView, SeveralFilesToOnePngMakeAStripOfPanelsWithOneRange) {
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("4 panels"), std::string::npos) << r.out;
   const Image img = read_png(dir / "strip.png");
-  ASSERT_EQ(img.width, 4 * 560 + 180);  // the default: 560x700 per panel and the colour bar
-  ASSERT_EQ(img.height, 700);
+  ASSERT_EQ(img.width, 4 * 560 + 180);  // the default: 560x600 per panel and the colour bar
+  ASSERT_EQ(img.height, 600);
   const double panel = 560.0 / img.width;
   int previous_red = 0;
   for (int i = 0; i < 4; ++i) {

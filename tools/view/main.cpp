@@ -43,7 +43,7 @@ int main(int argc, char** argv) {
   render->add_option("--color", color,
                      "field: speed, displacement, tag, id, radius, mass, velocity_z, any stored array "
                      "(default: speed if present, else radius)");
-  render->add_option("--size", size, "image WIDTHxHEIGHT (default 1600x1200; a strip: 560x700 per panel)");
+  render->add_option("--size", size, "image WIDTHxHEIGHT (default 1600x1200; a strip: 560x600 per panel)");
   render->add_option("--view", view, "camera side: +x -x +y -y +z -z iso")->capture_default_str();
   render->add_option("--cut", cut,
                      "x|y|z[:VALUE]: drop the particles on the camera's side of this plane "

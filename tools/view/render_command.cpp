@@ -226,7 +226,8 @@ class Painter {
       pn.text = vtkSmartPointer<vtkTextActor>::New();
       white(pn.text->GetTextProperty(), font_);
       pn.text->GetTextProperty()->SetVerticalJustificationToTop();
-      pn.text->SetDisplayPosition(font_ / 2, size.height - font_ / 2);
+      // Display coordinates are the window's, not the panel's.
+      pn.text->SetDisplayPosition(static_cast<int>(i * w * size.width) + font_ / 2, size.height - font_ / 2);
       pn.scene->AddActor2D(pn.text);
       window_->AddRenderer(pn.scene);
       panels_.push_back(pn);
@@ -248,7 +249,7 @@ class Painter {
     side->AddActor2D(bar_);
     extremes_ = vtkSmartPointer<vtkTextActor>::New();
     white(extremes_->GetTextProperty(), font_ * 5 / 6);
-    extremes_->SetDisplayPosition(font_ / 2, font_ / 2);
+    extremes_->SetDisplayPosition(static_cast<int>((1 - bar) * size.width) + font_ / 2, font_ / 2);
     side->AddActor2D(extremes_);
     window_->AddRenderer(side);
   }
@@ -290,7 +291,11 @@ class Painter {
       double fit[6];
       std::copy(p.fit.begin(), p.fit.end(), fit);
       pn.scene->ResetCamera(fit);
-      cam->Zoom(panels_.size() > 1 ? 1.1 : 1.25);
+      // A strip's narrow panels: fill them when looking along an axis (a cube shows as a square, narrower
+      // than its bounding sphere, which ResetCamera fits); the iso view's hexagon needs the margin.
+      const auto& t = o_.view.toward_camera;
+      const bool along_axis = (t[0] != 0) + (t[1] != 0) + (t[2] != 0) == 1;
+      cam->Zoom(panels_.size() == 1 ? 1.25 : along_axis ? 1.6 : 1.1);
       pn.scene->ResetCameraClippingRange(fit);
     }
     window_->Render();
@@ -445,7 +450,7 @@ void render(const RenderOptions& o) {
     pooled.insert(pooled.end(), frames.back().drawn_values.begin(), frames.back().drawn_values.end());
   }
   const ColourScale scale = o.range ? given_scale(*o.range, pooled) : robust_scale(std::move(pooled));
-  const ImageSize size = o.size ? *o.size : panels == 1 ? ImageSize{} : ImageSize{panels * 560 + 180, 700};
+  const ImageSize size = o.size ? *o.size : panels == 1 ? ImageSize{} : ImageSize{panels * 560 + 180, 600};
   Painter painter(size, panels, o);
   std::vector<const Prepared*> ptrs;
   double read_s = 0;

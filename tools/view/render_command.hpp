@@ -17,7 +17,7 @@ struct RenderOptions {
   std::vector<std::filesystem::path> inputs;
   std::filesystem::path output;
   std::string color;              ///< empty: speed when the frame has it, else radius
-  std::optional<ImageSize> size;  ///< default 1600x1200; a strip: 560x700 per panel plus the colour bar
+  std::optional<ImageSize> size;  ///< default 1600x1200; a strip: 560x600 per panel plus the colour bar
   ViewDirection view;
   std::optional<Cut> cut;
   std::optional<Range> range;  ///< default: 1st-99th percentile of the particles the cut keeps, all inputs
