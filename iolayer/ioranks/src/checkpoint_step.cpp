@@ -5,6 +5,8 @@
 #include <chrono>
 #include <thread>
 
+#include "basalt/io/xdmf.hpp"
+
 namespace basalt::io::detail {
 
 namespace {
@@ -33,6 +35,9 @@ std::uint64_t write_checkpoint_step(std::vector<FramePiece>& pieces, const RunIn
   Checkpoint c = assemble(pieces, info);
   const auto path = checkpoint_path(cfg.dir, c.step);
   write_checkpoint(c, path);
+  // ParaView opens the checkpoints as they are: ckpt_<step>.xmf beside each, ckpt_series.xmf for all.
+  write_checkpoint_xdmf(c, path);
+  write_checkpoint_series_xdmf(cfg.dir, c.step);
   const auto bytes = file_size_or_zero(path);
   throttle(cfg.throttle_mb_per_s, bytes, MPI_Wtime() - t0);
   rep.files += 1;

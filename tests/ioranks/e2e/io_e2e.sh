@@ -161,6 +161,16 @@ case $case_name in
     [ "$(wc -l <"$W/out/fields.csv")" -eq 101 ] || fail "fields.csv: expected a header and 100 rows"
     $CHECK pvd "$W/out" || fail "VTK frames disagree with the checkpoints after the restart"
     ;;
+  xdmf)
+    # ParaView opens the checkpoints as they are: ckpt_<step>.xmf beside each, ckpt_series.xmf for all,
+    # with Q = 1 and Q = 0; after a restart from step 50 the series lists only the new run's history.
+    for q in 1 0; do
+      must_run $((2 + q)) --io-ranks $q --steps 100 --checkpoint-every 25 --output "$W/q$q"
+      $CHECK xdmf "$W/q$q" 25,50,75,100 || fail "--io-ranks $q: the XDMF descriptions are wrong"
+    done
+    must_run 3 --io-ranks 1 --steps 25 --checkpoint-every 25 --output "$W/q1" --restart "$W/q1/ckpt_000050.h5"
+    $CHECK xdmf "$W/q1" 25,50,75 || fail "after a restart from step 50 to 75: the series is wrong"
+    ;;
   two_io_ranks)
     # 2 compute + 2 I/O ranks: one checkpoint file per step (I/O rank 0 gathers), one VTK piece per I/O
     # rank; the checkpoints equal those of 2 compute ranks writing themselves.
