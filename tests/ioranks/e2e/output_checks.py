@@ -11,6 +11,8 @@
                               once, with positive ages, and some contacts with an age below the step
   pvd DIR                     every frame of DIR/frames.pvd, read with vtkXMLPPolyDataReader, has the
                               positions of DIR/ckpt_<step>.h5 (same ids), when that checkpoint exists
+  compressed FILE             the checkpoint's position, velocity and bond datasets are chunked through the
+                              shuffle and deflate (gzip) filters
   xdmf DIR STEPS              DIR/ckpt_series.xmf is a time-ordered temporal collection of exactly the
                               checkpoints STEPS (comma-separated), and each grid, read as an XDMF reader
                               does (the DataItem paths through h5py, their Dimensions and number types),
@@ -141,6 +143,17 @@ def pvd(folder):
     return compared > 0
 
 
+def compressed(f):
+    with h5py.File(f, "r") as h:
+        for d in ("particles/position", "particles/velocity", "bonds/pairs"):
+            ds = h[d]
+            if ds.compression != "gzip" or not ds.shuffle:
+                print(f"{f}: {d} is not shuffled and deflated (compression {ds.compression}, shuffle {ds.shuffle})")
+                return False
+        print(f"{f}: deflate level {h['particles/position'].compression_opts}, with shuffle")
+    return True
+
+
 def xdmf_grid(grid, folder):
     """Reads one particle grid the way an XDMF reader does; returns (time, n, arrays by name) or raises."""
     types = {("Float", "8"): np.float64, ("Float", "4"): np.float32, ("Int", "8"): np.int64, ("Int", "4"): np.int32}
@@ -213,5 +226,5 @@ if __name__ == "__main__":
           "contacts": lambda: contacts(args[0], int(args[1])),
           "old_lists": lambda: old_lists(args[0]), "break_overlap": lambda: break_overlap(args[0]),
           "strip_rebuild": lambda: strip_rebuild(args[0]), "pvd": lambda: pvd(args[0]),
-          "xdmf": lambda: xdmf(args[0], args[1])}[cmd]()
+          "xdmf": lambda: xdmf(args[0], args[1]), "compressed": lambda: compressed(args[0])}[cmd]()
     sys.exit(0 if ok else 1)
