@@ -43,7 +43,15 @@ void check_complete(const h5::Reader& r) {
 
 }  // namespace
 
-void write_checkpoint(const Checkpoint& c, const fs::path& file) {
+Compression parse_compression(const std::string& name) {
+  if (name == "none") return Compression::none;
+  if (name == "fast") return Compression::fast;
+  if (name == "small") return Compression::small;
+  throw std::invalid_argument(
+      fmt::format("compression \"{}\": expected \"none\", \"fast\" or \"small\"", name));
+}
+
+void write_checkpoint(const Checkpoint& c, const fs::path& file, Compression compression) {
   c.validate(file);
   // The file stores particles sorted by id and bonds smaller id first; sort a copy if needed.
   Checkpoint storage;
@@ -65,6 +73,7 @@ void write_checkpoint(const Checkpoint& c, const fs::path& file) {
   }
 
   h5::Writer w(file, file.string() + ".partial");
+  w.compress(compression == Compression::fast ? 1 : compression == Compression::small ? 6 : 0);
   h5::write_schema(w, kSchema, kSchemaVersion);
   h5::write_geometry_layout(w, s->geometry, kRunAttributes);
   w.dataset("/particles/velocity", reinterpret_cast<const double*>(s->velocity.data()), s->size(), 3);

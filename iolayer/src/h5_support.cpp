@@ -309,14 +309,32 @@ void Writer::write_dataset(const std::string& path, hid_t file_type, hid_t mem_t
   const hsize_t dims[2] = {rows, columns};
   Handle space(H5Screate_simple(columns ? 2 : 1, dims, nullptr), H5Sclose);
   if (!space.valid()) fail(path, "cannot create dataspace");
+  Handle dcpl(H5Pcopy(dcpl_.get()), H5Pclose);
+  const std::size_t values = rows * (columns ? columns : 1);
+  if (deflate_level_ > 0 && values >= kCompressMinValues) {
+    const hsize_t width = columns ? columns : 1;
+    const hsize_t chunk[2] = {std::max<hsize_t>(1, std::min<hsize_t>(rows, 65536 / width)), width};
+    if (H5Pset_chunk(dcpl.get(), columns ? 2 : 1, chunk) < 0 || H5Pset_shuffle(dcpl.get()) < 0 ||
+        H5Pset_deflate(dcpl.get(), static_cast<unsigned>(deflate_level_)) < 0)
+      fail(path, "cannot set up the compression filters");
+  }
   Handle ds(
-      H5Dcreate2(file_id_.get(), path.c_str(), file_type, space.get(), H5P_DEFAULT, dcpl_.get(), H5P_DEFAULT),
+      H5Dcreate2(file_id_.get(), path.c_str(), file_type, space.get(), H5P_DEFAULT, dcpl.get(), H5P_DEFAULT),
       H5Dclose);
   if (!ds.valid()) fail(path, "cannot create dataset");
   if (rows * (columns ? columns : 1) > 0 &&
       H5Dwrite(ds.get(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0)
     fail(path, "cannot write dataset (disk full?)");
   if (!ds.reset()) fail(path, "cannot close dataset (disk full?)");
+}
+
+void Writer::compress(int deflate_level) {
+  if (deflate_level < 0 || deflate_level > 9)
+    fail("", fmt::format("deflate level {} is not in 0..9", deflate_level));
+  if (deflate_level > 0 &&
+      (H5Zfilter_avail(H5Z_FILTER_DEFLATE) <= 0 || H5Zfilter_avail(H5Z_FILTER_SHUFFLE) <= 0))
+    fail("", "this HDF5 library has no deflate (zlib) or shuffle filter: use compression = \"none\"");
+  deflate_level_ = deflate_level;
 }
 
 void Writer::attribute(const std::string& object, const std::string& name, const std::string& value) {

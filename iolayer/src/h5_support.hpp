@@ -187,7 +187,8 @@ class Writer {
   [[noreturn]] void fail(const std::string& where, const std::string& what) const;
 
   void group(const std::string& path);
-  /// A dataset of shape (rows) for columns == 0, else (rows, columns), contiguous, uncompressed.
+  /// A dataset of shape (rows) for columns == 0, else (rows, columns), contiguous and uncompressed unless
+  /// compress() was called.
   template <class T>
   void dataset(const std::string& path, const T* data, std::size_t rows, std::size_t columns = 0) {
     write_dataset(path, Type<T>::file(), Type<T>::mem(), data, rows, columns);
@@ -211,6 +212,12 @@ class Writer {
 
   void commit();
 
+  /// From now on, datasets of at least kCompressMinValues values are written chunked (about 64 Ki values
+  /// per chunk) through HDF5's shuffle and deflate filters at `deflate_level` (1-9; 0: contiguous and
+  /// uncompressed, the default). Deterministic: the same data gives the same bytes.
+  void compress(int deflate_level);
+  static constexpr std::size_t kCompressMinValues = 4096;
+
  private:
   void write_dataset(const std::string& path, hid_t file_type, hid_t mem_type, const void* data,
                      std::size_t rows, std::size_t columns);
@@ -223,6 +230,7 @@ class Writer {
   Handle file_id_;
   Handle gcpl_;  // group creation: no timestamps
   Handle dcpl_;  // dataset creation: no timestamps, never write fill values
+  int deflate_level_ = 0;
   bool committed_ = false;
 };
 

@@ -186,6 +186,8 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
     // Obsolete since every checkpoint is a bit-for-bit restart point at no cost (a restart replays
     // the last rebuild); still accepted so that older scene files load.
     (void)t.boolean_or("exact_restart", true);
+    // Checkpoint compression: checked here, applied by the I/O layer, which reads it from the scene text.
+    (void)t.choice_or("compression", {"none", "fast", "small"}, "none");
     s.frames_in_flight = t.integer_or("frames_in_flight", 2);
     if (s.frames_in_flight < 1)
       t.fail("frames_in_flight", fmt::format("must be >= 1, got {}", s.frames_in_flight));

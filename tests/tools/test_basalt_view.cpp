@@ -73,6 +73,10 @@ struct Image {
       }
     return n;
   }
+  /// The same for the pixels with x0_fraction * width <= x < x1_fraction * width.
+  int count_between(const Rgb& c, int tol, double x0_fraction, double x1_fraction) const {
+    return count(c, tol, x1_fraction) - count(c, tol, x0_fraction);
+  }
 };
 
 Image read_png(const fs::path& file) {
@@ -566,4 +570,160 @@ TEST(BasaltView, RendersParticlesFarFromTheOrigin) {
     EXPECT_GT(img.count(kLow, 30, kSceneFraction), 30) << offset;
     EXPECT_GT(img.count(kHigh, 30, kSceneFraction), 30) << offset;
   }
+}
+
+// ---- issue 15: robust colour range, strips of panels, series and movies --------------------------------
+
+namespace {
+
+/// The lattice with `fast` particles on its -y face (seen from -y) far faster than the rest: the
+/// free-surface outliers that squeezed the demo's wave into one shade of blue.
+basalt::io::Checkpoint lattice_with_outliers(int fast) {
+  basalt::io::Checkpoint c = lattice_checkpoint();
+  for (int i = 0; i < fast; ++i) c.velocity[static_cast<std::size_t>(6 * 144 + i)][2] = 10.0;
+  return c;
+}
+
+std::string read_text(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+}  // namespace
+
+TEST(BasaltView, DefaultRangeIsThePercentilesSoOutliersDoNotSqueezeTheMap) {
+  const fs::path dir = basalt::test::scratch_dir("view-robust-range");
+  basalt::io::write_checkpoint(lattice_with_outliers(6), dir / "ckpt_000400.h5");
+  const std::string in = (dir / "ckpt_000400.h5").string();
+  Outcome r = basalt_view(fmt_args("render", in, "-o", (dir / "robust.png").string(),
+                                   "--size 400x300 --view -y --color velocity_z"),
+                          dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("p1-p99, clamped"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("values from 0 to 10"), std::string::npos) << r.out;  // the true extremes
+  const Image robust = read_png(dir / "robust.png");
+  // The bulk spans the map: low layers blue, high layers red, many of each.
+  EXPECT_GT(robust.count(kLow, 30, kSceneFraction), 300);
+  EXPECT_GT(robust.count(kHigh, 30, kSceneFraction), 300);
+
+  // The old default, the full range 0..10, paints the whole bulk blue: only the outliers are red.
+  r = basalt_view(fmt_args("render", in, "-o", (dir / "full.png").string(),
+                           "--size 400x300 --view -y --color velocity_z --range 0:10"),
+                  dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("--range, clamped"), std::string::npos) << r.out;
+  const Image full = read_png(dir / "full.png");
+  EXPECT_GT(full.count(kLow, 30, kSceneFraction), 3 * robust.count(kLow, 30, kSceneFraction));
+}
+
+TEST(BasaltView, SeveralFilesToOnePngMakeAStripOfPanelsWithOneRange) {
+  const fs::path dir = basalt::test::scratch_dir("view-strip");
+  // Four frames of a wave: at step s the layers below height s/100 move, the others are at rest.
+  std::vector<std::string> args{"render"};
+  for (int s = 1; s <= 4; ++s) {
+    basalt::io::Checkpoint c = lattice_checkpoint();
+    c.step = 200 * s;
+    c.time = 0.2 * s;
+    for (std::size_t i = 0; i < c.size(); ++i)
+      c.velocity[i][2] = c.geometry.position[i][2] < 3 * s ? 0.1 : 0.0;
+    const fs::path f = dir / fmt::format("ckpt_{:06d}.h5", c.step);
+    basalt::io::write_checkpoint(c, f);
+    args.push_back(f.string());
+  }
+  std::string cmd;
+  for (const auto& a : args) cmd += "'" + a + "' ";
+  const Outcome r =
+      basalt_view(cmd + fmt_args("-o", (dir / "strip.png").string(), "--view -y --color velocity_z"), dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("4 panels"), std::string::npos) << r.out;
+  const Image img = read_png(dir / "strip.png");
+  ASSERT_EQ(img.width, 4 * 560 + 180);  // the default: 560x600 per panel and the colour bar
+  ASSERT_EQ(img.height, 600);
+  const double panel = 560.0 / img.width;
+  int previous_red = 0;
+  for (int i = 0; i < 4; ++i) {
+    const int red = img.count_between(kHigh, 30, i * panel, (i + 1) * panel);
+    const int blue = img.count_between(kLow, 30, i * panel, (i + 1) * panel);
+    // One range for all: the moving part grows from panel to panel, in the same red.
+    EXPECT_GT(red, previous_red + 1000) << "panel " << i;
+    if (i < 3) {
+      EXPECT_GT(blue, 1000) << "panel " << i;
+    }
+    previous_red = red;
+  }
+}
+
+TEST(BasaltView, RendersASeriesIntoAFolderWithOneRange) {
+  const fs::path dir = basalt::test::scratch_dir("view-series");
+  basalt::io::Checkpoint c = lattice_checkpoint();  // velocity_z 0 .. 0.11 with height
+  basalt::io::write_checkpoint(c, dir / "ckpt_000100.h5");
+  c.step = 200;
+  for (auto& v : c.velocity) v[2] *= 0.4;  // slower: alone, its top would be red too
+  basalt::io::write_checkpoint(c, dir / "ckpt_000200.h5");
+  c.step = 300;
+  basalt::io::write_checkpoint(c, dir / "ckpt_000300.h5");
+  const Outcome r = basalt_view(fmt_args("render", (dir / "ckpt_000100.h5").string(),
+                                         (dir / "ckpt_000200.h5").string(), (dir / "ckpt_000300.h5").string(),
+                                         "-o", (dir / "frames/").string(), "--size 400x300 --view -y"),
+                                dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("wrote 3 pictures"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("[3/3]"), std::string::npos) << r.out;  // the progress line
+  std::vector<fs::path> pngs;
+  for (const auto& e : fs::directory_iterator(dir / "frames")) pngs.push_back(e.path());
+  ASSERT_EQ(pngs.size(), 3u);
+  const Image fast = read_png(dir / "frames" / "ckpt_000100.png");
+  const Image slow = read_png(dir / "frames" / "ckpt_000200.png");
+  ASSERT_EQ(fast.width, 400);
+  ASSERT_EQ(slow.width, 400);
+  EXPECT_GT(fast.count(kHigh, 30, kSceneFraction), 300);
+  EXPECT_GT(fast.count(kLow, 30, kSceneFraction), 300);
+  EXPECT_EQ(slow.count(kHigh, 30, kSceneFraction), 0);  // same colours mean the same speeds
+  EXPECT_GT(slow.count(kLow, 30, kSceneFraction), 300);
+}
+
+TEST(BasaltView, MovieOfARunFolderIsAnAnimatedPngWithOneFramePerCheckpoint) {
+  const fs::path dir = basalt::test::scratch_dir("view-movie");
+  fs::create_directories(dir / "run");
+  basalt::io::Checkpoint c = lattice_checkpoint();
+  for (int s = 1; s <= 5; ++s) {
+    c.step = 100 * s;
+    c.time = 0.1 * s;
+    basalt::io::write_checkpoint(c, dir / "run" / fmt::format("ckpt_{:06d}.h5", c.step));
+  }
+  std::ofstream(dir / "run" / "ckpt_000600.h5.partial") << "half-written";
+  const Outcome r = basalt_view(
+      fmt_args("movie", (dir / "run").string(), "-o", (dir / "run.png").string(), "--size 320x240 --view -y"),
+      dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("5 frames"), std::string::npos) << r.out;
+  const std::string png = read_text(dir / "run.png");
+  ASSERT_GT(png.size(), 8u);
+  EXPECT_EQ(png.substr(1, 3), "PNG");
+  // The chunks: acTL announces 5 frames, and there are 5 frame controls (fcTL).
+  int fctl = 0, frames = -1;
+  for (std::size_t at = 8; at + 12 <= png.size();) {
+    const auto byte = [&](std::size_t i) {
+      return static_cast<std::uint32_t>(static_cast<unsigned char>(png[i]));
+    };
+    const std::uint32_t len = (byte(at) << 24) | (byte(at + 1) << 16) | (byte(at + 2) << 8) | byte(at + 3);
+    const std::string type = png.substr(at + 4, 4);
+    if (type == "acTL") frames = static_cast<int>(byte(at + 11));
+    if (type == "fcTL") ++fctl;
+    at += 12 + len;
+  }
+  EXPECT_EQ(frames, 5);
+  EXPECT_EQ(fctl, 5);
+  // Any PNG reader sees the first frame: the right size, not blank, both ends of the map.
+  const Image first = read_png(dir / "run.png");
+  ASSERT_EQ(first.width, 320);
+  ASSERT_EQ(first.height, 240);
+  EXPECT_GT(first.count(kLow, 30, kSceneFraction), 30);
+  EXPECT_GT(first.count(kHigh, 30, kSceneFraction), 30);
+
+  const Outcome bad = basalt_view(fmt_args("movie", dir.string(), "-o", (dir / "x.png").string()), dir);
+  EXPECT_NE(bad.code, 0);
+  EXPECT_NE(bad.out.find("no checkpoints"), std::string::npos) << bad.out;
 }

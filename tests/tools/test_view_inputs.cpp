@@ -10,9 +10,11 @@
 #include <limits>
 
 #include "basalt/io/geometry.hpp"
+#include "color_field.hpp"
 #include "field_series.hpp"
 #include "options.hpp"
 #include "particle_selection.hpp"
+#include "render_command.hpp"
 #include "test_support.hpp"
 #include "units.hpp"
 
@@ -185,4 +187,63 @@ TEST(FieldSeriesCsv, NonFiniteValuesAndSaversNotDueAreRead) {
   EXPECT_TRUE(s.blank[3][1]);
   EXPECT_EQ(s.columns[1][3], std::numeric_limits<double>::infinity());
   EXPECT_EQ(s.lines, (std::vector<int>{2, 4, 5, 6}));  // the blank line 3 is skipped
+}
+
+// ---- issue 15: a colour range that outliers do not squeeze, series in step order ----------------------
+
+TEST(ColourScale, PercentilesIgnoreAFewOutliersAndReportTheTrueExtremes) {
+  // 1000 values 0.000 .. 0.999 (the bulk) and 5 fast particles at 45: p1..p99 stays near the bulk.
+  std::vector<double> v;
+  for (int i = 0; i < 1000; ++i) v.push_back(i / 1000.0);
+  for (int i = 0; i < 5; ++i) v.push_back(45.0);
+  v.push_back(std::numeric_limits<double>::quiet_NaN());  // ignored
+  const ColourScale s = robust_scale(v);
+  EXPECT_EQ(s.how, "p1-p99, clamped");
+  EXPECT_NEAR(s.range.min, 0.01, 1e-3);
+  EXPECT_LT(s.range.max, 1.0);  // the 5 outliers (0.5 %) lie above p99
+  EXPECT_GT(s.range.max, 0.98);
+  EXPECT_EQ(s.min, 0.0);
+  EXPECT_EQ(s.max, 45.0);
+
+  // Interpolated like numpy.percentile: 0..100 gives exactly 1 and 99.
+  std::vector<double> w;
+  for (int i = 100; i >= 0; --i) w.push_back(i);
+  EXPECT_DOUBLE_EQ(robust_scale(w).range.min, 1.0);
+  EXPECT_DOUBLE_EQ(robust_scale(w).range.max, 99.0);
+}
+
+TEST(ColourScale, FallsBackToTheFullRangeAndPadsAConstantField) {
+  // 99.5 % of the particles at rest, a few moving: p1 == p99, so the full range is used.
+  std::vector<double> v(1000, 0.0);
+  for (int i = 0; i < 5; ++i) v.push_back(0.2);
+  ColourScale s = robust_scale(v);
+  EXPECT_EQ(s.how, "full range");
+  EXPECT_EQ(s.range.min, 0.0);
+  EXPECT_EQ(s.range.max, 0.2);
+
+  s = robust_scale(std::vector<double>(10, 2.0));
+  EXPECT_LT(s.range.min, 2.0);
+  EXPECT_GT(s.range.max, 2.0);
+  EXPECT_EQ(s.min, 2.0);
+  EXPECT_THROW(robust_scale({std::numeric_limits<double>::infinity()}), std::invalid_argument);
+  EXPECT_THROW(robust_scale({}), std::invalid_argument);
+
+  s = given_scale({0, 1}, {-3, 0.5, 7});
+  EXPECT_EQ(s.how, "--range, clamped");
+  EXPECT_EQ(s.range.max, 1.0);
+  EXPECT_EQ(s.min, -3.0);
+  EXPECT_EQ(s.max, 7.0);
+}
+
+TEST(RenderSeries, CheckpointsOfAFolderInStepOrder) {
+  const fs::path dir = basalt::test::scratch_dir("view-ckpt-order");
+  for (const char* name : {"ckpt_1000.h5", "ckpt_000200.h5", "ckpt_30.h5", "ckpt_40.h5.partial", "ckpt_x.h5",
+                           "geometry.h5", "ckpt_.h5"})
+    std::ofstream(dir / name) << "x";
+  const auto found = checkpoints_in(dir);
+  ASSERT_EQ(found.size(), 3u);
+  EXPECT_EQ(found[0].filename(), "ckpt_30.h5");
+  EXPECT_EQ(found[1].filename(), "ckpt_000200.h5");
+  EXPECT_EQ(found[2].filename(), "ckpt_1000.h5");
+  EXPECT_TRUE(checkpoints_in(dir / "missing").empty());
 }

@@ -4,6 +4,7 @@
 #include <vtkDataArray.h>
 #include <vtkPointData.h>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -79,6 +80,57 @@ vtkSmartPointer<vtkDoubleArray> color_values(vtkPolyData& pd, const std::string&
     }
   }
   return out;
+}
+
+namespace {
+
+std::vector<double> finite_only(std::vector<double> v) {
+  v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return !std::isfinite(x); }), v.end());
+  return v;
+}
+
+/// Linear interpolation between the closest ranks of the sorted `v` (numpy's default).
+double percentile(const std::vector<double>& sorted, double q) {
+  const double pos = q * static_cast<double>(sorted.size() - 1);
+  const auto lo = static_cast<std::size_t>(std::floor(pos));
+  const std::size_t hi = std::min(lo + 1, sorted.size() - 1);
+  const double f = pos - static_cast<double>(lo);
+  return sorted[lo] + f * (sorted[hi] - sorted[lo]);
+}
+
+}  // namespace
+
+ColourScale robust_scale(std::vector<double> values) {
+  values = finite_only(std::move(values));
+  if (values.empty()) throw std::invalid_argument("no finite value to colour by");
+  std::sort(values.begin(), values.end());
+  ColourScale s;
+  s.min = values.front();
+  s.max = values.back();
+  s.range = {percentile(values, 0.01), percentile(values, 0.99)};
+  s.how = "p1-p99, clamped";
+  if (!(s.range.min < s.range.max)) {
+    s.range = {s.min, s.max};
+    s.how = "full range";
+  }
+  if (!(s.range.min < s.range.max)) {  // a constant field: centre it in the map
+    const double pad = s.min == 0 ? 1.0 : 0.05 * std::abs(s.min);
+    s.range = {s.min - pad, s.max + pad};
+  }
+  return s;
+}
+
+ColourScale given_scale(const Range& given, const std::vector<double>& values) {
+  ColourScale s;
+  s.range = given;
+  s.how = "--range, clamped";
+  const std::vector<double> v = finite_only(values);
+  if (!v.empty()) {
+    const auto [lo, hi] = std::minmax_element(v.begin(), v.end());
+    s.min = *lo;
+    s.max = *hi;
+  }
+  return s;
 }
 
 std::string field_units(const std::string& field, const io::Units& units) {

@@ -26,22 +26,31 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
 
   bv::RenderOptions r;
-  std::string size = "1600x1200", view = "iso", cut, range, color;
+  std::string size, view = "iso", cut, range, color;
   std::string reference;
   auto* render =
       app.add_subcommand("render", "Draw the particles as spheres coloured by a field, write a PNG");
-  render->add_option("file", r.input, "checkpoint (.h5), geometry (.h5/.geo) or VTK frame (.vtp/.pvtp)")
+  render
+      ->add_option("files", r.inputs,
+                   "checkpoints (.h5), geometries (.h5/.geo) or VTK frames (.vtp/.pvtp); several: one "
+                   "colour range for all")
       ->required();
-  render->add_option("-o,--output", r.output, "PNG to write")->required();
+  render
+      ->add_option("-o,--output", r.output,
+                   "PNG to write (several files: one panel each, side by side), or a folder (ending in '/'): "
+                   "one PNG per file")
+      ->required();
   render->add_option("--color", color,
                      "field: speed, displacement, tag, id, radius, mass, velocity_z, any stored array "
                      "(default: speed if present, else radius)");
-  render->add_option("--size", size, "image WIDTHxHEIGHT")->capture_default_str();
+  render->add_option("--size", size, "image WIDTHxHEIGHT (default 1600x1200; a strip: 560x600 per panel)");
   render->add_option("--view", view, "camera side: +x -x +y -y +z -z iso")->capture_default_str();
   render->add_option("--cut", cut,
                      "x|y|z[:VALUE]: drop the particles on the camera's side of this plane "
                      "(default VALUE: the middle)");
-  render->add_option("--range", range, "MIN:MAX of the colour map (default: the field's range)");
+  render->add_option("--range", range,
+                     "MIN:MAX of the colour map (default: 1st-99th percentile of the particles in view, "
+                     "outside clamped)");
   render->add_option("--reference", reference, "initial geometry/checkpoint, for --color displacement");
   render
       ->add_option("--mapper", r.mapper, "imposter (ray-cast spheres, fast) or glyph (triangulated spheres)")
@@ -52,6 +61,24 @@ int main(int argc, char** argv) {
       "draw every particle, also those buried inside the packing (slower; same picture up to a few "
       "pixels)");
   render->add_flag("-q,--quiet", r.quiet, "print nothing on success");
+
+  bv::MovieOptions m;
+  std::string movie_size = "800x600", movie_view = "iso", movie_cut, movie_range, movie_reference;
+  auto* movie = app.add_subcommand(
+      "movie", "Render checkpoints (a run's folder, or files) with one colour range into an animated PNG");
+  movie
+      ->add_option("files", m.render.inputs,
+                   "a run's output folder (its ckpt_<step>.h5 in step order), or files")
+      ->required();
+  movie->add_option("-o,--output", m.render.output, "animated PNG to write (.png or .apng)")->required();
+  movie->add_option("--color", m.render.color, "field, as for render");
+  movie->add_option("--size", movie_size, "image WIDTHxHEIGHT")->capture_default_str();
+  movie->add_option("--view", movie_view, "camera side: +x -x +y -y +z -z iso")->capture_default_str();
+  movie->add_option("--cut", movie_cut, "x|y|z[:VALUE], as for render");
+  movie->add_option("--range", movie_range, "MIN:MAX (default: 1st-99th percentile over every frame)");
+  movie->add_option("--reference", movie_reference, "initial geometry/checkpoint, for --color displacement");
+  movie->add_option("--fps", m.fps, "frames per second")->capture_default_str();
+  movie->add_flag("-q,--quiet", m.render.quiet, "print nothing but errors");
 
   bv::ConvertOptions c;
   std::string convert_reference;
@@ -87,7 +114,7 @@ int main(int argc, char** argv) {
 
   try {
     if (render->parsed()) {
-      r.size = bv::parse_size(size);
+      if (!size.empty()) r.size = bv::parse_size(size);
       r.view = bv::parse_view(view);
       if (!cut.empty()) r.cut = bv::parse_cut(cut);
       if (!range.empty()) r.range = bv::parse_range(range);
@@ -96,6 +123,14 @@ int main(int argc, char** argv) {
       r.cull = !draw_all;
       bv::ensure_display();
       bv::render(r);
+    } else if (movie->parsed()) {
+      m.render.size = bv::parse_size(movie_size);
+      m.render.view = bv::parse_view(movie_view);
+      if (!movie_cut.empty()) m.render.cut = bv::parse_cut(movie_cut);
+      if (!movie_range.empty()) m.render.range = bv::parse_range(movie_range);
+      if (!movie_reference.empty()) m.render.reference = movie_reference;
+      bv::ensure_display();
+      bv::movie(m);
     } else if (convert->parsed()) {
       if (!convert_reference.empty()) c.reference = convert_reference;
       bv::convert(c);

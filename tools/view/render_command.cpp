@@ -1,6 +1,7 @@
 #include "render_command.hpp"
 
 #include <fmt/format.h>
+#include <unistd.h>
 #include <vtkCamera.h>
 #include <vtkColorTransferFunction.h>
 #include <vtkFloatArray.h>
@@ -10,6 +11,7 @@
 #include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
+#include <vtkPolyDataMapper.h>
 #include <vtkProperty.h>
 #include <vtkRenderWindow.h>
 #include <vtkRenderer.h>
@@ -19,9 +21,12 @@
 #include <vtkTextProperty.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
+#include <set>
 #include <stdexcept>
+#include <utility>
 
 #include "color_field.hpp"
 #include "particle_frame.hpp"
@@ -87,208 +92,422 @@ std::string describe_clock(const io::FrameInfo& info, const std::string& kind) {
   return fmt::format("step {}   t = {:.6g} {}", info.step, info.time, info.units.time);
 }
 
-}  // namespace
+const char* kColourArray = "basalt-view colour";
 
-void render(const RenderOptions& o) {
-  require_writable(o.output.string());
-  if (o.output.extension() != ".png")
-    throw std::invalid_argument(fmt::format("output {}: render writes PNG images (.png)", o.output.string()));
-  if (o.mapper != "imposter" && o.mapper != "glyph")
-    throw std::invalid_argument(fmt::format("--mapper \"{}\": expected imposter or glyph", o.mapper));
-  auto t0 = Clock::now();
-  Frame frame = read_frame(o.input, o.reference);
+/// One frame ready to draw: the particles kept (cut, buried ones dropped), relative to the frame's
+/// centre, with the colour values as active scalars and the radii as 32-bit floats for the imposters.
+struct Prepared {
+  std::filesystem::path input;
+  io::FrameInfo info;
+  std::string kind;
+  std::string field;
+  vtkSmartPointer<vtkPolyData> shown;
+  std::vector<double> drawn_values;  ///< the colour values of the particles the cut keeps
+  std::array<double, 6> fit{};       ///< the whole frame's bounds (with radii) relative to its centre
+  vtkIdType total = 0, in_view = 0;
+  double read_s = 0;
+};
+
+Prepared prepare(const fs::path& input, const RenderOptions& o) {
+  const auto t0 = Clock::now();
+  Prepared p;
+  p.input = input;
+  Frame frame = read_frame(input, o.reference);
+  p.info = frame.info;
+  p.kind = frame.kind;
   vtkPolyData& full = *frame.polydata;
-  const vtkIdType total = full.GetNumberOfPoints();
-  if (total == 0) throw io::FormatError(o.input, "", "no particles to draw");
+  p.total = full.GetNumberOfPoints();
+  if (p.total == 0) throw io::FormatError(input, "", "no particles to draw");
   if (full.GetPointData()->GetArray("radius") == nullptr)
-    throw io::FormatError(o.input, "", "no \"radius\" point array: cannot size the spheres");
+    throw io::FormatError(input, "", "no \"radius\" point array: cannot size the spheres");
 
-  std::string field = o.color;
-  if (field.empty()) field = full.GetPointData()->GetArray("speed") ? "speed" : "radius";
-  // Colour values are taken before the cut so that the range describes the whole frame.
-  const std::string color_array = "basalt-view colour: " + field;
-  auto values = color_values(full, field);
-  values->SetName(color_array.c_str());
+  p.field = o.color;
+  if (p.field.empty()) p.field = full.GetPointData()->GetArray("speed") ? "speed" : "radius";
+  auto values = color_values(full, p.field);
+  values->SetName(kColourArray);
   full.GetPointData()->AddArray(values);
-  full.GetPointData()->SetActiveScalars(color_array.c_str());
-  double full_bounds[6];
-  full.GetBounds(full_bounds);
+  double b[6];
+  full.GetBounds(b);
 
   // Which particles to draw: the cut's half, less those buried inside the packing.
   std::vector<vtkIdType> kept;
   if (o.cut) {
     kept = cut_indices(full, *o.cut, o.view);
   } else {
-    kept.resize(static_cast<std::size_t>(total));
-    for (vtkIdType i = 0; i < total; ++i) kept[static_cast<std::size_t>(i)] = i;
+    kept.resize(static_cast<std::size_t>(p.total));
+    for (vtkIdType i = 0; i < p.total; ++i) kept[static_cast<std::size_t>(i)] = i;
   }
-  const auto in_view = static_cast<vtkIdType>(kept.size());
-  if (in_view == 0) {
+  p.in_view = static_cast<vtkIdType>(kept.size());
+  if (p.in_view == 0) {
     const int a = o.cut->axis;
-    throw std::invalid_argument(fmt::format("--cut: no particles left (the particles' {} runs from {} to {})",
-                                            static_cast<char>('x' + a), full_bounds[2 * a],
-                                            full_bounds[2 * a + 1]));
+    throw std::invalid_argument(
+        fmt::format("{}: --cut: no particles left (the particles' {} runs from {} to {})", input.string(),
+                    static_cast<char>('x' + a), b[2 * a], b[2 * a + 1]));
   }
-  if (o.cull) {
-    double rr[2];
-    full.GetPointData()->GetArray("radius")->GetRange(rr);
-    kept = drop_buried(full, kept, 2 * rr[1]);
-  }
-  vtkSmartPointer<vtkPolyData> shown =
-      static_cast<vtkIdType>(kept.size()) == total ? frame.polydata : select_points(full, kept);
-  shown->GetPointData()->SetActiveScalars(color_array.c_str());
-  // Drawn relative to the frame's centre: OpenGL works in single precision, so particles 1e9 from the
-  // origin (1e12: nothing at all) collapsed onto a few positions and the picture was blank.
-  const double centre[3] = {0.5 * (full_bounds[0] + full_bounds[1]), 0.5 * (full_bounds[2] + full_bounds[3]),
-                            0.5 * (full_bounds[4] + full_bounds[5])};
-  shown = relative_to(*shown, centre);
-  const double read_s = seconds_since(t0);
-
-  Range range;
-  if (o.range) {
-    range = *o.range;
-  } else {
-    double r[2];
-    values->GetRange(r);
-    range = {r[0], r[1]};
-    if (!(range.min < range.max)) {  // a constant field: centre it in the map
-      const double pad = range.min == 0 ? 1.0 : 0.05 * std::abs(range.min);
-      range = {range.min - pad, range.max + pad};
-    }
-  }
-  auto lut = cool_to_warm(range);
-
-  vtkSmartPointer<vtkPolyDataMapper> mapper;
-  if (o.mapper == "imposter") {
-    // VTK 9.1's sphere mapper reads its scale array as 32-bit floats: give it a float copy.
-    vtkDataArray* radius = shown->GetPointData()->GetArray("radius");
-    auto radius32 = vtkSmartPointer<vtkFloatArray>::New();
-    radius32->SetName("radius_float32");
-    radius32->SetNumberOfTuples(radius->GetNumberOfTuples());
-    for (vtkIdType i = 0; i < radius->GetNumberOfTuples(); ++i)
-      radius32->SetValue(i, static_cast<float>(radius->GetComponent(i, 0)));
-    shown->GetPointData()->AddArray(radius32);
-    auto spheres = vtkSmartPointer<vtkOpenGLSphereMapper>::New();
-    spheres->SetScaleArray("radius_float32");
-    mapper = spheres;
-  }
-  vtkSmartPointer<vtkMapper> any_mapper;
-  if (mapper) {
-    mapper->SetInputData(shown);
-    any_mapper = mapper;
-  } else {
-    auto sphere = vtkSmartPointer<vtkSphereSource>::New();
-    sphere->SetRadius(1.0);
-    sphere->SetThetaResolution(10);
-    sphere->SetPhiResolution(6);
-    auto glyphs = vtkSmartPointer<vtkGlyph3DMapper>::New();
-    glyphs->SetInputData(shown);
-    glyphs->SetSourceConnection(sphere->GetOutputPort());
-    glyphs->SetScaleArray("radius");
-    glyphs->SetScaleModeToScaleByMagnitude();
-    glyphs->SetScaleFactor(1.0);
-    glyphs->OrientOff();
-    any_mapper = glyphs;
-  }
-  any_mapper->SetLookupTable(lut);
-  any_mapper->SetScalarModeToUsePointData();
-  any_mapper->ScalarVisibilityOn();
-  any_mapper->UseLookupTableScalarRangeOn();
-
-  auto actor = vtkSmartPointer<vtkActor>::New();
-  actor->SetMapper(any_mapper);
-  actor->GetProperty()->SetAmbient(0.15);
-  actor->GetProperty()->SetDiffuse(0.85);
-  actor->GetProperty()->SetSpecular(0.0);
-
-  const double bg[3] = {0.32, 0.34, 0.43};
-  const double bar_width = 0.16;  // fraction of the image on the right for the colour bar
-  auto scene = vtkSmartPointer<vtkRenderer>::New();
-  scene->SetViewport(0, 0, 1 - bar_width, 1);
-  scene->SetBackground(bg[0], bg[1], bg[2]);
-  scene->AddActor(actor);
-  auto side = vtkSmartPointer<vtkRenderer>::New();
-  side->SetViewport(1 - bar_width, 0, 1, 1);
-  side->SetBackground(bg[0], bg[1], bg[2]);
-  side->InteractiveOff();
-
-  const int h = o.size.height;
-  const int font = std::max(10, h / 48);
-  auto bar = vtkSmartPointer<vtkScalarBarActor>::New();
-  bar->SetLookupTable(lut);
-  const std::string title = field_title(field, frame.info.units);
-  bar->SetTitle(title.c_str());
-  // The title must fit the colour bar's panel: about 0.6 font sizes per character.
-  const int panel_px = static_cast<int>(bar_width * o.size.width);
-  const int title_font = std::max(
-      7, std::min(font, static_cast<int>(0.9 * panel_px / (0.6 * static_cast<double>(title.size())))));
-  bar->SetNumberOfLabels(6);
-  bar->SetLabelFormat("%-#8.4g");
-  bar->UnconstrainedFontSizeOn();
-  bar->SetPosition(0.12, 0.08);
-  bar->SetPosition2(0.8, 0.86);
-  bar->SetBarRatio(0.3);
-  bar->SetVerticalTitleSeparation(font);
-  bar->SetTextPad(font / 3);
-  bar->GetTitleTextProperty()->SetFontSize(title_font);
-  bar->GetTitleTextProperty()->SetColor(1, 1, 1);
-  bar->GetTitleTextProperty()->ItalicOff();
-  bar->GetTitleTextProperty()->ShadowOff();
-  bar->GetLabelTextProperty()->SetFontSize(font * 5 / 6);
-  bar->GetLabelTextProperty()->SetColor(1, 1, 1);
-  bar->GetLabelTextProperty()->ItalicOff();
-  bar->GetLabelTextProperty()->ShadowOff();
-  side->AddActor2D(bar);
-
-  auto text = vtkSmartPointer<vtkTextActor>::New();
-  text->SetInput(fmt::format("{}\n{}: {} particles{}", describe_clock(frame.info, frame.kind),
-                             o.input.filename().string(), total,
-                             o.cut ? fmt::format(" ({} behind the cut at {})", in_view,
-                                                 std::string(1, static_cast<char>('x' + o.cut->axis)))
-                                   : std::string())
-                     .c_str());
-  text->GetTextProperty()->SetFontSize(font);
-  text->GetTextProperty()->SetColor(1, 1, 1);
-  text->GetTextProperty()->SetVerticalJustificationToTop();
-  text->SetDisplayPosition(font / 2, h - font / 2);
-  scene->AddActor2D(text);
-
-  // Camera: look at the centre of the whole frame (now the origin) from the requested side.
-  auto* cam = scene->GetActiveCamera();
-  const double c[3] = {0, 0, 0};
-  cam->SetFocalPoint(c);
-  cam->SetPosition(c[0] + o.view.toward_camera[0], c[1] + o.view.toward_camera[1],
-                   c[2] + o.view.toward_camera[2]);
-  cam->SetViewUp(o.view.up.data());
-  cam->SetViewAngle(30);
-  // Fit the whole frame (not just the kept half), including the spheres' radii.
+  // The colour range is taken from every particle the cut keeps, buried ones included, so that
+  // skipping them (a matter of speed) never changes a colour.
+  p.drawn_values.reserve(kept.size());
+  for (vtkIdType i : kept) p.drawn_values.push_back(values->GetValue(i));
   double rr[2];
   full.GetPointData()->GetArray("radius")->GetRange(rr);
-  const double pad = rr[1];
-  const double fit[6] = {full_bounds[0] - centre[0] - pad, full_bounds[1] - centre[0] + pad,
-                         full_bounds[2] - centre[1] - pad, full_bounds[3] - centre[1] + pad,
-                         full_bounds[4] - centre[2] - pad, full_bounds[5] - centre[2] + pad};
-  scene->ResetCamera(fit);
-  cam->Zoom(1.25);
-  scene->ResetCameraClippingRange(fit);
+  if (o.cull) kept = drop_buried(full, kept, 2 * rr[1]);
+  vtkSmartPointer<vtkPolyData> shown =
+      static_cast<vtkIdType>(kept.size()) == p.total ? frame.polydata : select_points(full, kept);
+  // Drawn relative to the frame's centre: OpenGL works in single precision, so particles 1e9 from the
+  // origin (1e12: nothing at all) collapsed onto a few positions and the picture was blank.
+  const double centre[3] = {0.5 * (b[0] + b[1]), 0.5 * (b[2] + b[3]), 0.5 * (b[4] + b[5])};
+  p.shown = relative_to(*shown, centre);
+  p.shown->GetPointData()->SetActiveScalars(kColourArray);
 
-  auto window = vtkSmartPointer<vtkRenderWindow>::New();
-  window->SetOffScreenRendering(1);
-  window->SetMultiSamples(0);
-  window->SetSize(o.size.width, o.size.height);
-  window->AddRenderer(scene);
-  window->AddRenderer(side);
-  auto t1 = Clock::now();
-  window->Render();
-  write_png(*window, o.output);
+  // VTK 9.1's sphere mapper reads its scale array as 32-bit floats: give it a float copy.
+  vtkDataArray* radius = p.shown->GetPointData()->GetArray("radius");
+  auto radius32 = vtkSmartPointer<vtkFloatArray>::New();
+  radius32->SetName("radius_float32");
+  radius32->SetNumberOfTuples(radius->GetNumberOfTuples());
+  for (vtkIdType i = 0; i < radius->GetNumberOfTuples(); ++i)
+    radius32->SetValue(i, static_cast<float>(radius->GetComponent(i, 0)));
+  p.shown->GetPointData()->AddArray(radius32);
+
+  // The camera fits the whole frame (not just the kept half), including the spheres' radii.
+  const double pad = rr[1];
+  p.fit = {b[0] - centre[0] - pad, b[1] - centre[0] + pad, b[2] - centre[1] - pad,
+           b[3] - centre[1] + pad, b[4] - centre[2] - pad, b[5] - centre[2] + pad};
+  p.read_s = seconds_since(t0);
+  return p;
+}
+
+/// The window, renderers, mappers and colour bar, set up once and reused for every picture: the
+/// OpenGL set-up (shader compilation in software) costs about 2 s, the drawing itself far less.
+class Painter {
+ public:
+  Painter(ImageSize size, int panels, const RenderOptions& o) : size_(size), o_(o) {
+    const double bg[3] = {0.32, 0.34, 0.43};
+    // The colour bar's panel: 16 % of a single picture's width, of a 1.6:1 picture's for a strip.
+    const double bar_px = 0.16 * std::min(static_cast<double>(size.width), 1.6 * size.height);
+    const double bar = std::min(0.5, bar_px / size.width);
+    bar_px_ = static_cast<int>(bar * size.width);
+    window_ = vtkSmartPointer<vtkRenderWindow>::New();
+    window_->SetOffScreenRendering(1);
+    window_->SetMultiSamples(0);
+    window_->SetSize(size.width, size.height);
+    font_ = std::max(10, size.height / 48);
+    for (int i = 0; i < panels; ++i) {
+      Panel pn;
+      pn.scene = vtkSmartPointer<vtkRenderer>::New();
+      const double w = (1 - bar) / panels;
+      pn.scene->SetViewport(i * w, 0, (i + 1) * w, 1);
+      pn.scene->SetBackground(bg[0], bg[1], bg[2]);
+      if (o.mapper == "imposter") {
+        auto spheres = vtkSmartPointer<vtkOpenGLSphereMapper>::New();
+        spheres->SetScaleArray("radius_float32");
+        pn.mapper = spheres;
+      } else {
+        auto sphere = vtkSmartPointer<vtkSphereSource>::New();
+        sphere->SetRadius(1.0);
+        sphere->SetThetaResolution(10);
+        sphere->SetPhiResolution(6);
+        auto glyphs = vtkSmartPointer<vtkGlyph3DMapper>::New();
+        glyphs->SetSourceConnection(sphere->GetOutputPort());
+        glyphs->SetScaleArray("radius");
+        glyphs->SetScaleModeToScaleByMagnitude();
+        glyphs->SetScaleFactor(1.0);
+        glyphs->OrientOff();
+        pn.mapper = glyphs;
+      }
+      pn.mapper->SetScalarModeToUsePointData();
+      pn.mapper->ScalarVisibilityOn();
+      pn.mapper->UseLookupTableScalarRangeOn();
+      auto actor = vtkSmartPointer<vtkActor>::New();
+      actor->SetMapper(pn.mapper);
+      actor->GetProperty()->SetAmbient(0.15);
+      actor->GetProperty()->SetDiffuse(0.85);
+      actor->GetProperty()->SetSpecular(0.0);
+      pn.scene->AddActor(actor);
+      pn.text = vtkSmartPointer<vtkTextActor>::New();
+      white(pn.text->GetTextProperty(), font_);
+      pn.text->GetTextProperty()->SetVerticalJustificationToTop();
+      // Display coordinates are the window's, not the panel's.
+      pn.text->SetDisplayPosition(static_cast<int>(i * w * size.width) + font_ / 2, size.height - font_ / 2);
+      pn.scene->AddActor2D(pn.text);
+      window_->AddRenderer(pn.scene);
+      panels_.push_back(pn);
+    }
+    auto side = vtkSmartPointer<vtkRenderer>::New();
+    side->SetViewport(1 - bar, 0, 1, 1);
+    side->SetBackground(bg[0], bg[1], bg[2]);
+    side->InteractiveOff();
+    bar_ = vtkSmartPointer<vtkScalarBarActor>::New();
+    bar_->SetNumberOfLabels(6);
+    bar_->SetLabelFormat("%-#8.4g");
+    bar_->UnconstrainedFontSizeOn();
+    bar_->SetPosition(0.12, 0.1);
+    bar_->SetPosition2(0.8, 0.84);
+    bar_->SetBarRatio(0.3);
+    bar_->SetVerticalTitleSeparation(font_);
+    bar_->SetTextPad(font_ / 3);
+    white(bar_->GetLabelTextProperty(), font_ * 5 / 6);
+    side->AddActor2D(bar_);
+    extremes_ = vtkSmartPointer<vtkTextActor>::New();
+    white(extremes_->GetTextProperty(), font_ * 5 / 6);
+    extremes_->SetDisplayPosition(static_cast<int>((1 - bar) * size.width) + font_ / 2, font_ / 2);
+    side->AddActor2D(extremes_);
+    window_->AddRenderer(side);
+  }
+
+  /// Draws one frame per panel (as many as the painter has) with the colour map over `scale`.
+  void draw(const std::vector<const Prepared*>& frames, const ColourScale& scale) {
+    auto lut = cool_to_warm(scale.range);
+    const std::string& field = frames.front()->field;
+    const std::string title =
+        fmt::format("{}\n{}", field_title(field, frames.front()->info.units), scale.how);
+    bar_->SetLookupTable(lut);
+    bar_->SetTitle(title.c_str());
+    // The title must fit the colour bar's panel: about 0.6 font sizes per character of its longest line.
+    const auto longest = static_cast<double>(std::max(title.find('\n'), title.size() - title.find('\n') - 1));
+    white(bar_->GetTitleTextProperty(),
+          std::max(7, std::min(font_, static_cast<int>(0.9 * bar_px_ / (0.6 * longest)))));
+    extremes_->SetInput(fmt::format("min {:.4g}\nmax {:.4g}", scale.min, scale.max).c_str());
+    for (std::size_t i = 0; i < panels_.size(); ++i) {
+      const Prepared& p = *frames[i];
+      Panel& pn = panels_[i];
+      pn.mapper->SetLookupTable(lut);
+      if (auto* m = vtkPolyDataMapper::SafeDownCast(pn.mapper)) m->SetInputData(p.shown);
+      if (auto* g = vtkGlyph3DMapper::SafeDownCast(pn.mapper)) g->SetInputData(p.shown);
+      const std::string cut = o_.cut ? fmt::format(" ({} behind the cut at {})", p.in_view,
+                                                   std::string(1, static_cast<char>('x' + o_.cut->axis)))
+                                     : std::string();
+      // A strip's panels say only their clock: the file names are in the command.
+      pn.text->SetInput(panels_.size() > 1
+                            ? describe_clock(p.info, p.kind).c_str()
+                            : fmt::format("{}\n{}: {} particles{}", describe_clock(p.info, p.kind),
+                                          p.input.filename().string(), p.total, cut)
+                                  .c_str());
+      // Camera: look at the centre of the whole frame (now the origin) from the requested side.
+      auto* cam = pn.scene->GetActiveCamera();
+      cam->SetFocalPoint(0, 0, 0);
+      cam->SetPosition(o_.view.toward_camera.data());
+      cam->SetViewUp(o_.view.up.data());
+      cam->SetViewAngle(30);
+      double fit[6];
+      std::copy(p.fit.begin(), p.fit.end(), fit);
+      pn.scene->ResetCamera(fit);
+      // A strip's narrow panels: fill them when looking along an axis (a cube shows as a square, narrower
+      // than its bounding sphere, which ResetCamera fits); the iso view's hexagon needs the margin.
+      const auto& t = o_.view.toward_camera;
+      const bool along_axis = (t[0] != 0) + (t[1] != 0) + (t[2] != 0) == 1;
+      cam->Zoom(panels_.size() == 1 ? 1.25 : along_axis ? 1.6 : 1.1);
+      pn.scene->ResetCameraClippingRange(fit);
+    }
+    window_->Render();
+  }
+
+  vtkRenderWindow& window() { return *window_; }
+
+ private:
+  struct Panel {
+    vtkSmartPointer<vtkRenderer> scene;
+    vtkSmartPointer<vtkMapper> mapper;
+    vtkSmartPointer<vtkTextActor> text;
+  };
+  static void white(vtkTextProperty* t, int font) {
+    t->SetFontSize(font);
+    t->SetColor(1, 1, 1);
+    t->ItalicOff();
+    t->ShadowOff();
+  }
+
+  ImageSize size_;
+  const RenderOptions& o_;
+  int font_ = 10, bar_px_ = 100;
+  vtkSmartPointer<vtkRenderWindow> window_;
+  std::vector<Panel> panels_;
+  vtkSmartPointer<vtkScalarBarActor> bar_;
+  vtkSmartPointer<vtkTextActor> extremes_;
+};
+
+void check_options(const RenderOptions& o) {
+  if (o.inputs.empty()) throw std::invalid_argument("nothing to render: give at least one file");
+  if (o.mapper != "imposter" && o.mapper != "glyph")
+    throw std::invalid_argument(fmt::format("--mapper \"{}\": expected imposter or glyph", o.mapper));
+}
+
+bool is_folder_output(const fs::path& out) {
+  std::error_code ec;
+  const std::string s = out.string();
+  return fs::is_directory(out, ec) || (!s.empty() && s.back() == '/');
+}
+
+/// Prints "[k/n] name" over itself on a terminal; elsewhere (logs) a line at every tenth.
+class Progress {
+ public:
+  Progress(std::size_t n, bool quiet) : n_(n), quiet_(quiet), tty_(::isatty(STDERR_FILENO) == 1) {}
+  void step(std::size_t k, const std::string& what) {
+    if (quiet_) return;
+    if (tty_) {
+      fmt::print(stderr, "\r[{}/{}] {}\033[K", k, n_, what);
+      if (k == n_) fmt::print(stderr, "\n");
+    } else if (k == n_ || (k * 10 / n_) != ((k - 1) * 10 / n_)) {
+      fmt::print(stderr, "[{}/{}] {}\n", k, n_, what);
+    }
+  }
+
+ private:
+  std::size_t n_;
+  bool quiet_, tty_;
+};
+
+/// Renders `inputs` one picture each through one painter with one colour range; `sink` takes each
+/// finished picture (the painter's window) and its frame. Two passes when there are many frames:
+/// the first reads every frame for the common range, the second draws (frames are not all kept).
+template <class Sink>
+void render_each(const RenderOptions& o, ImageSize size, Sink&& sink) {
+  const std::size_t n = o.inputs.size();
+  const bool keep = n <= 4;
+  std::vector<Prepared> kept;
+  std::vector<double> pooled;
+  Progress reading(n, o.quiet || n < 4);
+  for (std::size_t i = 0; i < n; ++i) {
+    Prepared p = prepare(o.inputs[i], o);
+    if (!o.range)
+      pooled.insert(pooled.end(), p.drawn_values.begin(), p.drawn_values.end());
+    else if (i == 0)
+      pooled = p.drawn_values;
+    if (keep) kept.push_back(std::move(p));
+    reading.step(i + 1, "read " + o.inputs[i].filename().string());
+  }
+  const ColourScale scale = o.range ? given_scale(*o.range, pooled) : robust_scale(std::move(pooled));
+  Painter painter(size, 1, o);
+  Progress drawing(n, o.quiet || n < 2);
+  for (std::size_t i = 0; i < n; ++i) {
+    Prepared p = keep ? std::move(kept[i]) : prepare(o.inputs[i], o);
+    painter.draw({&p}, scale);
+    sink(painter.window(), p, scale);
+    drawing.step(i + 1, "drew " + o.inputs[i].filename().string());
+  }
+}
+
+std::string scale_text(const ColourScale& s) {
+  return fmt::format("range {:.6g}..{:.6g} ({}; values from {:.6g} to {:.6g})", s.range.min, s.range.max,
+                     s.how, s.min, s.max);
+}
+
+}  // namespace
+
+std::vector<fs::path> checkpoints_in(const fs::path& dir) {
+  std::vector<std::pair<long long, fs::path>> found;
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(dir, ec)) {
+    const std::string name = e.path().filename().string();
+    if (name.size() < 9 || name.rfind("ckpt_", 0) != 0 || name.substr(name.size() - 3) != ".h5") continue;
+    const std::string digits = name.substr(5, name.size() - 8);
+    if (digits.empty() ||
+        !std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }))
+      continue;
+    found.emplace_back(std::stoll(digits), e.path());
+  }
+  std::sort(found.begin(), found.end());
+  std::vector<fs::path> out;
+  for (auto& f : found) out.push_back(f.second);
+  return out;
+}
+
+void render(const RenderOptions& o) {
+  check_options(o);
+  if (is_folder_output(o.output)) {  // a series: one picture per input
+    std::error_code ec;
+    fs::create_directory(o.output, ec);
+    if (!fs::is_directory(o.output, ec))
+      throw std::invalid_argument(fmt::format("cannot create the folder {}", o.output.string()));
+    require_writable((o.output / "x.png").string());
+    std::set<std::string> names;
+    for (const auto& in : o.inputs)
+      if (!names.insert(in.stem().string()).second)
+        throw std::invalid_argument(fmt::format(
+            "two inputs named {}: their pictures would overwrite each other", in.stem().string()));
+    const auto t0 = Clock::now();
+    ColourScale used;
+    render_each(o, o.size.value_or(ImageSize{}),
+                [&](vtkRenderWindow& w, const Prepared& p, const ColourScale& s) {
+                  write_png(w, o.output / (p.input.stem().string() + ".png"));
+                  used = s;
+                });
+    if (!o.quiet)
+      fmt::print("wrote {} pictures into {} (coloured by {}, {}; {:.1f} s)\n", o.inputs.size(),
+                 o.output.string(), o.color.empty() ? "the default field" : o.color, scale_text(used),
+                 seconds_since(t0));
+    return;
+  }
+
+  require_writable(o.output.string());
+  if (o.output.extension() != ".png")
+    throw std::invalid_argument(fmt::format(
+        "output {}: render writes PNG images (.png), or into a folder (end it with '/')", o.output.string()));
+  const int panels = static_cast<int>(o.inputs.size());
+  std::vector<Prepared> frames;
+  std::vector<double> pooled;
+  for (const auto& in : o.inputs) {
+    frames.push_back(prepare(in, o));
+    pooled.insert(pooled.end(), frames.back().drawn_values.begin(), frames.back().drawn_values.end());
+  }
+  const ColourScale scale = o.range ? given_scale(*o.range, pooled) : robust_scale(std::move(pooled));
+  const ImageSize size = o.size ? *o.size : panels == 1 ? ImageSize{} : ImageSize{panels * 560 + 180, 600};
+  Painter painter(size, panels, o);
+  std::vector<const Prepared*> ptrs;
+  double read_s = 0;
+  vtkIdType drawn = 0;
+  for (const auto& f : frames) {
+    ptrs.push_back(&f);
+    read_s += f.read_s;
+    drawn += f.shown->GetNumberOfPoints();
+  }
+  const auto t1 = Clock::now();
+  painter.draw(ptrs, scale);
+  write_png(painter.window(), o.output);
   const double draw_s = seconds_since(t1);
-  if (!o.quiet)
+  if (o.quiet) return;
+  const Prepared& f = frames.front();
+  if (panels == 1)
     fmt::print(
-        "wrote {} ({}x{}, {} particles, {} in view, {} drawn, coloured by {}, range {:.6g}..{:.6g}; read "
-        "{:.2f} s, "
-        "draw {:.2f} s)\n",
-        o.output.string(), o.size.width, o.size.height, total, in_view, shown->GetNumberOfPoints(), field,
-        range.min, range.max, read_s, draw_s);
+        "wrote {} ({}x{}, {} particles, {} in view, {} drawn, coloured by {}, {}; read {:.2f} s, draw {:.2f} "
+        "s)\n",
+        o.output.string(), size.width, size.height, f.total, f.in_view, drawn, f.field, scale_text(scale),
+        read_s, draw_s);
+  else
+    fmt::print("wrote {} ({}x{}, {} panels, {} drawn, coloured by {}, {}; read {:.2f} s, draw {:.2f} s)\n",
+               o.output.string(), size.width, size.height, panels, drawn, f.field, scale_text(scale), read_s,
+               draw_s);
+}
+
+void movie(const MovieOptions& m) {
+  RenderOptions o = m.render;
+  if (o.inputs.size() == 1 && fs::is_directory(o.inputs.front())) {
+    const fs::path dir = o.inputs.front();
+    o.inputs = checkpoints_in(dir);
+    if (o.inputs.empty())
+      throw std::invalid_argument(
+          fmt::format("{}: no checkpoints (ckpt_<step>.h5) in this folder", dir.string()));
+  }
+  check_options(o);
+  const std::string ext = o.output.extension().string();
+  if (ext != ".png" && ext != ".apng")
+    throw std::invalid_argument(fmt::format(
+        "output {}: movie writes an animated PNG (.png or .apng), which browsers and image viewers play",
+        o.output.string()));
+  if (!(m.fps > 0 && m.fps <= 100))
+    throw std::invalid_argument(fmt::format("--fps {}: expected 0 < fps <= 100", m.fps));
+  require_writable(o.output.string());
+  const auto t0 = Clock::now();
+  const ImageSize size = o.size.value_or(ImageSize{800, 600});
+  AnimatedPng apng(o.output, static_cast<int>(o.inputs.size()), m.fps);
+  ColourScale used;
+  render_each(o, size, [&](vtkRenderWindow& w, const Prepared&, const ColourScale& s) {
+    apng.add(w);
+    used = s;
+  });
+  apng.finish();
+  if (!o.quiet)
+    fmt::print("wrote {} ({} frames, {}x{}, {} frames/s, {}; {:.1f} s)\n", o.output.string(), o.inputs.size(),
+               size.width, size.height, m.fps, scale_text(used), seconds_since(t0));
 }
 
 }  // namespace basalt::view

@@ -1,9 +1,13 @@
 #include "checkpoint_step.hpp"
 
 #include <fmt/format.h>
+#include <toml++/toml.h>
 
 #include <chrono>
+#include <stdexcept>
 #include <thread>
+
+#include "basalt/io/xdmf.hpp"
 
 namespace basalt::io::detail {
 
@@ -21,6 +25,17 @@ std::filesystem::path checkpoint_path(const std::filesystem::path& dir, std::int
 
 }  // namespace
 
+Compression compression_of_scene(const std::string& scene_text) {
+  toml::table scene;
+  try {
+    scene = toml::parse(scene_text);
+  } catch (const toml::parse_error&) {
+    return Compression::none;  // not a TOML scene (tests hand over any text): nothing asked for
+  }
+  const auto name = scene["output"]["compression"].value<std::string>();
+  return name ? parse_compression(*name) : Compression::none;
+}
+
 void throttle(double mb_per_s, std::uint64_t bytes, double elapsed) {
   if (mb_per_s <= 0) return;
   const double want = static_cast<double>(bytes) / (mb_per_s * 1e6);
@@ -32,7 +47,10 @@ std::uint64_t write_checkpoint_step(std::vector<FramePiece>& pieces, const RunIn
   const double t0 = MPI_Wtime();
   Checkpoint c = assemble(pieces, info);
   const auto path = checkpoint_path(cfg.dir, c.step);
-  write_checkpoint(c, path);
+  write_checkpoint(c, path, compression_of_scene(info.scene_text));
+  // ParaView opens the checkpoints as they are: ckpt_<step>.xmf beside each, ckpt_series.xmf for all.
+  write_checkpoint_xdmf(c, path);
+  write_checkpoint_series_xdmf(cfg.dir, c.step);
   const auto bytes = file_size_or_zero(path);
   throttle(cfg.throttle_mb_per_s, bytes, MPI_Wtime() - t0);
   rep.files += 1;

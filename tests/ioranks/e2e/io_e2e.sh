@@ -161,6 +161,40 @@ case $case_name in
     [ "$(wc -l <"$W/out/fields.csv")" -eq 101 ] || fail "fields.csv: expected a header and 100 rows"
     $CHECK pvd "$W/out" || fail "VTK frames disagree with the checkpoints after the restart"
     ;;
+  xdmf)
+    # ParaView opens the checkpoints as they are: ckpt_<step>.xmf beside each, ckpt_series.xmf for all,
+    # with Q = 1 and Q = 0; after a restart from step 50 the series lists only the new run's history.
+    for q in 1 0; do
+      must_run $((2 + q)) --io-ranks $q --steps 100 --checkpoint-every 25 --output "$W/q$q"
+      $CHECK xdmf "$W/q$q" 25,50,75,100 || fail "--io-ranks $q: the XDMF descriptions are wrong"
+    done
+    must_run 3 --io-ranks 1 --steps 25 --checkpoint-every 25 --output "$W/q1" --restart "$W/q1/ckpt_000050.h5"
+    $CHECK xdmf "$W/q1" 25,50,75 || fail "after a restart from step 50 to 75: the series is wrong"
+    ;;
+  compressed)
+    # output.compression = "fast" | "small": smaller checkpoints, shuffle + deflate on the big datasets,
+    # the same values as an uncompressed run, and a restart from a compressed checkpoint bit for bit.
+    must_run 3 --io-ranks 1 --steps 100 --checkpoint-every 100 --output "$W/none"
+    scene0=$SCENE
+    for level in fast small; do
+      sed "s/^\[output\]\$/[output]\ncompression = \"$level\"/" "$scene0" >"$W/$level.toml"
+      grep -q "^compression = \"$level\"" "$W/$level.toml" || fail "could not set the compression in $W/$level.toml"
+      SCENE=$W/$level.toml
+      rm -rf "$W/straight" "$W/split"
+      restart_bitwise 3 1
+      $CHECK compressed "$W/split/ckpt_000200.h5" || fail "$level: the checkpoint is not compressed"
+      must_run 1 --steps 100 --checkpoint-every 100 --output "$W/q0_$level"
+      $CHECK compressed "$W/q0_$level/ckpt_000100.h5" || fail "$level, Q = 0: the checkpoint is not compressed"
+      $CHECK same "$W/none/ckpt_000100.h5" "$W/split/ckpt_000100.h5" || fail "$level: values differ from the uncompressed run"
+      none_size=$(stat -c %s "$W/none/ckpt_000100.h5")
+      size=$(stat -c %s "$W/split/ckpt_000100.h5")
+      echo "$level: $size bytes against $none_size uncompressed"
+      [ "$size" -lt $((none_size * 3 / 4)) ] || fail "$level: $size bytes is not smaller than 3/4 of $none_size"
+    done
+    sed 's/^\[output\]$/[output]\ncompression = "zip"/' "$scene0" >"$W/bad.toml"
+    SCENE=$W/bad.toml
+    must_fail "compression" 1 --steps 10 --output "$W/bad"
+    ;;
   two_io_ranks)
     # 2 compute + 2 I/O ranks: one checkpoint file per step (I/O rank 0 gathers), one VTK piece per I/O
     # rank; the checkpoints equal those of 2 compute ranks writing themselves.

@@ -11,6 +11,13 @@
                               once, with positive ages, and some contacts with an age below the step
   pvd DIR                     every frame of DIR/frames.pvd, read with vtkXMLPPolyDataReader, has the
                               positions of DIR/ckpt_<step>.h5 (same ids), when that checkpoint exists
+  compressed FILE             the checkpoint's position, velocity and bond datasets are chunked through the
+                              shuffle and deflate (gzip) filters
+  xdmf DIR STEPS              DIR/ckpt_series.xmf is a time-ordered temporal collection of exactly the
+                              checkpoints STEPS (comma-separated), and each grid, read as an XDMF reader
+                              does (the DataItem paths through h5py, their Dimensions and number types),
+                              gives the checkpoint's particle count, positions, velocity and radius; so
+                              does each ckpt_<step>.xmf alone
 """
 import sys
 import xml.etree.ElementTree as ET
@@ -136,11 +143,88 @@ def pvd(folder):
     return compared > 0
 
 
+def compressed(f):
+    with h5py.File(f, "r") as h:
+        for d in ("particles/position", "particles/velocity", "bonds/pairs"):
+            ds = h[d]
+            if ds.compression != "gzip" or not ds.shuffle:
+                print(f"{f}: {d} is not shuffled and deflated (compression {ds.compression}, shuffle {ds.shuffle})")
+                return False
+        print(f"{f}: deflate level {h['particles/position'].compression_opts}, with shuffle")
+    return True
+
+
+def xdmf_grid(grid, folder):
+    """Reads one particle grid the way an XDMF reader does; returns (time, n, arrays by name) or raises."""
+    types = {("Float", "8"): np.float64, ("Float", "4"): np.float32, ("Int", "8"): np.int64, ("Int", "4"): np.int32}
+
+    def item(parent):
+        d = parent.find("DataItem")
+        assert d.get("Format") == "HDF", d.attrib
+        file, path = d.text.strip().split(":", 1)
+        with h5py.File(folder / file, "r") as h:
+            data = h[path][()]
+        dims = tuple(int(x) for x in d.get("Dimensions").split())
+        assert data.shape == dims, f"{d.text}: shape {data.shape}, Dimensions {dims}"
+        want = types[(d.get("NumberType"), d.get("Precision"))]
+        assert data.dtype == want, f"{d.text}: {data.dtype}, the XML says {want}"
+        return data
+
+    assert grid.get("GridType") == "Uniform"
+    time = float(grid.find("Time").get("Value"))
+    topo = grid.find("Topology")
+    assert topo.get("TopologyType") == "Polyvertex" and topo.get("NodesPerElement") == "1"
+    n = int(topo.get("NumberOfElements"))
+    assert grid.find("Geometry").get("GeometryType") == "XYZ"
+    arrays = {"position": item(grid.find("Geometry"))}
+    for a in grid.findall("Attribute"):
+        assert a.get("Center") == "Node"
+        arrays[a.get("Name")] = item(a)
+        comps = 3 if a.get("AttributeType") == "Vector" else 1
+        assert arrays[a.get("Name")].shape == ((n, 3) if comps == 3 else (n,)), a.get("Name")
+    assert arrays["position"].shape == (n, 3)
+    return time, n, arrays
+
+
+def xdmf(folder, steps):
+    folder = Path(folder)
+    want = [int(s) for s in steps.split(",")]
+    root = ET.parse(folder / "ckpt_series.xmf").getroot()
+    collection = root.find("Domain/Grid")
+    assert collection.get("GridType") == "Collection" and collection.get("CollectionType") == "Temporal"
+    grids = collection.findall("Grid")
+    got = [int(g.find("Information[@Name='step']").get("Value")) for g in grids]
+    if got != want:
+        print(f"ckpt_series.xmf lists steps {got}, expected {want}")
+        return False
+    times = []
+    for step, grid in zip(got, grids):
+        alone = ET.parse(folder / f"ckpt_{step:06d}.xmf").getroot().find("Domain/Grid")
+        for g in (grid, alone):
+            time, n, arrays = xdmf_grid(g, folder)
+            with h5py.File(folder / f"ckpt_{step:06d}.h5", "r") as h:
+                if n != h["particles/id"].shape[0] or time != h.attrs["time"]:
+                    print(f"step {step}: {n} particles at time {time}, the checkpoint says otherwise")
+                    return False
+                for name, path in (("position", "particles/position"), ("velocity", "particles/velocity"),
+                                   ("radius", "particles/radius"), ("id", "particles/id")):
+                    if not np.array_equal(arrays[name], h[path][()]):
+                        print(f"step {step}: {name} differs from {path}")
+                        return False
+        times.append(time)
+    if times != sorted(times) or len(set(times)) != len(times):
+        print(f"times not increasing: {times}")
+        return False
+    print(f"ckpt_series.xmf: {len(grids)} checkpoints in time order {times}, {n} particles each, read back equal")
+    return True
+
+
 if __name__ == "__main__":
     cmd, args = sys.argv[1], sys.argv[2:]
     ok = {"same": lambda: same(*args), "close": lambda: close(args[0], args[1], float(args[2])),
           "complete": lambda: complete(args[0]),
           "contacts": lambda: contacts(args[0], int(args[1])),
           "old_lists": lambda: old_lists(args[0]), "break_overlap": lambda: break_overlap(args[0]),
-          "strip_rebuild": lambda: strip_rebuild(args[0]), "pvd": lambda: pvd(args[0])}[cmd]()
+          "strip_rebuild": lambda: strip_rebuild(args[0]), "pvd": lambda: pvd(args[0]),
+          "xdmf": lambda: xdmf(args[0], args[1]), "compressed": lambda: compressed(args[0])}[cmd]()
     sys.exit(0 if ok else 1)

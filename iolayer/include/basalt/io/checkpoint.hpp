@@ -72,10 +72,21 @@ struct Checkpoint {
 /// Whether /particles/<name> is one of the schema's fixed datasets (not a particle field).
 bool is_fixed_particle_dataset(const std::string& name);
 
+/// HDF5's shuffle + deflate filters on a checkpoint's larger datasets (scene key output.compression;
+/// sizes and costs measured in docs/io-ranks.md). Lossless: a restart reads the same values.
+enum class Compression {
+  none,   ///< contiguous, uncompressed (the default)
+  fast,   ///< shuffle + deflate level 1
+  small,  ///< shuffle + deflate level 6
+};
+/// "none", "fast" or "small"; throws std::invalid_argument naming the value otherwise.
+Compression parse_compression(const std::string& name);
+
 /// Writes atomically: to "<file>.partial", then renames; the file carries the attribute
 /// /complete = 1 written last. A failure throws FormatError naming the path and leaves no file
 /// under the final name.
-void write_checkpoint(const Checkpoint& c, const std::filesystem::path& file);
+void write_checkpoint(const Checkpoint& c, const std::filesystem::path& file,
+                      Compression compression = Compression::none);
 
 /// Reads and validates a checkpoint; refuses (FormatError) a file without the completion mark,
 /// of another schema, or of a newer schema version.
