@@ -37,7 +37,8 @@ from geofile import GeoError, read_geo  # noqa: E402
 TABLES_PER_FILE = 100  # LAMMPS scans a table file from its start for every bond_coeff
 
 
-def convert(geo, outdir, stiffness, bond_model, pad_top, table_span, bottom_band, rest_length="sum_of_radii"):
+def convert(geo, outdir, stiffness, bond_model, pad_top, table_span, bottom_band, rest_length="sum_of_radii",
+            type_order="spatial", sort_bin=1.0):
     box_lo, box_hi, particles, bonds = read_geo(geo)
     radius = {p[0]: p[4] for p in particles}
     rmax = max(radius.values())
@@ -55,13 +56,27 @@ def convert(geo, outdir, stiffness, bond_model, pad_top, table_span, bottom_band
         return radius[a] + radius[b]
 
     # one bond type per distinct (r0, r1 + r2), printed with 17 significant digits (exact doubles)
+    # Spatial order (type_order "spatial"): atoms are written in bins of sort_bin (z slowest, x fastest),
+    # and bonds, which LAMMPS keeps with their first atom and walks atom by atom, in their first atom's
+    # order; bond types are numbered in that order, so the table lookups of consecutive bonds touch
+    # neighbouring tables in memory. Run with LAMMPS's own atom sorting off (in.wave.lmp, sort 0) to
+    # keep it. type_order "file": the .geo's order.
+    order = list(range(len(bonds)))
+    if type_order == "spatial":
+        def bin_key(p):
+            return (int((p[3] - dom_lo[2]) // sort_bin), int((p[2] - dom_lo[1]) // sort_bin),
+                    int((p[1] - dom_lo[0]) // sort_bin), p[0])
+        particles = sorted(particles, key=bin_key)
+        rank = {p[0]: i for i, p in enumerate(particles)}
+        order.sort(key=lambda i: (rank[bonds[i][0]], i))
     type_of_r0 = {}
-    bond_types = []
-    for a, b, _ in bonds:
+    bond_types = [0] * len(bonds)
+    for i in order:
+        a, b, _ = bonds[i]
         key = (f"{rest(a, b):.17g}", f"{radius[a] + radius[b]:.17g}")
         if key not in type_of_r0:
             type_of_r0[key] = len(type_of_r0) + 1
-        bond_types.append(type_of_r0[key])
+        bond_types[i] = type_of_r0[key]
 
     os.makedirs(outdir, exist_ok=True)
     tmp = os.path.join(outdir, "data.lmp.tmp")
@@ -74,8 +89,9 @@ def convert(geo, outdir, stiffness, bond_model, pad_top, table_span, bottom_band
         for pid, x, y, z, r, tag in particles:
             f.write(f"{pid + 1} 1 {x:.10g} {y:.10g} {z:.10g} {2.0 * r:.12g} 1 1\n")
         f.write("\nBonds\n\n")
-        for i, ((a, b, _), t) in enumerate(zip(bonds, bond_types)):
-            f.write(f"{i + 1} {t} {a + 1} {b + 1}\n")
+        for n, i in enumerate(order):
+            a, b, _ = bonds[i]
+            f.write(f"{n + 1} {bond_types[i]} {a + 1} {b + 1}\n")
     os.replace(tmp, os.path.join(outdir, "data.lmp"))
 
     with open(os.path.join(outdir, "bond_style.in"), "w") as f:
@@ -125,6 +141,8 @@ def main():
     p.add_argument("--rest-length", choices=("sum_of_radii", "initial_distance"), default="sum_of_radii",
                    help="bond rest length: r1 + r2 (ESyS, scenes/wave-esys.toml) or the initial distance "
                         "(Basalt's scenes/wave.toml)")
+    p.add_argument("--type-order", choices=("spatial", "file"), default="spatial",
+                   help="bond type numbering: spatial (as LAMMPS walks its bonds; faster table lookups) or file")
     p.add_argument("--pad-top", type=float, default=0.5, help="box padding above, fraction of the height")
     p.add_argument("--table-span", type=float, default=0.2,
                    help="bond tables cover r0 (1 +- span); LAMMPS stops if a bond leaves it")
@@ -133,7 +151,8 @@ def main():
     args = p.parse_args()
     try:
         info = convert(args.geometry, args.outdir, args.stiffness, args.bond_model, args.pad_top, args.table_span,
-                       args.bottom_band, args.rest_length)
+                       args.bottom_band, args.rest_length,
+                       args.type_order)
     except GeoError as e:
         print(f"error: {e}", file=sys.stderr)
         return 2

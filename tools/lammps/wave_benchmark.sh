@@ -29,6 +29,8 @@ grid=""
 newton=on
 physics=esys
 contacts=1
+type_order=spatial
+sort=""
 
 usage() { sed -n '2,18p' "$0" | sed 's/^# \{0,1\}//'; }
 need_value() { [[ $# -ge 2 && -n "$2" ]] || { echo "error: $1 needs a value" >&2; exit 2; }; }
@@ -46,6 +48,8 @@ while [[ $# -gt 0 ]]; do
     --newton) need_value "$@"; newton="$2"; shift 2 ;;
     --physics) need_value "$@"; physics="$2"; shift 2 ;;
     --no-contacts) contacts=0; shift ;;
+    --type-order) need_value "$@"; type_order="$2"; shift 2 ;;
+    --sort) need_value "$@"; sort="$2"; shift 2 ;;
     -h|--help) usage; exit 0 ;;
     *) echo "error: unknown option '$1' (see --help)" >&2; exit 2 ;;
   esac
@@ -67,6 +71,10 @@ case "$physics" in
   *) echo "error: --physics must be esys or basalt, got '$physics'" >&2; exit 2 ;;
 esac
 
+# LAMMPS's atom sorting (every N steps; 0 = never) would undo the spatial order geo2data.py wrote
+[[ -n "$sort" ]] || { [[ "$type_order" == spatial ]] && sort=0 || sort=1000; }
+[[ "$sort" =~ ^[0-9]+$ ]] || { echo "error: --sort must be a number of steps, got '$sort'" >&2; exit 2; }
+
 for exe in lmp mpirun; do
   if ! command -v "$exe" > /dev/null; then
     echo "LAMMPS is not available: '$exe' not on PATH (Debian package lammps). Nothing was run." >&2
@@ -82,13 +90,14 @@ mkdir -p "$output" || { echo "error: cannot create output directory $output" >&2
 output="$(cd "$output" && pwd)"
 
 start=$(date +%s.%N)
-/usr/bin/python3 "$here/geo2data.py" "$geometry" "$output" --bond-model "$bond_model" --rest-length "$rest_length"
+/usr/bin/python3 "$here/geo2data.py" "$geometry" "$output" --bond-model "$bond_model" --rest-length "$rest_length" \
+  --type-order "$type_order"
 echo "conversion: $(echo "$(date +%s.%N) - $start" | bc) s"
 
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
 rm -f "$output/ke.dat"
 (cd "$output" && mpirun -np "$ranks" lmp -in "$here/in.wave.lmp" -log "$output/log.lammps" -echo none -screen none \
-  -var dir "$output" -var steps "$steps" -var ke "$ke" -var skin "$skin" -var newton "$newton" -var wall "$wall" -var contacts "$contacts" -var px "$px" -var py "$py" -var pz "$pz") ||
+  -var dir "$output" -var steps "$steps" -var ke "$ke" -var skin "$skin" -var newton "$newton" -var wall "$wall" -var contacts "$contacts" -var sort "$sort" -var px "$px" -var py "$py" -var pz "$pz") ||
   { echo "error: LAMMPS failed; see $output/log.lammps" >&2; tail -5 "$output/log.lammps" >&2; exit 1; }
 
 loop=$(grep -m1 '^Loop time of' "$output/log.lammps")
