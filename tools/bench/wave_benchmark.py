@@ -222,8 +222,8 @@ def main():
                   "type per bond) + gran/hooke, whose contact then also acts on compressed bonded pairs (kinetic "
                   "energy up to 79 % off Basalt's over 2,000 steps): "
                   + "; ".join(f"{k[0].replace('cube', '')} mm, {k[1]} rank(s): {fmt_rate(med[k])} "
-                              f"(Basalt / it {ratio(k[0], k[1], 'LAMMPS harmonic')}, table / it "
-                              f"{statistics.median([x / y for x, y in zip(results[(k[0], k[1], 'LAMMPS')], results[k])]):.2f}x)"
+                              f"(Basalt / it {ratio(k[0], k[1], 'LAMMPS harmonic')}, it / LAMMPS table "
+                              f"{statistics.median([y / x for x, y in zip(results[(k[0], k[1], 'LAMMPS')], results[k])]):.1f}x)"
                               for k in sorted(hk)) + "."]
     lines += ["", "All repeats (particle-steps/s):", ""]
     for k, v in sorted(results.items()):
