@@ -4,7 +4,7 @@
 #   tools/lammps/wave_benchmark.sh [--geometry FILE.geo] [--steps N] [--ranks R] [--ke]
 #                                  [--bond-model table|harmonic] [--skin S] [--output DIR]
 #                                  [--generate-side L] [--grid PX,PY,PZ] [--newton on|off]
-#                                  [--physics esys|basalt] [--no-contacts]
+#                                  [--physics esys|basalt] [--no-contacts] [--type-order spatial|file] [--sort N]
 #
 # Converts the .geo with geo2data.py, runs in.wave.lmp with `mpirun -np R lmp` inside DIR and
 # prints LAMMPS's own loop time ("Loop time of ...": the stepping loop only) as particle-steps/s.
@@ -32,7 +32,7 @@ contacts=1
 type_order=spatial
 sort=""
 
-usage() { sed -n '2,18p' "$0" | sed 's/^# \{0,1\}//'; }
+usage() { sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'; }
 need_value() { [[ $# -ge 2 && -n "$2" ]] || { echo "error: $1 needs a value" >&2; exit 2; }; }
 while [[ $# -gt 0 ]]; do
   case "$1" in
