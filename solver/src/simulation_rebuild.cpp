@@ -35,9 +35,10 @@ void Simulation<Real>::spatial_sort() {
   // by id, so the order is a function of the owned (id, position) set alone, never of the order
   // migration or a restart left them in: every rebuild is canonical (a restart replays one bit for
   // bit, docs/ARCHITECTURE.md). A cell holds a few particles: sorting them costs little.
-  grid_.build(p_.x, p_.y, p_.z, p_.n_owned, contact_cutoff_);
-  const auto& order = grid_.order();
-  const auto& start = grid_.start();
+  CellGrid grid;  // freed before the contact lists build theirs (peak memory)
+  grid.build(p_.x, p_.y, p_.z, p_.n_owned, contact_cutoff_);
+  const auto& order = grid.order();
+  const auto& start = grid.start();
   std::vector<std::uint32_t> perm(order.begin(), order.end());
   const auto by_id = [&](std::uint32_t i, std::uint32_t j) { return p_.id[i] < p_.id[j]; };
   for (std::size_t c = 0; c + 1 < start.size(); ++c)

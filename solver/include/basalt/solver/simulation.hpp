@@ -193,7 +193,6 @@ class Simulation {
   Bonds<Real> bonds_;
   IdMap ids_;
   ForceField<Real> forces_;  ///< the models, their lists and the energy ledger
-  CellGrid grid_;            ///< the owned particles' cells for the canonical sort (rebuilds only)
   std::vector<BrokenBond> broken_;
   bool bond_broke_ = false;
 
