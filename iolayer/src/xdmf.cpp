@@ -12,6 +12,8 @@
 #include <tuple>
 #include <vector>
 
+#include "basalt/io/xml_escape.hpp"
+
 namespace basalt::io {
 
 namespace fs = std::filesystem;
@@ -56,29 +58,6 @@ std::string attribute(const std::string& h5, const char* name, const char* datas
   return fmt::format(
       "      <Attribute Name=\"{}\" AttributeType=\"{}\" Center=\"Node\">\n{}      </Attribute>\n", name,
       components == 3 ? "Vector" : "Scalar", data_item(h5, dataset, n, components, number_type, precision));
-}
-
-std::string xml_escape(const std::string& s) {
-  std::string out;
-  for (char ch : s) {
-    switch (ch) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += ch;
-    }
-  }
-  return out;
 }
 
 std::string document(const std::string& body) {

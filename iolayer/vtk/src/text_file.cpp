@@ -6,6 +6,7 @@
 #include <system_error>
 
 #include "basalt/io/geometry.hpp"
+#include "basalt/io/xml_escape.hpp"
 
 namespace basalt::io::detail {
 
@@ -45,30 +46,6 @@ void write_text_atomically(const fs::path& file, const std::string& text) {
     }
   }
   commit(tmp, file);
-}
-
-std::string xml_escape(const std::string& s) {
-  std::string out;
-  out.reserve(s.size());
-  for (char c : s) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
 }
 
 }  // namespace basalt::io::detail

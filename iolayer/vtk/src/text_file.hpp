@@ -3,6 +3,8 @@
 #include <filesystem>
 #include <string>
 
+#include "basalt/io/xml_escape.hpp"
+
 namespace basalt::io::detail {
 
 /// "<file>.partial": where a file is written before it is renamed to its final name.
@@ -13,6 +15,6 @@ void require_folder(const std::filesystem::path& file);
 void commit(const std::filesystem::path& tmp, const std::filesystem::path& file);
 /// Writes `text` to `file` through a temporary name; the final name never holds a partial file.
 void write_text_atomically(const std::filesystem::path& file, const std::string& text);
-std::string xml_escape(const std::string& s);
+using io::xml_escape;  // basalt/io/xml_escape.hpp, shared with the XDMF writer
 
 }  // namespace basalt::io::detail
