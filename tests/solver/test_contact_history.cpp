@@ -185,3 +185,64 @@ saturation = 20
                 dims[1], dims[2], worst, ages.size());
   }
 }
+
+TEST(ContactHistory, PairsGoToTheFirstGroupThatTakesThemAcrossModels) {
+  if (basalt::test::rank() != 0) return;
+  // Three spheres in a row, tags 0, 0, 1, squeezed together: with two contact models (linear_elastic
+  // for tags 0-0, test_contact_age with growth 0, i.e. the same law, for 0-1), each pair goes to the
+  // model of the first group that takes it, and the run equals one with linear_elastic for all pairs.
+  const std::string common = R"(
+[run]
+dt = 1e-3
+steps = 0
+skin = 0.05
+)";
+  const auto two_models = basalt::test::scene_from(common + R"(
+[[interactions]]
+type = "linear_elastic"
+K = 100.0
+tags = [0, 0]
+[[interactions]]
+type = "test_contact_age"
+K = 100.0
+growth = 0.0
+tags = [0, 1]
+)");
+  const auto one_model = basalt::test::scene_from(common + R"(
+[[interactions]]
+type = "linear_elastic"
+K = 100.0
+)");
+  basalt::io::Geometry g;
+  g.add_particle(1, {0, 0, 0}, 0.5, 0);
+  g.add_particle(2, {1.05, 0, 0}, 0.5, 0);
+  g.add_particle(3, {2.1, 0.1, 0}, 0.5, 1);
+  RunOptions opt;
+  opt.quiet = true;
+  Simulation<double> a(two_models, g, MPI_COMM_SELF, opt), b(one_model, g, MPI_COMM_SELF, opt);
+  ASSERT_EQ(a.force_computes().size(), 2u);
+  for (auto* sim : {&a, &b}) {
+    auto& p = sim->particles();
+    for (std::size_t i = 0; i < p.n_owned; ++i) p.vx[i] = p.id[i] == 1 ? 0.5 : (p.id[i] == 3 ? -0.5 : 0.0);
+    sim->state_changed();
+  }
+  std::size_t aged = 0;
+  for (int s = 0; s < 400; ++s) {
+    a.step();
+    b.step();
+    ContactRecords r;
+    a.force_computes()[1]->history_records(a.particles(), r);
+    aged = std::max(aged, r.size());
+    for (std::size_t k = 0; k < r.size(); ++k)  // only the 0-1 pair (ids 2 and 3) has an age
+      EXPECT_EQ(std::min(r.a[k], r.b[k]) * 10 + std::max(r.a[k], r.b[k]), 23) << "step " << s;
+  }
+  EXPECT_EQ(aged, 1u) << "the 0-1 pair must have touched";
+  const auto& pa = a.particles();
+  const auto& pb = b.particles();
+  for (std::size_t i = 0; i < pa.n_owned; ++i) {
+    std::size_t j = 0;
+    while (pb.id[j] != pa.id[i]) ++j;
+    EXPECT_NEAR(pa.x[i], pb.x[j], 1e-12) << "id " << pa.id[i];
+    EXPECT_NEAR(pa.vx[i], pb.vx[j], 1e-12) << "id " << pa.id[i];
+  }
+}
