@@ -20,23 +20,9 @@ namespace chk = basalt::packer::test;
 namespace {
 
 PackOptions options(double rmin, double rmax, std::uint64_t seed = 3) {
-  PackOptions o;
-  o.rmin = rmin;
-  o.rmax = rmax;
-  o.seed = seed;
-  return o;
+  return chk::options(rmin, rmax, seed);
 }
-
-/// The invariants every packing must satisfy, checked by brute force.
-void expect_valid(const Volume& v, const Packing& p, const PackOptions& o) {
-  ASSERT_GT(p.size(), 0u);
-  EXPECT_LE(chk::worst_overlap(p), o.overlap_tolerance) << v.description();
-  EXPECT_LE(chk::worst_protrusion(v, p), o.overlap_tolerance) << v.description();
-  for (double r : p.radius) {
-    EXPECT_GE(r, o.rmin * (1 - 1e-12));
-    EXPECT_LE(r, o.rmax * (1 + 1e-12));
-  }
-}
+using chk::expect_valid;
 
 std::string slurp(const fs::path& f) {
   std::ifstream in(f, std::ios::binary);

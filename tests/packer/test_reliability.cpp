@@ -19,22 +19,9 @@ namespace chk = basalt::packer::test;
 namespace {
 
 PackOptions options(double rmin, double rmax, std::uint64_t seed = 1) {
-  PackOptions o;
-  o.rmin = rmin;
-  o.rmax = rmax;
-  o.seed = seed;
-  return o;
+  return chk::options(rmin, rmax, seed);
 }
-
-void expect_valid(const Volume& v, const Packing& p, const PackOptions& o) {
-  ASSERT_GT(p.size(), 0u);
-  EXPECT_LE(chk::worst_overlap(p), o.overlap_tolerance) << v.description();
-  EXPECT_LE(chk::worst_protrusion(v, p), o.overlap_tolerance) << v.description();
-  for (double r : p.radius) {
-    EXPECT_GE(r, o.rmin * (1 - 1e-12));
-    EXPECT_LE(r, o.rmax * (1 + 1e-12));
-  }
-}
+using chk::expect_valid;
 
 std::string error_of(const std::function<void()>& f) {
   try {
