@@ -89,10 +89,16 @@ void Checkpoint::validate(const fs::path& source) const {
   for (std::size_t k = 0; k < nc; ++k) {
     if (contact_model[k] < 0)
       throw FormatError(source, "/contacts/model", fmt::format("contact {}: negative model index", k));
-    for (const auto pid : contact_ids[k])
-      if (!std::binary_search(ids.begin(), ids.end(), pid))
-        throw FormatError(source, "/contacts/ids",
-                          fmt::format("contact {}: particle id {} does not exist", k, pid));
+    if (!std::binary_search(ids.begin(), ids.end(), contact_ids[k][0]))
+      throw FormatError(source, "/contacts/ids",
+                        fmt::format("contact {}: particle id {} does not exist", k, contact_ids[k][0]));
+    // The second id is a particle, or a wall as -1 - its index (a particle touching a frictional wall).
+    const auto pid = contact_ids[k][1];
+    if (pid < 0 ? (-1 - pid) >= static_cast<std::int64_t>(walls.size())
+                : !std::binary_search(ids.begin(), ids.end(), pid))
+      throw FormatError(source, "/contacts/ids",
+                        fmt::format("contact {}: {} {} does not exist", k, pid < 0 ? "wall" : "particle id",
+                                    pid < 0 ? -1 - pid : pid));
   }
   for (double v : contact_history)
     if (!std::isfinite(v)) throw FormatError(source, "/contacts/history", "a history value is not finite");

@@ -16,6 +16,10 @@ ForceField<Real>::ForceField(const Scene& scene)
     if (c->kind() == ModelKind::bond) bond_compute_ = c.get();
     if (c->kind() == ModelKind::pair) pair_computes_.push_back(c.get());
   }
+  for (auto& c : computes_)  // pairs first, then walls: the order of the checkpoints' model index
+    if (c->kind() == ModelKind::pair && c->history_bytes() > 0) history_computes_.push_back(c.get());
+  for (auto& c : computes_)
+    if (c->kind() == ModelKind::wall && c->history_bytes() > 0) history_computes_.push_back(c.get());
   for (const auto& g : scene.contacts) {
     std::size_t k = 0;
     while (pair_computes_[k]->model() != g.model) ++k;
@@ -25,7 +29,7 @@ ForceField<Real>::ForceField(const Scene& scene)
   pairs_take_all_ = scene.contacts.size() == 1 && scene.contacts[0].tags.empty();
   // Checkpoints store all contact histories in one table of one width.
   std::size_t width = 0;
-  for (const auto* c : pair_computes_) {
+  for (const auto* c : history_computes_) {
     const auto b = c->history_bytes();
     if (b && width && b != width)
       throw InputError(
@@ -43,11 +47,21 @@ ForceField<Real>::ForceField(const Scene& scene)
   kinetic_term_ = static_cast<std::size_t>(ledger_.find("kinetic_energy"));
   wall_work_term_ = static_cast<std::size_t>(ledger_.find("wall_work_in"));
   for (const auto& c : computes_)
-    compute_term_.push_back(ledger_.add(c->energy_term(), Ledger::Kind::potential));
-  body_term_.assign(ledger_.size(), 0);
+    compute_term_.push_back(
+        c->energy_term().empty() ? kNoTerm : ledger_.add(c->energy_term(), Ledger::Kind::potential));
+  for (std::size_t k = 0; k < computes_.size(); ++k) {
+    computes_[k]->set_time_step(scene.dt);
+    const auto term = computes_[k]->dissipation_term();
+    if (!term.empty()) dissipation_.emplace_back(ledger_.add(term, Ledger::Kind::dissipated), k);
+  }
+  // A compute without a potential (damping) adds its zero to a slot past the ledger's terms.
+  for (auto& t : compute_term_)
+    if (t == kNoTerm) t = ledger_.size();
+  body_term_.assign(ledger_.size() + 1, 0);
   for (std::size_t k = 0; k < computes_.size(); ++k)
-    if (computes_[k]->kind() == ModelKind::body) body_term_[compute_term_[k]] = 1;
-  pe_.assign(ledger_.size(), 0.0);
+    if (computes_[k]->kind() == ModelKind::body && compute_term_[k] < ledger_.size())
+      body_term_[compute_term_[k]] = 1;
+  pe_.assign(ledger_.size() + 1, 0.0);
   for (std::size_t k = 0; k < scene.fields.size(); ++k) {
     const auto& f = scene.fields[k];
     if (f.type == FieldSpec::Type::energy && ledger_.find(f.term) < 0)
@@ -56,6 +70,14 @@ ForceField<Real>::ForceField(const Scene& scene)
           "that owns it)",
           k, f.term));
   }
+}
+
+template <class Real>
+double ForceField<Real>::dissipated(std::size_t t) const {
+  double d = 0;
+  for (const auto& [term, k] : dissipation_)
+    if (term == t) d += computes_[k]->dissipated();
+  return d;
 }
 
 template <class Real>
@@ -77,7 +99,7 @@ int ForceField<Real>::pair_taker(std::int64_t ti, std::int64_t tj) const {
 template <class Real>
 std::vector<ContactRecords*> ForceField<Real>::pending_history() const {
   std::vector<ContactRecords*> r;
-  for (auto* c : pair_computes_) r.push_back(c->pending());
+  for (auto* c : history_computes_) r.push_back(c->pending());
   return r;
 }
 
@@ -108,7 +130,11 @@ void ForceField<Real>::rebuild_lists(const Particles<Real>& p,
     grid_.release();
     ghost_grid_.release();
   }
-  if (!walls_.empty()) walls_.rebuild(p, skin);
+  if (!walls_.empty()) {
+    walls_.rebuild(p, skin);
+    for (auto& c : computes_)
+      if (c->kind() == ModelKind::wall) c->rebuild_walls(p, walls_);
+  }
 }
 
 template <class Real>

@@ -27,6 +27,23 @@ std::vector<T> sendrecv(MPI_Comm comm, const std::vector<T>& out, int dest, int 
   return in;
 }
 
+/// Writes a received ghost refresh (na values per particle, in step_arrays() order) to ghosts
+/// [begin, begin + n).
+template <class Real, class Arrays>
+void unpack_step(const std::vector<Real>& buf, const Arrays& arrays, std::size_t na, std::size_t begin,
+                 std::size_t n) {
+  if (na == 3) {  // positions only: the common case, kept a plain loop
+    for (std::size_t k = 0; k < n; ++k) {
+      (*arrays[0])[begin + k] = buf[3 * k];
+      (*arrays[1])[begin + k] = buf[3 * k + 1];
+      (*arrays[2])[begin + k] = buf[3 * k + 2];
+    }
+    return;
+  }
+  for (std::size_t k = 0; k < n; ++k)
+    for (std::size_t a = 0; a < na; ++a) (*arrays[a])[begin + k] = buf[na * k + a];
+}
+
 template <class Real>
 const std::vector<Real>& axis(const Particles<Real>& p, int d) {
   return d == 0 ? p.x : (d == 1 ? p.y : p.z);
@@ -200,6 +217,7 @@ template <class Real>
 void Halo<Real>::begin_update_ghosts(Particles<Real>& p) {
   const MPI_Comm comm = dec_.comm().raw();
   const MPI_Datatype type = sizeof(Real) == sizeof(double) ? MPI_DOUBLE : MPI_FLOAT;
+  const auto [arrays, na] = Particles<Real>::step_arrays(p);
   int last = -1;
   for (int d = 0; d < 3; ++d)
     if (dec_.dims()[d] > 1) last = d;
@@ -210,15 +228,22 @@ void Halo<Real>::begin_update_ghosts(Particles<Real>& p) {
       const auto& list = send_[d][side];
       auto& sbuf = d == last ? async_send_[side] : sbuf_;
       auto& rbuf = d == last ? async_recv_[side] : rbuf_;
-      sbuf.resize(3 * list.size());
-      for (std::size_t k = 0; k < list.size(); ++k) {
-        const auto i = list[k];
-        sbuf[3 * k] = p.x[i];
-        sbuf[3 * k + 1] = p.y[i];
-        sbuf[3 * k + 2] = p.z[i];
+      sbuf.resize(na * list.size());
+      if (na == 3) {  // positions only: the common case, kept a plain loop
+        for (std::size_t k = 0; k < list.size(); ++k) {
+          const auto i = list[k];
+          sbuf[3 * k] = p.x[i];
+          sbuf[3 * k + 1] = p.y[i];
+          sbuf[3 * k + 2] = p.z[i];
+        }
+      } else {
+        for (std::size_t k = 0; k < list.size(); ++k) {
+          const auto i = static_cast<std::size_t>(list[k]);
+          for (std::size_t a = 0; a < na; ++a) sbuf[na * k + a] = (*arrays[a])[i];
+        }
       }
       const std::size_t nin = recv_count_[d][1 - side], begin = recv_begin_[d][1 - side];
-      rbuf.resize(3 * nin);
+      rbuf.resize(na * nin);
       const int dest = dec_.neighbor(d, side), src = dec_.neighbor(d, 1 - side);
       if (d == last) {
         MPI_Irecv(rbuf.data(), static_cast<int>(rbuf.size()), type, src, 21 + side, comm,
@@ -229,11 +254,7 @@ void Halo<Real>::begin_update_ghosts(Particles<Real>& p) {
       }
       MPI_Sendrecv(sbuf.data(), static_cast<int>(sbuf.size()), type, dest, 21, rbuf.data(),
                    static_cast<int>(rbuf.size()), type, src, 21, comm, MPI_STATUS_IGNORE);
-      for (std::size_t k = 0; k < nin; ++k) {
-        p.x[begin + k] = rbuf[3 * k];
-        p.y[begin + k] = rbuf[3 * k + 1];
-        p.z[begin + k] = rbuf[3 * k + 2];
-      }
+      unpack_step(rbuf, arrays, na, begin, nin);
     }
   }
 }
@@ -250,14 +271,10 @@ void Halo<Real>::end_update_ghosts(Particles<Real>& p) {
   const int d = async_axis_;
   if (d < 0) return;
   MPI_Waitall(4, requests_.data(), MPI_STATUSES_IGNORE);
+  const auto [arrays, na] = Particles<Real>::step_arrays(p);
   for (int side = 0; side < 2; ++side) {
     const std::size_t nin = recv_count_[d][1 - side], begin = recv_begin_[d][1 - side];
-    const auto& rbuf = async_recv_[side];
-    for (std::size_t k = 0; k < nin; ++k) {
-      p.x[begin + k] = rbuf[3 * k];
-      p.y[begin + k] = rbuf[3 * k + 1];
-      p.z[begin + k] = rbuf[3 * k + 2];
-    }
+    unpack_step(async_recv_[side], arrays, na, begin, nin);
   }
   async_axis_ = -1;
 }

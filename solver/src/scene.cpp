@@ -2,9 +2,11 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -92,6 +94,14 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
     t.finish();
   }
 
+  std::optional<bool> rotation;
+  if (const auto* m = top.subtable("particles")) {
+    TableReader t(*m, label, "particles");
+    if (t.has("rotation")) rotation = t.boolean_or("rotation", false);
+    s.fixed_tags = t.integers_or("fixed_tags", {});
+    t.finish();
+  }
+
   {
     const auto* r = top.subtable("run");
     if (!r) top.fail("run", "missing (required): a [run] table with dt, steps, skin");
@@ -135,6 +145,23 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
       (bond ? s.bonds : s.contacts).push_back(std::move(g));
       t.finish();
     }
+  }
+
+  // Rotation: on when a model needs it, unless the scene turned it off (then that model is refused).
+  {
+    const InteractionSpec* needs = nullptr;
+    for (const auto* list : {&s.bonds, &s.contacts})
+      for (const auto& g : *list) {
+        const ModelEntry* m = find_model(g.model, g.kind);
+        if (m && (m->reads & kAngularVelocity) && !needs) needs = &g;
+      }
+    if (needs && rotation == false)
+      throw InputError(
+          fmt::format("{}: particles.rotation = false, but interaction \"{}\" (type \"{}\") needs rotating "
+                      "particles: set "
+                      "particles.rotation = true or choose a non-rotating model",
+                      label, needs->name, needs->model));
+    s.rotation = rotation.value_or(needs != nullptr);
   }
 
   if (const auto* arr = top.table_array("walls")) {
@@ -197,7 +224,9 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
         // An energy term of the ledger (those every scene has, and the body forces'), or another saver.
         std::vector<std::string> allowed = standard_energy_terms();
         for (const auto& m : model_registry())
-          if (!m.energy_term.empty()) allowed.emplace_back(m.energy_term);
+          for (const auto term : {m.energy_term, m.dissipation_term})
+            if (!term.empty() && std::find(allowed.begin(), allowed.end(), term) == allowed.end())
+              allowed.emplace_back(term);
         for (const char* other : {"total_energy", "bond_count", "wall_force"}) allowed.emplace_back(other);
         FieldSpec f;
         const std::string type = tf.choice_or("type", allowed, "");

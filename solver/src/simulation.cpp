@@ -34,8 +34,7 @@ bool tags_match(const TagFilter& t, std::int64_t ta, std::int64_t tb) {
 template <class Real>
 Simulation<Real>::Simulation(const Scene& scene, io::Geometry g, MPI_Comm comm, const RunOptions& options)
     : scene_(scene), options_(options), forces_(scene) {
-  p_.with_exact_rebuild = scene.checkpoint_every > 0;
-  p_.with_damage = forces_.bonds_can_break();
+  configure_particles();
   if (g.size() == 0)
     throw InputError(fmt::format("{}: the geometry has no particles", scene.geometry.string()));
   if (scene.bonds.size() > 254) throw InputError("interactions: at most 254 bond groups");
@@ -51,8 +50,17 @@ Simulation<Real>::Simulation(const Scene& scene, io::Geometry g, MPI_Comm comm, 
 }
 
 template <class Real>
+void Simulation<Real>::configure_particles() {
+  // The optional field groups this scene needs (Particles::enabled()): nothing else is allocated.
+  p_.with_exact_rebuild = scene_.checkpoint_every > 0;
+  p_.with_damage = forces_.bonds_can_break();
+  p_.with_rotation = scene_.rotation;
+  p_.ghost_velocity = forces_.needs_ghost_velocity();
+}
+
+template <class Real>
 double Simulation<Real>::kinetic_energy_local() const {
-  return ke_fresh_ ? ke_local_ : basalt::solver::kinetic_energy(p_);
+  return (ke_fresh_ ? ke_local_ : basalt::solver::kinetic_energy(p_)) + rotational_energy(p_);
 }
 
 template <class Real>
@@ -212,9 +220,19 @@ const std::vector<double>& Simulation<Real>::compute_forces(bool ghosts_in_fligh
     ghost_wait_ += sw.lap();
   }
   forces_.add(state, Part::ghost, Energy, advance, [] {});
+  hold_fixed();
   if (broken_.size() != before) bond_broke_ = true;  // the lists must learn the pair is now unbonded
   for (std::size_t k = before; k < broken_.size(); ++k) broken_[k].step = step_;
   return forces_.potentials();
+}
+
+template <class Real>
+void Simulation<Real>::hold_fixed() {
+  // Fixed particles feel forces (walls and savers see them) but neither kick moves or turns them.
+  for (const auto i : fixed_) {
+    p_.fx[i] = p_.fy[i] = p_.fz[i] = 0;
+    if (p_.with_rotation) p_.tx[i] = p_.ty[i] = p_.tz[i] = 0;
+  }
 }
 
 template <class Real>
@@ -246,6 +264,7 @@ void Simulation<Real>::step(FieldSink* sink) {
   // Forces are zeroed in the same pass: the non-finite check needs them only at a rebuild, and a
   // non-finite force has already made the velocity non-finite.
   const double moved2 = kick_zero_drift(p_, kick1_, Real(scene_.dt));
+  if (p_.with_rotation) rotate_kick_zero_drift(p_, kick1_, Real(scene_.dt));
   forces_zeroed_ = true;
   times_.integration += sw.lap();
   const bool parallel = comm().size() > 1;
@@ -274,6 +293,7 @@ void Simulation<Real>::step(FieldSink* sink) {
   times_.forces += force_time - ghost_wait_;
   times_.communication += ghost_wait_;
   if (kick2_ != Real(0)) {
+    if (p_.with_rotation) rotate_kick(p_, kick2_);
     if (kinetic_due(step_)) {
       ke_local_ = kick_energy(p_, kick2_);
       ke_fresh_ = true;

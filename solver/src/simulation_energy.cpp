@@ -14,6 +14,7 @@ template <class Real>
 double Simulation<Real>::term_value(std::size_t t, const std::vector<double>& pe) const {
   if (t == forces_.kinetic_term()) return kinetic_energy_local();
   if (t == forces_.wall_work_term()) return wall_work_in_;
+  if (forces_.ledger()[t].kind == Ledger::Kind::dissipated) return forces_.dissipated(t);
   return pe[t];
 }
 

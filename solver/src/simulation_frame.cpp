@@ -25,7 +25,7 @@ SimulationFrame<Real>::SimulationFrame(const Simulation<Real>& sim, std::uint32_
   for (std::size_t k = bonds.n_both_owned; k < bonds.size(); ++k) m += owns_ghost_bond(k) ? 1 : 0;
   h.bonds = m;
   if (kinds & io::kFrameCheckpoint)
-    for (const auto* c : sim.forces_.pair_computes())
+    for (const auto* c : sim.forces_.history_computes())
       if (c->history_bytes() > 0) {
         history_.emplace_back();
         c->history_records(p, history_.back());

@@ -17,7 +17,9 @@ std::optional<std::string> Simulation<Real>::check_finite() const {
   for (std::size_t i = 0; i < p_.n_owned; ++i) {
     const bool ok = std::isfinite(p_.x[i]) && std::isfinite(p_.y[i]) && std::isfinite(p_.z[i]) &&
                     std::isfinite(p_.vx[i]) && std::isfinite(p_.vy[i]) && std::isfinite(p_.vz[i]) &&
-                    std::isfinite(p_.fx[i]) && std::isfinite(p_.fy[i]) && std::isfinite(p_.fz[i]);
+                    std::isfinite(p_.fx[i]) && std::isfinite(p_.fy[i]) && std::isfinite(p_.fz[i]) &&
+                    (!p_.with_rotation ||
+                     (std::isfinite(p_.wx[i]) && std::isfinite(p_.wy[i]) && std::isfinite(p_.wz[i])));
     if (!ok)
       return fmt::format(
           "step {}: particle id {} went non-finite: position ({}, {}, {}), velocity ({}, {}, {}), force ({}, "
@@ -116,6 +118,11 @@ void Simulation<Real>::rebuild() {
     p_.yr.assign(p_.y.begin(), p_.y.begin() + static_cast<std::ptrdiff_t>(p_.n_owned));
     p_.zr.assign(p_.z.begin(), p_.z.begin() + static_cast<std::ptrdiff_t>(p_.n_owned));
   }
+  fixed_.clear();
+  if (!scene_.fixed_tags.empty())
+    for (std::size_t i = 0; i < p_.n_owned; ++i)
+      if (std::find(scene_.fixed_tags.begin(), scene_.fixed_tags.end(), p_.tag[i]) != scene_.fixed_tags.end())
+        fixed_.push_back(static_cast<std::uint32_t>(i));
   rebuild_step_ = step_;
   bond_broke_ = false;
   ++rebuilds_;

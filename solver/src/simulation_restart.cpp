@@ -18,8 +18,7 @@ template <class Real>
 Simulation<Real>::Simulation(const Scene& scene, const io::Checkpoint& c, const RestartLayout& layout,
                              MPI_Comm comm, const RunOptions& options)
     : scene_(scene), options_(options), forces_(scene) {
-  p_.with_exact_rebuild = scene.checkpoint_every > 0;
-  p_.with_damage = forces_.bonds_can_break();
+  configure_particles();
   if (c.size() == 0) throw InputError("the checkpoint has no particles");
   if (scene.bonds.size() > 254) throw InputError("interactions: at most 254 bond groups");
   if (c.dt != scene.dt)
@@ -108,7 +107,7 @@ void Simulation<Real>::distribute_checkpoint(const io::Checkpoint& c, const Rest
   // Contact history of the contacts with an owned end waits for the (replayed) rebuild to find
   // their pairs in the lists.
   std::vector<ContactRecords*> history;
-  for (auto* pc : forces_.pair_computes())
+  for (auto* pc : forces_.history_computes())
     if (pc->pending()) history.push_back(pc->pending());
   for (std::size_t k = 0; k < c.contact_ids.size(); ++k) {
     const auto model = static_cast<std::size_t>(c.contact_model[k]);

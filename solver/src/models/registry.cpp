@@ -13,7 +13,9 @@
 #include "basalt/solver/interactions/pair_driver.hpp"
 #include "basalt/solver/interactions/wall_driver.hpp"
 #include "basalt/solver/models/contact_age.hpp"
+#include "basalt/solver/models/damping.hpp"
 #include "basalt/solver/models/elastic_wall.hpp"
+#include "basalt/solver/models/friction.hpp"
 #include "basalt/solver/models/gravity.hpp"
 #include "basalt/solver/models/linear_bond.hpp"
 #include "basalt/solver/models/linear_elastic.hpp"
@@ -40,6 +42,14 @@ constexpr std::string_view energy_term_of() {
 }
 
 template <class Model>
+constexpr std::string_view dissipation_term_of() {
+  if constexpr (requires { Model::dissipation_term; })
+    return Model::dissipation_term;
+  else
+    return {};
+}
+
+template <class Model>
 ModelEntry entry() {
   return {Model::name,
           Model::kind,
@@ -49,6 +59,7 @@ ModelEntry entry() {
           Model::writes,
           history_bytes<Model>(),
           energy_term_of<Model>(),
+          dissipation_term_of<Model>(),
           [](TableReader& t) { return std::any(Model::parse(t)); },
           &make<double, Model>,
           &make<float, Model>};
@@ -58,11 +69,17 @@ ModelEntry entry() {
 
 const std::vector<ModelEntry>& model_registry() {
   static const std::vector<ModelEntry> models{
-      entry<LinearBond>(),     // bond
-      entry<LinearElastic>(),  // pair
-      entry<ContactAge>(),     // pair, test model for contact history
-      entry<ElasticWall>(),    // wall
-      entry<Gravity>(),        // body force
+      entry<LinearBond>(),         // bond
+      entry<LinearElastic>(),      // pair
+      entry<ContactAge>(),         // pair, test model for contact history
+      entry<Friction>(),           // pair, ESyS NRotFriction
+      entry<RotFriction>(),        // pair, ESyS RotFriction
+      entry<ElasticWall>(),        // wall
+      entry<FrictionWall>(),       // wall, with Coulomb friction
+      entry<Gravity>(),            // body force
+      entry<LinearDamping>(),      // body force, ESyS LinDamping
+      entry<RotationalDamping>(),  // body force, ESyS RotDamping
+      entry<LocalDamping>(),       // body force, Cundall
   };
   return models;
 }
@@ -87,7 +104,10 @@ std::string field_names(Fields f) {
                                                               {kRadius, "radius"},
                                                               {kInverseMass, "inverse_mass"},
                                                               {kId, "id"},
-                                                              {kTag, "tag"}};
+                                                              {kTag, "tag"},
+                                                              {kAngularVelocity, "angular_velocity"},
+                                                              {kTorque, "torque"},
+                                                              {kOrientation, "orientation"}};
   std::string s;
   for (const auto& [bit, name] : kNames)
     if (f & bit) s += (s.empty() ? "" : ", ") + std::string(name);
@@ -106,6 +126,7 @@ std::string describe_models() {
       s += fmt::format("  {}\n    {}\n", m.name, m.summary);
       for (const auto& k : m.keys) s += fmt::format("    {:<14} {}\n", k.key, k.doc);
       if (!m.energy_term.empty()) s += fmt::format("    energy term: {}\n", m.energy_term);
+      if (!m.dissipation_term.empty()) s += fmt::format("    dissipation term: {}\n", m.dissipation_term);
       s += fmt::format("    reads: {}; writes: {}; per-contact history: {}\n", field_names(m.reads),
                        field_names(m.writes),
                        m.history_bytes ? fmt::format("{} B", m.history_bytes) : std::string("none"));

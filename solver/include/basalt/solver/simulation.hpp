@@ -135,6 +135,10 @@ class Simulation {
   /// With BASALT_FRAME_TIMES=1: prints this rank's median/min/max time to pack and submit a frame.
   void report_frame_times(std::vector<double> seconds) const;
   void distribute(io::Geometry& g, MPI_Comm comm);
+  /// Which optional particle fields the scene needs (both constructors, before any particle exists).
+  void configure_particles();
+  /// Zeroes the forces and torques of fixed particles (scene particles.fixed_tags).
+  void hold_fixed();
   double kinetic_energy_local() const;
   /// Bonds of this rank counted once across ranks (a bond to a ghost by the rank owning the lower id).
   std::int64_t local_bond_count() const;
@@ -194,6 +198,7 @@ class Simulation {
   IdMap ids_;
   ForceField<Real> forces_;  ///< the models, their lists and the energy ledger
   std::vector<BrokenBond> broken_;
+  std::vector<std::uint32_t> fixed_;  ///< owned particles of a fixed tag (from the last rebuild)
   bool bond_broke_ = false;
 
   Real kick1_ = 0, kick2_ = 0;

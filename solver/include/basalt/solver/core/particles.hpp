@@ -9,6 +9,7 @@
 // out. Growing, reordering and removing particles, migration and ghost records, the memory report
 // and the "fields:" line at start are all derived from that list: a new per-particle array is one
 // member plus one line there.
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -20,7 +21,7 @@
 namespace basalt::solver {
 
 /// Groups of arrays a scene may leave out (Particles::enabled()).
-enum class FieldGroup { core, exact_rebuild, damage };
+enum class FieldGroup { core, exact_rebuild, damage, rotation };
 
 /// What an array of Particles is (for_each_array()).
 struct ArrayInfo {
@@ -55,11 +56,22 @@ struct Particles {
   /// how many of them broke; damage = bonds_broken / bonds_initial (frames, checkpoints).
   std::vector<std::int32_t> bonds_initial, bonds_broken;
   bool with_damage = false;
+  /// Optional (with_rotation: the scene's particles rotate, ESyS "RotSphere"): angular velocity,
+  /// torque and orientation (unit quaternion w + xi + yj + zk, identity at the start). The moment of
+  /// inertia is that of a solid sphere, 2/5 m r^2 (inverse_inertia(i)): nothing is stored for it.
+  std::vector<Real> wx, wy, wz;
+  std::vector<Real> tx, ty, tz;
+  std::vector<Real> qw, qx, qy, qz;
+  bool with_rotation = false;
+  /// Ghosts carry velocities (and angular velocities with rotation), refreshed every step with their
+  /// positions: set when a model reads the velocities of both particles of a pair (friction, damping).
+  bool ghost_velocity = false;
 
   /// Whether the arrays of a group are allocated.
   bool enabled(const ArrayInfo& a) const {
     return a.group == FieldGroup::core || (a.group == FieldGroup::exact_rebuild && with_exact_rebuild) ||
-           (a.group == FieldGroup::damage && with_damage);
+           (a.group == FieldGroup::damage && with_damage) ||
+           (a.group == FieldGroup::rotation && with_rotation);
   }
 
   /// Calls f(ArrayInfo, vector&) for every array, in a fixed order.
@@ -73,6 +85,17 @@ struct Particles {
   }
 
   Real mass(std::size_t i) const { return Real(1) / inv_mass[i]; }
+  /// 1 / I for a solid sphere, I = 2/5 m r^2.
+  Real inverse_inertia(std::size_t i) const { return Real(2.5) * inv_mass[i] / (radius[i] * radius[i]); }
+
+  /// The arrays a ghost refresh sends every step, in order: positions, then with ghost_velocity the
+  /// velocities and (with rotation) angular velocities.
+  template <class P>
+  static auto step_arrays(P& p) {
+    std::array<decltype(&p.x), 9> a{&p.x, &p.y, &p.z, &p.vx, &p.vy, &p.vz, &p.wx, &p.wy, &p.wz};
+    const std::size_t n = !p.ghost_velocity ? 3 : (p.with_rotation ? 9 : 6);
+    return std::pair{a, n};
+  }
 
   std::size_t size() const { return x.size(); }
   std::size_t n_ghost() const { return x.size() - n_owned; }
@@ -114,6 +137,7 @@ struct Particles {
     vy[i] = pvy;
     vz[i] = pvz;
     inv_mass[i] = im;
+    if (with_rotation) qw[i] = 1;
     x0[i] = float(px);
     y0[i] = float(py);
     z0[i] = float(pz);
@@ -188,12 +212,22 @@ struct Particles {
   static void for_each(P& p, F& f) {
     using G = FieldGroup;
     constexpr ArrayInfo pos{"position", true, true, G::core}, rad{"radius", true, true, G::core},
-        ident{"id", true, true, G::core}, tg{"tag", true, true, G::core},
-        vel{"velocity", false, true, G::core}, frc{"force", false, false, G::core},
+        ident{"id", true, true, G::core}, tg{"tag", true, true, G::core}, frc{"force", false, false, G::core},
         im{"inverse_mass", false, true, G::core}, ref{"skin_reference", false, false, G::core},
         exact{"position_at_rebuild", false, false, G::exact_rebuild},
         initial{"bond_damage", false, true, G::damage, "bonds_initial"},
-        broken{"bond_damage", false, true, G::damage, "bonds_broken"};
+        broken{"bond_damage", false, true, G::damage, "bonds_broken"},
+        trq{"torque", false, false, G::rotation},
+        ori{"orientation", false, true, G::rotation, "orientation_w"},
+        ori_x{"orientation", false, true, G::rotation, "orientation_x"},
+        ori_y{"orientation", false, true, G::rotation, "orientation_y"},
+        ori_z{"orientation", false, true, G::rotation, "orientation_z"};
+    // Velocities go to ghosts when a model reads both particles' velocities.
+    const bool gv = p.ghost_velocity;
+    const ArrayInfo vel{"velocity", gv, true, G::core},
+        ang_x{"angular_velocity", gv, true, G::rotation, "angular_velocity_x"},
+        ang_y{"angular_velocity", gv, true, G::rotation, "angular_velocity_y"},
+        ang_z{"angular_velocity", gv, true, G::rotation, "angular_velocity_z"};
     f(pos, p.x), f(pos, p.y), f(pos, p.z);
     f(rad, p.radius);
     f(ident, p.id);
@@ -204,6 +238,9 @@ struct Particles {
     f(ref, p.x0), f(ref, p.y0), f(ref, p.z0);
     f(exact, p.xr), f(exact, p.yr), f(exact, p.zr);
     f(initial, p.bonds_initial), f(broken, p.bonds_broken);
+    f(ang_x, p.wx), f(ang_y, p.wy), f(ang_z, p.wz);
+    f(trq, p.tx), f(trq, p.ty), f(trq, p.tz);
+    f(ori, p.qw), f(ori_x, p.qx), f(ori_y, p.qy), f(ori_z, p.qz);
   }
 };
 

@@ -1,6 +1,8 @@
 #pragma once
-// Loops a body-force model (a force on each particle from its own state: gravity, ...) over the owned
-// particles its groups take (by tag). Ghosts get nothing: each rank applies it to its own particles.
+// Loops a body-force model (a force on each particle from its own state: gravity, damping) over the
+// owned particles its groups take (by tag). Ghosts get nothing: each rank applies it to its own
+// particles. Body forces run last, in the ghost part of the step, so that a model that reads the
+// force (local damping) sees every other model's share.
 #include <algorithm>
 #include <string_view>
 #include <vector>
@@ -24,37 +26,64 @@ class BodyDriver final : public ForceCompute<Real> {
   }
 
   std::string_view model() const override { return Model::name; }
+  Fields reads() const override { return Model::reads; }
   ModelKind kind() const override { return ModelKind::body; }
   std::string_view energy_term() const override { return Model::energy_term; }
+  std::string_view dissipation_term() const override { return Model::dissipation_term; }
+  double dissipated() const override { return dissipated_; }
+  void set_dissipated(double d) override { dissipated_ = d; }
+  void set_time_step(double dt) override { dt_ = Real(dt); }
   double max_stiffness(double) const override { return 0; }
 
-  double compute(ForceState<Real>& s, Part part, bool energy, bool) override {
-    if (part != Part::owned) return 0;
-    return energy ? loop<true>(s.p) : loop<false>(s.p);
+  double compute(ForceState<Real>& s, Part part, bool energy, bool advance) override {
+    if (part != Part::ghost) return 0;
+    if (advance) return energy ? loop<true, true>(s.p) : loop<false, true>(s.p);
+    return energy ? loop<true, false>(s.p) : loop<false, false>(s.p);
   }
 
  private:
-  template <bool Energy>
-  double loop(Particles<Real>& p) const {
-    double e = 0;
+  template <bool Energy, bool Advance>
+  double loop(Particles<Real>& p) {
+    double e = 0, d = 0;
+    const bool rot = p.with_rotation;
+    BodyState<Real> b{};
+    b.dt = dt_;
     for (std::size_t g = 0; g < coeffs_.size(); ++g) {
       const auto& c = coeffs_[g];
       const auto& tags = tags_[g];
       for (std::size_t i = 0; i < p.n_owned; ++i) {
         if (!tags.empty() && std::find(tags.begin(), tags.end(), p.tag[i]) == tags.end()) continue;
-        const Real m = p.mass(i);
-        const auto f = Model::force(c, m, p.x[i], p.y[i], p.z[i]);
-        p.fx[i] += f[0];
-        p.fy[i] += f[1];
-        p.fz[i] += f[2];
-        if constexpr (Energy) e += double(Model::energy(c, m, p.x[i], p.y[i], p.z[i]));
+        b.m = p.mass(i);
+        b.x = p.x[i], b.y = p.y[i], b.z = p.z[i];
+        b.vx = p.vx[i], b.vy = p.vy[i], b.vz = p.vz[i];
+        b.fx = p.fx[i], b.fy = p.fy[i], b.fz = p.fz[i];
+        if (rot) {
+          b.inertia = Real(1) / p.inverse_inertia(i);
+          b.wx = p.wx[i], b.wy = p.wy[i], b.wz = p.wz[i];
+          b.tx = p.tx[i], b.ty = p.ty[i], b.tz = p.tz[i];
+        }
+        BodyForce<Real> f;
+        Model::apply(c, b, f);
+        p.fx[i] += f.fx;
+        p.fy[i] += f.fy;
+        p.fz[i] += f.fz;
+        if (rot) {
+          p.tx[i] += f.tx;
+          p.ty[i] += f.ty;
+          p.tz[i] += f.tz;
+        }
+        if constexpr (Advance) d += f.dissipated;
+        if constexpr (Energy) e += double(Model::energy(c, b));
       }
     }
+    dissipated_ += d;
     return e;
   }
 
   std::vector<Coeffs> coeffs_;
   std::vector<TagFilter> tags_;
+  double dissipated_ = 0;
+  Real dt_ = 0;
 };
 
 }  // namespace basalt::solver

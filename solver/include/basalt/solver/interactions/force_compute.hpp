@@ -53,6 +53,8 @@ class ForceCompute {
   virtual ~ForceCompute() = default;
   virtual std::string_view model() const = 0;
   virtual ModelKind kind() const = 0;
+  /// The particle fields its model reads (models/model.hpp).
+  virtual Fields reads() const { return kNoFields; }
   /// The energy-ledger term its potential energy goes to.
   virtual std::string_view energy_term() const {
     switch (kind()) {
@@ -66,6 +68,13 @@ class ForceCompute {
         return "body_potential_energy";
     }
   }
+  /// The ledger term the energy it dissipates goes to ("" when it dissipates none).
+  virtual std::string_view dissipation_term() const { return {}; }
+  /// This rank's share of the energy dissipated since the start (or the last set_dissipated()).
+  virtual double dissipated() const { return 0; }
+  virtual void set_dissipated(double) {}
+  /// The run's time step (models that integrate over a step: tangential springs, damping).
+  virtual void set_time_step(double) {}
   /// Largest spring constant for particles up to radius rmax (critical time step).
   virtual double max_stiffness(double rmax) const = 0;
   /// Adds forces of one part; returns the potential energy when `energy`. `advance`: a real step, so
@@ -75,6 +84,8 @@ class ForceCompute {
   // Pair models: the lists after a rebuild, and the contact history across it.
   /// Pair compute number `index` takes its pairs from the rebuilt lists and their history from pending().
   virtual void rebuild(const PairLists<Real>&, std::size_t /*index*/) {}
+  /// Wall models: the walls' candidates were rebuilt; their history comes from pending().
+  virtual void rebuild_walls(const Particles<Real>&, const Walls&) {}
   /// Before a rebuild (ghosts still present): the history of listed contacts into pending().
   virtual void save_history(const Particles<Real>&) {}
   /// Records waiting for the next rebuild (carried by migration, filled by a restart); null: no history.

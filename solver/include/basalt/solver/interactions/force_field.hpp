@@ -27,7 +27,16 @@ class ForceField {
 
   const std::vector<std::unique_ptr<ForceCompute<Real>>>& computes() const { return computes_; }
   const std::vector<ForceCompute<Real>*>& pair_computes() const { return pair_computes_; }
+  /// The computes that keep contact history (pair models, then wall models): a checkpoint's contact
+  /// model index counts these.
+  const std::vector<ForceCompute<Real>*>& history_computes() const { return history_computes_; }
   bool has_pairs() const { return !pair_computes_.empty(); }
+  /// Whether a pair model reads velocities (then ghosts carry them, Particles::ghost_velocity).
+  bool needs_ghost_velocity() const {
+    for (const auto* c : pair_computes_)
+      if (c->reads() & kVelocity) return true;
+    return false;
+  }
   /// Largest spring constant over the models for radii up to rmax.
   double max_stiffness(double rmax) const;
   /// Rest length of a new bond of group g (the bond model's rule); r without bond models.
@@ -45,6 +54,8 @@ class ForceField {
   const Ledger& ledger() const { return ledger_; }
   std::size_t kinetic_term() const { return kinetic_term_; }
   std::size_t wall_work_term() const { return wall_work_term_; }
+  /// This rank's energy dissipated so far into ledger term t (of kind dissipated).
+  double dissipated(std::size_t t) const;
   /// Whether ledger term t is a body force's potential.
   bool body_term(std::size_t t) const { return body_term_[t] != 0; }
   /// This rank's potentials by ledger term, from the last add() with energy since zero_energies().
@@ -69,7 +80,7 @@ class ForceField {
   // Rebuilds.
   /// Before a rebuild (ghosts still present): contact histories into the pending records.
   void save_history(const Particles<Real>& p) {
-    for (auto* c : pair_computes_) c->save_history(p);
+    for (auto* c : history_computes_) c->save_history(p);
   }
   /// The pending records of each pair compute (null: no history), for migration and restarts.
   std::vector<ContactRecords*> pending_history() const;
@@ -87,6 +98,7 @@ class ForceField {
   std::vector<std::unique_ptr<ForceCompute<Real>>> computes_;
   ForceCompute<Real>* bond_compute_ = nullptr;
   std::vector<ForceCompute<Real>*> pair_computes_;
+  std::vector<ForceCompute<Real>*> history_computes_;
   std::vector<TagFilter> pair_group_tags_;  ///< each scene pair group's tags
   std::vector<int> pair_group_compute_;     ///< each scene pair group's compute in pair_computes_
   bool pairs_take_all_ = false;             ///< one pair group, every tag
@@ -97,7 +109,9 @@ class ForceField {
   Ledger ledger_;
   std::vector<std::size_t> compute_term_;  ///< the ledger term of each compute's potential
   std::size_t kinetic_term_ = 0, wall_work_term_ = 0;
+  static constexpr std::size_t kNoTerm = std::size_t(-1);
   std::vector<char> body_term_;
+  std::vector<std::pair<std::size_t, std::size_t>> dissipation_;  ///< (ledger term, compute) pairs
   std::vector<double> pe_;
 };
 

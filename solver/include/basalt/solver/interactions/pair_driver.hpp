@@ -22,6 +22,9 @@ class PairDriver final : public ForceCompute<Real> {
   using Coeffs = typename Model::template Coeffs<Real>;
   using History = typename Model::History;
   static constexpr bool kHistory = basalt::solver::history_bytes<Model>() > 0;
+  /// A model reading velocities gets the pair's kinematics and returns a force vector and torques
+  /// (loop_kinematic); the others a scalar force along the line of centres (loop).
+  static constexpr bool kKinematic = (Model::reads & kVelocity) != 0;
 
   /// Takes the scene's pair groups of model Model.
   explicit PairDriver(const std::vector<InteractionSpec>& groups) {
@@ -36,6 +39,7 @@ class PairDriver final : public ForceCompute<Real> {
   }
 
   std::string_view model() const override { return Model::name; }
+  Fields reads() const override { return Model::reads; }
   ModelKind kind() const override { return ModelKind::pair; }
   double max_stiffness(double rmax) const override {
     double m = 0;
@@ -52,6 +56,14 @@ class PairDriver final : public ForceCompute<Real> {
   }
   /// One group for every pair of tags.
   bool takes_all() const { return uniform_; }
+
+  std::string_view dissipation_term() const override {
+    if constexpr (kKinematic) return Model::dissipation_term;
+    return {};
+  }
+  double dissipated() const override { return dissipated_; }
+  void set_dissipated(double d) override { dissipated_ = d; }
+  void set_time_step(double dt) override { dt_ = Real(dt); }
 
   double compute(ForceState<Real>& s, Part part, bool energy, bool advance) override {
     const bool own = part == Part::owned;
@@ -103,21 +115,29 @@ class PairDriver final : public ForceCompute<Real> {
 
  private:
   template <bool Newton>
-  double dispatch(Particles<Real>& p, const PairList& list, History* h, bool energy, bool advance) const {
-    if constexpr (kHistory) {
-      if (advance) {
-        if (uniform_)
-          return energy ? loop<true, true, Newton, true>(p, list, h)
-                        : loop<false, true, Newton, true>(p, list, h);
-        return energy ? loop<true, false, Newton, true>(p, list, h)
-                      : loop<false, false, Newton, true>(p, list, h);
+  double dispatch(Particles<Real>& p, const PairList& list, History* h, bool energy, bool advance) {
+    if constexpr (kKinematic) {
+      if (advance)
+        return energy ? loop_kinematic<true, Newton, true>(p, list, h)
+                      : loop_kinematic<false, Newton, true>(p, list, h);
+      return energy ? loop_kinematic<true, Newton, false>(p, list, h)
+                    : loop_kinematic<false, Newton, false>(p, list, h);
+    } else {
+      if constexpr (kHistory) {
+        if (advance) {
+          if (uniform_)
+            return energy ? loop<true, true, Newton, true>(p, list, h)
+                          : loop<false, true, Newton, true>(p, list, h);
+          return energy ? loop<true, false, Newton, true>(p, list, h)
+                        : loop<false, false, Newton, true>(p, list, h);
+        }
       }
+      if (uniform_)
+        return energy ? loop<true, true, Newton, false>(p, list, h)
+                      : loop<false, true, Newton, false>(p, list, h);
+      return energy ? loop<true, false, Newton, false>(p, list, h)
+                    : loop<false, false, Newton, false>(p, list, h);
     }
-    if (uniform_)
-      return energy ? loop<true, true, Newton, false>(p, list, h)
-                    : loop<false, true, Newton, false>(p, list, h);
-    return energy ? loop<true, false, Newton, false>(p, list, h)
-                  : loop<false, false, Newton, false>(p, list, h);
   }
 
   template <bool Energy, bool Uniform, bool Newton, bool Advance>
@@ -169,6 +189,89 @@ class PairDriver final : public ForceCompute<Real> {
       fy[i] += fyi;
       fz[i] += fzi;
     }
+    return energy;
+  }
+
+  /// Velocity-dependent models: the pair's kinematics in, a force vector, its point of action and a
+  /// couple out; torques only when the particles rotate. Dissipated energy accumulates on real steps
+  /// (once per pair across ranks, as the energies).
+  template <bool Energy, bool Newton, bool Advance>
+  double loop_kinematic(Particles<Real>& p, const PairList& list, History* hist) {
+    double energy = 0, dissipated = 0;
+    const bool rot = p.with_rotation;
+    const std::uint32_t* __restrict off = list.offset.data();
+    const std::int32_t* __restrict nb = list.neigh.data();
+    ContactKinematics<Real> k{};
+    k.dt = dt_;
+    for (std::size_t i = 0; i < p.n_owned; ++i) {
+      const Real ri = p.radius[i];
+      for (auto e = off[i]; e < off[i + 1]; ++e) {
+        const auto j = static_cast<std::size_t>(nb[e]);
+        k.dx = p.x[i] - p.x[j];
+        k.dy = p.y[i] - p.y[j];
+        k.dz = p.z[i] - p.z[j];
+        const Real r2 = k.dx * k.dx + k.dy * k.dy + k.dz * k.dz;
+        const Real rsum = ri + p.radius[j];
+        History none{};
+        History& h = kHistory ? hist[e] : none;
+        if (!(r2 < rsum * rsum)) {
+          if constexpr (kHistory && Advance) {
+            // What the history still held is lost with it (a shear spring's energy): dissipated.
+            if (Newton || p.id[i] < p.id[j])
+              dissipated += Model::parting_energy(
+                  coeffs_.size() == 1 ? coeffs_[0]
+                                      : coeffs_[static_cast<std::size_t>(group_of(p.tag[i], p.tag[j]))],
+                  h);
+            Model::apart(h);
+          }
+          continue;
+        }
+        const Coeffs& c = coeffs_.size() == 1
+                              ? coeffs_[0]
+                              : coeffs_[static_cast<std::size_t>(group_of(p.tag[i], p.tag[j]))];
+        k.r = std::sqrt(r2);
+        k.ri = ri;
+        k.rj = p.radius[j];
+        k.imi = p.inv_mass[i];
+        k.imj = p.inv_mass[j];
+        k.vx = p.vx[i] - p.vx[j];
+        k.vy = p.vy[i] - p.vy[j];
+        k.vz = p.vz[i] - p.vz[j];
+        if (rot) {
+          k.wix = p.wx[i], k.wiy = p.wy[i], k.wiz = p.wz[i];
+          k.wjx = p.wx[j], k.wjy = p.wy[j], k.wjz = p.wz[j];
+        }
+        ContactForce<Real> f;
+        Model::template contact<Advance>(c, h, k, f);
+        p.fx[i] += f.fx;
+        p.fy[i] += f.fy;
+        p.fz[i] += f.fz;
+        if constexpr (Newton) {
+          p.fx[j] -= f.fx;
+          p.fy[j] -= f.fy;
+          p.fz[j] -= f.fz;
+        }
+        if (rot) {
+          // Arms: c - x_i = -arm_i n, c - x_j = (r - arm_i) n, n = d / r; torque = arm x force.
+          const Real si = -f.arm_i / k.r, sj = (k.r - f.arm_i) / k.r;
+          const Real cx = k.dy * f.fz - k.dz * f.fy, cy = k.dz * f.fx - k.dx * f.fz,
+                     cz = k.dx * f.fy - k.dy * f.fx;
+          p.tx[i] += si * cx + f.mx;
+          p.ty[i] += si * cy + f.my;
+          p.tz[i] += si * cz + f.mz;
+          if constexpr (Newton) {
+            p.tx[j] -= sj * cx + f.mx;
+            p.ty[j] -= sj * cy + f.my;
+            p.tz[j] -= sj * cz + f.mz;
+          }
+        }
+        if (Newton || p.id[i] < p.id[j]) {
+          if constexpr (Advance) dissipated += f.dissipated;
+          if constexpr (Energy) energy += double(Model::energy(c, h, k));
+        }
+      }
+    }
+    dissipated_ += dissipated;
     return energy;
   }
 
@@ -228,6 +331,8 @@ class PairDriver final : public ForceCompute<Real> {
   PairList own_sub_, ghost_sub_;  ///< with several pair models: this model's share of the lists
   std::vector<History> hist_own_, hist_ghost_;
   ContactRecords pending_;
+  double dissipated_ = 0;  ///< this rank's share of the energy dissipated since the start
+  Real dt_ = 0;
 };
 
 }  // namespace basalt::solver

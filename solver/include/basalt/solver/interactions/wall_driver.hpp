@@ -2,6 +2,12 @@
 // Loops a wall model over the walls of the scene that use it and the owned particles within reach of
 // each (Walls::candidates). Tallies the force on each wall (minus the sum of forces it puts on
 // particles) and the wall energy; walls act on owned particles only, so there is no ghost part.
+// A velocity-dependent model (friction) gets the contact's kinematics and keeps a History per
+// (wall, particle) beside the candidates: saved by (particle id, -1 - wall index) before a rebuild,
+// carried with a migrating particle, found again by those ids, and written to checkpoints as a
+// contact whose second id is -1 - wall index (docs/formats.md).
+#include <cmath>
+#include <cstring>
 #include <string_view>
 #include <vector>
 
@@ -13,6 +19,9 @@ template <class Real, class Model>
 class WallDriver final : public ForceCompute<Real> {
  public:
   using Coeffs = typename Model::template Coeffs<Real>;
+  using History = typename Model::History;
+  static constexpr bool kKinematic = (Model::reads & kVelocity) != 0;
+  static constexpr bool kHistory = basalt::solver::history_bytes<Model>() > 0;
 
   /// Takes the scene's walls whose model is Model.
   explicit WallDriver(const std::vector<WallSpec>& walls) {
@@ -22,22 +31,88 @@ class WallDriver final : public ForceCompute<Real> {
       params_.push_back(walls[w].template params_of<Model>());
       coeffs_.push_back(Model::template coeffs<Real>(params_.back()));
     }
+    hist_.resize(index_.size());
+    pending_.width = history_width<Model>();
   }
 
   std::string_view model() const override { return Model::name; }
+  Fields reads() const override { return Model::reads; }
   ModelKind kind() const override { return ModelKind::wall; }
+  std::string_view dissipation_term() const override {
+    if constexpr (kKinematic) return Model::dissipation_term;
+    return {};
+  }
+  double dissipated() const override { return dissipated_; }
+  void set_dissipated(double d) override { dissipated_ = d; }
+  void set_time_step(double dt) override { dt_ = Real(dt); }
   double max_stiffness(double rmax) const override {
     double m = 0;
     for (const auto& p : params_) m = std::max(m, Model::max_stiffness(p, rmax));
     return m;
   }
 
-  double compute(ForceState<Real>& s, Part part, bool energy, bool) override {
+  double compute(ForceState<Real>& s, Part part, bool energy, bool advance) override {
     if (part != Part::owned) return 0;
-    return energy ? loop<true>(s.p, s.walls) : loop<false>(s.p, s.walls);
+    if constexpr (kKinematic) {
+      if (advance)
+        return energy ? loop_kinematic<true, true>(s.p, s.walls) : loop_kinematic<false, true>(s.p, s.walls);
+      return energy ? loop_kinematic<true, false>(s.p, s.walls) : loop_kinematic<false, false>(s.p, s.walls);
+    } else {
+      return energy ? loop<true>(s.p, s.walls) : loop<false>(s.p, s.walls);
+    }
+  }
+
+  // History (kinematic models with a History only).
+  void rebuild_walls(const Particles<Real>& p, const Walls& walls) override {
+    walls_ = &walls;
+    if constexpr (kHistory) {
+      std::vector<std::uint32_t> order;
+      pending_.index(order);
+      for (std::size_t k = 0; k < index_.size(); ++k) {
+        const auto& cand = walls.candidates(index_[k]);
+        auto& h = hist_[k];
+        h.assign(cand.size(), History{});
+        if (pending_.empty()) continue;
+        for (std::size_t c = 0; c < cand.size(); ++c) {
+          const auto r = pending_.find(order, p.id[static_cast<std::size_t>(cand[c])], wall_id(k));
+          if (r >= 0)
+            std::memcpy(static_cast<void*>(&h[c]), pending_.at(static_cast<std::size_t>(r)), sizeof(History));
+        }
+      }
+      pending_.clear();
+    }
+  }
+  void save_history(const Particles<Real>& p) override {
+    if constexpr (kHistory) collect(p, pending_);
+  }
+  ContactRecords* pending() override { return kHistory ? &pending_ : nullptr; }
+  void history_records(const Particles<Real>& p, ContactRecords& out) const override {
+    if constexpr (kHistory) collect(p, out);
+  }
+  std::size_t history_bytes() const override { return basalt::solver::history_bytes<Model>(); }
+  std::size_t memory_bytes() const override {
+    std::size_t b = 0;
+    for (const auto& h : hist_) b += h.capacity() * sizeof(History);
+    return b;
   }
 
  private:
+  /// The second id of a wall contact's record: -1 - the wall's index in the scene.
+  std::int64_t wall_id(std::size_t k) const { return -1 - static_cast<std::int64_t>(index_[k]); }
+
+  void collect(const Particles<Real>& p, ContactRecords& out) const {
+    out.width = history_width<Model>();
+    if (!walls_) return;
+    static const History zero{};
+    for (std::size_t k = 0; k < index_.size(); ++k) {
+      const auto& cand = walls_->candidates(index_[k]);
+      for (std::size_t c = 0; c < cand.size() && c < hist_[k].size(); ++c)
+        if (std::memcmp(&hist_[k][c], &zero, sizeof(History)) != 0)
+          out.push(p.id[static_cast<std::size_t>(cand[c])], wall_id(k),
+                   reinterpret_cast<const double*>(&hist_[k][c]));
+    }
+  }
+
   template <bool Energy>
   double loop(Particles<Real>& p, Walls& walls) const {
     double energy = 0;
@@ -67,9 +142,70 @@ class WallDriver final : public ForceCompute<Real> {
     return energy;
   }
 
+  template <bool Energy, bool Advance>
+  double loop_kinematic(Particles<Real>& p, Walls& walls) {
+    walls_ = &walls;
+    double energy = 0, dissipated = 0;
+    const bool rot = p.with_rotation;
+    WallKinematics<Real> kin{};
+    kin.dt = dt_;
+    for (std::size_t k = 0; k < index_.size(); ++k) {
+      const std::size_t w = index_[k];
+      const auto& spec = walls.spec(w);
+      const auto& c = coeffs_[k];
+      kin.nx = Real(spec.normal[0]), kin.ny = Real(spec.normal[1]), kin.nz = Real(spec.normal[2]);
+      const auto& at = walls.point(w);
+      const auto& vw = walls.velocity(w);
+      const Real px = Real(at[0]), py = Real(at[1]), pz = Real(at[2]);
+      double wfx = 0, wfy = 0, wfz = 0;
+      const auto& cand = walls.candidates(w);
+      auto& hist = hist_[k];
+      if (hist.size() != cand.size()) hist.assign(cand.size(), History{});
+      for (std::size_t ci = 0; ci < cand.size(); ++ci) {
+        const auto i = static_cast<std::size_t>(cand[ci]);
+        History& h = hist[ci];
+        kin.d = (p.x[i] - px) * kin.nx + (p.y[i] - py) * kin.ny + (p.z[i] - pz) * kin.nz;
+        kin.r = p.radius[i];
+        if (!(kin.d < kin.r)) {
+          if constexpr (Advance) {
+            dissipated += Model::parting_energy(c, h);
+            h = History{};
+          }
+          continue;
+        }
+        kin.im = p.inv_mass[i];
+        kin.vx = p.vx[i] - Real(vw[0]), kin.vy = p.vy[i] - Real(vw[1]), kin.vz = p.vz[i] - Real(vw[2]);
+        if (rot) kin.wx = p.wx[i], kin.wy = p.wy[i], kin.wz = p.wz[i];
+        ContactForce<Real> f;
+        Model::template contact<Advance>(c, h, kin, f);
+        p.fx[i] += f.fx;
+        p.fy[i] += f.fy;
+        p.fz[i] += f.fz;
+        if (rot) {  // (c - x) x F with c - x = -arm n
+          p.tx[i] += -f.arm_i * (kin.ny * f.fz - kin.nz * f.fy) + f.mx;
+          p.ty[i] += -f.arm_i * (kin.nz * f.fx - kin.nx * f.fz) + f.my;
+          p.tz[i] += -f.arm_i * (kin.nx * f.fy - kin.ny * f.fx) + f.mz;
+        }
+        wfx -= double(f.fx);
+        wfy -= double(f.fy);
+        wfz -= double(f.fz);
+        if constexpr (Advance) dissipated += f.dissipated;
+        if constexpr (Energy) energy += double(Model::energy(c, h, kin));
+      }
+      walls.force(w) = {wfx, wfy, wfz};
+    }
+    dissipated_ += dissipated;
+    return energy;
+  }
+
   std::vector<std::size_t> index_;  ///< the walls this model acts through
   std::vector<typename Model::Params> params_;
   std::vector<Coeffs> coeffs_;
+  std::vector<std::vector<History>> hist_;  ///< per wall of this model, per candidate
+  ContactRecords pending_;
+  const Walls* walls_ = nullptr;
+  double dissipated_ = 0;
+  Real dt_ = 0;
 };
 
 }  // namespace basalt::solver

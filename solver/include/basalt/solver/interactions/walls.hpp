@@ -16,7 +16,7 @@ namespace basalt::solver {
 class Walls {
  public:
   explicit Walls(const std::vector<WallSpec>& walls)
-      : walls_(walls), point_(walls.size()), force_(walls.size()) {
+      : walls_(walls), point_(walls.size()), force_(walls.size()), velocity_(walls.size()) {
     for (std::size_t w = 0; w < walls.size(); ++w) point_[w] = walls[w].point;
   }
 
@@ -30,11 +30,16 @@ class Walls {
   /// Owned particles within reach of wall w (local indices), from the last rebuild.
   const std::vector<std::int32_t>& candidates(std::size_t w) const { return candidates_[w]; }
 
+  /// Velocity of wall w at the time of the last move_to().
+  const std::array<double, 3>& velocity(std::size_t w) const { return velocity_[w]; }
+
   /// Moves the walls to their positions at time t.
   void move_to(double t) {
+    velocity_.resize(walls_.size());
     for (std::size_t w = 0; w < walls_.size(); ++w) {
       const auto u = walls_[w].motion.displacement_at(t);
       for (int d = 0; d < 3; ++d) point_[w][d] = walls_[w].point[d] + u[d];
+      velocity_[w] = walls_[w].motion.velocity_at(t);
     }
   }
 
@@ -93,6 +98,7 @@ class Walls {
   std::vector<WallSpec> walls_;
   std::vector<std::array<double, 3>> point_;
   std::vector<std::array<double, 3>> force_;
+  std::vector<std::array<double, 3>> velocity_;
   std::vector<std::array<double, 3>> point_at_rebuild_;
   std::vector<std::vector<std::int32_t>> candidates_;
 };

@@ -56,6 +56,10 @@ struct ContactAge {
     h.steps += 1;
   }
   static void apart(History& h) { h.steps = 0; }
+  template <class Real>
+  static double parting_energy(const Coeffs<Real>&, const History&) {
+    return 0;
+  }
   static History flip(const History& h) { return h; }  // an age has no orientation
 
   template <class Real>

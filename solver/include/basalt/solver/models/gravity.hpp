@@ -16,6 +16,7 @@ struct Gravity {
   static constexpr ModelKind kind = ModelKind::body;
   static constexpr std::string_view summary = "F = m g on each particle, E = -m g . x";
   static constexpr std::string_view energy_term = "gravity_potential_energy";
+  static constexpr std::string_view dissipation_term = {};
   static constexpr std::array keys{KeyDoc{"acceleration", "[gx, gy, gz], length/time^2 (required)"},
                                    KeyDoc{"tags", "particle tags it acts on (default: all)"}};
   static constexpr Fields reads = kPosition | kInverseMass | kTag;
@@ -43,14 +44,16 @@ struct Gravity {
   }
   static double max_stiffness(const Params&, double) { return 0; }
 
-  /// Force on a particle of mass m at (x, y, z).
+  /// Force on a particle.
   template <class Real>
-  static std::array<Real, 3> force(const Coeffs<Real>& c, Real m, Real, Real, Real) {
-    return {m * c.gx, m * c.gy, m * c.gz};
+  static void apply(const Coeffs<Real>& c, const BodyState<Real>& b, BodyForce<Real>& f) {
+    f.fx = b.m * c.gx;
+    f.fy = b.m * c.gy;
+    f.fz = b.m * c.gz;
   }
   template <class Real>
-  static Real energy(const Coeffs<Real>& c, Real m, Real x, Real y, Real z) {
-    return -m * (c.gx * x + c.gy * y + c.gz * z);
+  static Real energy(const Coeffs<Real>& c, const BodyState<Real>& b) {
+    return -b.m * (c.gx * b.x + c.gy * b.y + c.gz * b.z);
   }
 };
 

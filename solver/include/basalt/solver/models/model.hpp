@@ -52,8 +52,71 @@ enum Fields : std::uint32_t {
   kInverseMass = 1u << 4,
   kId = 1u << 5,
   kTag = 1u << 6,
+  kAngularVelocity = 1u << 7,
+  kTorque = 1u << 8,
+  kOrientation = 1u << 9,
 };
 constexpr Fields operator|(Fields a, Fields b) { return Fields(std::uint32_t(a) | std::uint32_t(b)); }
+
+/// What a velocity-dependent pair model (one with kVelocity in its reads: friction, viscous damping)
+/// sees of a pair i, j in contact. The driver fills it; angular velocities are zero for particles
+/// that do not rotate.
+template <class Real>
+struct ContactKinematics {
+  Real dx, dy, dz;     ///< x_i - x_j
+  Real r;              ///< |x_i - x_j|
+  Real ri, rj;         ///< radii
+  Real imi, imj;       ///< inverse masses
+  Real vx, vy, vz;     ///< v_i - v_j (centres)
+  Real wix, wiy, wiz;  ///< angular velocity of i
+  Real wjx, wjy, wjz;  ///< angular velocity of j
+  Real dt;             ///< the time step (tangential springs integrate the slip over it)
+};
+
+/// What such a model returns: the force on i (j gets the opposite), where it acts, and a couple.
+template <class Real>
+struct ContactForce {
+  Real fx = 0, fy = 0, fz = 0;  ///< force on i
+  /// Distance from i's centre to the contact point along -n (n = (x_i - x_j) / r); the point is
+  /// r - arm_i from j's centre. The torques are (c - x_i) x F on i and (c - x_j) x (-F) on j.
+  Real arm_i = 0;
+  Real mx = 0, my = 0, mz = 0;  ///< a couple on i (rolling resistance), -m on j
+  double dissipated = 0;        ///< energy the contact dissipated this step (friction, dashpots)
+};
+
+/// What a velocity-dependent wall model (kVelocity in its reads: friction) sees of a particle
+/// touching a planar wall. The contact point is the particle's point nearest the plane.
+template <class Real>
+struct WallKinematics {
+  Real nx, ny, nz;  ///< the wall's unit normal (into the particles' side)
+  Real d;           ///< signed distance of the centre from the plane (overlap r - d > 0)
+  Real r;           ///< radius
+  Real im;          ///< inverse mass
+  Real vx, vy, vz;  ///< particle velocity minus the wall's
+  Real wx, wy, wz;  ///< angular velocity (0 without rotation)
+  Real dt;
+};
+
+/// What a body-force model sees of one particle (velocities and torques zero where not kept).
+template <class Real>
+struct BodyState {
+  Real m;           ///< mass
+  Real x, y, z;     ///< position
+  Real vx, vy, vz;  ///< velocity
+  Real fx, fy, fz;  ///< the force from every other model this step (body forces come last)
+  Real inertia;     ///< moment of inertia (0 without rotation)
+  Real wx, wy, wz;  ///< angular velocity
+  Real tx, ty, tz;  ///< the torque from the other models
+  Real dt;
+};
+
+/// What a body-force model adds to one particle.
+template <class Real>
+struct BodyForce {
+  Real fx = 0, fy = 0, fz = 0;
+  Real tx = 0, ty = 0, tz = 0;
+  double dissipated = 0;  ///< energy it takes out this step (damping)
+};
 
 /// Bytes of per-contact history a model keeps (0 for an empty History: nothing is stored).
 template <class Model>

@@ -22,8 +22,9 @@ struct ModelEntry {
   std::string_view summary;
   std::span<const KeyDoc> keys;
   Fields reads, writes;
-  std::size_t history_bytes;     ///< per contact (0: none)
-  std::string_view energy_term;  ///< body forces: the ledger term of its potential energy ("" otherwise)
+  std::size_t history_bytes;          ///< per contact (0: none)
+  std::string_view energy_term;       ///< body forces: the ledger term of its potential energy ("" otherwise)
+  std::string_view dissipation_term;  ///< the ledger term of the energy it dissipates ("" for none)
   std::any (*parse)(TableReader&);
   std::unique_ptr<ForceCompute<double>> (*make_double)(const Scene&);
   std::unique_ptr<ForceCompute<float>> (*make_float)(const Scene&);

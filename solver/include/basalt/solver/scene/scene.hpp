@@ -86,6 +86,11 @@ struct Scene {
   } units;
   std::filesystem::path geometry;  ///< resolved against the scene file's folder
   double density = 1;
+  /// [particles] rotation: particles rotate (angular velocity, torque, orientation; ESyS "RotSphere").
+  bool rotation = false;
+  /// [particles] fixed_tags: particles of these tags feel forces but never move or turn (ESyS
+  /// setParticleNonDynamic): rough bases, anchors.
+  std::vector<std::int64_t> fixed_tags;
   double dt = 0;
   std::int64_t steps = 0;
   double skin = 0;

@@ -1,0 +1,271 @@
+// Granular physics (rotation, friction, damping, fixed particles), each against a closed form, a
+// conservation law or a decomposition:
+// - a sphere launched sliding on a frictional floor starts rolling without slip at t = 2 v0 / (7 mu g)
+//   with speed 5 v0 / 7 (both integrators);
+// - the Coulomb friction law alone: the shear spring sticks (F = Ks x slip) up to mu |F_n|, then slides
+//   at mu_dynamic |F_n| and dissipates exactly mu_dynamic |F_n| times the slip;
+// - a granular column collapsing under gravity with friction, rotation and damping: the energy ledger
+//   balances (mechanical + dissipated = initial), on any number of ranks the same kinetic energies as in
+//   a serial run (1e-9), and fixed particles never move.
+#include <gtest/gtest.h>
+#include <mpi.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <string>
+
+#include "basalt/solver/models/friction.hpp"
+#include "basalt/solver/simulation.hpp"
+#include "solver_helpers.hpp"
+#include "test_support.hpp"
+
+using namespace basalt::solver;
+
+namespace {
+
+double term(const Simulation<double>& sim, const std::vector<double>& v, const std::string& name) {
+  const int t = sim.ledger().find(name);
+  EXPECT_GE(t, 0) << name;
+  return t < 0 ? 0 : v[static_cast<std::size_t>(t)];
+}
+
+/// A column of spheres on a lattice with jittered radii (0.35-0.5, spacing 1), tags 1 for the bottom
+/// layer (fixed in some tests), 0 above; ids from 1.
+basalt::io::Geometry column(int nx, int ny, int nz) {
+  basalt::io::Geometry g;
+  std::int64_t id = 1;
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i, ++id) {
+        const auto u = static_cast<std::uint64_t>(id);
+        const double r = 0.425 + 0.075 * basalt::test::hash_unit(u);
+        g.add_particle(id,
+                       {0.5 + i + 0.04 * basalt::test::hash_unit(3 * u + 1),
+                        0.5 + j + 0.04 * basalt::test::hash_unit(3 * u + 2), 0.5 + k},
+                       r, k == 0 ? 1 : 0);
+      }
+  return g;
+}
+
+const std::string kColumnScene = R"(
+[particles]
+rotation = true
+[run]
+dt = 2e-3
+steps = 0
+skin = 0.1
+energy_check_every = 50
+[[interactions]]
+type = "rot_friction"
+K = 1000.0
+Ks = 500.0
+mu = 0.5
+mu_dynamic = 0.4
+[[walls]]
+name = "floor"
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
+interaction = "friction"
+K = 1000.0
+Ks = 500.0
+mu = 0.5
+[[walls]]
+name = "back"
+point = [0.0, 0.0, 0.0]
+normal = [1.0, 0.0, 0.0]
+K = 1000.0
+[[body_forces]]
+type = "gravity"
+acceleration = [0.0, 0.0, -1.0]
+[[body_forces]]
+type = "linear_damping"
+viscosity = 0.05
+[[body_forces]]
+type = "rotational_damping"
+viscosity = 0.05
+[[output.fields]]
+type = "kinetic_energy"
+[[output.fields]]
+type = "total_energy"
+[[output.fields]]
+type = "friction_dissipated"
+[[output.fields]]
+type = "damping_dissipated"
+)";
+
+}  // namespace
+
+class Rolling : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(Rolling, SlidingSphereRollsWithoutSlipAtTheClosedFormTimeAndSpeed) {
+  if (basalt::test::rank() != 0) return;
+  // Radius 1, density 1 (m = 4/3 pi), on a frictional floor under g = 1, launched at v0 = 1 without
+  // spin; mu = 0.2: slip stops at t = 2 v0 / (7 mu g) = 1.4286, then v = 5 v0 / 7 and w R = v.
+  const double mu = 0.2, g = 1, v0 = 1, R = 1, K = 1e5;
+  const auto scene = basalt::test::scene_from(std::string(R"(
+[particles]
+rotation = true
+[run]
+dt = 5e-4
+steps = 0
+skin = 0.05
+integrator = ")") + GetParam() + R"("
+[[walls]]
+name = "floor"
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
+interaction = "friction"
+K = 1.0e5
+Ks = 1.0e5
+mu = 0.2
+[[body_forces]]
+type = "gravity"
+acceleration = [0.0, 0.0, -1.0]
+)");
+  const double m = 4.0 / 3.0 * std::numbers::pi;
+  basalt::io::Geometry geo;
+  geo.add_particle(1, {0, 0, R - m * g / K}, R);  // resting on the floor: no bounce
+  RunOptions opt;
+  opt.quiet = true;
+  Simulation<double> sim(scene, geo, MPI_COMM_SELF, opt);
+  auto& p = sim.particles();
+  p.vx[0] = v0;
+  sim.state_changed();
+  const double t_roll = 2 * v0 / (7 * mu * g);
+  double t_stick = -1;
+  for (int s = 0; s < 5000; ++s) {
+    sim.step();
+    const double slip = p.vx[0] - p.wy[0] * R;
+    if (t_stick < 0 && slip < 0.01 * v0) t_stick = sim.time();
+    if (t_stick < 0) {  // while sliding: v = v0 - mu g t exactly (Coulomb force mu m g)
+      ASSERT_NEAR(p.vx[0], v0 - mu * g * sim.time(), 2e-3 * v0) << "t = " << sim.time();
+    }
+  }
+  std::printf("%s: slip stopped at t = %.4f (closed form %.4f), v = %.5f (5/7 = %.5f), w R = %.5f\n",
+              GetParam(), t_stick, t_roll, p.vx[0], 5.0 / 7.0, p.wy[0] * R);
+  EXPECT_NEAR(t_stick, 0.99 * t_roll, 0.02 * t_roll);  // the slip reaches 1 % of v0 at 0.99 t_roll
+  EXPECT_NEAR(p.vx[0], 5.0 / 7.0 * v0, 5e-3 * v0);
+  EXPECT_NEAR(p.wy[0] * R, p.vx[0], 5e-3 * v0) << "rolling without slip";
+  EXPECT_NEAR(p.z[0], R - m * g / K, 1e-4) << "stays on the floor";
+}
+
+INSTANTIATE_TEST_SUITE_P(Integrators, Rolling, ::testing::Values("velocity_verlet", "symplectic_euler"));
+
+TEST(CoulombFriction, SticksUpToMuThenSlidesAndDissipatesThePlasticWork) {
+  // Sphere i above sphere j (n = +z), overlap 0.1 (F_n = K 0.1 = 10), i sliding along +x at 1 with no
+  // rotation: the shear force on i grows by -Ks v dt each step until it reaches mu F_n = 5, then is cut
+  // to mu_dynamic F_n = 4, each further step dissipating 4 x slip (v dt) exactly.
+  using M = RotFriction;
+  M::Params prm{100.0, 45.0, 0.5, 0.4};
+  const auto c = M::coeffs<double>(prm);
+  ContactKinematics<double> k{};
+  k.dz = 0.9, k.r = 0.9, k.ri = 0.5, k.rj = 0.5, k.imi = 1, k.imj = 1, k.vx = 1, k.dt = 0.01;
+  M::History h;
+  ContactForce<double> f;
+  int steps_to_slide = 0;
+  for (int s = 1; s <= 200; ++s) {
+    f = {};
+    M::contact<true>(c, h, k, f);
+    EXPECT_NEAR(f.fz, 10.0, 1e-12);
+    if (h.sliding == 0) {
+      EXPECT_NEAR(f.fx, -45.0 * 0.01 * s, 1e-9) << "sticking: F = -Ks slip";
+      EXPECT_EQ(f.dissipated, 0.0);
+      steps_to_slide = s + 1;
+    } else {
+      EXPECT_NEAR(f.fx, -4.0, 1e-12) << "sliding: mu_dynamic F_n";
+      if (s > steps_to_slide) {
+        EXPECT_NEAR(f.dissipated, 4.0 * 0.01, 1e-12) << "step " << s;
+      }
+    }
+    EXPECT_NEAR(f.arm_i, 0.45, 1e-15);
+  }
+  EXPECT_EQ(steps_to_slide, 12) << "|F_s| = 0.45 s exceeds 5 at step 12";
+  // Not advancing reads the stored force and changes nothing.
+  const auto before = h;
+  ContactForce<double> g;
+  M::contact<false>(c, h, k, g);
+  EXPECT_EQ(g.fx, f.fx);
+  EXPECT_EQ(h.fx, before.fx);
+  // Flipped history is the force on the other particle.
+  EXPECT_EQ(M::flip(h).fx, -h.fx);
+  M::apart(h);
+  EXPECT_EQ(h.fx, 0.0);
+}
+
+TEST(Granular, ColumnCollapseBalancesTheLedgerAndFixedParticlesStay) {
+  if (basalt::test::rank() != 0) return;
+  auto s = basalt::test::scene_from(
+      std::string(kColumnScene)
+          .replace(kColumnScene.find("rotation = true"), 15, "rotation = true\nfixed_tags = [1]"));
+  const auto g = column(4, 4, 8);
+  RunOptions opt;
+  opt.quiet = true;
+  Simulation<double> sim(s, g, MPI_COMM_SELF, opt);
+  std::vector<std::array<double, 3>> fixed0;
+  const auto& p = sim.particles();
+  for (std::size_t i = 0; i < p.n_owned; ++i)
+    if (p.tag[i] == 1) fixed0.push_back({double(p.id[i]), p.x[i], p.z[i]});
+  ASSERT_EQ(fixed0.size(), 16u);
+  const auto v0 = sim.ledger_values();
+  const double e0 = sim.ledger().mechanical(v0);
+  basalt::test::MemorySink sink;
+  sink.begin(field_columns(s));
+  sim.run(2000, &sink);
+  const auto v = sim.ledger_values();
+  const double e = sim.ledger().mechanical(v), d = sim.ledger().sum(v, Ledger::Kind::dissipated);
+  std::printf("initial %.6g, now mechanical %.6g + dissipated %.6g (friction %.4g, damping %.4g) = %.6g\n",
+              e0, e, d, term(sim, v, "friction_dissipated"), term(sim, v, "damping_dissipated"), e + d);
+  EXPECT_GT(term(sim, v, "friction_dissipated"), 0.01 * std::abs(e0 - e)) << "friction must have worked";
+  EXPECT_GT(term(sim, v, "damping_dissipated"), 0.0);
+  EXPECT_NEAR(e + d, e0, 0.01 * (std::abs(e0 - e))) << "the ledger balances to 1 % of the energy released";
+  for (std::size_t i = 0; i < p.n_owned; ++i)
+    for (const auto& f : fixed0)
+      if (double(p.id[i]) == f[0]) {
+        EXPECT_EQ(p.x[i], f[1]);
+        EXPECT_EQ(p.z[i], f[2]);
+        EXPECT_EQ(p.wx[i], 0.0);
+      }
+  double spin = 0;
+  for (std::size_t i = 0; i < p.n_owned; ++i) spin = std::max(spin, std::abs(p.wy[i]));
+  EXPECT_GT(spin, 1e-3) << "the collapse must turn particles";
+}
+
+TEST(Granular, FrictionalRotatingColumnIsDecompositionInvariant) {
+  const auto scene = basalt::test::scene_from(kColumnScene);
+  const auto g = column(6, 4, 10);
+  constexpr int kSteps = 600;
+  const auto run = [&](MPI_Comm comm, std::array<int, 3> dims) {
+    RunOptions opt;
+    opt.dims = dims;
+    opt.quiet = true;
+    Simulation<double> sim(scene, g, comm, opt);
+    basalt::test::MemorySink sink;
+    sink.begin(field_columns(scene));
+    sim.run(kSteps, &sink);
+    return std::make_pair(sink.column(0), sim.rebuilds());
+  };
+  const int n = basalt::test::size();
+  std::vector<double> ref(kSteps);
+  if (basalt::test::rank() == 0) {
+    auto [ke, rebuilds] = run(MPI_COMM_SELF, {1, 1, 1});
+    ref = ke;
+    EXPECT_GT(rebuilds, 3);
+    EXPECT_GT(ref.back(), 0.0);
+  }
+  MPI_Bcast(ref.data(), kSteps, MPI_DOUBLE, 0, basalt::test::world());
+  if (n == 1) return;
+  std::vector<std::array<int, 3>> grids{{n, 1, 1}};
+  if (n == 4) grids.push_back({2, 1, 2});
+  for (const auto& dims : grids) {
+    const auto [ke, rebuilds] = run(basalt::test::world(), dims);
+    if (basalt::test::rank() != 0) continue;
+    double worst = 0;
+    for (std::size_t s = 0; s < ke.size(); ++s)
+      if (ref[s] > 1e-6 * ref.back()) worst = std::max(worst, std::abs(ke[s] - ref[s]) / ref[s]);
+    std::printf("np %d dims %d,%d,%d: max relative KE difference %.3g (%lld rebuilds)\n", n, dims[0], dims[1],
+                dims[2], worst, static_cast<long long>(rebuilds));
+    EXPECT_LT(worst, 1e-9) << "dims " << dims[0] << "," << dims[1] << "," << dims[2];
+  }
+}
