@@ -223,7 +223,12 @@ RawMesh parse_stl(const fs::path& file, std::string_view bytes) {
   }
   std::size_t i = 0;
   while (i < bytes.size() && std::isspace(static_cast<unsigned char>(bytes[i]))) ++i;
-  if (bytes.substr(i, 5) == "solid") return parse_ascii_stl(file, bytes);
+  // "solid" starts ASCII STL, and some binary headers too: text has no control characters.
+  const bool text = std::none_of(bytes.begin(), bytes.end(), [](char ch) {
+    const auto u = static_cast<unsigned char>(ch);
+    return u < 9 || (u > 13 && u < 32) || u == 127;
+  });
+  if (text && bytes.substr(i, 5) == "solid") return parse_ascii_stl(file, bytes);
   if (bytes.size() < 84)
     throw FormatError(file, fmt::format("byte offset {}", bytes.size()),
                       fmt::format("{} bytes: too short for a binary STL (84-byte header) and not ASCII STL "
