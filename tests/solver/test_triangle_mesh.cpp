@@ -163,6 +163,42 @@ TEST(TriangleMesh, RollingOnATiltedShiftedGridIsOnePlaneContact) {
     }
 }
 
+TEST(TriangleMesh, JustOffAnEdgeOrAVertexIsStillOnePlaneContact) {
+  // Centres a tiny distance (1e-15 to 1e-3) from a shared vertex or edge, in 16 directions: where rounding
+  // decides between face, edge and vertex. Exact and tilted (inexact) coordinates.
+  const double a = 0.4, b = 0.9;
+  const Vec3 e1{std::cos(a), std::sin(a), 0};
+  const Vec3 n{std::sin(b) * -std::sin(a), std::sin(b) * std::cos(a), std::cos(b)};
+  const Vec3 e2{n[1] * e1[2] - n[2] * e1[1], n[2] * e1[0] - n[0] * e1[2], n[0] * e1[1] - n[1] * e1[0]};
+  auto tilt = [&](const Vec3& x) {
+    Vec3 y;
+    for (int d = 0; d < 3; ++d) y[d] = 3.7 + x[0] * e1[d] + x[1] * e2[d] + x[2] * n[d];
+    return y;
+  };
+  auto flat = [](const Vec3& x) { return x; };
+  const auto exact = flat_grid(4, 4, flat), tilted = flat_grid(4, 4, tilt);
+  const double r = 0.5, h = 0.25;
+  std::vector<MeshContact> cs;
+  for (const auto* m : {&exact, &tilted}) {
+    const bool is_tilted = m == &tilted;
+    for (const auto& base :
+         std::vector<std::array<double, 2>>{{2, 2}, {1, 2}, {1, 1}, {2, 1.5}, {1.5, 1.5}, {0.5, 2.5}})
+      for (double eps : {1e-15, 1e-13, 1e-12, 1e-11, 1e-10, 1e-9, 1e-8, 1e-6, 1e-3})
+        for (int k = 0; k < 16; ++k) {
+          const double phi = 2 * M_PI * k / 16 + 0.01;
+          const Vec3 local{base[0] + eps * std::cos(phi), base[1] + eps * std::sin(phi), h};
+          cs.clear();
+          m->contacts(is_tilted ? tilt(local) : local, r, cs);
+          SCOPED_TRACE(testing::Message() << (is_tilted ? "tilted" : "exact") << " near (" << base[0] << ", "
+                                          << base[1] << ") eps " << eps << " direction " << k);
+          ASSERT_EQ(cs.size(), 1u);
+          const Vec3 want =
+              is_tilted ? Vec3{(r - h) * n[0], (r - h) * n[1], (r - h) * n[2]} : Vec3{0, 0, r - h};
+          expect_near(sum_force(cs), want, 1e-12);
+        }
+  }
+}
+
 TEST(TriangleMesh, ConvexEdgeOfACubeIsOneEdgeContact) {
   for (auto sides : {ContactMesh::Sides::two, ContactMesh::Sides::one}) {
     ContactMesh::Options opt;
