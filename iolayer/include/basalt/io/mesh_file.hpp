@@ -1,7 +1,8 @@
 #pragma once
 // Triangle meshes for mesh walls (silos, hoppers), read from ASCII or binary STL, Wavefront OBJ or OFF
 // (docs/mesh-walls.md). The format follows the extension (.stl, .obj, .off, any case); an STL file is
-// binary when its size is exactly 84 + 50 n bytes for the n its header gives, ASCII otherwise.
+// binary when its size is exactly 84 + 50 n bytes for the n its header gives, ASCII when it
+// starts with "solid" and has no control bytes, else a binary STL of the wrong size (an error).
 //
 // Vertices are welded: coordinates that are exactly equal (-0 equal to +0) become one vertex, so that
 // triangles share their edges (STL repeats every vertex per facet); with weld_tolerance > 0, vertices
