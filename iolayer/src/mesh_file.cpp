@@ -138,7 +138,8 @@ RawMesh parse_ascii_stl(const fs::path& file, std::string_view text) {
   auto expect = [&](std::string_view kw, std::string_view kw2 = {}) {
     const auto& f = next(kw2.empty() ? std::string(kw).c_str() : fmt::format("{} {}", kw, kw2).c_str());
     if (f[0] != kw || (!kw2.empty() && (f.size() < 2 || f[1] != kw2)))
-      in.fail(fmt::format("expected '{}{}{}', found '{}'", kw, kw2.empty() ? "" : " ", kw2, f[0]));
+      in.fail(fmt::format("expected '{}{}{}', found '{}{}{}'", kw, kw2.empty() ? "" : " ", kw2, f[0],
+                          f.size() > 1 ? " " : "", f.size() > 1 ? f[1] : std::string_view()));
   };
   bool any_solid = false;
   while (in.next('\0')) {

@@ -236,7 +236,7 @@ TEST_F(MeshFile, AsciiStlErrorsNameTheLine) {
   expect_error(write("nan.stl", replace_line(5, "      vertex 0 nan 0")),
                {"nan.stl", "line 5", "'nan' is not finite"});
   expect_error(write("kw.stl", replace_line(3, "    outer lop")),
-               {"kw.stl", "line 3", "expected 'outer loop'"});
+               {"kw.stl", "line 3", "expected 'outer loop', found 'outer lop'"});
   expect_error(write("two.stl", replace_line(4, "      vertex 0 0")),
                {"two.stl", "line 4", "3 coordinates, found 2"});
   expect_error(write("four.stl", replace_line(7, "      vertex 1 1 1\n    endloop")),

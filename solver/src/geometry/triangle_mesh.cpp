@@ -235,17 +235,19 @@ std::size_t ContactMesh::nonmanifold_edges() const {
 }
 
 void ContactMesh::set_pose(const RigidTransform& pose) {
+  std::array<std::array<double, 3>, 3> rot{{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
+  if (pose.angle != 0) {
+    const Vec3 u = unit(pose.axis);
+    if (norm(u) == 0) throw std::invalid_argument("ContactMesh::set_pose: rotation about a zero axis");
+    const double c = std::cos(pose.angle), s = std::sin(pose.angle), C = 1 - c;
+    const double x = u[0], y = u[1], z = u[2];
+    rot = {{{c + x * x * C, x * y * C - z * s, x * z * C + y * s},
+            {y * x * C + z * s, c + y * y * C, y * z * C - x * s},
+            {z * x * C - y * s, z * y * C + x * s, c + z * z * C}}};
+  }
   pose_ = pose;
+  rot_ = rot;
   moved_ = pose.angle != 0 || pose.translation != Vec3{0, 0, 0};
-  rot_ = {{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
-  if (pose.angle == 0) return;
-  const Vec3 u = unit(pose.axis);
-  if (norm(u) == 0) throw std::invalid_argument("ContactMesh::set_pose: rotation about a zero axis");
-  const double c = std::cos(pose.angle), s = std::sin(pose.angle), C = 1 - c;
-  const double x = u[0], y = u[1], z = u[2];
-  rot_ = {{{c + x * x * C, x * y * C - z * s, x * z * C + y * s},
-           {y * x * C + z * s, c + y * y * C, y * z * C - x * s},
-           {z * x * C - y * s, z * y * C + x * s, c + z * z * C}}};
 }
 
 ContactMesh::Vec3 ContactMesh::rotate(const Vec3& x) const {
