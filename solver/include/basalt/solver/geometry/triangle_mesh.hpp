@@ -15,7 +15,8 @@
 // Two-sided (default, for open surfaces): a sphere is pushed away from whichever side it is on.
 // One-sided (closed meshes wound counter-clockwise seen from the side the particles are on): only
 // spheres whose centre is on the side the normals point to touch; a centre behind the surface feels
-// nothing (the side of an edge or vertex point is that of its angle-weighted pseudo-normal).
+// nothing (the side of an edge or vertex point is that of its pseudo-normal: the sum of the adjacent
+// face normals for an edge, their angle-weighted sum for a vertex).
 //
 // Moving meshes: set_pose() places the mesh by a rigid transform of its rest vertices (rotation by an
 // angle about an axis through a point, then a translation). Queries run in the rest frame (the centre is
@@ -24,6 +25,7 @@
 #include <array>
 #include <cstdint>
 #include <span>
+#include <utility>
 #include <vector>
 
 namespace basalt::solver {
