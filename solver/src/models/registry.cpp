@@ -17,6 +17,7 @@
 #include "basalt/solver/models/elastic_wall.hpp"
 #include "basalt/solver/models/friction.hpp"
 #include "basalt/solver/models/gravity.hpp"
+#include "basalt/solver/models/hertz_mindlin.hpp"
 #include "basalt/solver/models/linear_bond.hpp"
 #include "basalt/solver/models/linear_elastic.hpp"
 
@@ -74,8 +75,10 @@ const std::vector<ModelEntry>& model_registry() {
       entry<ContactAge>(),         // pair, test model for contact history
       entry<Friction>(),           // pair, ESyS NRotFriction
       entry<RotFriction>(),        // pair, ESyS RotFriction
+      entry<HertzMindlin>(),       // pair, LIGGGHTS hertz/history, ESyS HertzMindlinVisco
       entry<ElasticWall>(),        // wall
       entry<FrictionWall>(),       // wall, with Coulomb friction
+      entry<HertzMindlinWall>(),   // wall
       entry<Gravity>(),            // body force
       entry<LinearDamping>(),      // body force, ESyS LinDamping
       entry<RotationalDamping>(),  // body force, ESyS RotDamping

@@ -1,0 +1,268 @@
+#pragma once
+// Hertz-Mindlin contact with viscous (Tsuji) damping and Coulomb friction, for rotating spheres
+// (LIGGGHTS "hertz" with "tangential history", ESyS-Particle "HertzMindlinVisco"). With overlap
+// d = ri + rj - r > 0, normal n = (x_i - x_j) / r, effective radius R* = ri rj / (ri + rj), effective
+// mass m* = mi mj / (mi + mj), E* = E / (2 (1 - nu^2)), G* = G / (2 (2 - nu)), G = E / (2 (1 + nu)):
+//   S_n = 2 E* sqrt(R* d),  S_t = 8 G* sqrt(R* d),  beta = ln e / sqrt(ln^2 e + pi^2),
+//   normal:     F_n = (4/3 E* sqrt(R*) d^{3/2} - gamma_n v_n) n,  gamma_n = -2 sqrt(5/6) beta sqrt(S_n m*);
+//   tangential: shear displacement xi (history, turned onto the tangent plane each step, length kept)
+//               xi += v_t dt;  F_t = -S_t xi - gamma_t v_t,  gamma_t = -2 sqrt(5/6) beta sqrt(S_t m*);
+//               when |F_t| > mu |F_n| it is cut to mu |F_n| and xi set to match (F_t + gamma_t v_t = -S_t
+//               xi).
+// v_n, v_t: normal and tangential parts of the contact point's relative velocity (with w x arm; the
+// contact point at r ri / (ri + rj) from i's centre). Energy: 8/15 E* sqrt(R*) d^{5/2} + S_t |xi|^2 / 2.
+// The dashpots and the Coulomb cut dissipate (ledger term friction_dissipated).
+// The wall version (HertzMindlinWall) is the same with R* = r, m* = m and the wall's E, nu.
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <string_view>
+
+#include "basalt/solver/models/model.hpp"
+#include "basalt/solver/scene/table_reader.hpp"
+
+namespace basalt::solver {
+
+namespace hertz {
+
+struct Material {
+  double E = 0, nu = 0;
+};
+
+/// The contact's material constants: E*, G* from two materials, and the damping factor from e.
+struct Constants {
+  double E_star = 0, G_star = 0, beta = 0, mu = 0;
+};
+
+inline Constants constants(const Material& a, const Material& b, double e, double mu) {
+  const double Ga = a.E / (2 * (1 + a.nu)), Gb = b.E / (2 * (1 + b.nu));
+  Constants c;
+  c.E_star = 1 / ((1 - a.nu * a.nu) / a.E + (1 - b.nu * b.nu) / b.E);
+  c.G_star = 1 / (2 * (2 - a.nu) / Ga + 2 * (2 - b.nu) / Gb);
+  const double le = std::log(e);
+  c.beta = e >= 1 ? 0.0 : le / std::sqrt(le * le + std::numbers::pi * std::numbers::pi);
+  c.mu = mu;
+  return c;
+}
+
+inline void parse_material(TableReader& t, const char* E, const char* nu, Material& m) {
+  m.E = t.positive(E);
+  m.nu = t.number_or(nu, 0.25);
+  if (!(m.nu > -1 && m.nu < 0.5)) t.fail(nu, "must be in (-1, 0.5)");
+}
+
+inline double restitution(TableReader& t) {
+  const double e = t.number_or("e", 1.0);
+  if (!(e > 0 && e <= 1)) t.fail("e", "must be in (0, 1]");
+  return e;
+}
+
+template <class Real>
+struct Coeffs {
+  Real E_star, G_star, beta, mu;
+};
+
+/// History: the shear displacement.
+struct History {
+  double x = 0, y = 0, z = 0;
+};
+
+/// The law for a contact of effective radius R, effective mass m, overlap d, contact-point relative
+/// velocity u (on the first body, relative to the second), normal n; turns and loads the history
+/// when Advance; returns the force on the first body and the energy dissipated this step.
+template <bool Advance, class Real>
+void law(const Coeffs<Real>& c, History& h, Real R, Real m, Real d, Real nx, Real ny, Real nz, Real ux,
+         Real uy, Real uz, Real dt, ContactForce<Real>& f) {
+  const Real root = std::sqrt(R * d);
+  const Real Sn = 2 * c.E_star * root, St = 8 * c.G_star * root;
+  const Real k = Real(-2) * Real(0.9128709291752769) * c.beta;  // -2 sqrt(5/6) beta >= 0
+  const Real gn = k * std::sqrt(Sn * m), gt = k * std::sqrt(St * m);
+  const Real un = ux * nx + uy * ny + uz * nz;
+  const Real tx = ux - un * nx, ty = uy - un * ny, tz = uz - un * nz;
+  const Real fn = Real(4.0 / 3.0) * c.E_star * root * d - gn * un;
+  Real sx = Real(h.x), sy = Real(h.y), sz = Real(h.z);
+  if constexpr (Advance) {
+    const Real before = sx * sx + sy * sy + sz * sz;
+    if (before > 0) {  // onto the current tangent plane, length kept
+      const Real sn = sx * nx + sy * ny + sz * nz;
+      sx -= sn * nx;
+      sy -= sn * ny;
+      sz -= sn * nz;
+      const Real after = sx * sx + sy * sy + sz * sz;
+      if (after > 0) {
+        const Real s = std::sqrt(before / after);
+        sx *= s, sy *= s, sz *= s;
+      }
+    }
+    sx += tx * dt;
+    sy += ty * dt;
+    sz += tz * dt;
+  }
+  Real ftx = -St * sx - gt * tx, fty = -St * sy - gt * ty, ftz = -St * sz - gt * tz;
+  const Real ft2 = ftx * ftx + fty * fty + ftz * ftz, limit = c.mu * (fn > 0 ? fn : Real(0));
+  if (Advance) f.dissipated = double(gn * un * un + gt * (tx * tx + ty * ty + tz * tz)) * double(dt);
+  if (ft2 > limit * limit) {
+    const Real scale = limit / std::sqrt(ft2);
+    const double before = 0.5 * double(St) * double(sx * sx + sy * sy + sz * sz);
+    ftx *= scale, fty *= scale, ftz *= scale;
+    if (St > 0) {
+      sx = -(ftx + gt * tx) / St;
+      sy = -(fty + gt * ty) / St;
+      sz = -(ftz + gt * tz) / St;
+    }
+    if (Advance) f.dissipated += before - 0.5 * double(St) * double(sx * sx + sy * sy + sz * sz);
+  }
+  if constexpr (Advance) {
+    h.x = double(sx);
+    h.y = double(sy);
+    h.z = double(sz);
+  }
+  f.fx = fn * nx + ftx;
+  f.fy = fn * ny + fty;
+  f.fz = fn * nz + ftz;
+}
+
+template <class Real>
+Real energy(const Coeffs<Real>& c, const History& h, Real R, Real d) {
+  const Real root = std::sqrt(R * d);
+  const Real St = 8 * c.G_star * root;
+  return Real(8.0 / 15.0) * c.E_star * root * d * d +
+         Real(0.5) * St * Real(h.x * h.x + h.y * h.y + h.z * h.z);
+}
+
+}  // namespace hertz
+
+struct HertzMindlin {
+  static constexpr std::string_view name = "hertz_mindlin";
+  static constexpr ModelKind kind = ModelKind::pair;
+  static constexpr std::string_view summary =
+      "Hertz normal + Mindlin tangential springs, Tsuji dashpots giving restitution e, Coulomb mu (LIGGGHTS "
+      "hertz/history, ESyS HertzMindlinVisco)";
+  static constexpr std::array keys{
+      KeyDoc{"E", "Young's modulus of the particles, force/length^2, > 0 (required)"},
+      KeyDoc{"nu", "Poisson's ratio, -1 < nu < 0.5 (default 0.25)"},
+      KeyDoc{"e", "coefficient of restitution, 0 < e <= 1 (default 1: no damping)"},
+      KeyDoc{"mu", "friction coefficient, >= 0 (default 0.5)"},
+      KeyDoc{"tags", "[a, b]: pairs tagged a and b (default: all pairs)"}};
+  static constexpr Fields reads = kPosition | kRadius | kId | kVelocity | kInverseMass | kAngularVelocity;
+  static constexpr Fields writes = kForce | kTorque;
+  static constexpr std::string_view dissipation_term = "friction_dissipated";
+
+  struct Params {
+    hertz::Material material;
+    double e = 1, mu = 0.5;
+  };
+  template <class Real>
+  using Coeffs = hertz::Coeffs<Real>;
+  using History = hertz::History;
+
+  static Params parse(TableReader& t) {
+    Params p;
+    hertz::parse_material(t, "E", "nu", p.material);
+    p.e = hertz::restitution(t);
+    p.mu = t.non_negative_or("mu", 0.5);
+    return p;
+  }
+  template <class Real>
+  static Coeffs<Real> coeffs(const Params& p) {
+    const auto c = hertz::constants(p.material, p.material, p.e, p.mu);
+    return {Real(c.E_star), Real(c.G_star), Real(c.beta), Real(c.mu)};
+  }
+  /// The tangent stiffness at an overlap of 5 % of rmax (for the critical time step estimate).
+  static double max_stiffness(const Params& p, double rmax) {
+    const auto c = hertz::constants(p.material, p.material, p.e, p.mu);
+    return 8 * c.G_star * std::sqrt(0.5 * rmax * 0.05 * rmax) +
+           2 * c.E_star * std::sqrt(0.5 * rmax * 0.05 * rmax);
+  }
+
+  static void apart(History& h) { h = History{}; }
+  static History flip(const History& h) { return {-h.x, -h.y, -h.z}; }
+  template <class Real>
+  static double parting_energy(const Coeffs<Real>&, const History&) {
+    return 0;  // the tangential stiffness vanishes with the overlap
+  }
+
+  template <bool Advance, class Real>
+  static void contact(const Coeffs<Real>& c, History& h, const ContactKinematics<Real>& k,
+                      ContactForce<Real>& f) {
+    const Real inv_r = Real(1) / k.r;
+    const Real nx = k.dx * inv_r, ny = k.dy * inv_r, nz = k.dz * inv_r;
+    f.arm_i = k.r * k.ri / (k.ri + k.rj);
+    const Real ai = f.arm_i, aj = k.r - f.arm_i;
+    const Real ox = -(ai * k.wix + aj * k.wjx), oy = -(ai * k.wiy + aj * k.wjy),
+               oz = -(ai * k.wiz + aj * k.wjz);
+    const Real ux = k.vx + oy * nz - oz * ny, uy = k.vy + oz * nx - ox * nz, uz = k.vz + ox * ny - oy * nx;
+    const Real R = k.ri * k.rj / (k.ri + k.rj), m = Real(1) / (k.imi + k.imj);
+    hertz::law<Advance>(c, h, R, m, k.ri + k.rj - k.r, nx, ny, nz, ux, uy, uz, k.dt, f);
+  }
+  template <class Real>
+  static Real energy(const Coeffs<Real>& c, const History& h, const ContactKinematics<Real>& k) {
+    return hertz::energy(c, h, k.ri * k.rj / (k.ri + k.rj), k.ri + k.rj - k.r);
+  }
+};
+
+struct HertzMindlinWall {
+  static constexpr std::string_view name = "hertz_mindlin";
+  static constexpr ModelKind kind = ModelKind::wall;
+  static constexpr std::string_view summary =
+      "Hertz-Mindlin with Tsuji damping and Coulomb friction against a planar wall (R* = r, m* = m)";
+  static constexpr std::array keys{KeyDoc{"E", "Young's modulus of the particles, > 0 (required)"},
+                                   KeyDoc{"nu", "Poisson's ratio of the particles (default 0.25)"},
+                                   KeyDoc{"E_wall", "Young's modulus of the wall (default E)"},
+                                   KeyDoc{"nu_wall", "Poisson's ratio of the wall (default nu)"},
+                                   KeyDoc{"e", "coefficient of restitution, 0 < e <= 1 (default 1)"},
+                                   KeyDoc{"mu", "friction coefficient, >= 0 (default 0.5)"}};
+  static constexpr Fields reads = kPosition | kRadius | kTag | kVelocity | kInverseMass | kAngularVelocity;
+  static constexpr Fields writes = kForce | kTorque;
+  static constexpr std::string_view dissipation_term = "friction_dissipated";
+
+  struct Params {
+    hertz::Material particle, wall;
+    double e = 1, mu = 0.5;
+  };
+  template <class Real>
+  using Coeffs = hertz::Coeffs<Real>;
+  using History = hertz::History;
+
+  static Params parse(TableReader& t) {
+    Params p;
+    hertz::parse_material(t, "E", "nu", p.particle);
+    p.wall = p.particle;
+    if (t.has("E_wall")) p.wall.E = t.positive("E_wall");
+    if (t.has("nu_wall")) {
+      p.wall.nu = t.number("nu_wall");
+      if (!(p.wall.nu > -1 && p.wall.nu < 0.5)) t.fail("nu_wall", "must be in (-1, 0.5)");
+    }
+    p.e = hertz::restitution(t);
+    p.mu = t.non_negative_or("mu", 0.5);
+    return p;
+  }
+  template <class Real>
+  static Coeffs<Real> coeffs(const Params& p) {
+    const auto c = hertz::constants(p.particle, p.wall, p.e, p.mu);
+    return {Real(c.E_star), Real(c.G_star), Real(c.beta), Real(c.mu)};
+  }
+  static double max_stiffness(const Params& p, double rmax) {
+    const auto c = hertz::constants(p.particle, p.wall, p.e, p.mu);
+    return (8 * c.G_star + 2 * c.E_star) * std::sqrt(rmax * 0.05 * rmax);
+  }
+  template <class Real>
+  static double parting_energy(const Coeffs<Real>&, const History&) {
+    return 0;
+  }
+
+  template <bool Advance, class Real>
+  static void contact(const Coeffs<Real>& c, History& h, const WallKinematics<Real>& k,
+                      ContactForce<Real>& f) {
+    f.arm_i = k.d;
+    const Real ux = k.vx - k.d * (k.wy * k.nz - k.wz * k.ny), uy = k.vy - k.d * (k.wz * k.nx - k.wx * k.nz),
+               uz = k.vz - k.d * (k.wx * k.ny - k.wy * k.nx);
+    hertz::law<Advance>(c, h, k.r, Real(1) / k.im, k.r - k.d, k.nx, k.ny, k.nz, ux, uy, uz, k.dt, f);
+  }
+  template <class Real>
+  static Real energy(const Coeffs<Real>& c, const History& h, const WallKinematics<Real>& k) {
+    return hertz::energy(c, h, k.r, k.r - k.d);
+  }
+};
+
+}  // namespace basalt::solver
