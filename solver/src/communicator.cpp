@@ -53,6 +53,17 @@ std::pair<double, int> Comm::max_loc(double v) const {
   return {out.v, out.r};
 }
 
+std::vector<double> Comm::all_gather(const std::vector<double>& v) const {
+  if (size_ == 1) return v;
+  const int n = static_cast<int>(v.size());
+  std::vector<int> counts(static_cast<std::size_t>(size_)), displs(static_cast<std::size_t>(size_), 0);
+  MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, comm_);
+  for (std::size_t r = 1; r < counts.size(); ++r) displs[r] = displs[r - 1] + counts[r - 1];
+  std::vector<double> all(static_cast<std::size_t>(displs.back() + counts.back()));
+  MPI_Allgatherv(v.data(), n, MPI_DOUBLE, all.data(), counts.data(), displs.data(), MPI_DOUBLE, comm_);
+  return all;
+}
+
 std::string Comm::broadcast(const std::string& s, int root) const {
   if (size_ == 1) return s;
   int n = static_cast<int>(s.size());

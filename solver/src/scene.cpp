@@ -227,13 +227,27 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
           for (const auto term : {m.energy_term, m.dissipation_term})
             if (!term.empty() && std::find(allowed.begin(), allowed.end(), term) == allowed.end())
               allowed.emplace_back(term);
-        for (const char* other : {"total_energy", "bond_count", "wall_force"}) allowed.emplace_back(other);
+        static const std::vector<std::pair<std::string, FieldSpec::Type>> kOther{
+            {"total_energy", FieldSpec::Type::total_energy},
+            {"bond_count", FieldSpec::Type::bond_count},
+            {"wall_force", FieldSpec::Type::wall_force},
+            {"rotational_kinetic_energy", FieldSpec::Type::rotational_kinetic_energy},
+            {"sliding_contacts", FieldSpec::Type::sliding_contacts},
+            {"runout", FieldSpec::Type::runout}};
+        for (const auto& kind : kOther) allowed.push_back(kind.first);
         FieldSpec f;
         const std::string type = tf.choice_or("type", allowed, "");
-        f.type = type == "total_energy" ? FieldSpec::Type::total_energy
-                 : type == "bond_count" ? FieldSpec::Type::bond_count
-                 : type == "wall_force" ? FieldSpec::Type::wall_force
-                                        : FieldSpec::Type::energy;
+        f.type = FieldSpec::Type::energy;
+        for (const auto& kind : kOther)
+          if (kind.first == type) f.type = kind.second;
+        if (f.type == FieldSpec::Type::runout) {
+          if (tf.has("origin")) f.origin = tf.vec3("origin");
+          if (tf.has("direction")) f.direction = unit(tf, "direction");
+          f.percentile = tf.number_or("percentile", 100);
+          if (!(f.percentile > 0 && f.percentile <= 100)) tf.fail("percentile", "must be in (0, 100]");
+        }
+        if (f.type == FieldSpec::Type::rotational_kinetic_energy && !s.rotation)
+          tf.fail("type", "rotational_kinetic_energy needs rotating particles (particles.rotation = true)");
         if (f.type == FieldSpec::Type::energy) f.term = type;
         f.every = tf.integer_or("every", 1);
         if (f.every < 1) tf.fail("every", fmt::format("must be >= 1, got {}", f.every));

@@ -9,6 +9,7 @@
 #include <limits>
 
 #include "basalt/solver/core/errors.hpp"
+#include "basalt/solver/integrate/integrators.hpp"
 #include "basalt/solver/output/simulation_frame.hpp"
 #include "basalt/solver/simulation.hpp"
 
@@ -45,6 +46,22 @@ bool Simulation<Real>::field_partials(const std::vector<double>& pe, std::vector
       case FieldSpec::Type::bond_count:
         local.push_back(double(local_bond_count()));
         break;
+      case FieldSpec::Type::rotational_kinetic_energy:
+        local.push_back(rotational_energy(p_));
+        break;
+      case FieldSpec::Type::sliding_contacts: {
+        std::size_t n = 0;
+        for (const auto& c : forces_.computes()) n += c->sliding_contacts();
+        local.push_back(double(n));
+        break;
+      }
+      case FieldSpec::Type::runout: {
+        // Collective (every rank computes its savers at the same steps); the value goes to rank 0's
+        // partial, so the ranks' partials sum to it.
+        const double r = runout(f);
+        local.push_back(comm().rank() == 0 ? r : 0.0);
+        break;
+      }
       case FieldSpec::Type::wall_force: {
         std::size_t w = 0;
         while (forces_.walls().spec(w).name != f.wall) ++w;
@@ -55,6 +72,27 @@ bool Simulation<Real>::field_partials(const std::vector<double>& pe, std::vector
     }
   }
   return any;
+}
+
+template <class Real>
+double Simulation<Real>::runout(const FieldSpec& f) const {
+  std::vector<double> s(p_.n_owned);
+  for (std::size_t i = 0; i < p_.n_owned; ++i)
+    s[i] = (double(p_.x[i]) - f.origin[0]) * f.direction[0] +
+           (double(p_.y[i]) - f.origin[1]) * f.direction[1] +
+           (double(p_.z[i]) - f.origin[2]) * f.direction[2];
+  if (f.percentile >= 100) {
+    double m = -std::numeric_limits<double>::infinity();
+    for (double v : s) m = std::max(m, v);
+    return comm().size() > 1 ? comm().max(m) : m;
+  }
+  auto all = comm().size() > 1 ? comm().all_gather(s) : std::move(s);
+  if (all.empty()) return 0;
+  // The value below which `percentile` % of the particles lie (nearest rank).
+  const auto k = static_cast<std::size_t>(
+      std::min<double>(double(all.size()) - 1, std::ceil(f.percentile / 100.0 * double(all.size())) - 1));
+  std::nth_element(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(k), all.end());
+  return all[k];
 }
 
 template <class Real>
@@ -150,6 +188,7 @@ void Simulation<Real>::report_frame_times(std::vector<double> seconds) const {
   template bool Simulation<R>::field_partials(const std::vector<double>&, std::vector<double>&, \
                                               std::vector<char>&) const;                        \
   template void Simulation<R>::output_fields(const std::vector<double>&);                       \
+  template double Simulation<R>::runout(const FieldSpec&) const;                                \
   template RestartLayout Simulation<R>::restart_layout() const;                                 \
   template void Simulation<R>::report_frame_times(std::vector<double>) const;                   \
   template void Simulation<R>::run(std::int64_t, OutputSink&);

@@ -93,6 +93,18 @@ type = "total_energy"
 type = "friction_dissipated"
 [[output.fields]]
 type = "damping_dissipated"
+[[output.fields]]
+type = "rotational_kinetic_energy"
+[[output.fields]]
+type = "sliding_contacts"
+[[output.fields]]
+type = "runout"
+origin = [0.0, 0.0, 0.0]
+direction = [2.0, 0.0, 0.0]
+[[output.fields]]
+type = "runout"
+direction = [1.0, 0.0, 0.0]
+percentile = 50
 )";
 
 }  // namespace
@@ -230,6 +242,26 @@ TEST(Granular, ColumnCollapseBalancesTheLedgerAndFixedParticlesStay) {
   double spin = 0;
   for (std::size_t i = 0; i < p.n_owned; ++i) spin = std::max(spin, std::abs(p.wy[i]));
   EXPECT_GT(spin, 1e-3) << "the collapse must turn particles";
+
+  // The granular savers at the last step, against the particles themselves.
+  ASSERT_EQ(sink.columns.size(), 8u);
+  EXPECT_EQ(sink.columns[6], "runout_max");
+  EXPECT_EQ(sink.columns[7], "runout_p50");
+  const auto& row = sink.rows.back();
+  double rot = 0, far = -1e300;
+  std::vector<double> xs;
+  for (std::size_t i = 0; i < p.n_owned; ++i) {
+    rot += 0.5 * (p.wx[i] * p.wx[i] + p.wy[i] * p.wy[i] + p.wz[i] * p.wz[i]) / p.inverse_inertia(i);
+    far = std::max(far, p.x[i]);
+    xs.push_back(p.x[i]);
+  }
+  std::sort(xs.begin(), xs.end());
+  EXPECT_NEAR(*row[4], rot, 1e-12 * rot);
+  EXPECT_GT(*row[5], 0.0) << "some contacts slide while the column collapses";
+  EXPECT_LT(*row[5], 4.0 * double(p.n_owned));
+  EXPECT_EQ(*row[6], far);
+  EXPECT_EQ(*row[7], xs[xs.size() / 2 - 1]) << "the 50th percentile of 128 values is the 64th";
+  EXPECT_GT(far, 4.5) << "the column spread along +x";
 }
 
 TEST(Granular, FrictionalRotatingColumnIsDecompositionInvariant) {

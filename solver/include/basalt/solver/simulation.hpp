@@ -167,6 +167,8 @@ class Simulation {
   bool field_partials(const std::vector<double>& pe, std::vector<double>& local,
                       std::vector<char>& due) const;
   void output_fields(const std::vector<double>& pe);
+  /// Collective: the runout saver's value (FieldSpec::percentile of the distances along its direction).
+  double runout(const FieldSpec& f) const;
   void distribute_checkpoint(const io::Checkpoint& c, const RestartLayout& layout, MPI_Comm comm);
   /// Restart: the optional particle fields the checkpoint stores (by name), for the owned particles
   /// (`mine`: their geometry indices in local order); bond damage counters adjusted for the replay.

@@ -54,6 +54,7 @@ class BodyDriver final : public ForceCompute<Real> {
       for (std::size_t i = 0; i < p.n_owned; ++i) {
         if (!tags.empty() && std::find(tags.begin(), tags.end(), p.tag[i]) == tags.end()) continue;
         b.m = p.mass(i);
+        b.im = p.inv_mass[i];
         b.x = p.x[i], b.y = p.y[i], b.z = p.z[i];
         b.vx = p.vx[i], b.vy = p.vy[i], b.vz = p.vz[i];
         b.fx = p.fx[i], b.fy = p.fy[i], b.fz = p.fz[i];

@@ -73,6 +73,8 @@ class ForceCompute {
   /// This rank's share of the energy dissipated since the start (or the last set_dissipated()).
   virtual double dissipated() const { return 0; }
   virtual void set_dissipated(double) {}
+  /// Contacts that slid at the last real step (this rank's share, each contact once across ranks).
+  virtual std::size_t sliding_contacts() const { return 0; }
   /// The run's time step (models that integrate over a step: tangential springs, damping).
   virtual void set_time_step(double) {}
   /// Largest spring constant for particles up to radius rmax (critical time step).

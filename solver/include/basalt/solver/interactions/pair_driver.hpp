@@ -62,11 +62,13 @@ class PairDriver final : public ForceCompute<Real> {
     return {};
   }
   double dissipated() const override { return dissipated_; }
+  std::size_t sliding_contacts() const override { return sliding_; }
   void set_dissipated(double d) override { dissipated_ = d; }
   void set_time_step(double dt) override { dt_ = Real(dt); }
 
   double compute(ForceState<Real>& s, Part part, bool energy, bool advance) override {
     const bool own = part == Part::owned;
+    if (own && advance) sliding_ = 0;
     const PairList& list = own ? *own_ : *ghost_;
     History* h = own ? hist_own_.data() : hist_ghost_.data();
     if (own) return dispatch<true>(s.p, list, h, energy, advance);
@@ -198,6 +200,7 @@ class PairDriver final : public ForceCompute<Real> {
   template <bool Energy, bool Newton, bool Advance>
   double loop_kinematic(Particles<Real>& p, const PairList& list, History* hist) {
     double energy = 0, dissipated = 0;
+    std::size_t sliding = 0;
     const bool rot = p.with_rotation;
     const std::uint32_t* __restrict off = list.offset.data();
     const std::int32_t* __restrict nb = list.neigh.data();
@@ -266,12 +269,16 @@ class PairDriver final : public ForceCompute<Real> {
           }
         }
         if (Newton || p.id[i] < p.id[j]) {
-          if constexpr (Advance) dissipated += f.dissipated;
+          if constexpr (Advance) {
+            dissipated += f.dissipated;
+            sliding += f.sliding;
+          }
           if constexpr (Energy) energy += double(Model::energy(c, h, k));
         }
       }
     }
     dissipated_ += dissipated;
+    sliding_ += sliding;
     return energy;
   }
 
@@ -331,7 +338,8 @@ class PairDriver final : public ForceCompute<Real> {
   PairList own_sub_, ghost_sub_;  ///< with several pair models: this model's share of the lists
   std::vector<History> hist_own_, hist_ghost_;
   ContactRecords pending_;
-  double dissipated_ = 0;  ///< this rank's share of the energy dissipated since the start
+  double dissipated_ = 0;    ///< this rank's share of the energy dissipated since the start
+  std::size_t sliding_ = 0;  ///< contacts sliding at the last real step
   Real dt_ = 0;
 };
 

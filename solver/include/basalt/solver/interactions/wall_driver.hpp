@@ -43,6 +43,7 @@ class WallDriver final : public ForceCompute<Real> {
     return {};
   }
   double dissipated() const override { return dissipated_; }
+  std::size_t sliding_contacts() const override { return sliding_; }
   void set_dissipated(double d) override { dissipated_ = d; }
   void set_time_step(double dt) override { dt_ = Real(dt); }
   double max_stiffness(double rmax) const override {
@@ -146,6 +147,7 @@ class WallDriver final : public ForceCompute<Real> {
   double loop_kinematic(Particles<Real>& p, Walls& walls) {
     walls_ = &walls;
     double energy = 0, dissipated = 0;
+    std::size_t sliding = 0;
     const bool rot = p.with_rotation;
     WallKinematics<Real> kin{};
     kin.dt = dt_;
@@ -189,12 +191,16 @@ class WallDriver final : public ForceCompute<Real> {
         wfx -= double(f.fx);
         wfy -= double(f.fy);
         wfz -= double(f.fz);
-        if constexpr (Advance) dissipated += f.dissipated;
+        if constexpr (Advance) {
+          dissipated += f.dissipated;
+          sliding += f.sliding;
+        }
         if constexpr (Energy) energy += double(Model::energy(c, h, kin));
       }
       walls.force(w) = {wfx, wfy, wfz};
     }
     dissipated_ += dissipated;
+    if (Advance) sliding_ = sliding;
     return energy;
   }
 
@@ -205,6 +211,7 @@ class WallDriver final : public ForceCompute<Real> {
   ContactRecords pending_;
   const Walls* walls_ = nullptr;
   double dissipated_ = 0;
+  std::size_t sliding_ = 0;
   Real dt_ = 0;
 };
 

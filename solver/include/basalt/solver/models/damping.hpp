@@ -3,12 +3,17 @@
 // "RotDamping", and Cundall's local damping):
 //   linear_damping:      F = -nu m (v - v_ref)                   (ESyS LinDampingPrms viscosity nu)
 //   rotational_damping:  T = -nu I w                             (ESyS RotDampingPrms viscosity nu)
+//   With `iterations = N` both follow ESyS-Particle 2.3.5 exactly (Model/Damping.hpp, RotDamping.hpp;
+//   docs/reference-runs.md): the damped velocity u solves u = v - v_ref + dt/m (F - nu m u) by fixed-
+//   point iteration from u = 0 while |du|^4 > 1e-12 and fewer than N iterations were made (F the
+//   force from every other model); N iterations made (converged or not) means no damping that step.
 //   local_damping:       F_k -= alpha |F_k| sign(v_k), each component k of the force from every other
 //                        model (non-viscous; alpha in [0, 1); Cundall 1987, as in PFC and Yade's
 //                        NewtonIntegrator damping), and the same on torques with w.
 // The energy they take out goes to the ledger term damping_dissipated (the power F . v over each step).
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <string_view>
 
 #include "basalt/solver/models/model.hpp"
@@ -22,19 +27,25 @@ struct LinearDamping {
   static constexpr std::string_view summary = "F = -nu m (v - v_ref) (ESyS LinDamping)";
   static constexpr std::string_view energy_term = {};
   static constexpr std::string_view dissipation_term = "damping_dissipated";
-  static constexpr std::array keys{KeyDoc{"viscosity", "nu, 1/time, >= 0 (required)"},
-                                   KeyDoc{"reference_velocity", "[vx, vy, vz] (default 0)"},
-                                   KeyDoc{"tags", "particle tags it acts on (default: all)"}};
+  static constexpr std::array keys{
+      KeyDoc{"viscosity", "nu, 1/time, >= 0 (required)"},
+      KeyDoc{"reference_velocity", "[vx, vy, vz] (default 0)"},
+      KeyDoc{"iterations",
+             "ESyS's implicit form with at most this many iterations (its maxIterations; default: none, "
+             "F = -nu m (v - v_ref))"},
+      KeyDoc{"tags", "particle tags it acts on (default: all)"}};
   static constexpr Fields reads = kVelocity | kInverseMass | kTag;
   static constexpr Fields writes = kForce;
 
   struct Params {
     double nu = 0;
     std::array<double, 3> v_ref{0, 0, 0};
+    std::int64_t iterations = 0;  ///< 0: explicit
   };
   template <class Real>
   struct Coeffs {
     Real nu, vx, vy, vz;
+    int iterations;
   };
   struct History {};
 
@@ -42,21 +53,47 @@ struct LinearDamping {
     Params p;
     p.nu = t.non_negative("viscosity");
     if (t.has("reference_velocity")) p.v_ref = t.vec3("reference_velocity");
+    p.iterations = iterations(t);
     return p;
+  }
+  static std::int64_t iterations(TableReader& t) {
+    const auto n = t.integer_or("iterations", 0);
+    if (n < 0 || n > 100000) t.fail("iterations", "must be in 1 .. 100000 (or absent)");
+    return n;
   }
   template <class Real>
   static Coeffs<Real> coeffs(const Params& p) {
-    return {Real(p.nu), Real(p.v_ref[0]), Real(p.v_ref[1]), Real(p.v_ref[2])};
+    return {Real(p.nu), Real(p.v_ref[0]), Real(p.v_ref[1]), Real(p.v_ref[2]), static_cast<int>(p.iterations)};
   }
   static double max_stiffness(const Params&, double) { return 0; }
 
+  /// ESyS's damped velocity: u = v + s dt (F - nu M u) iterated from 0 (s = 1 / M), or 0 when the
+  /// iteration limit is reached.
+  template <class Real>
+  static std::array<Real, 3> esys_velocity(Real nu, Real M, Real s, Real dt, int n, std::array<Real, 3> v,
+                                           std::array<Real, 3> F) {
+    std::array<Real, 3> u{0, 0, 0};
+    double error = 1;
+    int count = 0;
+    while (error * error > 1e-12 && count < n) {
+      ++count;
+      const auto old = u;
+      for (int d = 0; d < 3; ++d) u[d] = v[d] + s * dt * (F[d] - u[d] * nu * M);
+      error = double((u[0] - old[0]) * (u[0] - old[0]) + (u[1] - old[1]) * (u[1] - old[1]) +
+                     (u[2] - old[2]) * (u[2] - old[2]));
+    }
+    if (count >= n) u = {0, 0, 0};
+    return u;
+  }
+
   template <class Real>
   static void apply(const Coeffs<Real>& c, const BodyState<Real>& b, BodyForce<Real>& f) {
+    std::array<Real, 3> u{b.vx - c.vx, b.vy - c.vy, b.vz - c.vz};
+    if (c.iterations > 0) u = esys_velocity(c.nu, b.m, b.im, b.dt, c.iterations, u, {b.fx, b.fy, b.fz});
     const Real s = -c.nu * b.m;
-    const Real ux = b.vx - c.vx, uy = b.vy - c.vy, uz = b.vz - c.vz;
-    f.fx = s * ux;
-    f.fy = s * uy;
-    f.fz = s * uz;
+    f.fx = s * u[0];
+    f.fy = s * u[1];
+    f.fz = s * u[2];
     f.dissipated = -double(f.fx * b.vx + f.fy * b.vy + f.fz * b.vz) * double(b.dt);
   }
   template <class Real>
@@ -71,33 +108,46 @@ struct RotationalDamping {
   static constexpr std::string_view summary = "T = -nu I w (ESyS RotDamping)";
   static constexpr std::string_view energy_term = {};
   static constexpr std::string_view dissipation_term = "damping_dissipated";
-  static constexpr std::array keys{KeyDoc{"viscosity", "nu, 1/time, >= 0 (required)"},
-                                   KeyDoc{"tags", "particle tags it acts on (default: all)"}};
+  static constexpr std::array keys{
+      KeyDoc{"viscosity", "nu, 1/time, >= 0 (required)"},
+      KeyDoc{"iterations",
+             "ESyS's implicit form with at most this many iterations (default: none, T = -nu I w)"},
+      KeyDoc{"tags", "particle tags it acts on (default: all)"}};
   static constexpr Fields reads = kAngularVelocity | kInverseMass | kRadius | kTag;
   static constexpr Fields writes = kTorque;
 
   struct Params {
     double nu = 0;
+    std::int64_t iterations = 0;
   };
   template <class Real>
   struct Coeffs {
     Real nu;
+    int iterations;
   };
   struct History {};
 
-  static Params parse(TableReader& t) { return {t.non_negative("viscosity")}; }
+  static Params parse(TableReader& t) {
+    Params p{t.non_negative("viscosity")};
+    p.iterations = LinearDamping::iterations(t);
+    return p;
+  }
   template <class Real>
   static Coeffs<Real> coeffs(const Params& p) {
-    return {Real(p.nu)};
+    return {Real(p.nu), static_cast<int>(p.iterations)};
   }
   static double max_stiffness(const Params&, double) { return 0; }
 
   template <class Real>
   static void apply(const Coeffs<Real>& c, const BodyState<Real>& b, BodyForce<Real>& f) {
+    std::array<Real, 3> u{b.wx, b.wy, b.wz};
+    if (c.iterations > 0)
+      u = LinearDamping::esys_velocity(c.nu, b.inertia, Real(1) / b.inertia, b.dt, c.iterations, u,
+                                       {b.tx, b.ty, b.tz});
     const Real s = -c.nu * b.inertia;
-    f.tx = s * b.wx;
-    f.ty = s * b.wy;
-    f.tz = s * b.wz;
+    f.tx = s * u[0];
+    f.ty = s * u[1];
+    f.tz = s * u[2];
     f.dissipated = -double(f.tx * b.wx + f.ty * b.wy + f.tz * b.wz) * double(b.dt);
   }
   template <class Real>

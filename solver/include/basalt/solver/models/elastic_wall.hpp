@@ -25,6 +25,8 @@ struct ElasticWall {
   static constexpr Fields writes = kForce;
 
   enum class Stiffness { plain, esys_pi_r };
+  /// The value of pi ESyS-Particle's wall uses (EWallInteraction.hpp: a literal, not M_PI).
+  static constexpr double kEsysPi = 3.141592654;
   struct Params {
     double K = 0;
     Stiffness stiffness = Stiffness::plain;
@@ -49,7 +51,7 @@ struct ElasticWall {
     return {Real(p.K), p.stiffness == Stiffness::esys_pi_r};
   }
   static double max_stiffness(const Params& p, double rmax) {
-    return p.stiffness == Stiffness::esys_pi_r ? std::numbers::pi * rmax * p.K : p.K;
+    return p.stiffness == Stiffness::esys_pi_r ? kEsysPi * rmax * p.K : p.K;
   }
 
   /// Force along the wall normal on a particle of radius r overlapping the wall by o > 0.
@@ -65,7 +67,7 @@ struct ElasticWall {
  private:
   template <class Real>
   static Real stiffness(const Coeffs<Real>& c, Real r) {
-    return c.pi_r ? Real(std::numbers::pi) * r * c.K : c.K;
+    return c.pi_r ? Real(kEsysPi) * r * c.K : c.K;
   }
 };
 

@@ -35,6 +35,12 @@ struct CoulombFriction {
       KeyDoc{"mu_dynamic",
              "dynamic (sliding) friction coefficient, 0 <= mu_dynamic <= mu (default mu; ESyS "
              "dynamicMu)"},
+      KeyDoc{"convention",
+             "\"basalt\" (default) or \"esys\": ESyS-Particle 2.3.5's rules (the shear force is "
+             "never turned with the contact; the slide threshold is always mu)"},
+      KeyDoc{"scaling",
+             "ESyS's scaling: K and Ks times (ri + rj) / 4 (rot_friction) or (ri + rj) / 2 (friction) "
+             "(default false)"},
       KeyDoc{"tags", "[a, b]: pairs tagged a and b (default: all pairs)"}};
   static constexpr Fields reads =
       kPosition | kRadius | kId | kVelocity | kInverseMass | (Rotating ? kAngularVelocity : kNoFields);
@@ -43,10 +49,12 @@ struct CoulombFriction {
 
   struct Params {
     double K = 0, Ks = 0, mu = 0, mu_dynamic = 0;
+    bool esys = false, scaling = false;
   };
   template <class Real>
   struct Coeffs {
     Real K, Ks, mu, mu_dynamic;
+    bool esys, scaling;
   };
   struct History {
     double fx = 0, fy = 0, fz = 0;  ///< shear force on the first particle of the listed pair
@@ -60,18 +68,26 @@ struct CoulombFriction {
     p.mu = t.non_negative("mu");
     p.mu_dynamic = t.non_negative_or("mu_dynamic", p.mu);
     if (p.mu_dynamic > p.mu) t.fail("mu_dynamic", "must not exceed mu (the static coefficient)");
+    p.esys = t.choice_or("convention", {"basalt", "esys"}, "basalt") == "esys";
+    p.scaling = t.boolean_or("scaling", false);
     return p;
   }
   template <class Real>
   static Coeffs<Real> coeffs(const Params& p) {
-    return {Real(p.K), Real(p.Ks), Real(p.mu), Real(p.mu_dynamic)};
+    return {Real(p.K), Real(p.Ks), Real(p.mu), Real(p.mu_dynamic), p.esys, p.scaling};
   }
-  static double max_stiffness(const Params& p, double) { return std::max(p.K, p.Ks); }
+  static double max_stiffness(const Params& p, double rmax) {
+    return std::max(p.K, p.Ks) * (p.scaling ? scale_factor(rmax, rmax) : 1.0);
+  }
+  /// ESyS's stiffness scaling (RotFricInteraction.cpp: R^2 / (ri + rj) with R = (ri + rj) / 2;
+  /// FrictionInteraction.cpp: (ri + rj) / 2).
+  static double scale_factor(double ri, double rj) { return Rotating ? (ri + rj) / 4 : (ri + rj) / 2; }
 
   static void apart(History& h) { h = History{}; }
   /// The shear spring's energy, lost when the spheres part (the ledger counts it as dissipated).
   template <class Real>
   static double parting_energy(const Coeffs<Real>& c, const History& h) {
+    // (Scaled stiffness: the radii are not known here; the unscaled Ks is close enough for the ledger.)
     return c.Ks > 0 ? (h.fx * h.fx + h.fy * h.fy + h.fz * h.fz) / (2 * double(c.Ks)) : 0.0;
   }
   static History flip(const History& h) { return {-h.fx, -h.fy, -h.fz, h.sliding}; }
@@ -82,7 +98,9 @@ struct CoulombFriction {
                       ContactForce<Real>& f) {
     const Real inv_r = Real(1) / k.r;
     const Real nx = k.dx * inv_r, ny = k.dy * inv_r, nz = k.dz * inv_r;
-    const Real fn = c.K * (k.ri + k.rj - k.r);
+    const Real scale = c.scaling ? Real(scale_factor(double(k.ri), double(k.rj))) : Real(1);
+    const Real K = c.K * scale, Ks = c.Ks * scale;
+    const Real fn = K * (k.ri + k.rj - k.r);
     f.arm_i = k.r * k.ri / (k.ri + k.rj);
     Real sx = Real(h.fx), sy = Real(h.fy), sz = Real(h.fz);
     if constexpr (Advance) {
@@ -100,20 +118,21 @@ struct CoulombFriction {
       ux -= un * nx;
       uy -= un * ny;
       uz -= un * nz;
-      turn_into_plane(sx, sy, sz, nx, ny, nz);
+      if (!c.esys) turn_into_plane(sx, sy, sz, nx, ny, nz);  // ESyS never turns it
       const Real px = sx, py = sy, pz = sz;
-      sx -= c.Ks * k.dt * ux;
-      sy -= c.Ks * k.dt * uy;
-      sz -= c.Ks * k.dt * uz;
+      sx -= Ks * k.dt * ux;
+      sy -= Ks * k.dt * uy;
+      sz -= Ks * k.dt * uz;
       const Real s2 = sx * sx + sy * sy + sz * sz;
-      const Real limit = (h.sliding != 0 ? c.mu_dynamic : c.mu) * fn;
+      const Real limit = (h.sliding != 0 && !c.esys ? c.mu_dynamic : c.mu) * fn;
       if (s2 > limit * limit) {
-        const Real s = std::sqrt(s2), cut = c.mu_dynamic * fn, scale = cut / s;
-        f.dissipated = cut_energy(c, s, cut, (px * sx + py * sy + pz * sz) / s);
-        sx *= scale;
-        sy *= scale;
-        sz *= scale;
+        const Real s = std::sqrt(s2), cut = c.mu_dynamic * fn, shrink = cut / s;
+        f.dissipated = cut_energy(Ks, s, cut, (px * sx + py * sy + pz * sz) / s);
+        sx *= shrink;
+        sy *= shrink;
+        sz *= shrink;
         h.sliding = 1;
+        f.sliding = true;
       } else {
         h.sliding = 0;
       }
@@ -132,9 +151,9 @@ struct CoulombFriction {
   /// as D = (s - cut) (p . t + cut) / (2 Ks): in steady sliding mu_dynamic |F_n| times the slip, at
   /// the switch from static to dynamic friction the spring's drop as well.
   template <class Real>
-  static double cut_energy(const Coeffs<Real>& c, Real s, Real cut, Real p_dot_t) {
-    if (!(c.Ks > 0)) return 0;
-    return (double(s) - double(cut)) * (double(p_dot_t) + double(cut)) / (2 * double(c.Ks));
+  static double cut_energy(Real Ks, Real s, Real cut, Real p_dot_t) {
+    if (!(Ks > 0)) return 0;
+    return (double(s) - double(cut)) * (double(p_dot_t) + double(cut)) / (2 * double(Ks));
   }
 
   /// The shear force carried onto the tangent plane of the current normal n, its length kept (the
@@ -158,9 +177,10 @@ struct CoulombFriction {
 
   template <class Real>
   static Real energy(const Coeffs<Real>& c, const History& h, const ContactKinematics<Real>& k) {
+    const Real scale = c.scaling ? Real(scale_factor(double(k.ri), double(k.rj))) : Real(1);
     const Real d = k.ri + k.rj - k.r;
     const Real s2 = Real(h.fx * h.fx + h.fy * h.fy + h.fz * h.fz);
-    return Real(0.5) * c.K * d * d + (c.Ks > 0 ? s2 / (2 * c.Ks) : Real(0));
+    return Real(0.5) * c.K * scale * d * d + (c.Ks > 0 ? s2 / (2 * c.Ks * scale) : Real(0));
   }
 };
 
@@ -187,7 +207,15 @@ struct FrictionWall {
   using Coeffs = CoulombFriction<true>::Coeffs<Real>;
   using History = CoulombFriction<true>::History;
 
-  static Params parse(TableReader& t) { return CoulombFriction<true>::parse(t); }
+  static Params parse(TableReader& t) {
+    Params p;
+    p.K = t.non_negative("K");
+    p.Ks = t.non_negative("Ks");
+    p.mu = t.non_negative("mu");
+    p.mu_dynamic = t.non_negative_or("mu_dynamic", p.mu);
+    if (p.mu_dynamic > p.mu) t.fail("mu_dynamic", "must not exceed mu (the static coefficient)");
+    return p;
+  }
   template <class Real>
   static double parting_energy(const Coeffs<Real>& c, const History& h) {
     return CoulombFriction<true>::parting_energy(c, h);
@@ -222,11 +250,12 @@ struct FrictionWall {
       const Real limit = (h.sliding != 0 ? c.mu_dynamic : c.mu) * fn;
       if (s2 > limit * limit) {
         const Real s = std::sqrt(s2), cut = c.mu_dynamic * fn, scale = cut / s;
-        f.dissipated = CoulombFriction<true>::cut_energy(c, s, cut, (px * sx + py * sy + pz * sz) / s);
+        f.dissipated = CoulombFriction<true>::cut_energy(c.Ks, s, cut, (px * sx + py * sy + pz * sz) / s);
         sx *= scale;
         sy *= scale;
         sz *= scale;
         h.sliding = 1;
+        f.sliding = true;
       } else {
         h.sliding = 0;
       }

@@ -102,6 +102,7 @@ void law(const Coeffs<Real>& c, History& h, Real R, Real m, Real d, Real nx, Rea
   const Real ft2 = ftx * ftx + fty * fty + ftz * ftz, limit = c.mu * (fn > 0 ? fn : Real(0));
   if (Advance) f.dissipated = double(gn * un * un + gt * (tx * tx + ty * ty + tz * tz)) * double(dt);
   if (ft2 > limit * limit) {
+    f.sliding = true;
     const Real scale = limit / std::sqrt(ft2);
     const double before = 0.5 * double(St) * double(sx * sx + sy * sy + sz * sz);
     ftx *= scale, fty *= scale, ftz *= scale;

@@ -82,6 +82,7 @@ struct ContactForce {
   Real arm_i = 0;
   Real mx = 0, my = 0, mz = 0;  ///< a couple on i (rolling resistance), -m on j
   double dissipated = 0;        ///< energy the contact dissipated this step (friction, dashpots)
+  bool sliding = false;         ///< the contact slides (Coulomb limit reached) this step
 };
 
 /// What a velocity-dependent wall model (kVelocity in its reads: friction) sees of a particle
@@ -101,6 +102,7 @@ struct WallKinematics {
 template <class Real>
 struct BodyState {
   Real m;           ///< mass
+  Real im;          ///< inverse mass (as stored)
   Real x, y, z;     ///< position
   Real vx, vy, vz;  ///< velocity
   Real fx, fy, fz;  ///< the force from every other model this step (body forces come last)

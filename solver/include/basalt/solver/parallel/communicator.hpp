@@ -27,6 +27,8 @@ class Comm {
   void sum_all(std::vector<double>& v) const;
   /// (value, rank) of the largest value across ranks.
   std::pair<double, int> max_loc(double v) const;
+  /// Every rank's values, concatenated in rank order, on every rank.
+  std::vector<double> all_gather(const std::vector<double>& v) const;
   /// Broadcasts a string from `root`.
   std::string broadcast(const std::string& s, int root) const;
   /// Collective: if any rank has an error, every rank gets the message of the lowest such rank.

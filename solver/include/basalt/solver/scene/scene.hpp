@@ -54,17 +54,43 @@ struct WallSpec {
 /// wall_work_in, a body force's potential), the total mechanical energy, the bond count, or a wall's
 /// force.
 struct FieldSpec {
-  enum class Type { energy, total_energy, bond_count, wall_force };
+  enum class Type {
+    energy,
+    total_energy,
+    bond_count,
+    wall_force,
+    rotational_kinetic_energy,
+    sliding_contacts,
+    runout
+  };
   Type type = Type::energy;
   std::string term = "kinetic_energy";  ///< energy only: the ledger term
   std::int64_t every = 1;
   std::string wall;  ///< wall_force only
+  /// runout: the distance along `direction` from `origin` that `percentile` % of the particles do not
+  /// pass (100: the farthest particle).
+  std::array<double, 3> origin{0, 0, 0}, direction{1, 0, 0};
+  double percentile = 100;
   /// The column name (wall_force: the prefix of three columns).
   std::string name() const {
-    return type == Type::energy         ? term
-           : type == Type::total_energy ? "total_energy"
-           : type == Type::bond_count   ? "bond_count"
-                                        : "wall_force";
+    switch (type) {
+      case Type::energy:
+        return term;
+      case Type::total_energy:
+        return "total_energy";
+      case Type::bond_count:
+        return "bond_count";
+      case Type::wall_force:
+        return "wall_force";
+      case Type::rotational_kinetic_energy:
+        return "rotational_kinetic_energy";
+      case Type::sliding_contacts:
+        return "sliding_contacts";
+      case Type::runout:
+        return percentile >= 100 ? std::string("runout_max")
+                                 : "runout_p" + std::to_string(static_cast<int>(std::lround(percentile)));
+    }
+    return term;
   }
 };
 
