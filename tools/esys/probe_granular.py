@@ -77,6 +77,9 @@ class RotFriction:
             eff_r = 0.5 * r0 if mean_r else min(p1.r, p2.r)
             eff = eff_r * eff_r / r0
         self.p1, self.p2, self.k, self.ks = p1, p2, k * eff, ks * eff
+        # `rigid` never reaches the workers (LatticeMaster.cpp:3223-3235 does not send it; SubLattice.hpp:1203-1211
+        # builds the parameters with the default rigid=false): rigid=True runs calcSimpleForces. "rigid_as_source"
+        # runs Y. Wang's calcRigidBodyForces instead (the alternative the probe rejects).
         self.mu_d, self.mu_s, self.rigid = mu_d, mu_s, rigid
         self.ffric, self.slipping, self.touching = [0.0] * 3, False, False
 
@@ -97,8 +100,10 @@ class RotFriction:
         w1 = [0.0] * 3 if "no_omega_in_ds" in alt else p1.w
         w2 = [0.0] * 3 if "no_omega_in_ds" in alt else p2.w
         fn = norm(force)
-        if not self.rigid:
-            mu = self.mu_s if ("threshold_always_mu_s" in alt or not self.slipping) else self.mu_d
+        if not (self.rigid and "rigid_as_source" in alt):
+            # Measured: the Coulomb test always uses mu_s. The mirrored source (RotFricInteraction.cpp:174) uses
+            # mu_d after a slipping step ("threshold_mu_d_when_slipping"): rejected by the probe rotfric_slip.
+            mu = self.mu_d if ("threshold_mu_d_when_slipping" in alt and self.slipping) else self.mu_s
             vp1 = add(p1.v, cross(w1, sub(pos, p1.x)))
             vp2 = add(p2.v, cross(w2, sub(pos, p2.x)))
             ds = mul(DT, sub(vp2, vp1))
@@ -277,7 +282,7 @@ def sphere_defs(case):
         c["parts"] = [(0, (0, 0, 0), 0.5, 1.0, (0, 0, 0), (0, 0, 1.0)), (1, (0.7, 0.1, 0.0), 0.3, 2.0, (0, 20.0, 0), (3.0, 0, 0))]
         c["steps"] = 40
         c["pair"] = ("rotfric", dict(k=K, ks=K, mu_d=0.3, mu_s=0.6, scaling=False, rigid=False))
-        c["alts"] = ["threshold_always_mu_s", "slip_to_mu_s", "lever_radius"]
+        c["alts"] = ["threshold_mu_d_when_slipping", "slip_to_mu_s", "lever_radius"]
     elif case == "rotfric_separate":
         # contact, separation (spring reset), second contact against a wall bounce
         c["parts"] = [(0, (0, 0, 0.6), 0.5, 1.0, (0, 0, 0), (0, 0, 0)), (1, (0.82, 0, 0.6), 0.3, 1.0, (-0.5, 0.4, 0), (0, 0, 0))]
@@ -297,7 +302,7 @@ def sphere_defs(case):
         c["parts"] = [(0, (0, 0, 0), 0.5, 1.0, (0, 0, 0), (0, 0, 0)), (1, (0.75, 0, 0), 0.3, 2.0, (0, 0.5, 0), (0, 0, 1.0))]
         c["steps"], c["g"] = 300, (-2.0, 0.0, 0.0)
         c["pair"] = ("rotfric", dict(k=K, ks=K, mu_d=0.3, mu_s=0.6, scaling=False, rigid=True))
-        c["alts"] = ["rigid_off"]
+        c["alts"] = ["rigid_as_source"]
     elif case == "nrotfric":
         c["ptype"] = "NRotSphere"
         c["parts"] = [(0, (0, 0, 0), 0.5, 1.0, (0, 0, 0), None), (1, (0.75, 0, 0), 0.3, 2.0, (0, 0.5, 0.2), None)]
@@ -325,7 +330,8 @@ def sphere_defs(case):
         c["alts"] = {"damp_lin_1": ["damp_converged", "damp_plain"], "damp_lin_small": ["damp_converged"],
                      "damp_lin_maxit3": ["damp_no_zeroing"]}[case]
     elif case == "damp_lin_gravity":
-        c["parts"] = [(0, (0, 0, 0), 0.5, 1.5, (0, 0, 0), (0, 0, 0))]
+        # (with v0 = 0 this ESyS run hung once: every other case sets a velocity)
+        c["parts"] = [(0, (0, 0, 0), 0.5, 1.5, (0.02, 0, 0), (0, 0, 0))]
         c["lin"], c["g"], c["steps"] = (10.0, 100), (0.0, 0.0, -3.0), 20
         c["alts"] = ["damp_converged", "damp_plain"]
     elif case.startswith("damp_rot_"):
@@ -371,8 +377,6 @@ def build_model(c, alt):
             prm["scaling"] = True
         if "scaling_mean" in alt:
             prm["mean_r"] = True
-        if "rigid_off" in alt:
-            prm["rigid"] = False
         for i in range(len(ps)):
             for j in range(i + 1, len(ps)):
                 pairs.append(RotFriction(ps[i], ps[j], **prm) if kind == "rotfric" else NRotFriction(ps[i], ps[j], **prm))
