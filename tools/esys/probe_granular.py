@@ -330,7 +330,8 @@ def sphere_defs(case):
         c["alts"] = {"damp_lin_1": ["damp_converged", "damp_plain"], "damp_lin_small": ["damp_converged"],
                      "damp_lin_maxit3": ["damp_no_zeroing"]}[case]
     elif case == "damp_lin_gravity":
-        # (with v0 = 0 this ESyS run hung once: every other case sets a velocity)
+        # Not in CASES: this ESyS run (one particle, gravity + LinDamping, nothing else) hangs with the worker at
+        # 100 % CPU, with v0 = 0 and with v0 = 0.02; not investigated. `combo` covers gravity + damping.
         c["parts"] = [(0, (0, 0, 0), 0.5, 1.5, (0.02, 0, 0), (0, 0, 0))]
         c["lin"], c["g"], c["steps"] = (10.0, 100), (0.0, 0.0, -3.0), 20
         c["alts"] = ["damp_converged", "damp_plain"]
@@ -359,7 +360,7 @@ def sphere_defs(case):
 
 CASES = ["rot_free", "rotfric_stick", "rotfric_rotating_spring", "rotfric_slip", "rotfric_separate",
          "rotfric_scaling_mean", "rotfric_scaling_min", "rotfric_rigid", "nrotfric", "nrotfric_scaling", "wall_rot",
-         "gravity", "damp_lin_1", "damp_lin_small", "damp_lin_maxit3", "damp_lin_gravity", "damp_rot_1",
+         "gravity", "damp_lin_1", "damp_lin_small", "damp_lin_maxit3", "damp_rot_1",
          "damp_rot_small", "damp_rot_maxit3", "combo", "ekin"]
 
 
