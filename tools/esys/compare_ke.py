@@ -8,7 +8,9 @@ Both files are CSV with a header and a `step` column. ESyS's row n holds the kin
 velocities after the kick of step n, i.e. of v((n - 1/2) dt) in velocity-Verlet terms; a velocity-Verlet
 code's half-step kinetic energy at step m (v((m + 1/2) dt)) matches ESyS row m + 1: use --shift 1.
 Rows where the reference is below --floor times its maximum are skipped in the relative measure (they are
-reported in absolute terms). Exit status 1 when the largest relative deviation exceeds --tolerance.
+reported in absolute terms). Also prints the first step at which the series differ at all and the first
+at which they differ by more than --tolerance (relative, any step with a non-zero reference: the end of
+the "chaos window" between two runs). Exit status 1 when the largest relative deviation exceeds --tolerance.
 """
 
 import argparse
@@ -62,6 +64,10 @@ def main():
     if small:
         d, s = max(small)
         print(f"absolute deviation where the reference is small: max {d:.3e} (step {s})")
+    first_diff = next((s for s, r, c in pairs if c != r), None)
+    first_over = next((s for s, r, c in pairs if abs(r) > 0 and abs(c - r) / abs(r) > args.tolerance), None)
+    print(f"first step with any difference: {first_diff}; first step with relative deviation > "
+          f"{args.tolerance:g}: {first_over}")
     ok = worst <= args.tolerance
     print(f"{'PASS' if ok else 'FAIL'}: tolerance {args.tolerance:g}")
     return 0 if ok else 1
