@@ -86,7 +86,9 @@ struct Scene {
   } units;
   std::filesystem::path geometry;  ///< resolved against the scene file's folder
   double density = 1;
-  double dt = 0;
+  double dt = 0;                     ///< run.dt; with run.dt_fraction 0 until the simulation sets it
+  double dt_fraction = 0;            ///< run.dt_fraction: dt = this x the critical step (0: run.dt is given)
+  std::string precision = "double";  ///< run.precision: "double" or "float" (basalt-run's Simulation<Real>)
   std::int64_t steps = 0;
   double skin = 0;
   Integrator integrator = Integrator::velocity_verlet;
