@@ -38,7 +38,7 @@ namespace io = basalt::io;
 namespace {
 
 struct Cli {
-  std::string scene_file, geometry, output, dims_text, restart, precision;
+  std::string scene_file, geometry, output, dims_text, restart, precision, preset;
   std::int64_t steps = -1;
   bool quiet = false, force_dt = false, force_overlap = false;
   int io_ranks = 0;
@@ -303,6 +303,10 @@ int run_world(int argc, char** argv) {
   app.add_option("--throttle-io-mbps", cli.throttle_mbps,
                  "benchmark only: make output storage this slow (MB/s)")
       ->check(CLI::NonNegativeNumber);
+  app.add_option("--preset", cli.preset,
+                 "named accuracy/speed setting (docs/stability.md): fast (float, dt_fraction 0.5), balanced "
+                 "(double, 0.25), reference (double, 0.05); overrides run.dt, run.dt_fraction, run.precision")
+      ->check(CLI::IsMember({"fast", "balanced", "reference"}));
   app.add_option("--precision", cli.precision,
                  "floating-point type of the solver: double or float; overrides run.precision")
       ->check(CLI::IsMember({"double", "float"}));
@@ -335,6 +339,11 @@ int run_world(int argc, char** argv) {
   if (cli.fields_every > 0)
     for (auto& f : scene.fields) f.every = cli.fields_every;
   if (cli.frames_in_flight > 0) scene.frames_in_flight = cli.frames_in_flight;
+  if (!cli.preset.empty()) {  // docs/stability.md, "Presets": the error and speed measured for each
+    scene.precision = cli.preset == "fast" ? "float" : "double";
+    scene.dt = 0;
+    scene.dt_fraction = cli.preset == "fast" ? 0.5 : cli.preset == "balanced" ? 0.25 : 0.05;
+  }
   if (!cli.precision.empty()) scene.precision = cli.precision;
 
   // A restart reads its checkpoint on every rank (so that a bad one stops all ranks alike, early).

@@ -182,7 +182,8 @@ void Simulation<Real>::estimate_critical_step(bool fresh) {
   }
   if (!(st.dt_critical > 0)) return;
   st.fraction = scene_.dt / st.dt_critical;
-  st.warn = st.fraction > scene_.dt_safety;
+  st.warn =
+      st.fraction > scene_.dt_safety && !(scene_.dt_fraction > 0 && st.fraction <= 1);  // chosen knowingly
   if (st.fraction > 1 && !(scene_.force_dt || options_.force_dt))
     throw InputError(fmt::format(
         "{} = {:.6g} is {:.3g} times the critical time step {:.6g} (2 / omega_max of the network, {} power "
