@@ -89,6 +89,28 @@ TYPED_TEST(CriticalStep, ChainHighestMode) {
   EXPECT_LE(sim.stability().dt_bound, exact);
 }
 
+// Particles that start apart have no spring yet: the critical step is that of one contact between two
+// of the lightest particles, 2 / sqrt(2 k_max / m_min), and dt above it is refused.
+TEST(CriticalStepApart, OneFutureContactBetweenLightestParticles) {
+  const std::string body = R"([run]
+dt = 0.02
+steps = 0
+skin = 0.05
+[[interactions]]
+type = "linear_elastic"
+K = 1000.0
+)";
+  Geometry g;
+  g.add_particle(1, {0, 0, 0}, 0.5);
+  g.add_particle(2, {3, 0, 0}, 1.0);
+  g.sort_by_id();
+  Simulation<double> sim(basalt::test::scene_from(body), g, MPI_COMM_SELF);
+  EXPECT_NEAR(sim.stability().dt_critical, 2 / std::sqrt(2 * 1000 / mass_of(0.5)), 1e-12);
+  std::string fast = body;
+  fast.replace(fast.find("dt = 0.02"), 9, "dt = 0.04");
+  EXPECT_THROW(Simulation<double>(basalt::test::scene_from(fast), g, MPI_COMM_SELF), InputError);
+}
+
 // cube1 with the wave scene (bonds, contacts, the base wall), on every rank count.
 TEST(CriticalStepCube1, MatchesConvergedEstimateAndMeasuredLimit) {
   Scene scene = wave_scene();

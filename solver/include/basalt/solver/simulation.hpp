@@ -37,13 +37,16 @@ struct RunOptions {
 };
 
 /// The critical time step estimate and what the guard decided (solver/src/simulation_stability.cpp,
-/// docs/stability.md). dt_critical = 2 / omega_max of the network of bonds, contacts and walls.
+/// docs/stability.md). dt_critical = 2 / omega_max of the network of bonds, contacts and walls
+/// (dt_power), or dt_contact (a contact that forms later) if that is smaller.
 struct StabilityReport {
   double m_min = 0, k_max = 0, dt_critical = 0, fraction = 0;
   bool warn = false;
-  double dt_pair = 0;      ///< the former estimate 2 sqrt(m_min / k_max) (one spring, one particle)
-  double dt_bound = 0;     ///< 2 / omega from the bound omega^2 <= max_i (2 sum_j k_ij + sum_walls k) / m_i
-  double dt_power = 0;     ///< 2 / omega from power iterations on M^-1 K (the real network): dt_critical
+  double dt_pair = 0;   ///< the former estimate 2 sqrt(m_min / k_max) (one spring, one particle)
+  double dt_bound = 0;  ///< 2 / omega from the bound omega^2 <= max_i (2 sum_j k_ij + sum_walls k) / m_i
+  double dt_power = 0;  ///< 2 / omega from power iterations on M^-1 K (the real network)
+  double dt_contact =
+      0;  ///< one new contact of a lightest particle: 2 / sqrt(2 k_pair / m_min) or (wall) k_wall
   int iterations = 0;      ///< power iterations done
   double rmin = 0;         ///< smallest radius (the blow-up check's scale)
   double dt_fraction = 0;  ///< run.dt_fraction when the scene chose dt that way
