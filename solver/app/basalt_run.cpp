@@ -38,7 +38,7 @@ namespace io = basalt::io;
 namespace {
 
 struct Cli {
-  std::string scene_file, geometry, output, dims_text, restart;
+  std::string scene_file, geometry, output, dims_text, restart, precision, preset;
   std::int64_t steps = -1;
   bool quiet = false, force_dt = false, force_overlap = false;
   int io_ranks = 0;
@@ -91,7 +91,8 @@ std::string mb(std::uint64_t bytes) { return fmt::format("{:.2f} MB", double(byt
 
 /// "fields: position, velocity, ... = 112 B/particle" (and the contact history per contact): what the
 /// scene allocates.
-std::string fields_line(const Simulation<double>& sim) {
+template <class Real>
+std::string fields_line(const Simulation<Real>& sim) {
   std::string names;
   std::size_t bytes = 0;
   for (const auto& [name, b] : sim.particles().field_bytes()) {
@@ -123,6 +124,7 @@ void print_report(const io::OutputReport& r, int n_io) {
   fmt::print("{}\n", text);
 }
 
+template <class Real>
 int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::OutputConfig cfg,
                 const io::VtkFrameWriter& vtk, const io::Checkpoint* ckpt, const fs::path& ckpt_file) {
   const Comm comm(layout.compute);
@@ -134,13 +136,13 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
   options.force_overlap = cli.force_overlap;
 
   const auto t0 = std::chrono::steady_clock::now();
-  std::unique_ptr<Simulation<double>> sim;
+  std::unique_ptr<Simulation<Real>> sim;
   io::RunInfo info;
   std::optional<std::string> setup_error;
   try {
     if (ckpt) {
-      sim = std::make_unique<Simulation<double>>(
-          scene, *ckpt, basalt::run::restart_layout_of(*ckpt, ckpt_file), layout.compute, options);
+      sim = std::make_unique<Simulation<Real>>(scene, *ckpt, basalt::run::restart_layout_of(*ckpt, ckpt_file),
+                                               layout.compute, options);
       info.box_min = ckpt->geometry.box_min;
       info.box_max = ckpt->geometry.box_max;
       info.periodic = ckpt->geometry.periodic;
@@ -156,12 +158,14 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
       info.box_max = g.box_max;
       info.periodic = g.periodic;
       info.units = g.units;
-      sim = std::make_unique<Simulation<double>>(scene, std::move(g), layout.compute, options);
+      sim = std::make_unique<Simulation<Real>>(scene, std::move(g), layout.compute, options);
     }
     info.attributes = basalt::run::restart_attributes(sim->restart_layout());
     info.attributes["code_version"] = std::string(basalt::kVersion);
+    info.attributes["precision"] = scene.precision;  // a restart in the other precision is refused
     info.scene_text = scene.text;
-    info.dt = scene.dt;  // constant for the run: sent once to the I/O ranks, stored in every checkpoint
+    scene.dt = sim->dt();  // run.dt, or run.dt_fraction x the critical step
+    info.dt = scene.dt;    // constant for the run: sent once to the I/O ranks, stored in every checkpoint
   } catch (const std::exception& e) {
     setup_error = e.what();
   }
@@ -180,20 +184,29 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
     fmt::print(
         "basalt-run {}: {} particles, {} bonds on {} compute rank(s) ({}x{}x{}) + {} I/O rank(s), {} steps "
         "of "
-        "dt = {} {}{}\n",
+        "dt = {} {} in {}{}\n",
         basalt::kVersion, sim->total_particles(), sim->bond_count(), comm.size(),
         sim->decomposition().dims()[0], sim->decomposition().dims()[1], sim->decomposition().dims()[2],
-        layout.n_io, steps, scene.dt, scene.units.time,
+        layout.n_io, steps, scene.dt, scene.units.time, scene.precision,
         ckpt ? fmt::format(", continuing from step {} ({})", ckpt->step, ckpt_file.string()) : std::string());
-    if (st.dt_critical > 0)
+    if (st.dt_critical > 0) {
       fmt::print(
-          "time step: dt = {:.3g} x critical step {:.4g} (2 sqrt(m_min/k_max), m_min = {:.4g}, k_max = "
-          "{:.4g}); "
-          "safe fraction {}\n",
-          st.fraction, st.dt_critical, st.m_min, st.k_max, scene.dt_safety);
+          "critical step: {:.4g} {} (2/omega_max, {} power iterations on the network: {:.4g}; one new "
+          "contact "
+          "of the lightest particle: {:.4g}); bound {:.4g} (omega^2 <= max_i 2 sum_j k_ij / m_i); former "
+          "estimate 2 sqrt(m_min/k_max) = {:.4g} (m_min = {:.4g}, k_max = {:.4g})\n",
+          st.dt_critical, scene.units.time, st.iterations, st.dt_power, st.dt_contact, st.dt_bound,
+          st.dt_pair, st.m_min, st.k_max);
+      fmt::print("time step: dt = {:.6g} {} = {:.3g} x critical{}; safe fraction {}\n", scene.dt,
+                 scene.units.time, st.fraction,
+                 st.dt_fraction > 0 ? fmt::format(" (run.dt_fraction = {})", st.dt_fraction) : "",
+                 scene.dt_safety);
+    }
     if (st.warn)
-      fmt::print(stderr, "warning: dt = {} is {:.3g} x the critical time step, above the safe fraction {}\n",
-                 scene.dt, st.fraction, scene.dt_safety);
+      fmt::print(stderr,
+                 "warning: dt = {} is {:.3g} x the critical time step, above the safe fraction {}{}\n",
+                 scene.dt, st.fraction, scene.dt_safety,
+                 st.fraction > 1 ? " (forced): expect the blow-up check to stop the run" : "");
     fmt::print("{}\n", fields_line(*sim));
     if (sim->unassigned_bonds() > 0)
       fmt::print(stderr, "warning: {} bonds of the geometry match no bond interaction and exert no force\n",
@@ -290,6 +303,13 @@ int run_world(int argc, char** argv) {
   app.add_option("--throttle-io-mbps", cli.throttle_mbps,
                  "benchmark only: make output storage this slow (MB/s)")
       ->check(CLI::NonNegativeNumber);
+  app.add_option("--preset", cli.preset,
+                 "named accuracy/speed setting (docs/stability.md): fast (float, dt_fraction 0.5), balanced "
+                 "(double, 0.25), reference (double, 0.05); overrides run.dt, run.dt_fraction, run.precision")
+      ->check(CLI::IsMember({"fast", "balanced", "reference"}));
+  app.add_option("--precision", cli.precision,
+                 "floating-point type of the solver: double or float; overrides run.precision")
+      ->check(CLI::IsMember({"double", "float"}));
   app.add_flag("--quiet", cli.quiet, "no progress line");
   app.add_flag("--force-dt", cli.force_dt, "run even when dt exceeds the critical time step");
   app.add_flag("--force-overlap", cli.force_overlap,
@@ -319,6 +339,12 @@ int run_world(int argc, char** argv) {
   if (cli.fields_every > 0)
     for (auto& f : scene.fields) f.every = cli.fields_every;
   if (cli.frames_in_flight > 0) scene.frames_in_flight = cli.frames_in_flight;
+  if (!cli.preset.empty()) {  // docs/stability.md, "Presets": the error and speed measured for each
+    scene.precision = cli.preset == "fast" ? "float" : "double";
+    scene.dt = 0;
+    scene.dt_fraction = cli.preset == "fast" ? 0.5 : cli.preset == "balanced" ? 0.25 : 0.05;
+  }
+  if (!cli.precision.empty()) scene.precision = cli.precision;
 
   // A restart reads its checkpoint on every rank (so that a bad one stops all ranks alike, early).
   std::optional<io::Checkpoint> ckpt;
@@ -331,6 +357,8 @@ int run_world(int argc, char** argv) {
       throw InputError(fmt::format("--restart: {}", e.what()));
     }
     basalt::run::check_same_scene(*ckpt, ckpt_file, scene);
+    basalt::run::check_same_precision(*ckpt, ckpt_file, scene.precision);
+    if (scene.dt_fraction > 0) scene.dt = ckpt->dt;  // the run's step, chosen at its start
     (void)basalt::run::restart_layout_of(*ckpt, ckpt_file);
   } else if (!fs::exists(scene.geometry)) {
     throw InputError(
@@ -372,7 +400,9 @@ int run_world(int argc, char** argv) {
     const auto report = server.run();
     return report.error && !cfg.continue_on_error ? 1 : 0;
   }
-  return run_compute(cli, scene, layout, cfg, vtk, ckpt ? &*ckpt : nullptr, ckpt_file);
+  if (scene.precision == "float")
+    return run_compute<float>(cli, scene, layout, cfg, vtk, ckpt ? &*ckpt : nullptr, ckpt_file);
+  return run_compute<double>(cli, scene, layout, cfg, vtk, ckpt ? &*ckpt : nullptr, ckpt_file);
 }
 
 }  // namespace

@@ -90,6 +90,16 @@ void check_same_scene(const io::Checkpoint& c, const fs::path& file, const solve
                     file.string(), c.size(), scene.file.string()));
 }
 
+void check_same_precision(const io::Checkpoint& c, const fs::path& file, const std::string& precision) {
+  const auto it = c.geometry.attributes.find("precision");
+  const std::string written = it == c.geometry.attributes.end() ? "double" : it->second;
+  if (written != precision)
+    throw InputError(fmt::format(
+        "{}: this checkpoint was written by a run in {} precision; restarting it in {} is refused (the "
+        "continuation would not be the run's): restart with --precision {} (or run.precision = \"{}\")",
+        file.string(), written, precision, written, written));
+}
+
 void truncate_fields(const fs::path& csv, std::int64_t step) {
   if (!fs::exists(csv)) return;
   std::ifstream in(csv);

@@ -25,6 +25,11 @@ solver::RestartLayout restart_layout_of(const io::Checkpoint& c, const std::file
 /// Refuses (InputError naming both files) a checkpoint written by another scene.
 void check_same_scene(const io::Checkpoint& c, const std::filesystem::path& file, const solver::Scene& scene);
 
+/// Refuses (InputError naming the file and both precisions) a restart in another precision than the
+/// checkpoint's run (attribute "precision"; checkpoints without it were written in double).
+void check_same_precision(const io::Checkpoint& c, const std::filesystem::path& file,
+                          const std::string& precision);
+
 /// Keeps the header and the rows with step <= `step` of an existing fields.csv (rewritten atomically),
 /// so that the restarted run appends to one series without duplicate steps.
 void truncate_fields(const std::filesystem::path& csv, std::int64_t step);

@@ -106,7 +106,20 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
     const auto* r = top.subtable("run");
     if (!r) top.fail("run", "missing (required): a [run] table with dt, steps, skin");
     TableReader t(*r, label, "run");
-    s.dt = t.positive("dt");
+    if (t.has("dt") && t.has("dt_fraction"))
+      t.fail("dt_fraction",
+             "run.dt and run.dt_fraction are both given: choose one (run.dt an absolute step, "
+             "run.dt_fraction a fraction of the critical step)");
+    if (t.has("dt_fraction")) {
+      s.dt_fraction = t.positive("dt_fraction");  // dt is set by the simulation (simulation_stability.cpp)
+    } else if (t.has("dt")) {
+      s.dt = t.positive("dt");
+    } else {
+      t.fail_here(
+          "missing run.dt or run.dt_fraction (one is required): the time step, absolute or as a "
+          "fraction of the critical step");
+    }
+    s.precision = t.choice_or("precision", {"double", "float"}, "double");
     s.steps = t.integer("steps");
     if (s.steps < 0) t.fail("steps", fmt::format("must be >= 0, got {}", s.steps));
     s.skin = t.positive("skin");

@@ -46,6 +46,7 @@ Simulation<Real>::Simulation(const Scene& scene, io::Geometry g, MPI_Comm comm, 
   distribute(g, comm);
   rebuild();
   check_start(true);
+  estimate_critical_step(true);  // simulation_stability.cpp; may set dt (run.dt_fraction)
   start_ledger(compute_forces<true>());
 }
 
@@ -79,28 +80,6 @@ std::int64_t Simulation<Real>::local_bond_count() const {
 template <class Real>
 std::int64_t Simulation<Real>::bond_count() const {
   return comm().sum(static_cast<long long>(local_bond_count()));
-}
-
-template <class Real>
-void Simulation<Real>::check_stability(const io::Geometry& g) {
-  double m_min = std::numeric_limits<double>::infinity(), rmax = 0;
-  for (std::size_t i = 0; i < g.size(); ++i) {
-    m_min = std::min(m_min, particle_mass(g, i, scene_.density));
-    rmax = std::max(rmax, g.radius[i]);
-  }
-  const double k_max = forces_.max_stiffness(rmax);
-  stability_.m_min = m_min;
-  stability_.k_max = k_max;
-  if (k_max <= 0) return;
-  stability_.dt_critical = 2 * std::sqrt(m_min / k_max);
-  stability_.fraction = scene_.dt / stability_.dt_critical;
-  stability_.warn = stability_.fraction > scene_.dt_safety;
-  if (stability_.fraction > 1 && !(scene_.force_dt || options_.force_dt))
-    throw InputError(fmt::format(
-        "run.dt = {} is {:.3g} times the critical time step {:.6g} (2 sqrt(m_min / k_max), m_min = {:.6g}, "
-        "k_max = {:.6g}): the run would be unstable. Lower dt (a safe choice is <= {} x critical), or set "
-        "run.force_dt = true / --force-dt to run anyway",
-        scene_.dt, stability_.fraction, stability_.dt_critical, m_min, k_max, scene_.dt_safety));
 }
 
 template <class Real>
@@ -276,6 +255,7 @@ void Simulation<Real>::step(FieldSink* sink) {
   times_.communication += sw.lap();
   bool in_flight = false;
   if (!(need <= rebuild_limit2_)) {
+    check_blowup();  // simulation_stability.cpp: stops a run that moved absurdly far in this step
     rebuild();
     rebuild_step_ = step_ + 1;  // the positions it used are those of the step being completed
     sw.lap();

@@ -21,12 +21,13 @@ Simulation<Real>::Simulation(const Scene& scene, const io::Checkpoint& c, const 
   configure_particles();
   if (c.size() == 0) throw InputError("the checkpoint has no particles");
   if (scene.bonds.size() > 254) throw InputError("interactions: at most 254 bond groups");
-  if (c.dt != scene.dt)
+  if (scene.dt_fraction > 0) scene_.dt = c.dt;  // the run's dt (a fraction of the critical step at its start)
+  if (c.dt != scene_.dt)
     throw InputError(
         fmt::format("the checkpoint was written with dt = {}, the scene has run.dt = {}", c.dt, scene.dt));
   const bool se = scene.integrator == Integrator::symplectic_euler;
-  kick1_ = Real(se ? scene.dt : scene.dt / 2);
-  kick2_ = Real(se ? 0.0 : scene.dt / 2);
+  kick1_ = Real(se ? scene_.dt : scene_.dt / 2);
+  kick2_ = Real(se ? 0.0 : scene_.dt / 2);
   rebuild_limit2_ = 0.25 * scene.skin * scene.skin;
   check_stability(c.geometry);
   distribute_checkpoint(c, layout, comm);
@@ -39,10 +40,11 @@ Simulation<Real>::Simulation(const Scene& scene, const io::Checkpoint& c, const 
                  "older basalt-run): the lists are rebuilt at step {}, so the continuation agrees with the "
                  "uninterrupted run to rounding only\n",
                  step_);
-    if (!forces_.walls().empty()) forces_.walls().move_to(double(step_) * scene.dt);
+    if (!forces_.walls().empty()) forces_.walls().move_to(double(step_) * scene_.dt);
     rebuild();
   }
   check_start(false);
+  estimate_critical_step(false);  // simulation_stability.cpp
   start_ledger(compute_forces<true>());
 }
 

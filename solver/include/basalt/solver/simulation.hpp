@@ -36,10 +36,20 @@ struct RunOptions {
   double progress_seconds = 2.0;     ///< time between progress lines
 };
 
-/// The critical time step estimate and what the guard decided.
+/// The critical time step estimate and what the guard decided (solver/src/simulation_stability.cpp,
+/// docs/stability.md). dt_critical = 2 / omega_max of the network of bonds, contacts and walls
+/// (dt_power), or dt_contact (a contact that forms later) if that is smaller.
 struct StabilityReport {
   double m_min = 0, k_max = 0, dt_critical = 0, fraction = 0;
   bool warn = false;
+  double dt_pair = 0;   ///< the former estimate 2 sqrt(m_min / k_max) (one spring, one particle)
+  double dt_bound = 0;  ///< 2 / omega from the bound omega^2 <= max_i (2 sum_j k_ij + sum_walls k) / m_i
+  double dt_power = 0;  ///< 2 / omega from power iterations on M^-1 K (the real network)
+  double dt_contact =
+      0;  ///< one new contact of a lightest particle: 2 / sqrt(2 k_pair / m_min) or (wall) k_wall
+  int iterations = 0;      ///< power iterations done
+  double rmin = 0;         ///< smallest radius (the blow-up check's scale)
+  double dt_fraction = 0;  ///< run.dt_fraction when the scene chose dt that way
 };
 
 /// What a restart needs besides the checkpoint's particles to rebuild the SAME decomposition and
@@ -87,6 +97,8 @@ class Simulation {
   // State and diagnostics (collective where noted).
   std::int64_t current_step() const { return step_; }
   double time() const { return time_; }
+  /// The time step (run.dt, or run.dt_fraction x the critical step).
+  double dt() const { return scene_.dt; }
   const Particles<Real>& particles() const { return p_; }
   /// Mutable access (tests, set-up) drops the kinetic energy cached by the last step.
   Particles<Real>& particles() {
@@ -148,6 +160,11 @@ class Simulation {
   double term_value(std::size_t t, const std::vector<double>& pe) const;
   void progress(std::int64_t done, std::int64_t total, double seconds) const;
   void check_stability(const io::Geometry& g);
+  /// Collective, after the first rebuild (simulation_stability.cpp): the network's critical step, dt
+  /// from run.dt_fraction (fresh starts), and the refusal above it unless forced.
+  void estimate_critical_step(bool fresh);
+  /// Collective, before a rebuild: stops the run when a particle moved absurdly far in one step.
+  void check_blowup();
   /// Collective, after the first rebuild: refuses coincident particles (naming both ids and their
   /// distance) and, at a fresh start unless forced, overlaps deeper than half the smaller radius
   /// between unbonded particles or into a wall; warns (rank 0) of the deepest overlap above 10 %.

@@ -117,7 +117,9 @@ struct Scene {
   /// [particles] fixed_tags: particles of these tags feel forces but never move or turn (ESyS
   /// setParticleNonDynamic): rough bases, anchors.
   std::vector<std::int64_t> fixed_tags;
-  double dt = 0;
+  double dt = 0;                     ///< run.dt; with run.dt_fraction 0 until the simulation sets it
+  double dt_fraction = 0;            ///< run.dt_fraction: dt = this x the critical step (0: run.dt is given)
+  std::string precision = "double";  ///< run.precision: "double" or "float" (basalt-run's Simulation<Real>)
   std::int64_t steps = 0;
   double skin = 0;
   Integrator integrator = Integrator::velocity_verlet;

@@ -1,0 +1,52 @@
+#pragma once
+// The critical time step of a mass-spring network (docs/stability.md). For the generalized
+// eigenproblem K v = omega^2 M v of the linearised network (springs k_ij along the lines of centres,
+// walls as springs to an infinite mass), velocity Verlet and symplectic Euler are stable for
+// dt < 2 / omega_max. Two estimates:
+//  - a bound: with v^T K v = sum_bonds k (n . (v_i - v_j))^2 <= sum_bonds 2 k (|v_i|^2 + |v_j|^2) and
+//    a wall term k (n . v_i)^2 <= k |v_i|^2, the Rayleigh quotient v^T K v / v^T M v is at most
+//        omega_bound^2 = max_i (2 sum_j k_ij + sum_walls k_iw) / m_i
+//    (Gershgorin's bound on M^-1 K in this form; it needs only the owned particle's mass);
+//  - power iterations on M^-1 K, each product K v from two force evaluations (positions perturbed
+//    along v), so the models' real stiffnesses and the current contacts enter. The Rayleigh
+//    quotient rises towards omega_max^2 from below: 2 / omega_power is at least the true step.
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+namespace basalt::solver::stability {
+
+/// The critical step 2 / omega for omega^2 (infinite for no stiffness).
+inline double critical_step(double omega2) {
+  return omega2 > 0 ? 2 / std::sqrt(omega2) : std::numeric_limits<double>::infinity();
+}
+
+/// Start vector of the power iterations: component d of particle `id`, in [-1, 1), a function of the
+/// id alone (the same on any number of ranks).
+inline double start_component(std::int64_t id, int d) {
+  std::uint64_t k = static_cast<std::uint64_t>(id) * 3u + static_cast<std::uint64_t>(d);
+  k += 0x9E3779B97F4A7C15ull;
+  k = (k ^ (k >> 30)) * 0xBF58476D1CE4E5B9ull;
+  k = (k ^ (k >> 27)) * 0x94D049BB133111EBull;
+  k ^= k >> 31;
+  return double(k >> 11) * 0x1.0p-53 * 2.0 - 1.0;
+}
+
+/// Power iterations stop when the Rayleigh quotient changed by less than this (relative) between
+/// two iterations, or after kMaxIterations.
+inline constexpr double kTolerance = 1e-4;
+inline constexpr int kMaxIterations = 60;
+
+/// Perturbation of the power iterations: the largest displacement, as a fraction of the smallest
+/// radius (large enough against rounding of the positions, small enough to stay linear).
+template <class Real>
+constexpr double perturbation() {
+  return sizeof(Real) >= 8 ? 1e-6 : 1e-3;
+}
+
+/// The blow-up check: a particle that moved farther than skin/2 + kBlowupRadii x the smallest radius
+/// since the last rebuild (which happens as soon as one moved skin/2) moved more than that fraction
+/// of the smallest radius in one step.
+inline constexpr double kBlowupRadii = 0.5;
+
+}  // namespace basalt::solver::stability

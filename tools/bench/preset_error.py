@@ -1,0 +1,104 @@
+#!/usr/bin/env python3
+"""Error and speed of basalt-run's presets (docs/stability.md, "Presets") on one scene + geometry.
+
+    tools/bench/preset_error.py --build build --scene scenes/wave.toml \\
+        --geometry $BASALT_REFERENCE_DIR/cube1.geo [--time 2.0] [--np 1]
+
+Runs a reference (double, run.dt_fraction = 0.01) and each preset for the same simulated time, saving
+the kinetic energy every step, and prints per preset: dt, steps, the L2 and max relative error of
+the kinetic-energy curve against the reference (linearly interpolated at the preset's times, over
+the times where the reference KE exceeds 1 % of its maximum), and the throughput basalt-run reports.
+"""
+import argparse
+import csv
+import math
+import os
+import re
+import subprocess
+import sys
+import tempfile
+
+PRESETS = {"fast": ("float", 0.5), "balanced": ("double", 0.25), "reference": ("double", 0.05)}
+
+
+def basalt_run(args, work, tag, extra, steps):
+    out = os.path.join(work, tag)
+    cmd = (["mpiexec", "-n", str(args.np)] if args.np > 1 else []) + [
+        os.path.join(args.build, "bin", "basalt-run"), args.scene, "--geometry", args.geometry, "--steps",
+        str(steps), "--output", out, "--quiet", "--fields-every", "1"] + extra
+    p = subprocess.run(cmd, capture_output=True, text=True)
+    if p.returncode != 0:
+        raise SystemExit(f"{' '.join(cmd)} failed:\n{p.stderr}")
+    t, ke = [], []
+    with open(os.path.join(out, "fields.csv")) as f:
+        r = csv.reader(f)
+        header = next(r)
+        col = header.index("kinetic_energy")
+        for row in r:
+            t.append(float(row[1]))
+            ke.append(float(row[col]))
+    m = re.search(r"([0-9.]+) M particle-steps/s", p.stdout)
+    crit = re.search(r"critical step: ([0-9.eE+-]+)", p.stdout)
+    return t, ke, float(m.group(1)) if m else float("nan"), float(crit.group(1)) if crit else None
+
+
+def interp(t, ke, x):
+    lo, hi = 0, len(t) - 1
+    if x <= t[0]:
+        return ke[0]
+    if x >= t[-1]:
+        return ke[-1]
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if t[mid] <= x:
+            lo = mid
+        else:
+            hi = mid
+    w = (x - t[lo]) / (t[hi] - t[lo])
+    return (1 - w) * ke[lo] + w * ke[hi]
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--build", default="build")
+    ap.add_argument("--scene", default="scenes/wave.toml")
+    ap.add_argument("--geometry", required=True)
+    ap.add_argument("--time", type=float, default=2.0, help="simulated time (scene units)")
+    ap.add_argument("--np", type=int, default=1)
+    args = ap.parse_args()
+    with tempfile.TemporaryDirectory(prefix="basalt-presets-") as work:
+        _, _, _, crit = basalt_run(args, work, "probe", [], 0)
+        ref_dt = 0.01 * crit
+        # The reference: double at dt_fraction 0.01 (no preset has it): a scene copy with dt_fraction.
+        with open(args.scene) as f:
+            text = f.read()
+        text = re.sub(r"(?m)^\s*dt(_fraction)?\s*=.*$", "dt_fraction = 0.01", text, count=1)
+        ref_scene = os.path.join(work, "reference.toml")
+        with open(ref_scene, "w") as f:
+            f.write(text)
+        rargs = argparse.Namespace(**{**vars(args), "scene": ref_scene})
+        rt, rke, rspeed, _ = basalt_run(rargs, work, "ref", ["--precision", "double"],
+                                        int(math.ceil(args.time / ref_dt)))
+        peak = max(rke)
+        print(f"scene {args.scene}, geometry {os.path.basename(args.geometry)}, {args.time} time units, "
+              f"np {args.np}; critical step {crit:.6g}; reference double dt_fraction 0.01 "
+              f"({len(rt)} steps, {rspeed} M particle-steps/s)")
+        print("| preset | precision | dt_fraction | steps | KE L2 rel. error | KE max rel. error | M particle-steps/s |")
+        print("| --- | --- | --- | --- | --- | --- | --- |")
+        for name, (prec, frac) in PRESETS.items():
+            steps = int(math.ceil(args.time / (frac * crit)))
+            t, ke, speed, _ = basalt_run(args, work, name, ["--preset", name], steps)
+            num = den = worst = 0.0
+            for x, k in zip(t, ke):
+                r = interp(rt, rke, x)
+                if r < 0.01 * peak:
+                    continue
+                num += (k - r) ** 2
+                den += r * r
+                worst = max(worst, abs(k - r) / r)
+            print(f"| {name} | {prec} | {frac} | {steps} | {math.sqrt(num / den):.3g} | {worst:.3g} | {speed} |")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
