@@ -50,20 +50,46 @@ struct WallSpec {
   }
 };
 
+/// One [[mesh_walls]] entry: a triangle mesh (STL/OBJ/OFF, placed by scale and offset when parsed) acting
+/// through a wall model, moved rigidly: a translation (WallMotion) and a rotation at a constant angular
+/// velocity about an axis through a point (the point travels with the translation). docs/scenes.md.
+struct MeshWallSpec {
+  std::string name;
+  std::filesystem::path file;                   ///< resolved against the scene's folder
+  std::vector<std::array<double, 3>> vertices;  ///< after scale and offset (the rest pose)
+  std::vector<std::array<std::int32_t, 3>> triangles;
+  bool one_sided = false;                     ///< sides = "one": only the normals' side touches
+  std::string model = "elastic";              ///< the registry name of its wall model
+  std::any params;                            ///< Model::Params
+  TagFilter tags;                             ///< particle tags the wall touches (empty: all)
+  WallMotion motion;                          ///< translation
+  std::array<double, 3> axis{0, 0, 1};        ///< rotation axis (unit)
+  std::array<double, 3> axis_point{0, 0, 0};  ///< a point on the axis at t = 0
+  double angular_velocity = 0;                ///< radians per time unit, right-handed about axis
+
+  bool moves() const { return motion.moves() || angular_velocity != 0; }
+  template <class Model>
+  const typename Model::Params& params_of() const {
+    return std::any_cast<const typename Model::Params&>(params);
+  }
+};
+
 /// One field saver ([[output.fields]]): a term of the energy ledger (kinetic_energy, the potentials,
 /// wall_work_in, a body force's potential), the total mechanical energy, the bond count, or a wall's
-/// force.
+/// force (planar or mesh wall), or the mass of the particles below a height (mass_below: discharge).
 struct FieldSpec {
-  enum class Type { energy, total_energy, bond_count, wall_force };
+  enum class Type { energy, total_energy, bond_count, wall_force, mass_below };
   Type type = Type::energy;
   std::string term = "kinetic_energy";  ///< energy only: the ledger term
   std::int64_t every = 1;
   std::string wall;  ///< wall_force only
+  double z = 0;      ///< mass_below only: particles whose centre is below this height
   /// The column name (wall_force: the prefix of three columns).
   std::string name() const {
     return type == Type::energy         ? term
            : type == Type::total_energy ? "total_energy"
            : type == Type::bond_count   ? "bond_count"
+           : type == Type::mass_below   ? "mass_below"
                                         : "wall_force";
   }
 };
@@ -102,6 +128,7 @@ struct Scene {
   std::vector<InteractionSpec> bonds;     ///< bond groups, in scene order (a bond's group indexes these)
   std::vector<InteractionSpec> contacts;  ///< pair (contact) groups, in scene order
   std::vector<WallSpec> walls;
+  std::vector<MeshWallSpec> mesh_walls;  ///< their history ids follow the planar walls' (-1 - (walls + k))
   std::vector<InteractionSpec> body_forces;  ///< [[body_forces]]: tags = the particle tags it acts on
   std::filesystem::path output_dir = "out";
   std::vector<FieldSpec> fields;
