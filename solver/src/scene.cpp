@@ -299,7 +299,7 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
           bool found = false;
           for (const auto& w : s.walls) found = found || w.name == f.wall;
           for (const auto& w : s.mesh_walls) found = found || w.name == f.wall;
-          if (!found) tf.fail("wall", fmt::format("no wall or mesh wall named \"{}\"", f.wall));
+          if (!found) tf.fail("wall", fmt::format("no wall named \"{}\" (planar or mesh)", f.wall));
         }
         if (f.type == FieldSpec::Type::mass_below) {
           f.z = tf.number("z");

@@ -406,7 +406,8 @@ TEST(MeshWalls, SceneErrorsNameFileLineAndKey) {
       std::string::npos);
   EXPECT_NE(err("[[mesh_walls]]\nfile = \"" + silo + "\"\nK = 1.0\nscal = 2.0\n").find("mesh_walls[0].scal"),
             std::string::npos);
-  EXPECT_NE(err("[[output.fields]]\ntype = \"wall_force\"\nwall = \"silo\"\n").find("no wall or mesh wall"),
+  EXPECT_NE(err("[[output.fields]]\ntype = \"wall_force\"\nwall = \"silo\"\n")
+                .find("no wall named \"silo\" (planar or mesh)"),
             std::string::npos);
   // scale and offset place the mesh; a mesh wall's name is a wall_force target; mass_below takes z.
   const auto s = basalt::test::scene_from(
