@@ -92,7 +92,8 @@ void Checkpoint::validate(const fs::path& source) const {
     if (!std::binary_search(ids.begin(), ids.end(), contact_ids[k][0]))
       throw FormatError(source, "/contacts/ids",
                         fmt::format("contact {}: particle id {} does not exist", k, contact_ids[k][0]));
-    // The second id is a particle, or a wall as -1 - its index (a particle touching a frictional wall).
+    // The second id is a particle, or a wall as -1 - its index (a particle touching a frictional wall;
+    // mesh walls follow the planar ones in the solver's list of walls).
     const auto pid = contact_ids[k][1];
     if (pid < 0 ? (-1 - pid) >= static_cast<std::int64_t>(walls.size())
                 : !std::binary_search(ids.begin(), ids.end(), pid))

@@ -11,7 +11,7 @@ namespace basalt::solver {
 
 template <class Real>
 ForceField<Real>::ForceField(const Scene& scene)
-    : computes_(make_force_computes<Real>(scene)), walls_(scene.walls) {
+    : computes_(make_force_computes<Real>(scene)), walls_(scene.walls, scene.mesh_walls) {
   for (auto& c : computes_) {
     if (c->kind() == ModelKind::bond) bond_compute_ = c.get();
     if (c->kind() == ModelKind::pair) pair_computes_.push_back(c.get());

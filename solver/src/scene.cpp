@@ -10,6 +10,7 @@
 #include <set>
 #include <sstream>
 
+#include "basalt/io/mesh_file.hpp"
 #include "basalt/solver/models/registry.hpp"
 
 namespace basalt::solver {
@@ -55,6 +56,50 @@ WallMotion parse_motion(TableReader& t, const std::array<double, 3>& normal) {
   }
   t.finish();
   return m;
+}
+
+/// One [[mesh_walls]] table: the mesh read and placed (scale, then offset), its model, sides, tags, motion.
+MeshWallSpec parse_mesh_wall(TableReader& t, const std::string& label, const std::string& path,
+                             const fs::path& base_dir) {
+  MeshWallSpec w;
+  fs::path file = t.string("file");
+  w.file = file.is_absolute() ? file : base_dir / file;
+  io::MeshReadOptions opt;
+  opt.weld_tolerance = t.non_negative_or("weld_tolerance", 0);
+  io::TriangleMesh m;
+  try {
+    m = io::read_mesh(w.file, opt);
+  } catch (const std::exception& e) {
+    t.fail("file", e.what());
+  }
+  const double scale = t.has("scale") ? t.positive("scale") : 1.0;
+  const auto offset = t.vec3_opt("offset").value_or(std::array<double, 3>{0, 0, 0});
+  for (auto& v : m.vertices)
+    for (int d = 0; d < 3; ++d) v[d] = v[d] * scale + offset[d];
+  w.vertices = std::move(m.vertices);
+  w.triangles = std::move(m.triangles);
+  w.one_sided = t.choice_or("sides", {"two", "one"}, "two") == "one";
+  w.model = t.choice_or("interaction", model_names(ModelKind::wall), "elastic");
+  w.params = find_model(w.model, ModelKind::wall)->parse(t);
+  w.tags = t.integers_or("tags", {});
+  if (const auto* mt = t.subtable("motion")) {
+    TableReader tm(*mt, label, path + ".motion");
+    if (const auto* rt = tm.subtable("rotation")) {
+      TableReader tr(*rt, label, path + ".motion.rotation");
+      w.axis = unit(tr, "axis");
+      w.axis_point = tr.vec3_opt("point").value_or(std::array<double, 3>{0, 0, 0});
+      w.angular_velocity = tr.number("angular_velocity");
+      if (!std::isfinite(w.angular_velocity)) tr.fail("angular_velocity", "must be finite");
+      tr.finish();
+    }
+    // A mesh has no normal to move along by default: sine motions name their direction.
+    const std::string type = tm.has("type") ? tm.string("type") : "fixed";
+    if ((type == "sine" || type == "half_sine") && !tm.has("direction"))
+      tm.fail("direction", fmt::format("missing (required for a mesh wall's \"{}\" motion)", type));
+    w.motion = parse_motion(tm, {0, 0, 1});
+  }
+  t.finish();
+  return w;
 }
 
 }  // namespace
@@ -196,6 +241,16 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
     }
   }
 
+  if (const auto* arr = top.table_array("mesh_walls")) {
+    for (std::size_t k = 0; k < arr->size(); ++k) {
+      const auto path = fmt::format("mesh_walls[{}]", k);
+      TableReader t(*(*arr)[k].as_table(), label, path);
+      const auto name = group_name(t, fmt::format("mesh{}", k), names);
+      s.mesh_walls.push_back(parse_mesh_wall(t, label, path, base_dir));
+      s.mesh_walls.back().name = name;
+    }
+  }
+
   if (const auto* arr = top.table_array("body_forces")) {
     for (std::size_t k = 0; k < arr->size(); ++k) {
       TableReader t(*(*arr)[k].as_table(), label, fmt::format("body_forces[{}]", k));
@@ -246,7 +301,8 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
             {"wall_force", FieldSpec::Type::wall_force},
             {"rotational_kinetic_energy", FieldSpec::Type::rotational_kinetic_energy},
             {"sliding_contacts", FieldSpec::Type::sliding_contacts},
-            {"runout", FieldSpec::Type::runout}};
+            {"runout", FieldSpec::Type::runout},
+            {"mass_below", FieldSpec::Type::mass_below}};
         for (const auto& kind : kOther) allowed.push_back(kind.first);
         FieldSpec f;
         const std::string type = tf.choice_or("type", allowed, "");
@@ -268,7 +324,12 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
           f.wall = tf.string("wall");
           bool found = false;
           for (const auto& w : s.walls) found = found || w.name == f.wall;
-          if (!found) tf.fail("wall", fmt::format("no wall named \"{}\"", f.wall));
+          for (const auto& w : s.mesh_walls) found = found || w.name == f.wall;
+          if (!found) tf.fail("wall", fmt::format("no wall named \"{}\" (planar or mesh)", f.wall));
+        }
+        if (f.type == FieldSpec::Type::mass_below) {
+          f.z = tf.number("z");
+          if (!std::isfinite(f.z)) tf.fail("z", "must be finite");
         }
         tf.finish();
         s.fields.push_back(std::move(f));

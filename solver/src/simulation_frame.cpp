@@ -35,18 +35,31 @@ SimulationFrame<Real>::SimulationFrame(const Simulation<Real>& sim, std::uint32_
   // The scene's optional particle fields that frames carry (Particles' array list).
   p.for_each_array([&](const ArrayInfo& a, const auto&) { h.fields += !a.output.empty() && p.enabled(a); });
   // Walls: global; the force is summed over the ranks (collective), rank 0 carries them.
+  // Mesh walls follow the planar ones (so a checkpoint's wall count covers their history ids, -1 -
+  // (planar walls + k)): position = where the rotation axis passes, normal = the axis, velocity = the
+  // translation's.
   const auto& wd = sim.forces_.walls();
-  if (wd.size() > 0) {
+  if (wd.size() + wd.meshes() > 0) {
     std::vector<double> f;
     for (std::size_t w = 0; w < wd.size(); ++w) f.insert(f.end(), wd.force(w).begin(), wd.force(w).end());
+    for (std::size_t k = 0; k < wd.meshes(); ++k)
+      f.insert(f.end(), wd.mesh_force(k).begin(), wd.mesh_force(k).end());
     if (sim.comm().size() > 1) sim.comm().sum_all(f);
-    if (sim.comm().rank() == 0)
+    if (sim.comm().rank() == 0) {
       for (std::size_t w = 0; w < wd.size(); ++w) {
         const auto& s = wd.spec(w);
         const auto v = s.motion.velocity_at(sim.time_);
         walls_.push_back(
             {s.name, wd.point(w), s.normal, {v[0], v[1], v[2]}, {f[3 * w], f[3 * w + 1], f[3 * w + 2]}});
       }
+      for (std::size_t k = 0; k < wd.meshes(); ++k) {
+        const auto& s = wd.mesh_spec(k);
+        const auto v = s.motion.velocity_at(sim.time_);
+        const std::size_t at = 3 * (wd.size() + k);
+        walls_.push_back(
+            {s.name, wd.mesh_axis_point(k), s.axis, {v[0], v[1], v[2]}, {f[at], f[at + 1], f[at + 2]}});
+      }
+    }
   }
 }
 

@@ -63,10 +63,23 @@ bool Simulation<Real>::field_partials(const std::vector<double>& pe, std::vector
         break;
       }
       case FieldSpec::Type::wall_force: {
+        const auto& walls = forces_.walls();
         std::size_t w = 0;
-        while (forces_.walls().spec(w).name != f.wall) ++w;
-        const auto& fw = forces_.walls().force(w);
-        local.insert(local.end(), fw.begin(), fw.end());
+        while (w < walls.size() && walls.spec(w).name != f.wall) ++w;
+        if (w < walls.size()) {
+          local.insert(local.end(), walls.force(w).begin(), walls.force(w).end());
+          break;
+        }
+        std::size_t m = 0;  // a mesh wall (the scene checked the name)
+        while (walls.mesh_spec(m).name != f.wall) ++m;
+        local.insert(local.end(), walls.mesh_force(m).begin(), walls.mesh_force(m).end());
+        break;
+      }
+      case FieldSpec::Type::mass_below: {  // owned particles' share; the sink sums the ranks
+        double mass = 0;
+        for (std::size_t i = 0; i < p_.n_owned; ++i)
+          if (double(p_.z[i]) < f.z && p_.inv_mass[i] > 0) mass += 1.0 / double(p_.inv_mass[i]);
+        local.push_back(mass);
         break;
       }
     }

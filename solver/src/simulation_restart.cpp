@@ -121,7 +121,7 @@ void Simulation<Real>::distribute_checkpoint(const io::Checkpoint& c, const Rest
           history.empty() ? 0 : history.front()->width));
     const auto ia = static_cast<std::size_t>(g.index_of(c.contact_ids[k][0]));
     const auto ib = static_cast<std::size_t>(g.index_of(c.contact_ids[k][1]));
-    if (owned[ia] || owned[ib])
+    if (owned[ia] || (c.contact_ids[k][1] >= 0 && owned[ib]))  // a wall's id (< 0) has no index
       history[model]->push(c.contact_ids[k][0], c.contact_ids[k][1],
                            c.contact_history.data() + k * c.contact_width);
   }

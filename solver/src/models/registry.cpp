@@ -10,6 +10,7 @@
 #include "basalt/solver/core/errors.hpp"
 #include "basalt/solver/interactions/body_driver.hpp"
 #include "basalt/solver/interactions/bond_driver.hpp"
+#include "basalt/solver/interactions/mesh_wall_driver.hpp"
 #include "basalt/solver/interactions/pair_driver.hpp"
 #include "basalt/solver/interactions/wall_driver.hpp"
 #include "basalt/solver/models/contact_age.hpp"
@@ -32,6 +33,19 @@ std::unique_ptr<ForceCompute<Real>> make(const Scene& s) {
   if constexpr (Model::kind == ModelKind::wall) return std::make_unique<WallDriver<Real, Model>>(s.walls);
   if constexpr (Model::kind == ModelKind::body)
     return std::make_unique<BodyDriver<Real, Model>>(s.body_forces);
+}
+
+template <class Real, class Model>
+std::unique_ptr<ForceCompute<Real>> make_mesh(const Scene& s) {
+  return std::make_unique<MeshWallDriver<Real, Model>>(s.mesh_walls, s.walls.size());
+}
+
+template <class Real, class Model>
+constexpr auto mesh_maker() -> std::unique_ptr<ForceCompute<Real>> (*)(const Scene&) {
+  if constexpr (Model::kind == ModelKind::wall)
+    return &make_mesh<Real, Model>;
+  else
+    return nullptr;
 }
 
 template <class Model>
@@ -63,7 +77,9 @@ ModelEntry entry() {
           dissipation_term_of<Model>(),
           [](TableReader& t) { return std::any(Model::parse(t)); },
           &make<double, Model>,
-          &make<float, Model>};
+          &make<float, Model>,
+          mesh_maker<double, Model>(),
+          mesh_maker<float, Model>()};
 }
 
 }  // namespace
@@ -121,7 +137,7 @@ std::string describe_models() {
   std::string s;
   for (const auto kind : {ModelKind::bond, ModelKind::pair, ModelKind::wall, ModelKind::body}) {
     s += fmt::format("{} models ({}):\n", kind_name(kind),
-                     kind == ModelKind::wall   ? "[[walls]] interaction = \"<name>\""
+                     kind == ModelKind::wall   ? "[[walls]] or [[mesh_walls]] interaction = \"<name>\""
                      : kind == ModelKind::body ? "[[body_forces]] type = \"<name>\""
                                                : "[[interactions]] type = \"<name>\"");
     for (const auto& m : model_registry()) {
@@ -157,6 +173,18 @@ std::vector<std::unique_ptr<ForceCompute<Real>>> make_force_computes(const Scene
   if (bonds.size() > 1) throw InputError("interactions: all bond groups must use the same bond model");
   for (const auto& g : scene.contacts) add(g.model, ModelKind::pair, pairs);
   for (const auto& w : scene.walls) add(w.model, ModelKind::wall, walls);
+  // Mesh walls: one driver per wall model they use, after the planar walls' (checkpoints' model order).
+  std::set<std::string_view> meshes;
+  for (const auto& w : scene.mesh_walls) {
+    if (!meshes.insert(w.model).second) continue;
+    const auto* m = find_model(w.model, ModelKind::wall);
+    if (!m || !m->make_mesh_double)
+      throw InputError(fmt::format("no wall model \"{}\" in this build", w.model));
+    if constexpr (std::is_same_v<Real, double>)
+      out.push_back(m->make_mesh_double(scene));
+    else
+      out.push_back(m->make_mesh_float(scene));
+  }
   std::set<std::string_view> bodies;
   for (const auto& b : scene.body_forces) add(b.model, ModelKind::body, bodies);
   return out;

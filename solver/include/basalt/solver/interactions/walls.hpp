@@ -3,24 +3,39 @@
 // the particles put on it (this rank's share, summed by whichever wall models act on it), and the
 // owned particles within reach of it since the last rebuild. Wall models (wall_driver.hpp) read
 // and write these; field savers, frames and the energy guard read them.
+// The scene's mesh walls likewise (mesh_wall_driver.hpp): each mesh's ContactMesh at its pose at the
+// current time, its force and power, and its candidates (owned particles within radius + skin of a
+// triangle's box at the rebuild). A moving mesh counts in moved2_since_rebuild() by the largest
+// displacement of its vertices since the rebuild (exact for a rigid motion: the displacement is affine
+// in the point, so its largest norm over a triangle is at a vertex); with the particles' own
+// displacements limited the same way, no particle outside the candidates can reach the mesh before the
+// next rebuild.
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "basalt/solver/core/particles.hpp"
+#include "basalt/solver/geometry/triangle_mesh.hpp"
 #include "basalt/solver/scene/scene.hpp"
 
 namespace basalt::solver {
 
 class Walls {
  public:
-  explicit Walls(const std::vector<WallSpec>& walls)
+  explicit Walls(const std::vector<WallSpec>& walls, const std::vector<MeshWallSpec>& meshes = {})
       : walls_(walls), point_(walls.size()), force_(walls.size()), velocity_(walls.size()) {
     for (std::size_t w = 0; w < walls.size(); ++w) point_[w] = walls[w].point;
+    for (const auto& m : meshes) {
+      ContactMesh::Options opt;
+      opt.sides = m.one_sided ? ContactMesh::Sides::one : ContactMesh::Sides::two;
+      meshes_.emplace_back(m, ContactMesh(m.vertices, m.triangles, opt));
+    }
   }
 
-  bool empty() const { return walls_.empty(); }
+  /// No planar and no mesh walls.
+  bool empty() const { return walls_.empty() && meshes_.empty(); }
   std::size_t size() const { return walls_.size(); }
   const WallSpec& spec(std::size_t w) const { return walls_[w]; }
   const std::array<double, 3>& point(std::size_t w) const { return point_[w]; }
@@ -33,6 +48,30 @@ class Walls {
   /// Velocity of wall w at the time of the last move_to().
   const std::array<double, 3>& velocity(std::size_t w) const { return velocity_[w]; }
 
+  // Mesh walls (the history id of mesh k is -1 - (size() + k)).
+  std::size_t meshes() const { return meshes_.size(); }
+  const MeshWallSpec& mesh_spec(std::size_t k) const { return meshes_[k].spec; }
+  const ContactMesh& mesh(std::size_t k) const { return meshes_[k].mesh; }
+  const std::vector<std::int32_t>& mesh_candidates(std::size_t k) const { return meshes_[k].candidates; }
+  /// Force the particles put on mesh k at the last force computation (this rank's share).
+  const std::array<double, 3>& mesh_force(std::size_t k) const { return meshes_[k].force; }
+  std::array<double, 3>& mesh_force(std::size_t k) { return meshes_[k].force; }
+  /// Power mesh k put into the particles at the last force computation: sum of F . v_wall(contact point).
+  double& mesh_power(std::size_t k) { return meshes_[k].power; }
+  /// Translation velocity of mesh k at the last move_to().
+  const std::array<double, 3>& mesh_velocity(std::size_t k) const { return meshes_[k].velocity; }
+  /// Where its rotation axis passes now (the axis point carried by the translation).
+  const std::array<double, 3>& mesh_axis_point(std::size_t k) const { return meshes_[k].axis_point; }
+  /// Velocity of mesh k's material point q at the last move_to(): v + omega x (q - axis point).
+  std::array<double, 3> mesh_velocity_at(std::size_t k, const std::array<double, 3>& q) const {
+    const auto& m = meshes_[k];
+    const auto& a = m.spec.axis;
+    const double w = m.spec.angular_velocity;
+    const double rx = q[0] - m.axis_point[0], ry = q[1] - m.axis_point[1], rz = q[2] - m.axis_point[2];
+    return {m.velocity[0] + w * (a[1] * rz - a[2] * ry), m.velocity[1] + w * (a[2] * rx - a[0] * rz),
+            m.velocity[2] + w * (a[0] * ry - a[1] * rx)};
+  }
+
   /// Moves the walls to their positions at time t.
   void move_to(double t) {
     velocity_.resize(walls_.size());
@@ -40,6 +79,17 @@ class Walls {
       const auto u = walls_[w].motion.displacement_at(t);
       for (int d = 0; d < 3; ++d) point_[w][d] = walls_[w].point[d] + u[d];
       velocity_[w] = walls_[w].motion.velocity_at(t);
+    }
+    for (auto& m : meshes_) {
+      if (!m.spec.moves()) continue;  // the identity pose: rest-frame results, bit for bit
+      RigidTransform pose;
+      pose.translation = m.spec.motion.displacement_at(t);
+      pose.axis_point = m.spec.axis_point;
+      pose.axis = m.spec.axis;
+      pose.angle = m.spec.angular_velocity * t;
+      m.mesh.set_pose(pose);
+      m.velocity = m.spec.motion.velocity_at(t);
+      for (int d = 0; d < 3; ++d) m.axis_point[d] = m.spec.axis_point[d] + pose.translation[d];
     }
   }
 
@@ -50,6 +100,7 @@ class Walls {
       const auto v = walls_[w].motion.velocity_at(t);
       pw -= force_[w][0] * v[0] + force_[w][1] * v[1] + force_[w][2] * v[2];
     }
+    for (const auto& m : meshes_) pw += m.power;
     return pw;
   }
 
@@ -72,6 +123,23 @@ class Walls {
         c.push_back(static_cast<std::int32_t>(i));
       }
     }
+    thread_local std::vector<std::int32_t> tris;
+    for (auto& m : meshes_) {
+      auto& c = m.candidates;
+      c.clear();
+      const auto& tags = m.spec.tags;
+      for (std::size_t i = 0; i < p.n_owned; ++i) {
+        if (!tags.empty() && std::find(tags.begin(), tags.end(), p.tag[i]) == tags.end()) continue;
+        tris.clear();
+        m.mesh.candidates({double(p.x[i]), double(p.y[i]), double(p.z[i])}, double(p.radius[i]) + skin, tris);
+        if (!tris.empty()) c.push_back(static_cast<std::int32_t>(i));
+      }
+      if (m.spec.moves()) {
+        m.vertices_at_rebuild.resize(m.mesh.num_vertices());
+        for (std::size_t v = 0; v < m.vertices_at_rebuild.size(); ++v)
+          m.vertices_at_rebuild[v] = m.mesh.vertex(v);
+      }
+    }
   }
 
   /// Squared distance the walls moved towards their particles since the last rebuild (the same on
@@ -85,12 +153,22 @@ class Walls {
                        (point_[w][2] - point_at_rebuild_[w][2]) * n[2];
       if (u > 0) m = std::max(m, u * u);
     }
+    for (const auto& mw : meshes_) {
+      if (!mw.spec.moves()) continue;
+      for (std::size_t v = 0; v < mw.vertices_at_rebuild.size(); ++v) {
+        const auto x = mw.mesh.vertex(v);
+        const auto& x0 = mw.vertices_at_rebuild[v];
+        m = std::max(m, (x[0] - x0[0]) * (x[0] - x0[0]) + (x[1] - x0[1]) * (x[1] - x0[1]) +
+                            (x[2] - x0[2]) * (x[2] - x0[2]));
+      }
+    }
     return m;
   }
 
   std::size_t memory_bytes() const {
     std::size_t b = 0;
     for (const auto& c : candidates_) b += c.capacity() * sizeof(std::int32_t);
+    for (const auto& m : meshes_) b += m.candidates.capacity() * sizeof(std::int32_t);
     return b;
   }
 
@@ -101,6 +179,19 @@ class Walls {
   std::vector<std::array<double, 3>> velocity_;
   std::vector<std::array<double, 3>> point_at_rebuild_;
   std::vector<std::vector<std::int32_t>> candidates_;
+
+  struct Mesh {
+    Mesh(const MeshWallSpec& s, ContactMesh m) : spec(s), mesh(std::move(m)), axis_point(s.axis_point) {}
+    MeshWallSpec spec;
+    ContactMesh mesh;
+    std::vector<std::int32_t> candidates;
+    std::array<double, 3> force{0, 0, 0};
+    double power = 0;
+    std::array<double, 3> velocity{0, 0, 0};
+    std::array<double, 3> axis_point;
+    std::vector<std::array<double, 3>> vertices_at_rebuild;  ///< moving meshes only
+  };
+  std::vector<Mesh> meshes_;
 };
 
 }  // namespace basalt::solver

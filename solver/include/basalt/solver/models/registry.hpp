@@ -28,6 +28,9 @@ struct ModelEntry {
   std::any (*parse)(TableReader&);
   std::unique_ptr<ForceCompute<double>> (*make_double)(const Scene&);
   std::unique_ptr<ForceCompute<float>> (*make_float)(const Scene&);
+  /// Wall models: the driver of the scene's mesh walls that use it (null for other kinds).
+  std::unique_ptr<ForceCompute<double>> (*make_mesh_double)(const Scene&) = nullptr;
+  std::unique_ptr<ForceCompute<float>> (*make_mesh_float)(const Scene&) = nullptr;
 };
 
 /// Every model, in the order --list-models prints them.

@@ -50,9 +50,33 @@ struct WallSpec {
   }
 };
 
+/// One [[mesh_walls]] entry: a triangle mesh (STL/OBJ/OFF, placed by scale and offset when parsed) acting
+/// through a wall model, moved rigidly: a translation (WallMotion) and a rotation at a constant angular
+/// velocity about an axis through a point (the point travels with the translation). docs/scenes.md.
+struct MeshWallSpec {
+  std::string name;
+  std::filesystem::path file;                   ///< resolved against the scene's folder
+  std::vector<std::array<double, 3>> vertices;  ///< after scale and offset (the rest pose)
+  std::vector<std::array<std::int32_t, 3>> triangles;
+  bool one_sided = false;                     ///< sides = "one": only the normals' side touches
+  std::string model = "elastic";              ///< the registry name of its wall model
+  std::any params;                            ///< Model::Params
+  TagFilter tags;                             ///< particle tags the wall touches (empty: all)
+  WallMotion motion;                          ///< translation
+  std::array<double, 3> axis{0, 0, 1};        ///< rotation axis (unit)
+  std::array<double, 3> axis_point{0, 0, 0};  ///< a point on the axis at t = 0
+  double angular_velocity = 0;                ///< radians per time unit, right-handed about axis
+
+  bool moves() const { return motion.moves() || angular_velocity != 0; }
+  template <class Model>
+  const typename Model::Params& params_of() const {
+    return std::any_cast<const typename Model::Params&>(params);
+  }
+};
+
 /// One field saver ([[output.fields]]): a term of the energy ledger (kinetic_energy, the potentials,
 /// wall_work_in, a body force's potential), the total mechanical energy, the bond count, or a wall's
-/// force.
+/// force (planar or mesh wall), or the mass of the particles below a height (mass_below: discharge).
 struct FieldSpec {
   enum class Type {
     energy,
@@ -61,7 +85,8 @@ struct FieldSpec {
     wall_force,
     rotational_kinetic_energy,
     sliding_contacts,
-    runout
+    runout,
+    mass_below
   };
   Type type = Type::energy;
   std::string term = "kinetic_energy";  ///< energy only: the ledger term
@@ -71,6 +96,7 @@ struct FieldSpec {
   /// pass (100: the farthest particle).
   std::array<double, 3> origin{0, 0, 0}, direction{1, 0, 0};
   double percentile = 100;
+  double z = 0;  ///< mass_below only: particles whose centre is below this height
   /// The column name (wall_force: the prefix of three columns).
   std::string name() const {
     switch (type) {
@@ -86,6 +112,8 @@ struct FieldSpec {
         return "rotational_kinetic_energy";
       case Type::sliding_contacts:
         return "sliding_contacts";
+      case Type::mass_below:
+        return "mass_below";
       case Type::runout:
         return percentile >= 100 ? std::string("runout_max")
                                  : "runout_p" + std::to_string(static_cast<int>(std::lround(percentile)));
@@ -130,6 +158,7 @@ struct Scene {
   std::vector<InteractionSpec> bonds;     ///< bond groups, in scene order (a bond's group indexes these)
   std::vector<InteractionSpec> contacts;  ///< pair (contact) groups, in scene order
   std::vector<WallSpec> walls;
+  std::vector<MeshWallSpec> mesh_walls;  ///< their history ids follow the planar walls' (-1 - (walls + k))
   std::vector<InteractionSpec> body_forces;  ///< [[body_forces]]: tags = the particle tags it acts on
   std::filesystem::path output_dir = "out";
   std::vector<FieldSpec> fields;
