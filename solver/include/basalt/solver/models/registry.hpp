@@ -25,6 +25,8 @@ struct ModelEntry {
   std::size_t history_bytes;     ///< per contact (0: none)
   std::string_view energy_term;  ///< body forces: the ledger term of its potential energy ("" otherwise)
   std::any (*parse)(TableReader&);
+  /// The stiffest spring of one group with these (parsed) parameters, at the largest radius.
+  double (*max_stiffness)(const std::any& params, double rmax);
   std::unique_ptr<ForceCompute<double>> (*make_double)(const Scene&);
   std::unique_ptr<ForceCompute<float>> (*make_float)(const Scene&);
 };
