@@ -343,6 +343,8 @@ case $case_name in
   stopped_by_signal)
     # Issue 16: SIGTERM or SIGINT to mpirun: every rank stops at the next agreement point, the rows and
     # checkpoints computed so far are written, the exit status is non-zero and the message says why.
+    # mpirun kills the ranks 1 s after its SIGTERM by default; on a loaded CI machine give them 20 s.
+    export OMPI_MCA_odls_base_sigkill_timeout=20
     for q in 0 1; do
       for sig in TERM INT; do
         out="$W/q$q-$sig"
