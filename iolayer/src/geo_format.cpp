@@ -23,8 +23,10 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <string_view>
+#include <type_traits>
 #include <unordered_map>
 
 #include "basalt/io/geometry.hpp"
@@ -73,6 +75,10 @@ class LineReader {
     T v{};
     const char* end = s.data() + s.size();
     auto [p, ec] = std::from_chars(s.data(), end, v);
+    if constexpr (std::is_integral_v<T>)
+      if (ec == std::errc::result_out_of_range && p == end)
+        fail(fmt::format("{} '{}' is out of range: it must be a whole number from {} to {}", what, s,
+                         std::numeric_limits<T>::min(), std::numeric_limits<T>::max()));
     if (ec != std::errc() || p != end) fail(fmt::format("{} '{}' is not a valid number", what, s));
     return v;
   }

@@ -50,6 +50,34 @@ std::int64_t Geometry::index_of(std::int64_t pid) const {
   return it - id.begin();
 }
 
+std::optional<std::pair<std::size_t, std::size_t>> Geometry::duplicate_bond() const {
+  using Pair = std::pair<std::int64_t, std::int64_t>;
+  auto key = [](const Bond& b) { return b.a < b.b ? Pair{b.a, b.b} : Pair{b.b, b.a}; };
+  std::vector<Pair> pairs(bonds.size());
+  for (std::size_t k = 0; k < bonds.size(); ++k) pairs[k] = key(bonds[k]);
+  std::sort(pairs.begin(), pairs.end());
+  const auto twice = std::adjacent_find(pairs.begin(), pairs.end());
+  if (twice == pairs.end()) return std::nullopt;
+  const Pair p = *twice;
+  std::vector<Pair>().swap(pairs);
+  std::optional<std::size_t> first;
+  for (std::size_t k = 0; k < bonds.size(); ++k) {
+    if (key(bonds[k]) != p) continue;
+    if (first) return std::pair{*first, k};
+    first = k;
+  }
+  return std::nullopt;  // not reached
+}
+
+std::string duplicate_bond_text(const Geometry& g, std::pair<std::size_t, std::size_t> d) {
+  const auto& b = g.bonds[d.first];
+  return fmt::format(
+      "bonds {} and {} (counted from 0 in file order) both join particles {} and {}: a pair bonded twice "
+      "acts as "
+      "two springs; remove one",
+      d.first, d.second, std::min(b.a, b.b), std::max(b.a, b.b));
+}
+
 void Geometry::validate(const fs::path& source) const {
   const std::size_t n = id.size();
   if (position.size() != n || radius.size() != n || tag.size() != n)
@@ -87,6 +115,7 @@ void Geometry::validate(const fs::path& source) const {
         throw FormatError(source, fmt::format("bond {}", k),
                           fmt::format("refers to particle id {}, which does not exist", e));
   }
+  if (const auto d = duplicate_bond()) throw FormatError(source, "bonds", duplicate_bond_text(*this, *d));
 }
 
 static std::string lower_extension(const fs::path& file) {

@@ -232,7 +232,7 @@ bool is_complete_checkpoint(const fs::path& file) {
   }
 }
 
-fs::path latest_complete_checkpoint(const fs::path& dir) {
+fs::path latest_complete_checkpoint(const fs::path& dir, std::vector<fs::path>* skipped) {
   std::error_code ec;
   std::vector<std::pair<std::int64_t, fs::path>> candidates;
   for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
@@ -248,8 +248,10 @@ fs::path latest_complete_checkpoint(const fs::path& dir) {
   std::sort(candidates.begin(), candidates.end(), [](const auto& a, const auto& b) {
     return a.first != b.first ? a.first > b.first : a.second > b.second;
   });
-  for (const auto& [step, path] : candidates)
+  for (const auto& [step, path] : candidates) {
     if (is_complete_checkpoint(path)) return path;
+    if (skipped) skipped->push_back(path);
+  }
   return {};
 }
 

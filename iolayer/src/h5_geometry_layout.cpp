@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "basalt/version.hpp"
+#include "geometry_order.hpp"
 #include "id_set.hpp"
 
 namespace basalt::io::h5 {
@@ -195,6 +196,7 @@ Geometry read_geometry_layout(const Reader& r, Names extra_reserved) {
         r.fail("/bonds/pairs", fmt::format("bond {} refers to particle id {}, which does not exist", k, e));
     g.bonds[k] = {a, b, tags[k]};
   }
+  if (const auto d = g.duplicate_bond()) r.fail("/bonds/pairs", duplicate_bond_text(g, *d));
 
   // Statistics are optional: files written by other tools may leave them out.
   if (r.exists("/statistics"))

@@ -23,6 +23,7 @@
 #include "basalt/io/io_ranks.hpp"
 #include "basalt/io/vtk_frame_writer.hpp"
 #include "basalt/solver/core/errors.hpp"
+#include "basalt/solver/core/stop_request.hpp"
 #include "basalt/solver/models/registry.hpp"
 #include "basalt/solver/parallel/communicator.hpp"
 #include "basalt/solver/scene/scene.hpp"
@@ -350,7 +351,7 @@ int run_world(int argc, char** argv) {
   std::optional<io::Checkpoint> ckpt;
   fs::path ckpt_file;
   if (!cli.restart.empty()) {
-    ckpt_file = basalt::run::resolve_restart(cli.restart);
+    ckpt_file = basalt::run::resolve_restart(cli.restart, world_root);
     try {
       ckpt = io::read_checkpoint(ckpt_file);
     } catch (const std::exception& e) {
@@ -411,6 +412,10 @@ int main(int argc, char** argv) {
   // A file-size limit (ulimit -f) must make the write fail with EFBIG, named, not kill the rank.
   std::signal(SIGXFSZ, SIG_IGN);
   MPI_Init(&argc, &argv);
+  // SIGTERM / SIGINT (mpirun forwards them to every rank): the compute ranks stop together at their next
+  // agreement point (at most 32 steps on), the output computed so far is written, and the exit status
+  // is 128 + the signal's number, after the message.
+  install_stop_handlers();
   int rank = 0;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   int code = 0;
@@ -421,6 +426,7 @@ int main(int argc, char** argv) {
     if (rank == 0) fmt::print(stderr, "basalt-run: error: {}\n", e.what());
     code = 1;
   }
+  if (stop_signal != 0) code = 128 + stop_signal;
   MPI_Finalize();
   return code;
 }

@@ -11,8 +11,9 @@ class ClientSink final : public solver::OutputSink {
   ClientSink(io::OutputClient& client, bool continue_on_error)
       : client_(client), continue_(continue_on_error) {}
   void begin(const std::vector<std::string>&) override {}  // the client knows the columns (OutputConfig)
-  void fields(std::int64_t step, double time, std::span<const double> partials) override {
-    client_.submit_fields(step, time, partials);
+  void fields(std::int64_t step, double time, std::span<const double> partials,
+              std::span<const char> due) override {
+    client_.submit_fields(step, time, partials, due);
   }
   std::uint32_t frame_kinds(std::int64_t step) const override { return client_.frame_kinds(step); }
   void frame(const io::FrameSource& source) override { client_.submit_frame(source); }

@@ -13,12 +13,30 @@ namespace basalt::run {
 namespace fs = std::filesystem;
 using solver::InputError;
 
-fs::path resolve_restart(const fs::path& p) {
+fs::path resolve_restart(const fs::path& p, bool print) {
   if (fs::is_directory(p)) {
-    const auto latest = io::latest_complete_checkpoint(p);
+    std::vector<fs::path> skipped;
+    const auto latest = io::latest_complete_checkpoint(p, &skipped);
+    std::string names;
+    for (const auto& s : skipped) names += (names.empty() ? "" : ", ") + s.filename().string();
     if (latest.empty())
-      throw InputError(
-          fmt::format("--restart {}: no complete checkpoint (ckpt_<step>.h5) in this folder", p.string()));
+      throw InputError(fmt::format("--restart {}: no complete checkpoint (ckpt_<step>.h5) in this folder{}",
+                                   p.string(),
+                                   skipped.empty() ? std::string()
+                                                   : fmt::format(" ({} not complete: cut off, or being "
+                                                                 "written when the run stopped)",
+                                                                 names)));
+    if (print) {
+      if (!skipped.empty())
+        fmt::print(
+            stderr,
+            "basalt-run: warning: --restart {}: {} not complete (cut off, or being written when the run "
+            "stopped); continuing from the newest complete checkpoint, {}\n",
+            p.string(), names, latest.string());
+      else
+        fmt::print("restart: {} is the newest complete checkpoint in {}\n", latest.filename().string(),
+                   p.string());
+    }
     return latest;
   }
   if (!fs::exists(p)) throw InputError(fmt::format("--restart {}: no such file or folder", p.string()));

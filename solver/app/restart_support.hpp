@@ -14,8 +14,9 @@
 namespace basalt::run {
 
 /// A file is taken as is; a folder gives its latest complete checkpoint. Throws InputError naming the
-/// path when there is none.
-std::filesystem::path resolve_restart(const std::filesystem::path& file_or_dir);
+/// path when there is none. With `print` (world rank 0), says which checkpoint of the folder is taken,
+/// and warns naming the newer ones passed over as not complete.
+std::filesystem::path resolve_restart(const std::filesystem::path& file_or_dir, bool print = false);
 
 /// Checkpoint attributes that let a restart rebuild the same decomposition (exact decimal text).
 std::map<std::string, std::string> restart_attributes(const solver::RestartLayout& layout);

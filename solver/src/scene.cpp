@@ -102,9 +102,17 @@ MeshWallSpec parse_mesh_wall(TableReader& t, const std::string& label, const std
   return w;
 }
 
+std::string scene_too_large(const std::string& label, std::uintmax_t bytes) {
+  return fmt::format(
+      "{}: the scene is {:.1f} MB, more than the {} MB a scene may have (its text is stored in every "
+      "checkpoint); keep particles and tables in the geometry file",
+      label, double(bytes) * 1e-6, kMaxSceneBytes / 1000000);
+}
+
 }  // namespace
 
 Scene parse_scene_text(const std::string& text, const std::string& label, const fs::path& base_dir) {
+  if (text.size() > kMaxSceneBytes) throw InputError(scene_too_large(label, text.size()));
   toml::table root;
   try {
     root = toml::parse(text, label);
@@ -331,6 +339,18 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
           f.z = tf.number("z");
           if (!std::isfinite(f.z)) tf.fail("z", "must be finite");
         }
+        // Two savers of one column would write two columns of one name (a reader takes one of them).
+        for (std::size_t j = 0; j < s.fields.size(); ++j) {
+          const auto& earlier = s.fields[j];
+          if (earlier.type != f.type || earlier.term != f.term || earlier.wall != f.wall) continue;
+          const bool wall = f.type == FieldSpec::Type::wall_force;
+          tf.fail(wall ? "wall" : "type",
+                  fmt::format("{} is saved already by output.fields[{}]: two savers would write two columns "
+                              "named {}; keep one (its every = N sets how often)",
+                              wall ? fmt::format("the force of wall \"{}\"", f.wall)
+                                   : fmt::format("\"{}\"", f.name()),
+                              j, wall ? fmt::format("wall_force_{}_x/y/z", f.wall) : f.name()));
+        }
         tf.finish();
         s.fields.push_back(std::move(f));
       }
@@ -344,6 +364,9 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
 Scene parse_scene(const fs::path& file) {
   std::ifstream in(file);
   if (!in) throw InputError(fmt::format("{}: cannot open the scene file", file.string()));
+  std::error_code ec;
+  if (const auto size = fs::file_size(file, ec); !ec && size > kMaxSceneBytes)
+    throw InputError(scene_too_large(file.string(), size));
   std::stringstream ss;
   ss << in.rdbuf();
   Scene s = parse_scene_text(ss.str(), file.string(), file.parent_path());

@@ -11,6 +11,7 @@
 #include "basalt/solver/core/errors.hpp"
 #include "basalt/solver/integrate/integrators.hpp"
 #include "basalt/solver/models/registry.hpp"
+#include "basalt/solver/scene/load_checks.hpp"
 
 namespace basalt::solver {
 
@@ -42,6 +43,7 @@ Simulation<Real>::Simulation(const Scene& scene, io::Geometry g, MPI_Comm comm, 
   kick1_ = Real(se ? scene.dt : scene.dt / 2);
   kick2_ = Real(se ? 0.0 : scene.dt / 2);
   rebuild_limit2_ = 0.25 * scene.skin * scene.skin;
+  run_load_checks(scene, g, scene.geometry.string(), comm);
   check_stability(g);
   distribute(g, comm);
   rebuild();

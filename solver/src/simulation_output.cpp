@@ -9,6 +9,7 @@
 #include <limits>
 
 #include "basalt/solver/core/errors.hpp"
+#include "basalt/solver/core/stop_request.hpp"
 #include "basalt/solver/integrate/integrators.hpp"
 #include "basalt/solver/output/simulation_frame.hpp"
 #include "basalt/solver/simulation.hpp"
@@ -114,9 +115,9 @@ void Simulation<Real>::output_fields(const std::vector<double>& pe) {
   thread_local std::vector<double> local;
   thread_local std::vector<char> due;
   if (!field_partials(pe, local, due)) return;
-  for (std::size_t c = 0; c < local.size(); ++c)
-    if (!due[c]) local[c] = std::numeric_limits<double>::quiet_NaN();
-  output_->fields(step_, time_, local);
+  // The due mask travels beside the values: a NaN sum stays a NaN ("nan" in fields.csv), never a saver
+  // that was not due (an empty cell).
+  output_->fields(step_, time_, local, due);
 }
 
 template <class Real>
@@ -149,6 +150,14 @@ void Simulation<Real>::run(std::int64_t steps, OutputSink& out) {
     Stopwatch sw;
     const std::uint32_t kinds = out.frame_kinds(step_);
     if (kinds != 0) {
+      // No checkpoint or frame from a state with non-finite values: the last complete checkpoint stays
+      // the newest, a valid restart point.
+      auto bad = check_finite();
+      if (parallel) bad = comm().agree_error(bad);
+      if (bad)
+        throw RunError(
+            fmt::format("{}; the {} of step {} is not written (the checkpoints written before stay)", *bad,
+                        (kinds & io::kFrameCheckpoint) ? "checkpoint" : "frame", step_));
       Stopwatch frame_clock;
       out.frame(SimulationFrame<Real>(*this, kinds));
       frame_seconds.push_back(frame_clock.lap());
@@ -158,6 +167,15 @@ void Simulation<Real>::run(std::int64_t steps, OutputSink& out) {
     // not one per step; polling every step costs more than it gains: MPI's progress engine yields
     // the core when idle).
     if (kinds != 0 || (k & 31) == 31 || k + 1 == steps) {
+      // A stop asked by a signal (SIGTERM, SIGINT) is agreed here too: every rank stops at this step,
+      // and the rows and frames handed over so far are written before basalt-run exits.
+      int sig = stop_signal;
+      if (parallel) sig = static_cast<int>(comm().max(static_cast<double>(sig)));
+      if (sig != 0)
+        throw RunError(
+            fmt::format("stopped by {} at step {}: the output due up to this step is written; "
+                        "--restart from the last checkpoint continues the run",
+                        signal_name(sig), step_));
       auto error = out.poll();
       if (parallel) error = comm().agree_error(error);
       if (error && !reported) {

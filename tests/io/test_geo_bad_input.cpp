@@ -112,6 +112,29 @@ TEST_F(GeoBadInput, BondToMissingId) {
   expect_error(with_line(16, "11 11 0"), {"bad.geo", "line 16", "joins particle 11 to itself"});
 }
 
+// Issue 16: a pair bonded twice (either order) would act as two springs; refused naming both bonds.
+TEST_F(GeoBadInput, DuplicateBondsAreRefused) {
+  expect_error(with_line(17, "10 11 0"),
+               {"bad.geo", "bonds 0 and 2", "both join particles 10 and 11", "two springs"});
+  expect_error(with_line(17, "11 10 0"), {"bad.geo", "bonds 0 and 2", "both join particles 10 and 11"});
+  expect_error(with_line(17, "12 11 3"), {"bad.geo", "bonds 1 and 2", "both join particles 11 and 12"});
+}
+
+// Issue 16: a tag beyond the int32 range is named as out of range (not "not a valid number").
+TEST_F(GeoBadInput, TagsBeyondInt32AreOutOfRange) {
+  expect_error(with_line(9, "2.0 1.0 1.0 0.5 11 2147483648"),
+               {"bad.geo", "line 9", "tag '2147483648' is out of range", "-2147483648 to 2147483647"});
+  expect_error(with_line(9, "2.0 1.0 1.0 0.5 11 -2147483649"),
+               {"bad.geo", "line 9", "tag '-2147483649' is out of range"});
+  expect_error(with_line(16, "11 12 99999999999"),
+               {"bad.geo", "line 16", "bond tag '99999999999' is out of range"});
+  expect_error(with_line(9, "2.0 1.0 1.0 0.5 99999999999999999999 1"),
+               {"bad.geo", "line 9", "id '99999999999999999999' is out of range"});
+  // The extremes themselves are fine.
+  EXPECT_EQ(read_geo(with_line(9, "2.0 1.0 1.0 0.5 11 2147483647")).tag[1], 2147483647);
+  EXPECT_EQ(read_geo(with_line(9, "2.0 1.0 1.0 0.5 11 -2147483648")).tag[1], -2147483648LL);
+}
+
 TEST_F(GeoBadInput, NegativeOrZeroRadius) {
   expect_error(with_line(10, "3.0 1.0 1.0 -0.5 12 1"), {"bad.geo", "line 10", "radius", "got -0.5"});
   expect_error(with_line(10, "3.0 1.0 1.0 0 12 1"), {"bad.geo", "line 10", "radius", "> 0, got 0"});

@@ -172,6 +172,23 @@ TEST_F(H5BadInput, BondToMissingId) {
   expect_error({"cube.h5: /bonds/pairs: bond 1 joins particle 20 to itself"});
 }
 
+// Issue 16: a pair bonded twice would act as two springs: refused by the reader and never written.
+TEST_F(H5BadInput, DuplicateBondsAreRefused) {
+  edit_file(file_, [](hid_t f) {
+    replace(f, "/bonds/pairs", std::vector<std::int64_t>{0, 10, 10, 20, 0, 10}, 2);
+  });
+  expect_error({"cube.h5: /bonds/pairs: bonds 0 and 2", "both join particles 0 and 10", "two springs"});
+  edit_file(file_, [](hid_t f) {
+    replace(f, "/bonds/pairs", std::vector<std::int64_t>{0, 10, 50, 60, 50, 60}, 2);
+  });
+  expect_error({"cube.h5: /bonds/pairs: bonds 1 and 2", "both join particles 50 and 60"});
+  Geometry g = ten_particles();
+  g.add_bond(10, 0);  // the first bond in the other order
+  expect_format_error([&] { write_h5(g, dir_ / "twice.h5"); },
+                      {"twice.h5", "bonds 0 and 3", "both join particles 0 and 10"});
+  EXPECT_FALSE(fs::exists(dir_ / "twice.h5"));
+}
+
 TEST_F(H5BadInput, NegativeOrZeroRadius) {
   edit_file(file_, [&](hid_t f) { replace(f, "/particles/radius", radii(-0.25)); });
   expect_error({"cube.h5: /particles/radius: particle id 30 (row 3)", "got -0.25"});

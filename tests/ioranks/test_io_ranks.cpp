@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include "basalt/io/io_ranks.hpp"
@@ -135,6 +136,54 @@ TEST(IoRanks, FieldSeriesAndCheckpointsFromEveryRank) {
   }
   EXPECT_EQ(latest_complete_checkpoint(dir), dir / "ckpt_000030.h5");
   free_layout(res.layout);
+}
+
+// Issue 16: a non-finite sum is written as nan or inf, never as an empty cell (which means "saver not
+// due"): the due mask travels beside the values, also to the I/O ranks (Q >= 1), where a NaN used to
+// stand for "not due".
+TEST(IoRanks, NonFiniteSumsAreWrittenAndNotDueCellsStayEmpty) {
+  const auto dir = basalt::test::scratch_dir("ioranks-nonfinite");
+  OutputConfig cfg;
+  cfg.dir = dir;
+  cfg.fields_every = 1;
+  cfg.field_names = {"nan_sum", "inf_sum", "every_other"};
+  cfg.field_batch_rows = 3;
+  RankLayout layout = split_ranks(basalt::test::world(), io_ranks_for(basalt::test::size()));
+  const int P = layout.n_compute;
+  if (layout.is_io) {
+    (void)IoServer(layout, cfg).run();
+  } else {
+    OutputClient client(layout, cfg, RunInfo{});
+    int c = 0;
+    MPI_Comm_rank(layout.compute, &c);
+    const double nan = std::numeric_limits<double>::quiet_NaN(),
+                 inf = std::numeric_limits<double>::infinity();
+    for (std::int64_t step = 0; step < 10; ++step) {
+      const bool due_now = step % 2 == 0;
+      // Rank 0's NaN makes the sum NaN, its inf the sum inf; the third column is not due at odd steps
+      // (its value then is whatever the solver left there: here a NaN, or -0.0 on other ranks).
+      const double partials[3] = {c == 0 ? -nan : 1.0, c == 0 ? inf : 1.0,
+                                  due_now ? 2.0 : (c == 0 ? nan : -0.0)};
+      const char due[3] = {1, 1, static_cast<char>(due_now)};
+      client.submit_fields(step, step * 0.5, partials, due);
+      client.poll();
+    }
+    const auto report = client.finish();
+    EXPECT_FALSE(report.error.has_value());
+  }
+  MPI_Barrier(basalt::test::world());
+  std::ifstream in(dir / "fields.csv");
+  std::string line;
+  ASSERT_TRUE(std::getline(in, line));
+  EXPECT_EQ(line, "step,time,nan_sum,inf_sum,every_other");
+  int rows = 0;
+  while (std::getline(in, line)) {
+    const std::string third = rows % 2 == 0 ? fmt::format("{}", 2.0 * P) : "";
+    EXPECT_EQ(line, fmt::format("{},{},nan,inf,{}", rows, rows * 0.5, third));
+    ++rows;
+  }
+  EXPECT_EQ(rows, 10);
+  free_layout(layout);
 }
 
 TEST(IoRanks, UnwritableFolderReachesEveryComputeRank) {

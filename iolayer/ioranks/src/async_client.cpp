@@ -27,8 +27,16 @@ class AsyncClient final : public OutputClientImpl {
 
   void submit_frame(const FrameSource& source) override {
     poll();
-    if (static_cast<int>(frames_in_flight_.size()) >= std::max(1, cfg.max_frames_in_flight))
+    const int bound = std::max(1, cfg.max_frames_in_flight);
+    if (static_cast<int>(frames_in_flight_.size()) >= bound)
       complete_front(frames_in_flight_, /*block=*/true);
+    // At most `bound` frames whose outcome (written, or the error) this rank does not know: an output
+    // error reaches it within that many output steps, however slow the storage (docs/io-ranks.md).
+    if (static_cast<int>(unacknowledged_.size()) >= bound)
+      wait_for_verdicts(static_cast<std::size_t>(bound - 1));
+    const FrameHeader header = source.header();
+    const int verdicts = ((header.kinds & kFrameVtk) ? 1 : 0) + ((header.kinds & kFrameCheckpoint) ? 1 : 0);
+    if (verdicts > 0) unacknowledged_.push_back({header.step, verdicts});
     InFlight f;
     f.bytes = take_buffer();
     serialize(source, f.bytes);  // written once, in place: the buffer is what is sent
@@ -66,12 +74,14 @@ class AsyncClient final : public OutputClientImpl {
       if (!error) error = text;
       MPI_Iprobe(MPI_ANY_SOURCE, kTagError, layout.bridge, &flag, &st);
     }
+    take_verdicts();
   }
 
   void drain() override {
     hand_over_field_rows();
     while (!frames_in_flight_.empty()) complete_front(frames_in_flight_, true);
     while (!fields_in_flight_.empty()) complete_front(fields_in_flight_, true);
+    wait_for_verdicts(0);
     for (int q = 0; q < layout.n_io; ++q)
       MPI_Send(nullptr, 0, MPI_BYTE, layout.io_bridge_rank(q), kTagDone, layout.bridge);
   }
@@ -93,6 +103,44 @@ class AsyncClient final : public OutputClientImpl {
     std::vector<std::byte> bytes;
     MPI_Request request = MPI_REQUEST_NULL;
   };
+
+  struct Unacknowledged {
+    std::int64_t step = 0;
+    int verdicts = 0;  // still to come: one per kind written (VTK piece, checkpoint file)
+  };
+
+  /// Receives the I/O ranks' verdicts that have arrived (kTagAck: step, then the error text if any).
+  void take_verdicts() {
+    int flag = 0;
+    MPI_Status st;
+    for (MPI_Iprobe(MPI_ANY_SOURCE, kTagAck, layout.bridge, &flag, &st); flag;
+         MPI_Iprobe(MPI_ANY_SOURCE, kTagAck, layout.bridge, &flag, &st)) {
+      int n = 0;
+      MPI_Get_count(&st, MPI_BYTE, &n);
+      verdict_.resize(static_cast<std::size_t>(n));
+      MPI_Recv(verdict_.data(), n, MPI_BYTE, st.MPI_SOURCE, kTagAck, layout.bridge, MPI_STATUS_IGNORE);
+      std::int64_t step = 0;
+      std::memcpy(&step, verdict_.data(), sizeof(step));
+      if (verdict_.size() > sizeof(step) && !error)
+        error = std::string(reinterpret_cast<const char*>(verdict_.data()) + sizeof(step),
+                            verdict_.size() - sizeof(step));
+      for (auto& u : unacknowledged_)
+        if (u.step == step) {
+          --u.verdicts;
+          break;
+        }
+      while (!unacknowledged_.empty() && unacknowledged_.front().verdicts <= 0) unacknowledged_.pop_front();
+    }
+  }
+
+  /// Blocks (sleeping, measured as waiting for output) until at most `left` frames await their verdict.
+  void wait_for_verdicts(std::size_t left) {
+    if (unacknowledged_.size() <= left) return;
+    const double t0 = MPI_Wtime();
+    Backoff backoff;
+    for (take_verdicts(); unacknowledged_.size() > left; take_verdicts()) backoff.sleep();
+    local.compute_wait_seconds += MPI_Wtime() - t0;
+  }
 
   std::vector<std::byte> take_buffer() {
     if (spare_.empty()) return {};
@@ -127,6 +175,8 @@ class AsyncClient final : public OutputClientImpl {
   std::deque<InFlight> fields_in_flight_;
   std::vector<std::vector<std::byte>> spare_;  // buffers to reuse (keeps capacity)
   int errors_received_ = 0;
+  std::deque<Unacknowledged> unacknowledged_;  // frames posted whose verdict has not arrived
+  std::vector<std::byte> verdict_;             // receive buffer
 };
 
 }  // namespace

@@ -32,14 +32,26 @@ FieldSeriesWriter::~FieldSeriesWriter() {
   std::fclose(out_);
 }
 
-void FieldSeriesWriter::append(std::int64_t step, double time, std::span<const double> values) {
-  fmt::format_to(std::back_inserter(buffer_), "{},{}", step, time);
-  // NaN marks a saver not due at this step: an empty cell.
-  for (double v : values)
-    if (std::isnan(v))
-      buffer_ += ',';
-    else
-      fmt::format_to(std::back_inserter(buffer_), ",{}", v);
+namespace {
+/// A number as fields.csv writes it: shortest round-trip text, nan / inf / -inf when not finite.
+void put(std::string& out, double v) {
+  if (std::isnan(v))
+    out += "nan";  // one spelling, whatever the NaN's sign bit
+  else if (std::isinf(v))
+    out += v > 0 ? "inf" : "-inf";
+  else
+    fmt::format_to(std::back_inserter(out), "{}", v);
+}
+}  // namespace
+
+void FieldSeriesWriter::append(std::int64_t step, double time, std::span<const double> values,
+                               std::span<const double> due) {
+  fmt::format_to(std::back_inserter(buffer_), "{},", step);
+  put(buffer_, time);
+  for (std::size_t c = 0; c < values.size(); ++c) {
+    buffer_ += ',';
+    if (due.empty() || due[c] > 0) put(buffer_, values[c]);  // empty cell: the saver was not due
+  }
   buffer_ += '\n';
 }
 

@@ -18,7 +18,14 @@ class FieldSeriesWriter {
   FieldSeriesWriter(const FieldSeriesWriter&) = delete;
   FieldSeriesWriter& operator=(const FieldSeriesWriter&) = delete;
 
-  void append(std::int64_t step, double time, std::span<const double> values);
+  /// One row. A column whose due flag is 0 is an empty cell (saver not due); a due value that is not
+  /// finite is written as nan, inf or -inf.
+  void append(std::int64_t step, double time, std::span<const double> values, std::span<const double> due);
+  /// One row [step, time, due_1 .. due_n, v_1 .. v_n] as it travels (due > 0: due).
+  void append_wire_row(const double* row, std::size_t n_fields) {
+    append(static_cast<std::int64_t>(row[0]), row[1], std::span<const double>(row + 2 + n_fields, n_fields),
+           std::span<const double>(row + 2, n_fields));
+  }
   void flush();  ///< throws FormatError naming the file when the disk refuses
   std::uint64_t bytes() const { return bytes_; }
   double seconds() const { return seconds_; }

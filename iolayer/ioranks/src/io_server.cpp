@@ -5,6 +5,7 @@
 #include <sys/resource.h>
 
 #include <cstring>
+#include <deque>
 #include <map>
 #include <memory>
 #include <stdexcept>
@@ -110,6 +111,7 @@ class Server {
       local_.fields.bytes = csv_->bytes();
       local_.fields.write_seconds = csv_->seconds();
     }
+    for (auto& a : acks_) wait_without_spinning(a.request);
     local_.io_cpu_seconds = process_cpu_seconds() - cpu0;
     local_.io_wall_seconds = MPI_Wtime() - wall0;
     OutputReport all = reduce_report(L_.bridge, local_);
@@ -141,25 +143,25 @@ class Server {
     fields_failed_ = !csv_ && io_index_ == 0 && cfg_.fields_every > 0;
   }
 
-  /// Sums a batch of rows [step, time, partials...] into the rows of their steps; appends the rows
-  /// every compute rank has sent, in step order (every rank sends its rows in order).
+  /// Sums a batch of rows [step, time, due flags..., partials...] into the rows of their steps; appends
+  /// the rows every compute rank has sent, in step order (every rank sends its rows in order).
   void add_field_batch() {
     const std::size_t n_fields = cfg_.field_names.size();
-    const std::size_t width = 2 + n_fields;
+    const std::size_t width = 2 + 2 * n_fields;
     const std::size_t count = buffer_.size() / sizeof(double);
     std::vector<double> values(count);
     std::memcpy(values.data(), buffer_.data(), buffer_.size());
     for (std::size_t r = 0; r + width <= count; r += width) {
       const auto step = static_cast<std::int64_t>(values[r]);
       auto& row = rows_[step];
-      if (row.sum.empty()) row.sum.assign(n_fields, 0.0);
-      row.time = values[r + 1];
-      for (std::size_t k = 0; k < n_fields; ++k) row.sum[k] += values[r + 2 + k];
+      if (row.sum.empty()) row.sum.assign(width, 0.0);
+      row.sum[0] = values[r];
+      row.sum[1] = values[r + 1];
+      for (std::size_t k = 2; k < width; ++k) row.sum[k] += values[r + k];
       ++row.count;
     }
     while (!rows_.empty() && rows_.begin()->second.count == L_.n_compute) {
-      if (csv_ && !fields_failed_)
-        csv_->append(rows_.begin()->first, rows_.begin()->second.time, rows_.begin()->second.sum);
+      if (csv_ && !fields_failed_) csv_->append_wire_row(rows_.begin()->second.sum.data(), n_fields);
       rows_.erase(rows_.begin());
     }
     if (csv_ && !fields_failed_) try {
@@ -170,21 +172,53 @@ class Server {
       }
   }
 
-  /// Writes a step once every compute rank this I/O rank serves has sent its piece.
+  /// Writes a step once every compute rank this I/O rank serves has sent its piece, then tells the
+  /// compute ranks the outcome (acknowledge): the VTK piece to the ranks it serves, the checkpoint (I/O
+  /// rank 0 writes the file) to every compute rank.
   void add_piece(FramePiece piece) {
     const auto step = piece.step;
     auto& list = pending_[step];
     list.push_back(std::move(piece));
     if (list.size() != L_.served.size()) return;
     const auto kinds = list.front().kinds;
-    if (kinds & kFrameVtk) write_vtk(list, step);
-    if (kinds & kFrameCheckpoint) write_checkpoint(list);
+    if (kinds & kFrameVtk) {
+      const bool ok = write_vtk(list, step);
+      for (int c : L_.served) acknowledge(c, step, ok);
+    }
+    if (kinds & kFrameCheckpoint) {
+      const bool ok = write_checkpoint(list);
+      if (io_index_ == 0)
+        for (int c = 0; c < L_.n_compute; ++c) acknowledge(c, step, ok);
+    }
     pending_.erase(step);
   }
 
+  /// The verdict on one step's output for compute rank `c`: the step, then the error text if it failed.
+  /// Compute ranks wait for it before they have more than frames_in_flight frames whose outcome they do
+  /// not know, so an output error reaches them within that many output steps (docs/io-ranks.md).
+  /// Non-blocking: a compute rank may be in a collective with the others while this travels.
+  void acknowledge(int c, std::int64_t step, bool ok) {
+    while (!acks_.empty()) {
+      int done = 0;
+      MPI_Test(&acks_.front().request, &done, MPI_STATUS_IGNORE);
+      if (!done) break;
+      acks_.pop_front();
+    }
+    Ack& a = acks_.emplace_back();
+    a.bytes.resize(sizeof(step));
+    std::memcpy(a.bytes.data(), &step, sizeof(step));
+    if (!ok && local_.error) {
+      const auto* text = reinterpret_cast<const std::byte*>(local_.error->data());
+      a.bytes.insert(a.bytes.end(), text, text + local_.error->size());
+    }
+    MPI_Isend(a.bytes.data(), checked_count(a.bytes.size()), MPI_BYTE, c, kTagAck, L_.bridge, &a.request);
+  }
+
   /// This I/O rank's piece of the VTK frame (and, on I/O rank 0, the frame's index and the series).
-  void write_vtk(const std::vector<FramePiece>& pieces, std::int64_t step) {
-    if (!vtk_ || frames_failed_) return;
+  /// False when this kind of output has failed (now or before).
+  bool write_vtk(const std::vector<FramePiece>& pieces, std::int64_t step) {
+    if (!vtk_) return true;
+    if (frames_failed_) return false;
     try {
       const double t0 = MPI_Wtime();
       const auto bytes = vtk_(pieces, step, pieces.front().time, io_index_, L_.n_io, cfg_.dir);
@@ -196,33 +230,41 @@ class Server {
       frames_failed_ = true;
       report_error(e.what());
     }
+    return !frames_failed_;
   }
 
   /// One file per checkpoint: the other I/O ranks hand their pieces to I/O rank 0, which writes it.
-  void write_checkpoint(std::vector<FramePiece>& pieces) {
+  /// False (on I/O rank 0) when checkpoints have failed (now or before).
+  bool write_checkpoint(std::vector<FramePiece>& pieces) {
     if (io_index_ != 0) {
       concat_pieces(pieces, gathered_);
       MPI_Request req;
       MPI_Isend(gathered_.data(), checked_count(gathered_.size()), MPI_BYTE, 0, kTagGather, L_.io, &req);
       wait_without_spinning(req);
-      return;
+      return true;
     }
     for (int q = 1; q < L_.n_io; ++q) {
       receive_without_spinning(q, kTagGather, L_.io, gathered_);
       split_pieces(gathered_, pieces);
     }
-    if (checkpoints_failed_) return;
+    if (checkpoints_failed_) return false;
     try {
       write_checkpoint_step(pieces, info_, cfg_, local_.checkpoints);
     } catch (const std::exception& e) {
       checkpoints_failed_ = true;
       report_error(e.what());
     }
+    return !checkpoints_failed_;
   }
 
+  struct Ack {
+    std::vector<std::byte> bytes;
+    MPI_Request request = MPI_REQUEST_NULL;
+  };
+  std::deque<Ack> acks_;  // verdicts in flight (a deque: their buffers must not move)
+
   struct Row {
-    double time = 0;
-    std::vector<double> sum;
+    std::vector<double> sum;  // [step, time, due flags summed, values summed]
     int count = 0;
   };
 

@@ -10,8 +10,9 @@
 
 namespace basalt::io::detail {
 
-/// Message tags on the bridge (compute <-> I/O) and among the I/O ranks (kTagGather).
-enum Tag : int { kTagInfo = 701, kTagFrame, kTagFields, kTagDone, kTagError, kTagGather };
+/// Message tags on the bridge (compute <-> I/O) and among the I/O ranks (kTagGather). kTagAck: an I/O
+/// rank's verdict on one step's output (the step as int64, then the error text when it failed).
+enum Tag : int { kTagInfo = 701, kTagFrame, kTagFields, kTagDone, kTagError, kTagGather, kTagAck };
 
 /// `bytes` as an MPI count; throws std::runtime_error beyond MPI's 2 GiB message limit.
 int checked_count(std::size_t bytes);

@@ -15,9 +15,11 @@ OutputClientImpl::OutputClientImpl(const RankLayout& l, OutputConfig c, RunInfo 
   MPI_Comm_rank(layout.compute, &compute_rank);
 }
 
-void OutputClientImpl::add_field_row(std::int64_t step, double time, std::span<const double> partials) {
+void OutputClientImpl::add_field_row(std::int64_t step, double time, std::span<const double> partials,
+                                     std::span<const char> due) {
   field_rows.push_back(static_cast<double>(step));
   field_rows.push_back(time);
+  for (std::size_t c = 0; c < partials.size(); ++c) field_rows.push_back(due.empty() || due[c] ? 1.0 : 0.0);
   field_rows.insert(field_rows.end(), partials.begin(), partials.end());
   if (++field_rows_count >= static_cast<std::size_t>(std::max(1, cfg.field_batch_rows)))
     hand_over_field_rows();
@@ -50,8 +52,9 @@ void OutputClient::submit_frame(const FramePiece& piece) { submit_frame(PieceSou
 
 void OutputClient::submit_frame(const FrameSource& source) { impl_->submit_frame(source); }
 
-void OutputClient::submit_fields(std::int64_t step, double time, std::span<const double> partials) {
-  impl_->add_field_row(step, time, partials);
+void OutputClient::submit_fields(std::int64_t step, double time, std::span<const double> partials,
+                                 std::span<const char> due) {
+  impl_->add_field_row(step, time, partials, due);
 }
 
 void OutputClient::poll() { impl_->poll(); }

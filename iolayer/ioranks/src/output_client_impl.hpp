@@ -34,7 +34,8 @@ class OutputClientImpl {
   virtual void settle() {}
 
   /// Adds one row to field_rows; hands the batch over when it is full.
-  void add_field_row(std::int64_t step, double time, std::span<const double> partials);
+  void add_field_row(std::int64_t step, double time, std::span<const double> partials,
+                     std::span<const char> due);
 
   RankLayout layout;
   OutputConfig cfg;
@@ -42,7 +43,9 @@ class OutputClientImpl {
   VtkFrameWriter vtk;
   int compute_rank = 0;
 
-  std::vector<double> field_rows;  // [step, time, v...] per row
+  // Per row: [step, time, due_1 .. due_n (1 or 0), v_1 .. v_n]. Summed over the ranks, a due flag
+  // counts the ranks (every rank has the same savers due), so a sum > 0 means due.
+  std::vector<double> field_rows;
   std::size_t field_rows_count = 0;
 
   OutputReport local;                 // Q = 0: what this rank wrote; always: its wait time

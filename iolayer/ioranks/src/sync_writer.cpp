@@ -89,19 +89,24 @@ class SyncWriter final : public OutputClientImpl {
     std::vector<double> sums(compute_rank == 0 ? field_rows.size() : 0);
     MPI_Reduce(field_rows.data(), sums.data(), static_cast<int>(field_rows.size()), MPI_DOUBLE, MPI_SUM, 0,
                layout.compute);
-    if (csv_ && !local.error) {
+    // Only a failure of fields.csv itself stops the rows: a failed checkpoint or frame must not drop the
+    // rows computed before it (they are handed over when the run stops).
+    if (csv_ && !fields_failed_) {
       // Step and time were summed too: rank 0's own are the row's.
       const std::size_t width = field_rows.size() / field_rows_count;
+      const std::size_t n_fields = (width - 2) / 2;
       for (std::size_t r = 0; r < field_rows_count; ++r) {
-        const double* row = field_rows.data() + r * width;
-        csv_->append(static_cast<std::int64_t>(row[0]), row[1],
-                     std::span<const double>(sums.data() + r * width + 2, width - 2));
+        double* row = sums.data() + r * width;
+        row[0] = field_rows[r * width];
+        row[1] = field_rows[r * width + 1];
+        csv_->append_wire_row(row, n_fields);
       }
       try {
         csv_->flush();
       } catch (const std::exception& e) {
-        local.error = e.what();
-        error = local.error;
+        fields_failed_ = true;
+        if (!local.error) local.error = e.what();
+        if (!error) error = local.error;
       }
     }
     field_rows.clear();
@@ -114,8 +119,9 @@ class SyncWriter final : public OutputClientImpl {
     if (!csv_) return;
     const double t0 = MPI_Wtime();
     try {
-      csv_->flush();
+      if (!fields_failed_) csv_->flush();
     } catch (const std::exception& e) {
+      fields_failed_ = true;
       if (!local.error) local.error = e.what();
     }
     local.fields.files = 1;
@@ -128,6 +134,7 @@ class SyncWriter final : public OutputClientImpl {
  private:
   std::vector<std::byte> gather_buffer_;    // this rank's frame (reused)
   std::unique_ptr<FieldSeriesWriter> csv_;  // compute rank 0
+  bool fields_failed_ = false;              // fields.csv itself could not be written
 };
 
 }  // namespace

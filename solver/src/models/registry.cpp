@@ -76,6 +76,9 @@ ModelEntry entry() {
           energy_term_of<Model>(),
           dissipation_term_of<Model>(),
           [](TableReader& t) { return std::any(Model::parse(t)); },
+          [](const std::any& p, double rmax) {
+            return Model::max_stiffness(std::any_cast<const typename Model::Params&>(p), rmax);
+          },
           &make<double, Model>,
           &make<float, Model>,
           mesh_maker<double, Model>(),

@@ -96,6 +96,8 @@ Checkpoint read_checkpoint(const std::filesystem::path& file);
 bool is_complete_checkpoint(const std::filesystem::path& file);
 
 /// The complete checkpoint with the highest step in `dir` (ckpt_<step>.h5), or empty path.
-std::filesystem::path latest_complete_checkpoint(const std::filesystem::path& dir);
+/// `skipped`, when given, receives the newer ckpt_<step>.h5 files passed over as not complete.
+std::filesystem::path latest_complete_checkpoint(const std::filesystem::path& dir,
+                                                 std::vector<std::filesystem::path>* skipped = nullptr);
 
 }  // namespace basalt::io

@@ -7,8 +7,10 @@
 #include <cstdint>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace basalt::io {
@@ -75,8 +77,13 @@ struct Geometry {
 
   /// Checks the invariants every reader and writer relies on; throws FormatError naming `source`
   /// and the first offending particle or bond: array lengths agree, radii finite and > 0,
-  /// positions finite, ids unique, bonds join two existing, distinct ids, masses > 0.
+  /// positions finite, ids unique, bonds join two existing, distinct ids, no pair bonded twice,
+  /// masses > 0.
   void validate(const std::filesystem::path& source) const;
+
+  /// Two bonds joining the same pair (in either order), as their indices (first < second), if any: a
+  /// duplicate would act as two springs. O(B log B) time, 16 bytes per bond while it runs.
+  std::optional<std::pair<std::size_t, std::size_t>> duplicate_bond() const;
 
   /// Index of a particle by id, or -1. O(log n): requires sort_by_id() to have been called.
   std::int64_t index_of(std::int64_t pid) const;

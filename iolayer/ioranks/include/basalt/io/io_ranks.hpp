@@ -102,8 +102,11 @@ class OutputClient {
   void submit_frame(const FrameSource& source);
   /// Same for a piece held as a FramePiece (tests).
   void submit_frame(const FramePiece& piece);
-  /// This rank's partial sums for one saved step (one value per field name).
-  void submit_fields(std::int64_t step, double time, std::span<const double> partials);
+  /// This rank's partial sums for one saved step (one value per field name); due[c] == 0 marks a saver
+  /// not due at this step (an empty cell in fields.csv); an empty `due` means every saver is due. The mask
+  /// travels beside the values, so a non-finite sum is written as nan or inf, never taken for "not due".
+  void submit_fields(std::int64_t step, double time, std::span<const double> partials,
+                     std::span<const char> due = {});
   /// Cheap; call once per step: completes finished sends and picks up errors from I/O ranks.
   void poll();
   /// An output error reported by an I/O rank (or the synchronous writer), if any.

@@ -26,6 +26,8 @@ struct ModelEntry {
   std::string_view energy_term;       ///< body forces: the ledger term of its potential energy ("" otherwise)
   std::string_view dissipation_term;  ///< the ledger term of the energy it dissipates ("" for none)
   std::any (*parse)(TableReader&);
+  /// The stiffest spring of one group with these (parsed) parameters, at the largest radius.
+  double (*max_stiffness)(const std::any& params, double rmax);
   std::unique_ptr<ForceCompute<double>> (*make_double)(const Scene&);
   std::unique_ptr<ForceCompute<float>> (*make_float)(const Scene&);
   /// Wall models: the driver of the scene's mesh walls that use it (null for other kinds).

@@ -19,8 +19,10 @@ class OutputSink {
   virtual ~OutputSink() = default;
   /// Field-saver column names (after "step" and "time"); called once before the first step.
   virtual void begin(const std::vector<std::string>& columns) = 0;
-  /// This rank's partial sums at a step where at least one saver is due; NaN = saver not due.
-  virtual void fields(std::int64_t step, double time, std::span<const double> local_partials) = 0;
+  /// This rank's partial sums at a step where at least one saver is due; due[c] == 0: column c's saver
+  /// is not due (its value is meaningless). A non-finite value is a real one (written as nan or inf).
+  virtual void fields(std::int64_t step, double time, std::span<const double> local_partials,
+                      std::span<const char> due) = 0;
   /// io::FrameKind bits wanted at this step (0: none). Must be the same on every compute rank.
   virtual std::uint32_t frame_kinds(std::int64_t step) const = 0;
   /// This rank's share of the frame of its step (kinds set in its header): the sink has it write

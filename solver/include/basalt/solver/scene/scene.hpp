@@ -169,6 +169,9 @@ struct Scene {
   std::int64_t frames_in_flight = 2;      ///< per compute rank: frames posted but not yet received
 };
 
+/// A scene's largest size in bytes (10 MB): its text is stored in every checkpoint.
+inline constexpr std::uintmax_t kMaxSceneBytes = 10'000'000;
+
 /// Reads and checks a scene file. Throws InputError naming file, line and key.
 Scene parse_scene(const std::filesystem::path& file);
 /// Same from text; `label` names the source in errors, relative paths resolve against `base_dir`.
