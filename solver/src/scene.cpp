@@ -342,7 +342,7 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
         // Two savers of one column would write two columns of one name (a reader takes one of them).
         for (std::size_t j = 0; j < s.fields.size(); ++j) {
           const auto& earlier = s.fields[j];
-          if (earlier.type != f.type || earlier.term != f.term || earlier.wall != f.wall) continue;
+          if (earlier.type != f.type || earlier.name() != f.name() || earlier.wall != f.wall) continue;
           const bool wall = f.type == FieldSpec::Type::wall_force;
           tf.fail(wall ? "wall" : "type",
                   fmt::format("{} is saved already by output.fields[{}]: two savers would write two columns "
