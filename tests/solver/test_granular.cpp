@@ -359,3 +359,66 @@ TEST(HertzMindlin, RestitutionAndContactDurationFollowTheClosedForms) {
     }
   }
 }
+
+TEST(HertzMindlin, ObliqueImpactFollowsTheSlidingAndStickingRegimes) {
+  if (basalt::test::rank() != 0) return;
+  // Kharaz, Gorham & Salman (2001): an Al2O3 sphere (d = 5 mm, rho = 4000 kg/m^3, E = 380 GPa,
+  // nu = 0.23, mu = 0.092) hits an aluminium-alloy wall (E = 70 GPa, nu = 0.25) at 3.9 m/s, in SI units.
+  // Rigid-body theory with Coulomb friction: when tan(theta) > 7/2 mu (1 + e) the sphere slides through
+  // the whole contact, leaving with v_t' = v_t - mu (1 + e) v_n and w R = 5/2 mu (1 + e) v_n; below, the
+  // contact sticks and the tangential compliance may reverse the slip (the data's negative tangential
+  // restitution at small angles), with w R below the sliding bound.
+  const double R = 2.5e-3, rho = 4000, v = 3.9, mu = 0.092, e = 0.98;
+  const auto scene = basalt::test::scene_from(R"(
+[material]
+density = 4000.0
+[particles]
+rotation = true
+[run]
+dt = 1.0e-8
+steps = 0
+skin = 1.0e-5
+energy_check_every = 0
+[[walls]]
+name = "target"
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
+interaction = "hertz_mindlin"
+E = 380.0e9
+nu = 0.23
+E_wall = 70.0e9
+nu_wall = 0.25
+e = 0.98
+mu = 0.092
+)");
+  (void)rho;
+  const double threshold = std::atan(3.5 * mu * (1 + e)) * 180 / std::numbers::pi;  // 32.0 degrees
+  for (const double theta : {10.0, 20.0, 45.0, 60.0, 80.0}) {
+    basalt::io::Geometry geo;
+    geo.add_particle(1, {0, 0, R + 1e-7}, R);
+    RunOptions opt;
+    opt.quiet = true;
+    opt.force_dt = true;
+    Simulation<double> sim(scene, geo, MPI_COMM_SELF, opt);
+    auto& p = sim.particles();
+    const double t = theta * std::numbers::pi / 180, vt = v * std::sin(t), vn = v * std::cos(t);
+    p.vx[0] = vt;
+    p.vz[0] = -vn;
+    sim.state_changed();
+    for (int s = 0; s < 200000 && !(p.z[0] > R + 2e-7 && p.vz[0] > 0); ++s) sim.step();
+    const double vt_out = p.vx[0], vn_out = p.vz[0], wR = p.wy[0] * R;  // wR > 0 rolls the sphere forward
+    std::printf("theta %4.1f: e_n %.4f, v_t'/v_t %.4f, w R / v_t %.4f (threshold %.1f deg)\n", theta,
+                vn_out / vn, vt_out / vt, wR / vt, threshold);
+    EXPECT_NEAR(vn_out / vn, e, 0.02 * e) << theta;
+    if (theta > threshold + 5) {
+      EXPECT_NEAR(vt_out, vt - mu * (1 + e) * vn, 0.02 * vt) << "sliding regime, theta " << theta;
+      EXPECT_NEAR(wR, 2.5 * mu * (1 + e) * vn, 0.02 * 2.5 * mu * (1 + e) * vn)
+          << "sliding regime, theta " << theta;
+    } else if (theta < threshold - 5) {
+      EXPECT_LE(wR, 2.5 * mu * (1 + e) * vn * 1.001) << "sticking regime, theta " << theta;
+      // Mindlin's compliance may reverse the contact point's slip (Maw et al. 1976), never enlarge it.
+      EXPECT_LT(std::abs(vt_out - wR), vt) << "sticking regime: exit slip within the impact slip";
+      EXPECT_GT(wR, 0.5 * vt) << "sticking regime: the sphere leaves spinning forward";
+    }
+  }
+}
