@@ -186,6 +186,7 @@ int main(int argc, char** argv) {
   std::optional<double> exponent;
   std::vector<std::string> tag_texts;
   bool no_bonds = false, record_time = false, quiet = false, allow_large = false, allow_low = false;
+  bool lattice = false;
   std::string seed_text = "1";
   double max_spheres = 1e7;
 
@@ -227,6 +228,10 @@ int main(int argc, char** argv) {
                     "bond every pair whose gap |ci-cj|-ri-rj is <= this (length units)")
         ->capture_default_str();
     sub->add_flag("--no-bonds", no_bonds, "write no bonds");
+    sub->add_flag("--lattice", lattice,
+                  "a loose granular fill instead: a cubic lattice of spacing 2 rmax, radii uniform in [rmin, "
+                  "rmax], each centre jittered by up to rmax - r (no overlaps; solid fraction ~0.3-0.5); "
+                  "pack a column in a box this way for a pile with a free surface");
     sub->add_option("--bond-tag", aopt.bond_tag, "tag of the bonds")->capture_default_str();
     sub->add_option("--overlap-tolerance", popt.overlap_tolerance,
                     "largest overlap allowed between spheres and with the boundary")
@@ -275,7 +280,9 @@ int main(int argc, char** argv) {
 
     ProgressBar bar(!quiet);
     popt.progress = [&](double f) { bar.update(f); };
-    const auto packing = basalt::packer::pack(*volume, popt);
+    if (lattice && popt.exponent) throw PackError("--lattice and --exponent exclude each other");
+    const auto packing =
+        lattice ? basalt::packer::lattice_packing(*volume, popt) : basalt::packer::pack(*volume, popt);
     bar.finish();
     const double pack_seconds = bar.seconds();
     basalt::packer::AssemblyStats st;
@@ -296,7 +303,7 @@ int main(int argc, char** argv) {
       command += " " + arg;
     }
     const auto low = basalt::packer::low_fraction_report(*volume, popt, packing, st.solid_fraction);
-    if (low.far_below && !allow_low)
+    if (low.far_below && !allow_low && !lattice)
       throw PackError(low.text + "; nothing written (--allow-low-fraction writes it anyway)");
 
     geometry.attributes["creator"] = fmt::format("basalt-pack {}", basalt::kVersion);
@@ -337,7 +344,7 @@ int main(int argc, char** argv) {
       fmt::print("  time                 {:.3f} s ({:.3f} s packing)\n", total_seconds, pack_seconds);
       fmt::print("  written              {}\n", output);
     }
-    if (!low.text.empty()) {
+    if (!low.text.empty() && !lattice) {
       if (low.far_below)
         std::fprintf(stderr, "basalt-pack: warning: %s (written as --allow-low-fraction asks)\n",
                      low.text.c_str());

@@ -341,3 +341,27 @@ TEST(Pack, ProgressIsReportedAndEndsAtOne) {
   EXPECT_LT(seen[seen.size() - 2], 1.0);
   EXPECT_EQ(seen.back(), 1.0);
 }
+
+TEST(Pack, LatticeWithJitterIsLooseDeterministicAndValid) {
+  // The granular fill: one sphere per lattice cell of side 2 rmax that fits, radii across [rmin, rmax],
+  // never overlapping nor leaving the volume, the same for the same seed, different for another.
+  auto box = make_box({0, 0, 0}, {10, 8, 20});
+  auto o = options(0.4, 0.5);
+  const auto p = lattice_packing(*box, o);
+  expect_valid(*box, p, o);
+  EXPECT_EQ(p.size(), 10u * 8u * 20u);
+  const double f = chk::solid_fraction(*box, p);
+  EXPECT_GT(f, 0.3);
+  EXPECT_LT(f, 0.53);  // pi/6 at most (every radius rmax)
+  double lo = 1, hi = 0;
+  for (double r : p.radius) lo = std::min(lo, r), hi = std::max(hi, r);
+  EXPECT_LT(lo, 0.41);
+  EXPECT_GT(hi, 0.49);
+  const auto again = lattice_packing(*box, o);
+  EXPECT_EQ(again.centre, p.centre);
+  o.seed = 99;
+  EXPECT_NE(lattice_packing(*box, o).centre, p.centre);
+  auto cyl = make_cylinder({0, 0, 0}, 3, 6);
+  const auto c = lattice_packing(*cyl, options(0.4, 0.5));
+  expect_valid(*cyl, c, options(0.4, 0.5));
+}

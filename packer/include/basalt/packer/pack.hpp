@@ -56,6 +56,12 @@ inline constexpr double kDenseCountExponent = 1.5;
 /// Memory the packer needs per sphere at its peak, for estimates (measured 0.83-0.93 KiB, docs/packer.md).
 inline constexpr double kBytesPerSphere = 1024;
 
+/// A loose granular assembly for flow scenes: a simple cubic lattice of spacing 2 rmax filling the
+/// volume (cells whose sphere of radius rmax lies inside), each sphere with a radius uniform in
+/// [rmin, rmax] and its centre moved by up to rmax - r along each axis, so no two overlap and none
+/// leaves the volume. Deterministic for a seed. Solid fraction about pi/6 <r^3>/rmax^3.
+Packing lattice_packing(const Volume& volume, const PackOptions& options);
+
 /// Throws PackError on impossible options (rmin <= 0, rmin > rmax, non-finite values ...).
 void check_options(const PackOptions& options);
 
