@@ -70,7 +70,7 @@ def run_one(a, args, b):
     out = os.path.join(d, "run")
     last = os.path.join(out, f"ckpt_{steps:06d}.h5")
     if not os.path.exists(last):
-        subprocess.run([os.path.join(b, "basalt-run"), os.path.join(ROOT, "scenes/column-collapse.toml"),
+        subprocess.run([os.path.join(b, "basalt-run"), args.scene,
                         "--geometry", geo, "--output", out, "--steps", str(steps),
                         "--checkpoint-every", str(steps // 4), "--quiet"], check=True,
                        stdout=open(os.path.join(d, "log.txt"), "w"), stderr=subprocess.STDOUT)
@@ -98,16 +98,29 @@ def main():
     ap.add_argument("--data", default=os.path.join(ROOT, "docs/data/column-collapse"))
     ap.add_argument("--img", default=os.path.join(ROOT, "docs/img"))
     ap.add_argument("--no-render", action="store_true")
+    ap.add_argument("--rot-damping", type=float, help="run with this rotational_damping viscosity instead of the scene's")
+    ap.add_argument("--tag", default="", help="suffix of the run folder and the csv/png names (variants)")
     args = ap.parse_args()
     aspects = args.aspect or ([0.5, 1, 2, 4] if args.quick else [0.5, 1, 2, 3, 4, 6, 8])
     b = bindir(args)
+    sfx = f"_{args.tag}" if args.tag else ""
+    args.out = args.out + sfx
+    args.scene = os.path.join(ROOT, "scenes/column-collapse.toml")
+    if args.rot_damping is not None:
+        import re
+        os.makedirs(args.out, exist_ok=True)
+        txt = open(args.scene).read()
+        txt, n = re.subn(r'(type = "rotational_damping"\nviscosity = )[0-9.eE+-]+', rf"\g<1>{args.rot_damping!r}", txt)
+        assert n == 1, "rotational_damping block not found in the scene"
+        args.scene = os.path.join(args.out, "scene.toml")
+        open(args.scene, "w").write(txt)
     # biggest first so the two workers finish together
     with cf.ThreadPoolExecutor(args.jobs) as ex:
         res = list(ex.map(lambda a: run_one(a, args, b), sorted(aspects, reverse=True)))
     res.sort(key=lambda r: r["a"])
     os.makedirs(args.data, exist_ok=True)
     keys = list(res[0].keys())
-    with open(os.path.join(args.data, "runout.csv"), "w", newline="") as f:
+    with open(os.path.join(args.data, f"runout{sfx}.csv"), "w", newline="") as f:
         w = csv.DictWriter(f, keys)
         w.writeheader()
         for r in res:
@@ -119,23 +132,20 @@ def main():
     A = np.array([r["a"] for r in res])
     Y = np.array([r["norm_runout"] for r in res])
     fits = []
-    sel = A >= 1
-    if sel.sum() >= 2:
-        X, Z = np.log(A[sel]), np.log(Y[sel])
-        p, cov = np.polyfit(X, Z, 1, cov=(sel.sum() > 2))
-        se = math.sqrt(cov[0, 0]) if sel.sum() > 2 else float("nan")
-        fits.append(("power_a_ge_1", int(sel.sum()), p[0], se, math.exp(p[1])))
-    big = A >= 2
-    if big.sum() >= 2:
-        X, Z = np.log(A[big]), np.log(Y[big])
-        p, cov = np.polyfit(X, Z, 1, cov=(big.sum() > 2))
-        se = math.sqrt(cov[0, 0]) if big.sum() > 2 else float("nan")
-        fits.append(("power_a_ge_2", int(big.sum()), p[0], se, math.exp(p[1])))
+    for lo in (1, 2, 4):
+        sel = A >= lo
+        if sel.sum() >= 2:
+            p, cov = np.polyfit(np.log(A[sel]), np.log(Y[sel]), 1, cov=(sel.sum() > 2))
+            se = math.sqrt(cov[0, 0]) if sel.sum() > 2 else float("nan")
+            fits.append((f"power_a_ge_{lo}", int(sel.sum()), p[0], se, math.exp(p[1])))
+    for i in range(len(A) - 1):  # local exponents between neighbours
+        s = math.log(Y[i + 1] / Y[i]) / math.log(A[i + 1] / A[i])
+        fits.append((f"local_{A[i]:g}_{A[i + 1]:g}", 2, s, float("nan"), Y[i] / A[i] ** s))
     small = A <= 2
     if small.sum() >= 1:
         k = float(np.sum(A[small] * Y[small]) / np.sum(A[small] ** 2))
         fits.append(("linear_a_le_2", int(small.sum()), k, float("nan"), 0.0))
-    with open(os.path.join(args.data, "fit.csv"), "w", newline="") as f:
+    with open(os.path.join(args.data, f"fit{sfx}.csv"), "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(["fit", "points", "exponent_or_slope", "std_error", "prefactor"])
         for row in fits:
@@ -159,14 +169,14 @@ def main():
     ax.grid(True, which="both", alpha=0.3)
     fig.tight_layout()
     os.makedirs(args.img, exist_ok=True)
-    fig.savefig(os.path.join(args.img, "column_collapse_runout.png"), dpi=120)
+    fig.savefig(os.path.join(args.img, f"column_collapse_runout{sfx}.png"), dpi=120)
     if not args.no_render:
         r = res[-1] if args.quick else [q for q in res if q["a"] == 4][0] if 4 in A else res[-1]
         ck = os.path.join(args.out, f"a{r['a']:g}", "run", f"ckpt_{r['steps']:06d}.h5")
-        png = os.path.join(args.img, f"column_collapse_deposit_a{r['a']:g}.png")
+        png = os.path.join(args.img, f"column_collapse_deposit_a{r['a']:g}{sfx}.png")
         subprocess.run(["xvfb-run", "-a", os.path.join(b, "basalt-view"), "render", ck, "-o", png,
                         "--view", "-y", "--color", "displacement", "--reference",
-                        os.path.join(args.out, f"a{r['a']:g}", "column.h5"), "--size", "1600x500", "-q"])
+                        os.path.join(args.out, f"a{r['a']:g}", "column.h5"), "--size", "2000x450", "-q"])
 
 
 if __name__ == "__main__":
