@@ -18,7 +18,8 @@ slope of (L_inf - L)/L against a (through the origin) for a <= 2.
 
   /usr/bin/python3 tools/granular/column_collapse.py            # a = 0.5 1 2 3 4 6 8
   /usr/bin/python3 tools/granular/column_collapse.py --quick    # a = 0.5 1 2 4
-Writes docs/data/column-collapse/runout.csv, fit.csv and docs/img/column_collapse_runout.png;
+Writes docs/data/column-collapse/runout.csv, fit.csv, docs/img/column_collapse_runout.png and a
+picture of the a = 4 deposit (--quick or --tag T: the same names with _quick or _T appended);
 the runs go to out/column-collapse/ (not committed).
 """
 import argparse
@@ -103,6 +104,8 @@ def main():
     args = ap.parse_args()
     aspects = args.aspect or ([0.5, 1, 2, 4] if args.quick else [0.5, 1, 2, 3, 4, 6, 8])
     b = bindir(args)
+    if args.quick and not args.tag:
+        args.tag = "quick"  # never overwrite the full study's files
     sfx = f"_{args.tag}" if args.tag else ""
     args.out = args.out + sfx
     args.scene = os.path.join(ROOT, "scenes/column-collapse.toml")
