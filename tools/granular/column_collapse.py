@@ -138,8 +138,11 @@ def main():
     for lo in (1, 2, 4):
         sel = A >= lo
         if sel.sum() >= 2:
-            p, cov = np.polyfit(np.log(A[sel]), np.log(Y[sel]), 1, cov=(sel.sum() > 2))
-            se = math.sqrt(cov[0, 0]) if sel.sum() > 2 else float("nan")
+            if sel.sum() > 2:
+                p, cov = np.polyfit(np.log(A[sel]), np.log(Y[sel]), 1, cov=True)
+                se = math.sqrt(cov[0, 0])
+            else:  # two points: no scatter, no error
+                p, se = np.polyfit(np.log(A[sel]), np.log(Y[sel]), 1), float("nan")
             fits.append((f"power_a_ge_{lo}", int(sel.sum()), p[0], se, math.exp(p[1])))
     for i in range(len(A) - 1):  # local exponents between neighbours
         s = math.log(Y[i + 1] / Y[i]) / math.log(A[i + 1] / A[i])
