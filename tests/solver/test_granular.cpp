@@ -17,6 +17,7 @@
 #include <string>
 
 #include "basalt/solver/models/friction.hpp"
+#include "basalt/solver/models/hertz_mindlin.hpp"
 #include "basalt/solver/simulation.hpp"
 #include "solver_helpers.hpp"
 #include "test_support.hpp"
@@ -339,6 +340,18 @@ e = )" + std::to_string(e) + "\n");
 }
 
 }  // namespace
+
+TEST(HertzMindlin, EffectiveModuliOfOneAndOfTwoMaterials) {
+  // E* = E / (2 (1 - nu^2)), G* = G / (2 (2 - nu)) for one material; 1/G* = (2 - nu1)/G1 + (2 - nu2)/G2.
+  const auto one = HertzMindlin::coeffs<double>(HertzMindlin::Params{{1.0e5, 0.25}, 0.5, 0.3});
+  EXPECT_NEAR(one.E_star, 1.0e5 / (2 * (1 - 0.0625)), 1e-9);
+  EXPECT_NEAR(one.G_star, 4.0e4 / (2 * 1.75), 1e-9);
+  HertzMindlinWall::Params w{{380.0e9, 0.23}, {70.0e9, 0.25}, 0.98, 0.092};
+  const auto two = HertzMindlinWall::coeffs<double>(w);
+  const double G1 = 380.0e9 / 2.46, G2 = 70.0e9 / 2.5;
+  EXPECT_NEAR(two.G_star, 1 / (1.77 / G1 + 1.75 / G2), 1e-6 * two.G_star);
+  EXPECT_NEAR(two.E_star, 1 / ((1 - 0.0529) / 380.0e9 + (1 - 0.0625) / 70.0e9), 1e-6 * two.E_star);
+}
 
 TEST(HertzMindlin, RestitutionAndContactDurationFollowTheClosedForms) {
   if (basalt::test::rank() != 0) return;

@@ -38,7 +38,7 @@ inline Constants constants(const Material& a, const Material& b, double e, doubl
   const double Ga = a.E / (2 * (1 + a.nu)), Gb = b.E / (2 * (1 + b.nu));
   Constants c;
   c.E_star = 1 / ((1 - a.nu * a.nu) / a.E + (1 - b.nu * b.nu) / b.E);
-  c.G_star = 1 / (2 * (2 - a.nu) / Ga + 2 * (2 - b.nu) / Gb);
+  c.G_star = 1 / ((2 - a.nu) / Ga + (2 - b.nu) / Gb);  // G / (2 (2 - nu)) for one material
   const double le = std::log(e);
   c.beta = e >= 1 ? 0.0 : le / std::sqrt(le * le + std::numbers::pi * std::numbers::pi);
   c.mu = mu;
