@@ -21,6 +21,7 @@
 #include "basalt/solver/models/hertz_mindlin.hpp"
 #include "basalt/solver/models/linear_bond.hpp"
 #include "basalt/solver/models/linear_elastic.hpp"
+#include "basalt/solver/models/rolling_friction.hpp"
 
 namespace basalt::solver {
 
@@ -94,6 +95,7 @@ const std::vector<ModelEntry>& model_registry() {
       entry<ContactAge>(),         // pair, test model for contact history
       entry<Friction>(),           // pair, ESyS NRotFriction
       entry<RotFriction>(),        // pair, ESyS RotFriction
+      entry<RollingFriction>(),    // pair, rot_friction with rolling resistance (Ai et al. 2011)
       entry<HertzMindlin>(),       // pair, LIGGGHTS hertz/history, ESyS HertzMindlinVisco
       entry<ElasticWall>(),        // wall
       entry<FrictionWall>(),       // wall, with Coulomb friction
