@@ -266,8 +266,21 @@ TEST(Granular, ColumnCollapseBalancesTheLedgerAndFixedParticlesStay) {
   EXPECT_GT(far, 4.5) << "the column spread along +x";
 }
 
-TEST(Granular, FrictionalRotatingColumnIsDecompositionInvariant) {
-  const auto scene = basalt::test::scene_from(kColumnScene);
+/// The column scene with Hertz-Mindlin contacts and floor (dashpots: effective masses across ranks).
+std::string hertz_column() {
+  auto s = std::string(kColumnScene);
+  const std::string pair = "type = \"rot_friction\"\nK = 1000.0\nKs = 500.0\nmu = 0.5\nmu_dynamic = 0.4\n";
+  s.replace(s.find(pair), pair.size(), "type = \"hertz_mindlin\"\nE = 2.0e4\nnu = 0.3\ne = 0.6\nmu = 0.5\n");
+  const std::string floor = "interaction = \"friction\"\nK = 1000.0\nKs = 500.0\nmu = 0.5\n";
+  s.replace(s.find(floor), floor.size(),
+            "interaction = \"hertz_mindlin\"\nE = 2.0e4\nnu = 0.3\ne = 0.6\nmu = 0.5\n");
+  return s;
+}
+
+class ColumnInvariance : public ::testing::TestWithParam<int> {};
+
+TEST_P(ColumnInvariance, FrictionalRotatingColumnIsDecompositionInvariant) {
+  const auto scene = basalt::test::scene_from(GetParam() == 0 ? kColumnScene : hertz_column());
   const auto g = column(6, 4, 10);
   constexpr int kSteps = 600;
   const auto run = [&](MPI_Comm comm, std::array<int, 3> dims) {
@@ -303,6 +316,8 @@ TEST(Granular, FrictionalRotatingColumnIsDecompositionInvariant) {
     EXPECT_LT(worst, 1e-9) << "dims " << dims[0] << "," << dims[1] << "," << dims[2];
   }
 }
+
+INSTANTIATE_TEST_SUITE_P(RotFrictionAndHertzMindlin, ColumnInvariance, ::testing::Values(0, 1));
 
 namespace {
 

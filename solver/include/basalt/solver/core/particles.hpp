@@ -213,7 +213,7 @@ struct Particles {
     using G = FieldGroup;
     constexpr ArrayInfo pos{"position", true, true, G::core}, rad{"radius", true, true, G::core},
         ident{"id", true, true, G::core}, tg{"tag", true, true, G::core}, frc{"force", false, false, G::core},
-        im{"inverse_mass", false, true, G::core}, ref{"skin_reference", false, false, G::core},
+        ref{"skin_reference", false, false, G::core},
         exact{"position_at_rebuild", false, false, G::exact_rebuild},
         initial{"bond_damage", false, true, G::damage, "bonds_initial"},
         broken{"bond_damage", false, true, G::damage, "bonds_broken"},
@@ -222,9 +222,10 @@ struct Particles {
         ori_x{"orientation", false, true, G::rotation, "orientation_x"},
         ori_y{"orientation", false, true, G::rotation, "orientation_y"},
         ori_z{"orientation", false, true, G::rotation, "orientation_z"};
-    // Velocities go to ghosts when a model reads both particles' velocities.
+    // Velocities (and inverse masses: effective masses of dashpots) go to ghosts when a model reads both
+    // particles' velocities.
     const bool gv = p.ghost_velocity;
-    const ArrayInfo vel{"velocity", gv, true, G::core},
+    const ArrayInfo vel{"velocity", gv, true, G::core}, im{"inverse_mass", gv, true, G::core},
         ang_x{"angular_velocity", gv, true, G::rotation, "angular_velocity_x"},
         ang_y{"angular_velocity", gv, true, G::rotation, "angular_velocity_y"},
         ang_z{"angular_velocity", gv, true, G::rotation, "angular_velocity_z"};
