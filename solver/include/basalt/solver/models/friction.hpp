@@ -102,11 +102,10 @@ struct CoulombFriction {
     const Real K = c.K * scale, Ks = c.Ks * scale;
     const Real fn = K * (k.ri + k.rj - k.r);
     f.arm_i = k.r * k.ri / (k.ri + k.rj);
-    Real sx = Real(h.fx), sy = Real(h.fy), sz = Real(h.fz);
-    if constexpr (Advance) {
-      // Velocity of i's contact point relative to j's: v_i - v_j + w_i x (-arm_i n) - w_j x (arm_j n).
-      Real ux = k.vx, uy = k.vy, uz = k.vz;
-      if constexpr (Rotating) {
+    // Velocity of i's contact point relative to j's: v_i - v_j + w_i x (-arm_i n) - w_j x (arm_j n).
+    Real ux = k.vx, uy = k.vy, uz = k.vz;
+    if constexpr (Rotating) {
+      if constexpr (Advance) {
         const Real ai = f.arm_i, aj = k.r - f.arm_i;
         const Real ox = -(ai * k.wix + aj * k.wjx), oy = -(ai * k.wiy + aj * k.wjy),
                    oz = -(ai * k.wiz + aj * k.wjz);
@@ -114,15 +113,27 @@ struct CoulombFriction {
         uy += oz * nx - ox * nz;
         uz += ox * ny - oy * nx;
       }
+    }
+    shear<Advance>(c, Ks, h, nx, ny, nz, fn, ux, uy, uz, k.dt, f);
+  }
+
+  /// The Coulomb law shared by pairs and walls: on a real step the stored shear force is turned onto
+  /// the tangent plane of n (unless esys), loaded by the tangential part of the contact point's
+  /// velocity u and cut at the Coulomb limit; f gets F_n n + F_s and what the cut dissipated.
+  template <bool Advance, class Real>
+  static void shear(const Coeffs<Real>& c, Real Ks, History& h, Real nx, Real ny, Real nz, Real fn, Real ux,
+                    Real uy, Real uz, Real dt, ContactForce<Real>& f) {
+    Real sx = Real(h.fx), sy = Real(h.fy), sz = Real(h.fz);
+    if constexpr (Advance) {
       const Real un = ux * nx + uy * ny + uz * nz;
       ux -= un * nx;
       uy -= un * ny;
       uz -= un * nz;
       if (!c.esys) turn_into_plane(sx, sy, sz, nx, ny, nz);  // ESyS never turns it
       const Real px = sx, py = sy, pz = sz;
-      sx -= Ks * k.dt * ux;
-      sy -= Ks * k.dt * uy;
-      sz -= Ks * k.dt * uz;
+      sx -= Ks * dt * ux;
+      sy -= Ks * dt * uy;
+      sz -= Ks * dt * uz;
       const Real s2 = sx * sx + sy * sy + sz * sz;
       const Real limit = (h.sliding != 0 && !c.esys ? c.mu_dynamic : c.mu) * fn;
       if (s2 > limit * limit) {
@@ -231,41 +242,10 @@ struct FrictionWall {
                       ContactForce<Real>& f) {
     const Real fn = c.K * (k.r - k.d);
     f.arm_i = k.d;
-    Real sx = Real(h.fx), sy = Real(h.fy), sz = Real(h.fz);
-    if constexpr (Advance) {
-      // Contact point velocity: v + w x (-d n).
-      Real ux = k.vx - k.d * (k.wy * k.nz - k.wz * k.ny);
-      Real uy = k.vy - k.d * (k.wz * k.nx - k.wx * k.nz);
-      Real uz = k.vz - k.d * (k.wx * k.ny - k.wy * k.nx);
-      const Real un = ux * k.nx + uy * k.ny + uz * k.nz;
-      ux -= un * k.nx;
-      uy -= un * k.ny;
-      uz -= un * k.nz;
-      CoulombFriction<true>::turn_into_plane(sx, sy, sz, k.nx, k.ny, k.nz);
-      const Real px = sx, py = sy, pz = sz;
-      sx -= c.Ks * k.dt * ux;
-      sy -= c.Ks * k.dt * uy;
-      sz -= c.Ks * k.dt * uz;
-      const Real s2 = sx * sx + sy * sy + sz * sz;
-      const Real limit = (h.sliding != 0 ? c.mu_dynamic : c.mu) * fn;
-      if (s2 > limit * limit) {
-        const Real s = std::sqrt(s2), cut = c.mu_dynamic * fn, scale = cut / s;
-        f.dissipated = CoulombFriction<true>::cut_energy(c.Ks, s, cut, (px * sx + py * sy + pz * sz) / s);
-        sx *= scale;
-        sy *= scale;
-        sz *= scale;
-        h.sliding = 1;
-        f.sliding = true;
-      } else {
-        h.sliding = 0;
-      }
-      h.fx = double(sx);
-      h.fy = double(sy);
-      h.fz = double(sz);
-    }
-    f.fx = fn * k.nx + sx;
-    f.fy = fn * k.ny + sy;
-    f.fz = fn * k.nz + sz;
+    // Contact point velocity: v + w x (-d n).
+    const Real ux = k.vx - k.d * (k.wy * k.nz - k.wz * k.ny), uy = k.vy - k.d * (k.wz * k.nx - k.wx * k.nz),
+               uz = k.vz - k.d * (k.wx * k.ny - k.wy * k.nx);
+    CoulombFriction<true>::shear<Advance>(c, c.Ks, h, k.nx, k.ny, k.nz, fn, ux, uy, uz, k.dt, f);
   }
 
   template <class Real>
