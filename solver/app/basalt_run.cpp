@@ -55,6 +55,22 @@ double cpu_seconds() {
          1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
 }
 
+// CLI11's NonNegativeNumber/PositiveNumber print their bound, the largest double, in 309 digits.
+const CLI::Validator kNonNegative(
+    [](const std::string& text) {
+      double v = 0;
+      if (!CLI::detail::lexical_cast(text, v) || !(v >= 0)) return "must be >= 0, got " + text;
+      return std::string{};
+    },
+    ">= 0");
+const CLI::Validator kPositive(
+    [](const std::string& text) {
+      double v = 0;
+      if (!CLI::detail::lexical_cast(text, v) || !(v > 0)) return "must be > 0, got " + text;
+      return std::string{};
+    },
+    "> 0");
+
 std::array<int, 3> parse_dims(const std::string& s) {
   std::array<int, 3> d{0, 0, 0};
   if (s.empty()) return d;
@@ -285,25 +301,25 @@ int run_world(int argc, char** argv) {
   app.add_option("--geometry", cli.geometry,
                  "geometry file (.h5 or .geo); overrides the scene's geometry.file");
   app.add_option("--steps", cli.steps, "number of steps; overrides run.steps (with --restart: steps to add)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(kNonNegative);
   app.add_option("--output", cli.output, "output folder; overrides output.directory");
   app.add_option("--dims", cli.dims_text, "compute-rank grid x,y,z (default: MPI_Dims_create)");
   app.add_option("--io-ranks", cli.io_ranks,
                  "dedicated I/O ranks among the mpirun ranks (0: compute ranks write)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(kNonNegative);
   app.add_option("--checkpoint-every", cli.checkpoint_every, "HDF5 checkpoint every N steps (0 = off)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(kNonNegative);
   app.add_option("--frames-every", cli.frames_every, "VTK frame every N steps (0 = off)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(kNonNegative);
   app.add_option("--fields-every", cli.fields_every, "every field saver every N steps (0 = off)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(kNonNegative);
   app.add_option("--restart", cli.restart,
                  "continue from a checkpoint, or from the latest complete one in a folder");
   app.add_option("--frames-in-flight", cli.frames_in_flight, "frames a compute rank may have posted (bound)")
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   app.add_option("--throttle-io-mbps", cli.throttle_mbps,
                  "benchmark only: make output storage this slow (MB/s)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(kNonNegative);
   app.add_option("--preset", cli.preset,
                  "named accuracy/speed setting (docs/stability.md): fast (float, dt_fraction 0.5), balanced "
                  "(double, 0.25), reference (double, 0.05); overrides run.dt, run.dt_fraction, run.precision")

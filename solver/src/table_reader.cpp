@@ -128,13 +128,15 @@ const toml::array* TableReader::table_array(const std::string& key) {
 
 double TableReader::positive(const std::string& key) {
   double v = number(key);
-  if (!(v > 0) || !std::isfinite(v)) fail(key, fmt::format("must be > 0, got {}", v));
+  if (!std::isfinite(v)) fail(key, fmt::format("must be a finite number > 0, got {}", v));
+  if (!(v > 0)) fail(key, fmt::format("must be > 0, got {}", v));
   return v;
 }
 
 double TableReader::non_negative(const std::string& key) {
   double v = number(key);
-  if (!(v >= 0) || !std::isfinite(v)) fail(key, fmt::format("must be >= 0, got {}", v));
+  if (!std::isfinite(v)) fail(key, fmt::format("must be a finite number >= 0, got {}", v));
+  if (!(v >= 0)) fail(key, fmt::format("must be >= 0, got {}", v));
   return v;
 }
 

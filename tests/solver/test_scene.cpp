@@ -109,6 +109,11 @@ TEST(Scene, ImpossibleValues) {
   EXPECT_NE(msg.find("run.dt: must be > 0"), std::string::npos) << msg;
   msg = with("dt = 1e-3", "dt = -1e-3");
   EXPECT_NE(msg.find("run.dt"), std::string::npos) << msg;
+  // Issue 16: infinity is named as not finite, not as "must be > 0".
+  msg = with("dt = 1e-3", "dt = inf");
+  EXPECT_NE(msg.find("run.dt: must be a finite number > 0, got inf"), std::string::npos) << msg;
+  msg = with("type = \"linear_bond\"\nK = 1000.0", "type = \"linear_bond\"\nK = nan");
+  EXPECT_NE(msg.find("interactions[0].K: must be a finite number >= 0"), std::string::npos) << msg;
   msg = with("type = \"linear_bond\"\nK = 1000.0", "type = \"linear_bond\"\nK = -5.0");
   EXPECT_NE(msg.find("interactions[0].K: must be >= 0"), std::string::npos) << msg;
   msg = with("normal = [0, 0, 2]", "normal = [0, 0, 0]");
