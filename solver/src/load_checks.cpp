@@ -157,8 +157,56 @@ std::vector<std::string> check_scene_with_geometry(const Scene& scene, const io:
   return warnings;
 }
 
-void run_load_checks(const Scene& scene, const io::Geometry& g, const std::string& source, MPI_Comm comm) {
-  const auto warnings = check_scene_with_geometry(scene, g, source);
+namespace {
+
+/// The largest |coordinate| and the smallest radius of a geometry.
+struct Reach {
+  double xmax = 0, rmin = std::numeric_limits<double>::infinity();
+};
+
+Reach reach_of(const io::Geometry& g) {
+  Reach r;
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    const auto& x = g.position[i];
+    r.xmax = std::max({r.xmax, std::abs(x[0]), std::abs(x[1]), std::abs(x[2])});
+    r.rmin = std::min(r.rmin, g.radius[i]);
+  }
+  return r;
+}
+
+}  // namespace
+
+double strain_resolution(const io::Geometry& g, double epsilon) {
+  const Reach r = reach_of(g);
+  return g.size() == 0 ? 0.0 : epsilon * r.xmax / (2 * r.rmin);
+}
+
+std::string check_precision(const io::Geometry& g, double epsilon, const std::string& precision,
+                            const std::string& source) {
+  const double res = strain_resolution(g, epsilon);
+  if (!(res > kResolutionWarn)) return {};
+  const Reach r = reach_of(g);
+  const std::string what = fmt::format(
+      "{}: coordinates reach |x| = {:.3g} with a smallest radius of {:.3g}: in {} a distance between "
+      "particles "
+      "there is rounded to a strain of {:.2g} (epsilon |x| / 2 r_min)",
+      source, r.xmax, r.rmin, precision, res);
+  const std::string remedy =
+      precision == "float"
+          ? "run in double (--precision double) or move the geometry nearer the origin"
+          : "move the geometry nearer the origin (rounding grows with |x|, not with its size)";
+  if (res > kResolutionRefuse)
+    throw InputError(
+        fmt::format("{}, above the limit {:g}: contact and bond forces would be mostly rounding; {}", what,
+                    kResolutionRefuse, remedy));
+  return fmt::format("{}, above {:g}: expect energies off by 1e-3 or more (docs/stability.md); {}", what,
+                     kResolutionWarn, remedy);
+}
+
+void run_load_checks(const Scene& scene, const io::Geometry& g, const std::string& source, MPI_Comm comm,
+                     double epsilon, const std::string& precision) {
+  auto warnings = check_scene_with_geometry(scene, g, source);
+  if (auto w = check_precision(g, epsilon, precision, source); !w.empty()) warnings.push_back(std::move(w));
   int rank = 0;
   MPI_Comm_rank(comm, &rank);
   if (rank == 0)

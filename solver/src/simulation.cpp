@@ -43,7 +43,7 @@ Simulation<Real>::Simulation(const Scene& scene, io::Geometry g, MPI_Comm comm, 
   kick1_ = Real(se ? scene.dt : scene.dt / 2);
   kick2_ = Real(se ? 0.0 : scene.dt / 2);
   rebuild_limit2_ = 0.25 * scene.skin * scene.skin;
-  run_load_checks(scene, g, scene.geometry.string(), comm);
+  run_load_checks(scene, g, scene.geometry.string(), comm, kEpsilon, kPrecision);
   check_stability(g);
   distribute(g, comm);
   rebuild();

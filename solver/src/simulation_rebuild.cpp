@@ -108,10 +108,11 @@ void Simulation<Real>::rebuild() {
   times_.communication += sw.lap();
   const auto bond_bucket_end = resolve_bonds();
   forces_.rebuild_lists(p_, bond_bucket_end, bonds_, scene_.skin, contact_cutoff_);
+  const auto& o = p_.skin_origin = skin_origin(dec_->box_min(), dec_->box_max());
   for (std::size_t i = 0; i < p_.n_owned; ++i) {
-    p_.x0[i] = float(p_.x[i]);
-    p_.y0[i] = float(p_.y[i]);
-    p_.z0[i] = float(p_.z[i]);
+    p_.x0[i] = float(double(p_.x[i]) - o[0]);
+    p_.y0[i] = float(double(p_.y[i]) - o[1]);
+    p_.z0[i] = float(double(p_.z[i]) - o[2]);
   }
   if (p_.with_exact_rebuild) {  // exact copies for the checkpoints (x0 is float); memory only then
     p_.xr.assign(p_.x.begin(), p_.x.begin() + static_cast<std::ptrdiff_t>(p_.n_owned));

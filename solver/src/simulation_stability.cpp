@@ -213,13 +213,15 @@ void Simulation<Real>::check_blowup() {
   // Called before a rebuild, when some particle (or wall) moved more than skin/2 since the last one.
   // Moving farther than skin/2 + kBlowupRadii rmin since then means moving more than kBlowupRadii rmin
   // in this one step: no DEM contact is resolved that way, the run has blown up (or a position went
-  // non-finite). The positions at the last rebuild are p_.x0 (float).
+  // non-finite). The positions at the last rebuild are p_.x0 (float, relative to p_.skin_origin).
   const double limit = 0.5 * scene_.skin + stability::kBlowupRadii * stability_.rmin;
   double worst = 0;
   std::size_t wi = 0;
   for (std::size_t i = 0; i < p_.n_owned; ++i) {
-    const double dx = double(p_.x[i]) - double(p_.x0[i]), dy = double(p_.y[i]) - double(p_.y0[i]),
-                 dz = double(p_.z[i]) - double(p_.z0[i]);
+    const auto& o = p_.skin_origin;
+    const double dx = double(p_.x[i]) - o[0] - double(p_.x0[i]),
+                 dy = double(p_.y[i]) - o[1] - double(p_.y0[i]),
+                 dz = double(p_.z[i]) - o[2] - double(p_.z0[i]);
     const double d2 = dx * dx + dy * dy + dz * dz;
     if (!(d2 <= worst)) {  // NaN wins
       worst = d2;

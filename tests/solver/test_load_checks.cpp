@@ -223,3 +223,34 @@ TEST(InputHygiene, ScenesLargerThanTenMegabytesAreRefused) {
   // A comment of 1 MB is fine.
   EXPECT_NO_THROW((void)scene_from(kRun + kBonds + "# " + std::string(1'000'000, 'x') + "\n"));
 }
+
+// Strain resolution of positions (issue 16, precision limits): eps |x|max / (2 rmin); nothing below 1e-5,
+// a warning naming the resolution and the remedy up to 1e-4, refused above.
+TEST(LoadChecks, PrecisionOfFarCoordinates) {
+  auto at = [](double d) {
+    basalt::io::Geometry g = pair_geometry();
+    for (auto& x : g.position) x[0] += d;
+    return g;
+  };
+  constexpr double kFloat = 1.1920929e-7, kDouble = 2.220446049250313e-16;
+  EXPECT_NEAR(strain_resolution(at(99), kFloat), kFloat * 100 / 1.0, 1e-12);
+  EXPECT_EQ(check_precision(at(0), kFloat, "float", "pair.geo"), "");           // 1.2e-7
+  EXPECT_EQ(check_precision(at(1e9), kDouble, "double", "pair.geo"), "");       // 2.2e-7
+  const std::string w = check_precision(at(200), kFloat, "float", "pair.geo");  // 2.4e-5
+  EXPECT_NE(w.find("pair.geo: coordinates reach |x| = 201"), std::string::npos) << w;
+  EXPECT_NE(w.find("in float a distance between particles there is rounded to a strain of 2.4e-05"),
+            std::string::npos)
+      << w;
+  EXPECT_NE(w.find("run in double"), std::string::npos) << w;
+  EXPECT_NE(
+      check_precision(at(1e11), kDouble, "double", "pair.geo").find("move the geometry nearer the origin"),
+      std::string::npos);
+  for (auto [d, eps] : {std::pair{1e3, kFloat}, std::pair{1e5, kFloat}, std::pair{1e12, kDouble}}) {
+    try {
+      (void)check_precision(at(d), eps, eps == kFloat ? "float" : "double", "pair.geo");
+      ADD_FAILURE() << "offset " << d << " accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("above the limit 0.0001"), std::string::npos) << e.what();
+    }
+  }
+}

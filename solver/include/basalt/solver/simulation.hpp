@@ -5,9 +5,11 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -143,6 +145,9 @@ class Simulation {
   std::size_t memory_bytes() const;
 
  private:
+  /// The precision's name and machine epsilon (load checks, messages).
+  static constexpr const char* kPrecision = std::is_same_v<Real, float> ? "float" : "double";
+  static constexpr double kEpsilon = double(std::numeric_limits<Real>::epsilon());
   friend class SimulationFrame<Real>;
   /// With BASALT_FRAME_TIMES=1: prints this rank's median/min/max time to pack and submit a frame.
   void report_frame_times(std::vector<double> seconds) const;

@@ -10,6 +10,7 @@
 // and the "fields:" line at start are all derived from that list: a new per-particle array is one
 // member plus one line there.
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -34,6 +35,18 @@ struct ArrayInfo {
   std::string_view output = {};
 };
 
+/// Origin of the skin reference x0 for the decomposition's box [lo, hi]: zero along an axis where the
+/// box lies within its own width of the coordinate origin (every such scene keeps x0 = float(x)), else
+/// the box's centre there, so that float rounding of x0 scales with the box, not with the offset.
+inline std::array<double, 3> skin_origin(const std::array<double, 3>& lo, const std::array<double, 3>& hi) {
+  std::array<double, 3> o{};
+  for (std::size_t d = 0; d < 3; ++d) {
+    const double c = 0.5 * (lo[d] + hi[d]), w = hi[d] - lo[d];
+    if (std::isfinite(c) && std::isfinite(w) && std::abs(c) > w) o[d] = c;
+  }
+  return o;
+}
+
 template <class Real>
 struct Particles {
   std::size_t n_owned = 0;
@@ -46,8 +59,11 @@ struct Particles {
   std::vector<Real> vx, vy, vz;
   std::vector<Real> fx, fy, fz;
   std::vector<Real> inv_mass;     ///< 1 / mass (the mass itself is mass(i))
-  std::vector<float> x0, y0, z0;  ///< positions at the last neighbour-list rebuild (float: only
-                                  ///< compared with half the skin)
+  std::vector<float> x0, y0, z0;  ///< positions at the last neighbour-list rebuild relative to
+                                  ///< skin_origin (float: only compared with half the skin)
+  /// Origin of x0: zero for a geometry near the coordinate origin, else the centre of the
+  /// decomposition's box (skin_origin()), so that float keeps x0 to the box's size, not to |x|.
+  std::array<double, 3> skin_origin{};
   /// Optional (with_exact_rebuild, i.e. checkpoints on): the same positions exactly, which a
   /// checkpoint stores so that a restart can replay that rebuild (docs/ARCHITECTURE.md).
   std::vector<Real> xr, yr, zr;
@@ -138,9 +154,9 @@ struct Particles {
     vz[i] = pvz;
     inv_mass[i] = im;
     if (with_rotation) qw[i] = 1;
-    x0[i] = float(px);
-    y0[i] = float(py);
-    z0[i] = float(pz);
+    x0[i] = float(double(px) - skin_origin[0]);
+    y0[i] = float(double(py) - skin_origin[1]);
+    z0[i] = float(double(pz) - skin_origin[2]);
   }
 
   /// Reorders the owned particles: new index k holds old index order[k]. Requires no ghosts.

@@ -43,6 +43,7 @@ double kick_zero_drift(Particles<Real>& p, Real h, Real dt) {
   const float* __restrict x0 = p.x0.data();
   const float* __restrict y0 = p.y0.data();
   const float* __restrict z0 = p.z0.data();
+  const Real ox = Real(p.skin_origin[0]), oy = Real(p.skin_origin[1]), oz = Real(p.skin_origin[2]);
   Real m = 0;
   Real sum = 0;
   for (std::size_t i = 0; i < n; ++i) {
@@ -57,7 +58,7 @@ double kick_zero_drift(Particles<Real>& p, Real h, Real dt) {
     x[i] += dt * ux;
     y[i] += dt * uy;
     z[i] += dt * uz;
-    const Real dx = x[i] - x0[i], dy = y[i] - y0[i], dz = z[i] - z0[i];
+    const Real dx = x[i] - ox - x0[i], dy = y[i] - oy - y0[i], dz = z[i] - oz - z0[i];
     const Real d2 = dx * dx + dy * dy + dz * dz;
     m = d2 > m ? d2 : m;
     sum += d2;

@@ -20,8 +20,23 @@ namespace basalt::solver {
 std::vector<std::string> check_scene_with_geometry(const Scene& scene, const io::Geometry& g,
                                                    const std::string& source);
 
+/// Strain resolution of positions in a precision of machine epsilon `epsilon`: eps |x|max / (2 rmin),
+/// the relative rounding of the distance of two of the smallest particles at the geometry's largest
+/// |coordinate| (rounding grows with the offset from the origin, not with the geometry's size).
+double strain_resolution(const io::Geometry& g, double epsilon);
+
+/// Warning limit of strain_resolution (on the wave benchmark the kinetic energy's L2 error was 40-1200
+/// times the resolution: docs/stability.md) and the limit above which a run is refused.
+inline constexpr double kResolutionWarn = 1e-5, kResolutionRefuse = 1e-4;
+
+/// Throws InputError when strain_resolution(g, epsilon) exceeds kResolutionRefuse; returns a warning
+/// above kResolutionWarn, else an empty string. `precision` names the type ("double", "float").
+std::string check_precision(const io::Geometry& g, double epsilon, const std::string& precision,
+                            const std::string& source);
+
 /// check_scene_with_geometry on every rank of `comm` (all hold the same geometry, so all throw alike);
 /// rank 0 prints the warnings on stderr.
-void run_load_checks(const Scene& scene, const io::Geometry& g, const std::string& source, MPI_Comm comm);
+void run_load_checks(const Scene& scene, const io::Geometry& g, const std::string& source, MPI_Comm comm,
+                     double epsilon, const std::string& precision);
 
 }  // namespace basalt::solver
