@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
-# Fuzzes the scene parser and the .geo reader, each for N minutes:
-#   bash tools/fuzz/run.sh [MINUTES] [TARGET...]     (default: 10 minutes each; fuzz_scene fuzz_geo)
+# Fuzzes the scene parser, the .geo reader and the mesh reader, each for N minutes:
+#   bash tools/fuzz/run.sh [MINUTES] [TARGET...]     (default: 10 minutes each; fuzz_scene fuzz_geo fuzz_mesh)
 # Engine (BASALT_FUZZ_ENGINE): "libfuzzer" (default when clang++ exists: coverage-guided, every library
 # built with -fsanitize=fuzzer-no-link,address,undefined) or "standalone" (g++, the stdlib-only random
 # mutator of standalone_main.cpp, with address,undefined). Builds into build-fuzz-<engine>/, starts from
-# the seed corpus tools/fuzz/corpus/<scene|geo> (plus the repository's scenes for fuzz_scene), keeps what
+# the seed corpus tools/fuzz/corpus/<scene|geo|mesh> (plus the repository's scenes for fuzz_scene), keeps what
 # libFuzzer learns in build-fuzz-<engine>/corpus/<target>, and writes a crashing input to
 # build-fuzz-<engine>/findings/<target>/. Exit status non-zero when a target found something
 # (reproduce: build-fuzz-<engine>/tools/fuzz/<target> FILE with libFuzzer).
@@ -13,7 +13,7 @@ here="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 minutes=${1:-10}
 shift || true
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(fuzz_scene fuzz_geo)
+[ ${#targets[@]} -gt 0 ] || targets=(fuzz_scene fuzz_geo fuzz_mesh)
 engine=${BASALT_FUZZ_ENGINE:-$(command -v clang++ >/dev/null && echo libfuzzer || echo standalone)}
 build="${BASALT_FUZZ_BUILD_DIR:-$here/build-fuzz-$engine}"
 if [ "$engine" = libfuzzer ]; then compilers=(CC=clang CXX=clang++); else compilers=(CC=gcc CXX=g++); fi
