@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <memory>
 #include <optional>
 
@@ -384,8 +385,19 @@ int run_world(int argc, char** argv) {
   }
 
   prepare_output_folder(scene.output_dir);
-  if (ckpt && world_root && !scene.fields.empty())
-    basalt::run::truncate_fields(scene.output_dir / "fields.csv", ckpt->step);
+  if (ckpt && world_root && !scene.fields.empty()) {
+    const fs::path csv = scene.output_dir / "fields.csv";
+    const auto last = basalt::run::truncate_fields(csv, ckpt->step);
+    std::int64_t every = std::numeric_limits<std::int64_t>::max();
+    for (const auto& f : scene.fields) every = std::min(every, f.every);
+    // A checkpoint written before the rows up to its step reached the file (basalt-runs before the rows
+    // were handed over first, or a crash of the machine): say so rather than leave a silent gap.
+    if (last && *last + every <= ckpt->step)
+      fmt::print(stderr,
+                 "basalt-run: warning: {} ends at step {}, before the checkpoint's step {}: the rows between "
+                 "were lost when the run stopped; the restarted run appends from step {}\n",
+                 csv.string(), *last, ckpt->step, ckpt->step + 1);
+  }
 
   io::OutputConfig cfg;
   cfg.dir = scene.output_dir;

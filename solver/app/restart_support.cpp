@@ -118,8 +118,9 @@ void check_same_precision(const io::Checkpoint& c, const fs::path& file, const s
         file.string(), written, precision, written, written));
 }
 
-void truncate_fields(const fs::path& csv, std::int64_t step) {
-  if (!fs::exists(csv)) return;
+std::optional<std::int64_t> truncate_fields(const fs::path& csv, std::int64_t step) {
+  if (!fs::exists(csv)) return std::nullopt;
+  std::optional<std::int64_t> last;
   std::ifstream in(csv);
   std::string line, kept;
   bool header = true;
@@ -131,7 +132,10 @@ void truncate_fields(const fs::path& csv, std::int64_t step) {
     }
     if (line.empty()) continue;
     const long long s = std::strtoll(line.c_str(), nullptr, 10);
-    if (s <= step) kept += line + "\n";
+    if (s <= step) {
+      kept += line + "\n";
+      last = s;
+    }
   }
   const fs::path tmp = csv.string() + ".partial";
   {
@@ -140,6 +144,7 @@ void truncate_fields(const fs::path& csv, std::int64_t step) {
     if (!out.flush()) throw InputError(fmt::format("{}: cannot rewrite for the restart", tmp.string()));
   }
   fs::rename(tmp, csv);
+  return last;
 }
 
 }  // namespace basalt::run

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <string>
 
 #include "basalt/io/checkpoint.hpp"
@@ -32,7 +33,8 @@ void check_same_precision(const io::Checkpoint& c, const std::filesystem::path& 
                           const std::string& precision);
 
 /// Keeps the header and the rows with step <= `step` of an existing fields.csv (rewritten atomically),
-/// so that the restarted run appends to one series without duplicate steps.
-void truncate_fields(const std::filesystem::path& csv, std::int64_t step);
+/// so that the restarted run appends to one series without duplicate steps. Returns the step of the last
+/// row kept (nullopt when the file does not exist or has no rows).
+std::optional<std::int64_t> truncate_fields(const std::filesystem::path& csv, std::int64_t step);
 
 }  // namespace basalt::run

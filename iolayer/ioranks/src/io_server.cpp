@@ -172,6 +172,25 @@ class Server {
       }
   }
 
+  /// Appends the field batches already queued for this rank before a checkpoint is written. Compute
+  /// ranks hand their rows over before their checkpoint piece, and MPI keeps one sender's messages in
+  /// order, so with one I/O rank every row up to the checkpoint's step is in fields.csv before the
+  /// checkpoint is; with more, pieces forwarded by other I/O ranks may overtake rows, which this narrows.
+  void take_queued_field_batches() {
+    if (!csv_) return;
+    int flag = 0;
+    MPI_Message msg;
+    MPI_Status st;
+    for (MPI_Improbe(MPI_ANY_SOURCE, kTagFields, L_.bridge, &flag, &msg, &st); flag;
+         MPI_Improbe(MPI_ANY_SOURCE, kTagFields, L_.bridge, &flag, &msg, &st)) {
+      int n = 0;
+      MPI_Get_count(&st, MPI_BYTE, &n);
+      buffer_.resize(static_cast<std::size_t>(n));
+      MPI_Mrecv(buffer_.data(), n, MPI_BYTE, &msg, MPI_STATUS_IGNORE);
+      add_field_batch();
+    }
+  }
+
   /// Writes a step once every compute rank this I/O rank serves has sent its piece, then tells the
   /// compute ranks the outcome (acknowledge): the VTK piece to the ranks it serves, the checkpoint (I/O
   /// rank 0 writes the file) to every compute rank.
@@ -186,6 +205,7 @@ class Server {
       for (int c : L_.served) acknowledge(c, step, ok);
     }
     if (kinds & kFrameCheckpoint) {
+      take_queued_field_batches();
       const bool ok = write_checkpoint(list);
       if (io_index_ == 0)
         for (int c = 0; c < L_.n_compute; ++c) acknowledge(c, step, ok);

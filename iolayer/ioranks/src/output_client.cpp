@@ -50,7 +50,13 @@ bool OutputClient::wants_fields(std::int64_t step) const {
 
 void OutputClient::submit_frame(const FramePiece& piece) { submit_frame(PieceSource(piece)); }
 
-void OutputClient::submit_frame(const FrameSource& source) { impl_->submit_frame(source); }
+void OutputClient::submit_frame(const FrameSource& source) {
+  // The field rows up to a checkpoint's step go out before it, so that a complete checkpoint on disk
+  // implies fields.csv holds every row up to its step: a run killed after the checkpoint and restarted
+  // from it has no gap in fields.csv (found by tools/soak/soak.py).
+  if (source.header().kinds & kFrameCheckpoint) impl_->hand_over_field_rows();
+  impl_->submit_frame(source);
+}
 
 void OutputClient::submit_fields(std::int64_t step, double time, std::span<const double> partials,
                                  std::span<const char> due) {

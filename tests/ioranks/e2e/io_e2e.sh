@@ -260,6 +260,33 @@ case $case_name in
       "$W/last.log" || { cat "$W/last.log"; fail "the fallback past the cut-off checkpoint is not said"; }
     must_fail "ckpt_999999.h5" 2 --io-ranks 1 --steps 20 --output "$W/out2" --restart "$W/out/ckpt_999999.h5"
     ;;
+  killed_fields_complete)
+    # SIGKILL right after the first checkpoint appears (Q = 1 and Q = 0): fields.csv must already hold
+    # every row up to its step. Compute ranks send rows in batches of 256, so before the rows were
+    # handed over ahead of each checkpoint, a run killed after ckpt_000050 had none of them on disk and
+    # a restart from it left a silent gap (found by tools/soak/soak.py).
+    for q in 1 0; do
+      out="$W/out_q$q"
+      "$MPIEXEC" -np $((1 + q)) "$BASALT_RUN" "$SCENE" --geometry "$GEOMETRY" --quiet --io-ranks $q \
+        --steps 100000 --checkpoint-every 50 --output "$out" >"$W/killed_q$q.log" 2>&1 &
+      mpirun_pid=$!
+      for _ in $(seq 1 3000); do
+        [ -e "$out/ckpt_000050.h5" ] && break
+        sleep 0.01
+      done
+      for pid in $(pgrep -P "$mpirun_pid"); do kill -9 "$pid"; done
+      kill -9 "$mpirun_pid" 2>/dev/null
+      wait "$mpirun_pid" 2>/dev/null
+      [ -e "$out/ckpt_000050.h5" ] || fail "Q = $q: no checkpoint before the kill"
+      rows=$(awk -F, 'NR > 1 && $1 <= 50' "$out/fields.csv" | wc -l)
+      [ "$rows" -eq 50 ] || fail "Q = $q: fields.csv holds $rows of the 50 rows up to the checkpoint's step 50"
+      # The restart from it appends with no gap and no duplicate.
+      must_run $((1 + q)) --io-ranks $q --steps 10 --output "$out" --restart "$out/ckpt_000050.h5"
+      steps=$(awk -F, 'NR > 1 {print $1}' "$out/fields.csv" | sort -n | uniq | wc -l)
+      total=$(awk -F, 'NR > 1' "$out/fields.csv" | wc -l)
+      [ "$steps" -eq 60 ] && [ "$total" -eq 60 ] || fail "Q = $q: after the restart fields.csv has $total rows, $steps steps (60 expected)"
+    done
+    ;;
   folder_removed)
     # The output folder disappears mid-run: the next checkpoint fails naming its path, the run stops
     # cleanly (exit 1, I/O rank released); a checkpoint completed elsewhere before stays restartable.
