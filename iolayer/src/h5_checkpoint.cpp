@@ -94,6 +94,7 @@ void write_checkpoint(const Checkpoint& c, const fs::path& file, Compression com
     w.group(g);
     w.scalar_attribute<std::int64_t>(g, "index", static_cast<std::int64_t>(i));
     for (int k = 0; k < 4; ++k) w.dataset(g + "/" + kWallVectors[k], wall_vector(wall, k).data(), 3);
+    if (!wall.motion_state.empty()) w.dataset(g + "/motion_state", wall.motion_state);
   }
   if (!s->contact_ids.empty()) {
     w.group("/contacts");
@@ -196,6 +197,7 @@ Checkpoint read_checkpoint_unguarded(const fs::path& file) {
       if (rows != 3) r.fail(ds, fmt::format("expected 3 values, found {}", rows));
       r.read_into(ds, wall_vector(wall, k).data());
     }
+    if (r.exists(g + "/motion_state")) wall.motion_state = r.read<double>(g + "/motion_state");
   }
 
   c.step = r.scalar_attribute<std::int64_t>("/", "step");

@@ -96,8 +96,9 @@ std::vector<std::string> check_scene_with_geometry(const Scene& scene, const io:
   for (std::size_t w = 0; w < scene.walls.size(); ++w) {
     const auto& mo = scene.walls[w].motion;
     if (!mo.moves()) continue;
-    const bool constant = mo.type == WallMotion::Type::constant_velocity;
-    const double v = constant ? norm(mo.velocity) : std::abs(mo.amplitude);
+    const bool constant = mo.type == WallMotion::Type::constant_velocity || mo.type == WallMotion::Type::ramp;
+    const bool servo = mo.type == WallMotion::Type::servo;
+    const double v = constant ? norm(mo.velocity) : (servo ? mo.servo.max_speed : std::abs(mo.amplitude));
     const double step = v * dt;
     if (std::isfinite(step) && step <= rmin) continue;
     throw InputError(
@@ -106,9 +107,9 @@ std::vector<std::string> check_scene_with_geometry(const Scene& scene, const io:
                     "= {}, {} the smallest particle radius {:.6g}: particles would pass through it; give the "
                     "wall's speed "
                     "in {}/{}",
-                    w, scene.walls[w].name, constant ? "velocity" : "amplitude",
+                    w, scene.walls[w].name, constant ? "velocity" : (servo ? "max_speed" : "amplitude"),
                     constant ? fmt::format("[{}, {}, {}]", mo.velocity[0], mo.velocity[1], mo.velocity[2])
-                             : fmt::format("{}", mo.amplitude),
+                             : fmt::format("{}", servo ? mo.servo.max_speed : mo.amplitude),
                     v, scene.units.length, scene.units.time, step, scene.units.length, dt,
                     std::isfinite(step) ? "more than" : "not finite, against", rmin, scene.units.length,
                     scene.units.time));

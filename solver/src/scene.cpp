@@ -41,12 +41,37 @@ std::string group_name(TableReader& t, const std::string& fallback, std::set<std
 
 WallMotion parse_motion(TableReader& t, const std::array<double, 3>& normal) {
   WallMotion m;
-  const std::string type = t.choice_or("type", {"fixed", "constant_velocity", "half_sine", "sine"}, "fixed");
+  const std::string type =
+      t.choice_or("type", {"fixed", "constant_velocity", "half_sine", "sine", "ramp", "servo"}, "fixed");
   if (type == "fixed") {
     m.type = WallMotion::Type::fixed;
   } else if (type == "constant_velocity") {
     m.type = WallMotion::Type::constant_velocity;
     m.velocity = t.vec3("velocity");
+  } else if (type == "ramp") {
+    m.type = WallMotion::Type::ramp;
+    m.velocity = t.vec3("velocity");
+    m.ramp_time = t.non_negative("ramp_time");
+    m.start_time = t.number_or("start_time", 0.0);
+    if (!std::isfinite(m.start_time) || m.start_time < 0) t.fail("start_time", "must be >= 0 and finite");
+  } else if (type == "servo") {
+    m.type = WallMotion::Type::servo;
+    const bool force = t.has("target_force"), stress = t.has("target_stress");
+    if (force == stress)
+      t.fail(force ? "target_stress" : "target_force",
+             force ? "give target_force or target_stress (with area), not both"
+                   : "missing: a servo wall needs target_force, or target_stress and area");
+    if (force) {
+      m.servo.target_force = t.number("target_force");
+      if (!std::isfinite(m.servo.target_force)) t.fail("target_force", "must be finite");
+      if (t.has("area")) t.fail("area", "only with target_stress (target_force is already a force)");
+    } else {
+      const double sigma = t.number("target_stress");
+      if (!std::isfinite(sigma)) t.fail("target_stress", "must be finite");
+      m.servo.target_force = sigma * t.positive("area");
+    }
+    m.servo.gain = t.positive("gain");
+    m.servo.max_speed = t.positive("max_speed");
   } else {
     m.type = type == "half_sine" ? WallMotion::Type::half_sine : WallMotion::Type::sine;
     m.amplitude = t.number("amplitude");
@@ -80,6 +105,8 @@ MeshWallSpec parse_mesh_wall(TableReader& t, const std::string& label, const std
   w.triangles = std::move(m.triangles);
   w.one_sided = t.choice_or("sides", {"two", "one"}, "two") == "one";
   w.model = t.choice_or("interaction", model_names(ModelKind::wall), "elastic");
+  if (!find_model(w.model, ModelKind::wall)->make_mesh_double)
+    t.fail("interaction", fmt::format("\"{}\" is for planar [[walls]] only", w.model));
   w.params = find_model(w.model, ModelKind::wall)->parse(t);
   w.tags = t.integers_or("tags", {});
   if (const auto* mt = t.subtable("motion")) {
@@ -96,6 +123,9 @@ MeshWallSpec parse_mesh_wall(TableReader& t, const std::string& label, const std
     const std::string type = tm.has("type") ? tm.string("type") : "fixed";
     if ((type == "sine" || type == "half_sine") && !tm.has("direction"))
       tm.fail("direction", fmt::format("missing (required for a mesh wall's \"{}\" motion)", type));
+    if (type == "servo")
+      tm.fail("type",
+              "\"servo\" is for planar [[walls]] only (a mesh wall has no normal to hold a force along)");
     w.motion = parse_motion(tm, {0, 0, 1});
   }
   t.finish();
@@ -240,6 +270,12 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
       w.model = t.choice_or("interaction", model_names(ModelKind::wall), "elastic");
       w.params = find_model(w.model, ModelKind::wall)->parse(t);
       w.tags = t.integers_or("tags", {});
+      // The bonded wall's particles (its model's key, read here: the walls' candidates need them).
+      if (w.model == "bonded") {
+        w.bond_tags = t.integers_or("bond_tags", {});
+        if (w.bond_tags.empty())
+          t.fail("bond_tags", "missing: the tags of the particles tied to the wall, e.g. [2]");
+      }
       if (const auto* m = t.subtable("motion")) {
         TableReader tm(*m, label, fmt::format("walls[{}].motion", k));
         w.motion = parse_motion(tm, w.normal);
@@ -307,6 +343,7 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
             {"total_energy", FieldSpec::Type::total_energy},
             {"bond_count", FieldSpec::Type::bond_count},
             {"wall_force", FieldSpec::Type::wall_force},
+            {"wall_position", FieldSpec::Type::wall_position},
             {"rotational_kinetic_energy", FieldSpec::Type::rotational_kinetic_energy},
             {"sliding_contacts", FieldSpec::Type::sliding_contacts},
             {"runout", FieldSpec::Type::runout},
@@ -328,7 +365,7 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
         if (f.type == FieldSpec::Type::energy) f.term = type;
         f.every = tf.integer_or("every", 1);
         if (f.every < 1) tf.fail("every", fmt::format("must be >= 1, got {}", f.every));
-        if (f.type == FieldSpec::Type::wall_force) {
+        if (f.per_wall()) {
           f.wall = tf.string("wall");
           bool found = false;
           for (const auto& w : s.walls) found = found || w.name == f.wall;
@@ -343,13 +380,15 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
         for (std::size_t j = 0; j < s.fields.size(); ++j) {
           const auto& earlier = s.fields[j];
           if (earlier.type != f.type || earlier.name() != f.name() || earlier.wall != f.wall) continue;
-          const bool wall = f.type == FieldSpec::Type::wall_force;
-          tf.fail(wall ? "wall" : "type",
-                  fmt::format("{} is saved already by output.fields[{}]: two savers would write two columns "
-                              "named {}; keep one (its every = N sets how often)",
-                              wall ? fmt::format("the force of wall \"{}\"", f.wall)
-                                   : fmt::format("\"{}\"", f.name()),
-                              j, wall ? fmt::format("wall_force_{}_x/y/z", f.wall) : f.name()));
+          const bool wall = f.per_wall();
+          const bool force = f.type == FieldSpec::Type::wall_force;
+          tf.fail(
+              wall ? "wall" : "type",
+              fmt::format("{} is saved already by output.fields[{}]: two savers would write two columns "
+                          "named {}; keep one (its every = N sets how often)",
+                          wall ? fmt::format("the {} of wall \"{}\"", force ? "force" : "position", f.wall)
+                               : fmt::format("\"{}\"", f.name()),
+                          j, wall ? fmt::format("{}_{}_x/y/z", f.name(), f.wall) : f.name()));
         }
         tf.finish();
         s.fields.push_back(std::move(f));
@@ -377,11 +416,11 @@ Scene parse_scene(const fs::path& file) {
 std::vector<std::string> field_columns(const Scene& scene) {
   std::vector<std::string> cols;
   for (const auto& f : scene.fields) {
-    if (f.type != FieldSpec::Type::wall_force) {
+    if (!f.per_wall()) {
       cols.push_back(f.name());
       continue;
     }
-    for (const char* c : {"x", "y", "z"}) cols.push_back(fmt::format("wall_force_{}_{}", f.wall, c));
+    for (const char* c : {"x", "y", "z"}) cols.push_back(fmt::format("{}_{}_{}", f.name(), f.wall, c));
   }
   return cols;
 }

@@ -249,7 +249,10 @@ void Simulation<Real>::step(FieldSink* sink) {
   forces_zeroed_ = true;
   times_.integration += sw.lap();
   const bool parallel = comm().size() > 1;
-  if (!forces_.walls().empty()) forces_.walls().move_to(double(step_ + 1) * scene_.dt);
+  if (!forces_.walls().empty()) {
+    forces_.walls().advance_servos(scene_.dt);
+    forces_.walls().move_to(double(step_ + 1) * scene_.dt);
+  }
   double need =
       bond_broke_ ? std::numeric_limits<double>::infinity()
                   : std::max(moved2, forces_.walls().empty() ? 0.0 : forces_.walls().moved2_since_rebuild());
@@ -284,10 +287,31 @@ void Simulation<Real>::step(FieldSink* sink) {
     }
   }
   times_.integration += sw.lap();
-  if (!forces_.walls().empty()) wall_work_in_ += std::max(0.0, forces_.walls().power(time_)) * scene_.dt;
+  if (!forces_.walls().empty()) {
+    wall_work_in_ += std::max(0.0, forces_.walls().power()) * scene_.dt;
+    steer_servos();
+  }
   save_fields(sink, pe);
   times_.output += sw.lap();
   if (scene_.energy_check_every > 0 && step_ % scene_.energy_check_every == 0) guard_energy(pe);
+}
+
+template <class Real>
+void Simulation<Real>::steer_servos() {
+  // The force on a servo wall is every rank's share summed (the same sum on every rank, so each moves
+  // it alike); its control law (WallMotion::servo) is free of MPI.
+  auto& walls = forces_.walls();
+  if (!walls.has_servo()) return;
+  std::vector<double> f;
+  for (std::size_t w = 0; w < walls.size(); ++w)
+    if (walls.servo(w)) f.insert(f.end(), walls.force(w).begin(), walls.force(w).end());
+  if (comm().size() > 1) comm().sum_all(f);
+  std::size_t k = 0;
+  for (std::size_t w = 0; w < walls.size(); ++w)
+    if (walls.servo(w)) {
+      walls.steer_servo(w, {f[k], f[k + 1], f[k + 2]});
+      k += 3;
+    }
 }
 
 template <class Real>

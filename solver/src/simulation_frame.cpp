@@ -48,16 +48,20 @@ SimulationFrame<Real>::SimulationFrame(const Simulation<Real>& sim, std::uint32_
     if (sim.comm().rank() == 0) {
       for (std::size_t w = 0; w < wd.size(); ++w) {
         const auto& s = wd.spec(w);
-        const auto v = s.motion.velocity_at(sim.time_);
+        const auto& v = wd.velocity(w);  // a servo wall's: that of the next step
         walls_.push_back(
-            {s.name, wd.point(w), s.normal, {v[0], v[1], v[2]}, {f[3 * w], f[3 * w + 1], f[3 * w + 2]}});
+            {s.name, wd.point(w), s.normal, {v[0], v[1], v[2]}, {f[3 * w], f[3 * w + 1], f[3 * w + 2]}, {}});
+        if (wd.servo(w)) {
+          const auto at = wd.point_at_rebuild(w);
+          walls_.back().motion_state.assign(at.begin(), at.end());
+        }
       }
       for (std::size_t k = 0; k < wd.meshes(); ++k) {
         const auto& s = wd.mesh_spec(k);
         const auto v = s.motion.velocity_at(sim.time_);
         const std::size_t at = 3 * (wd.size() + k);
         walls_.push_back(
-            {s.name, wd.mesh_axis_point(k), s.axis, {v[0], v[1], v[2]}, {f[at], f[at + 1], f[at + 2]}});
+            {s.name, wd.mesh_axis_point(k), s.axis, {v[0], v[1], v[2]}, {f[at], f[at + 1], f[at + 2]}, {}});
       }
     }
   }

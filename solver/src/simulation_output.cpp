@@ -25,7 +25,7 @@ bool Simulation<Real>::field_partials(const std::vector<double>& pe, std::vector
   for (const auto& f : scene_.fields) {
     const bool d = step_ % f.every == 0;
     any = any || d;
-    const std::size_t width = f.type == FieldSpec::Type::wall_force ? 3 : 1;
+    const std::size_t width = f.per_wall() ? 3 : 1;
     for (std::size_t c = 0; c < width; ++c) due.push_back(d);
     if (!d) {
       local.insert(local.end(), width, 0.0);
@@ -74,6 +74,22 @@ bool Simulation<Real>::field_partials(const std::vector<double>& pe, std::vector
         std::size_t m = 0;  // a mesh wall (the scene checked the name)
         while (walls.mesh_spec(m).name != f.wall) ++m;
         local.insert(local.end(), walls.mesh_force(m).begin(), walls.mesh_force(m).end());
+        break;
+      }
+      case FieldSpec::Type::wall_position: {  // the same on every rank: rank 0's partial carries it
+        const auto& walls = forces_.walls();
+        std::size_t w = 0;
+        while (w < walls.size() && walls.spec(w).name != f.wall) ++w;
+        std::array<double, 3> x{0, 0, 0};
+        if (w < walls.size()) {
+          x = walls.point(w);
+        } else {
+          std::size_t m = 0;  // a mesh wall: where its rotation axis point has been carried
+          while (walls.mesh_spec(m).name != f.wall) ++m;
+          x = walls.mesh_axis_point(m);
+        }
+        if (comm().rank() != 0) x = {0, 0, 0};
+        local.insert(local.end(), x.begin(), x.end());
         break;
       }
       case FieldSpec::Type::mass_below: {  // owned particles' share; the sink sums the ranks

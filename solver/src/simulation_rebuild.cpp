@@ -173,6 +173,7 @@ void Simulation<Real>::check_start(bool fresh) {
     const auto& n = walls.spec(w).normal;
     const auto& at = walls.point(w);
     for (const auto i : walls.candidates(w)) {
+      if (walls.spec(w).bonds(p_.tag[i])) continue;  // tied to the wall: its spring, not an overlap
       const double d = (double(p_.x[i]) - at[0]) * n[0] + (double(p_.y[i]) - at[1]) * n[1] +
                        (double(p_.z[i]) - at[2]) * n[2];
       const double overlap = (double(p_.radius[i]) - d) / double(p_.radius[i]);

@@ -33,6 +33,7 @@ Simulation<Real>::Simulation(const Scene& scene, const io::Checkpoint& c, const 
   run_load_checks(scene, c.geometry, "the checkpoint", comm, kEpsilon, kPrecision);
   check_stability(c.geometry);
   distribute_checkpoint(c, layout, comm);
+  restore_servos(c, !c.position_at_rebuild.empty());
   if (!c.position_at_rebuild.empty()) {
     replay_rebuild(c);
   } else {
@@ -186,6 +187,7 @@ void Simulation<Real>::replay_rebuild(const io::Checkpoint& c) {
   if (!forces_.walls().empty()) forces_.walls().move_to(double(c.rebuild_step) * scene_.dt);
   rebuild();
   step_ = now;
+  restore_servos(c, false);  // from where the rebuild saw them to where the checkpoint has them
   // Back to the checkpoint's positions; the ghosts follow as after any step without a rebuild.
   for (std::size_t i = 0; i < p_.n_owned; ++i) {
     const auto& x = g.position[static_cast<std::size_t>(g.index_of(p_.id[i]))];
@@ -200,11 +202,32 @@ void Simulation<Real>::replay_rebuild(const io::Checkpoint& c) {
   bond_broke_ = c.rebuild_pending;  // a bond broke at the checkpoint step: the next step rebuilds
 }
 
+template <class Real>
+void Simulation<Real>::restore_servos(const io::Checkpoint& c, bool at_rebuild) {
+  // A servo wall's point and velocity are state (no closed form): the checkpoint's, exactly; before
+  // replaying the last rebuild, its point at that rebuild (motion_state).
+  auto& walls = forces_.walls();
+  for (std::size_t w = 0; w < walls.size(); ++w) {
+    if (!walls.servo(w)) continue;
+    const io::WallState* st = nullptr;
+    for (const auto& cw : c.walls)
+      if (cw.name == walls.spec(w).name) st = &cw;
+    if (!st || (at_rebuild && st->motion_state.size() != 3))
+      throw InputError(fmt::format("the checkpoint has no servo state for wall \"{}\" (/walls/{}{})",
+                                   walls.spec(w).name, walls.spec(w).name, st ? "/motion_state" : ""));
+    const auto& x = at_rebuild
+                        ? std::array<double, 3>{st->motion_state[0], st->motion_state[1], st->motion_state[2]}
+                        : st->position;
+    walls.restore_servo(w, x, st->velocity);
+  }
+}
+
 #define BASALT_INSTANTIATE(R)                                                                                \
   template Simulation<R>::Simulation(const Scene&, const io::Checkpoint&, const RestartLayout&, MPI_Comm,    \
                                      const RunOptions&);                                                     \
   template void Simulation<R>::distribute_checkpoint(const io::Checkpoint&, const RestartLayout&, MPI_Comm); \
   template void Simulation<R>::replay_rebuild(const io::Checkpoint&);                                        \
+  template void Simulation<R>::restore_servos(const io::Checkpoint&, bool);                                  \
   template void Simulation<R>::restore_particle_fields(const io::Checkpoint&,                                \
                                                        const std::vector<std::size_t>&, bool);
 BASALT_INSTANTIATE(double)

@@ -91,7 +91,7 @@ void Simulation<Real>::estimate_critical_step(bool fresh) {
       const auto i = static_cast<std::size_t>(ci);
       const double d = (double(p_.x[i]) - pt[0]) * nrm[0] + (double(p_.y[i]) - pt[1]) * nrm[1] +
                        (double(p_.z[i]) - pt[2]) * nrm[2];
-      if (d < double(p_.radius[i])) ks[i] += k_of(2, double(p_.radius[i]));
+      if (d < double(p_.radius[i]) || walls.spec(w).bonds(p_.tag[i])) ks[i] += k_of(2, double(p_.radius[i]));
     }
   }
   double bound2 = 0;

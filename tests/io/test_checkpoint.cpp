@@ -28,8 +28,8 @@ Checkpoint sample_checkpoint() {
   c.velocity = {{0.1, 0, 0}, {0, 0.3, 0}, {0, 0, -1e-9}, {1, 2, 3}, {-4, 5, -6}, {7.5e-300, 0, 1}};
   c.bond_rest_length = {0.75, 1.4999999999999998, 0.5, 1.0};
   c.bond_broken = {0, 1, 0, 0};
-  c.walls = {{"top", {0, 0, 15}, {0, 0, -1}, {0, 0, 0}, {0, 0, 12.5}},
-             {"base", {0, 0, 0}, {0, 0, 1}, {0, 0, 0.1}, {0, 0, -3.25}}};
+  c.walls = {{"top", {0, 0, 15}, {0, 0, -1}, {0, 0, 0}, {0, 0, 12.5}, {0.0, 0.1, 14.999999999999998}},
+             {"base", {0, 0, 0}, {0, 0, 1}, {0, 0, 0.1}, {0, 0, -3.25}, {}}};
   c.step = 1700;
   c.time = 1.7000000000000002;
   c.dt = 1e-3;
@@ -61,6 +61,7 @@ void expect_same(const Checkpoint& a, const Checkpoint& b) {
     EXPECT_EQ(a.walls[k].normal, b.walls[k].normal);
     EXPECT_EQ(a.walls[k].velocity, b.walls[k].velocity);
     EXPECT_EQ(a.walls[k].force, b.walls[k].force);
+    EXPECT_EQ(a.walls[k].motion_state, b.walls[k].motion_state);  // a servo wall's, bit for bit
   }
   EXPECT_EQ(a.step, b.step);
   EXPECT_EQ(a.time, b.time);

@@ -29,7 +29,8 @@ FramePiece make_piece(int rank, int n, std::int64_t step) {
   p.bonds.push_back({p.id[0], p.id[1], 7});
   p.bond_rest_length.push_back(0.75);
   p.bond_broken.push_back(rank == 1);
-  if (rank == 0) p.walls.push_back({"base", {0, 0, 0.1}, {0, 0, 1}, {0, 0, 0.05}, {0, 0, 3.5}});
+  if (rank == 0)
+    p.walls.push_back({"base", {0, 0, 0.1}, {0, 0, 1}, {0, 0, 0.05}, {0, 0, 3.5}, {0.25, -1.0, 0.1}});
   return p;
 }
 }  // namespace
@@ -52,6 +53,7 @@ TEST(Frame, RoundTripIsExact) {
   ASSERT_EQ(q.walls.size(), 1u);
   EXPECT_EQ(q.walls[0].name, "base");
   EXPECT_EQ(q.walls[0].force, p.walls[0].force);
+  EXPECT_EQ(q.walls[0].motion_state, p.walls[0].motion_state);
   EXPECT_TRUE(q.position_at_rebuild.empty());
   EXPECT_EQ(q.rebuild_step, -1);
 }
@@ -229,7 +231,7 @@ TEST(FrameWriter, RecycledBufferIsOverwrittenNotAppended) {
   {
     FrameWriter w(bytes, small_header(3, 1));
     fill_all(w, 3, 1);
-    w.wall({"base", {0, 0, 1}, {0, 0, 1}, {0, 0, 2}, {0, 0, 3}});
+    w.wall({"base", {0, 0, 1}, {0, 0, 1}, {0, 0, 2}, {0, 0, 3}, {}});
     w.finish();
   }
   const auto q = deserialize(bytes);

@@ -41,7 +41,7 @@ FramePiece piece_for(int c, int n_compute, std::int64_t step, std::uint32_t kind
   p.bonds.push_back({p.id[0], p.id[1], 0});
   p.bond_rest_length.push_back(double(n_compute));
   p.bond_broken.push_back(0);
-  if (c == 0) p.walls.push_back({"base", {0, 0, double(step)}, {0, 0, 1}, {0, 0, 0}, {0, 0, 0}});
+  if (c == 0) p.walls.push_back({"base", {0, 0, double(step)}, {0, 0, 1}, {0, 0, 0}, {0, 0, 0}, {}});
   return p;
 }
 

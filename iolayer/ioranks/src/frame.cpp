@@ -255,6 +255,10 @@ FramePiece deserialize(std::span<const std::byte> bytes) {
     wall.normal = r.value<Vec3>();
     wall.velocity = r.value<Vec3>();
     wall.force = r.value<Vec3>();
+    const auto n_state = r.value<std::uint64_t>();
+    if (n_state > bytes.size()) throw std::runtime_error("frame: wall state overruns the buffer");
+    wall.motion_state.resize(n_state);
+    for (auto& v : wall.motion_state) v = r.value<double>();
   }
   if (h.fields > bytes.size()) throw std::runtime_error("frame: particle field count overruns the buffer");
   p.fields.resize(h.fields);

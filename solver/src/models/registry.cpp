@@ -10,9 +10,11 @@
 #include "basalt/solver/core/errors.hpp"
 #include "basalt/solver/interactions/body_driver.hpp"
 #include "basalt/solver/interactions/bond_driver.hpp"
+#include "basalt/solver/interactions/bonded_wall_driver.hpp"
 #include "basalt/solver/interactions/mesh_wall_driver.hpp"
 #include "basalt/solver/interactions/pair_driver.hpp"
 #include "basalt/solver/interactions/wall_driver.hpp"
+#include "basalt/solver/models/bonded_wall.hpp"
 #include "basalt/solver/models/contact_age.hpp"
 #include "basalt/solver/models/damping.hpp"
 #include "basalt/solver/models/elastic_wall.hpp"
@@ -31,7 +33,12 @@ template <class Real, class Model>
 std::unique_ptr<ForceCompute<Real>> make(const Scene& s) {
   if constexpr (Model::kind == ModelKind::bond) return std::make_unique<BondDriver<Real, Model>>(s.bonds);
   if constexpr (Model::kind == ModelKind::pair) return std::make_unique<PairDriver<Real, Model>>(s.contacts);
-  if constexpr (Model::kind == ModelKind::wall) return std::make_unique<WallDriver<Real, Model>>(s.walls);
+  if constexpr (Model::kind == ModelKind::wall) {
+    if constexpr (requires { Model::bonded; })
+      return std::make_unique<BondedWallDriver<Real, Model>>(s.walls);
+    else
+      return std::make_unique<WallDriver<Real, Model>>(s.walls);
+  }
   if constexpr (Model::kind == ModelKind::body)
     return std::make_unique<BodyDriver<Real, Model>>(s.body_forces);
 }
@@ -43,7 +50,7 @@ std::unique_ptr<ForceCompute<Real>> make_mesh(const Scene& s) {
 
 template <class Real, class Model>
 constexpr auto mesh_maker() -> std::unique_ptr<ForceCompute<Real>> (*)(const Scene&) {
-  if constexpr (Model::kind == ModelKind::wall)
+  if constexpr (Model::kind == ModelKind::wall && !requires { Model::bonded; })
     return &make_mesh<Real, Model>;
   else
     return nullptr;
@@ -100,6 +107,7 @@ const std::vector<ModelEntry>& model_registry() {
       entry<ElasticWall>(),        // wall
       entry<FrictionWall>(),       // wall, with Coulomb friction
       entry<HertzMindlinWall>(),   // wall
+      entry<BondedWall>(),         // wall, ESyS NRotBondedWall
       entry<Gravity>(),            // body force
       entry<LinearDamping>(),      // body force, ESyS LinDamping
       entry<RotationalDamping>(),  // body force, ESyS RotDamping

@@ -19,6 +19,9 @@ struct WallState {
   Vec3 normal{0, 0, 1};
   Vec3 velocity{0, 0, 0};
   Vec3 force{0, 0, 0};  ///< force particles exert on the wall at this step
+  /// Optional (/walls/<name>/motion_state): what a restart needs of a wall whose motion has no closed
+  /// form (a servo wall: its position at the last neighbour-list rebuild). Empty for other walls.
+  std::vector<double> motion_state;
 };
 
 struct Checkpoint {

@@ -185,6 +185,8 @@ class Simulation {
   /// Returns this rank's potential energies by ledger term (valid when Energy).
   template <bool Energy>
   const std::vector<double>& compute_forces(bool ghosts_in_flight = false, bool advance = false);
+  /// Collective: each servo wall's velocity for the next step from the force on it summed over ranks.
+  void steer_servos();
   void save_fields(FieldSink* sink, const std::vector<double>& pe);
   bool field_partials(const std::vector<double>& pe, std::vector<double>& local,
                       std::vector<char>& due) const;
@@ -197,6 +199,9 @@ class Simulation {
   void restore_particle_fields(const io::Checkpoint& c, const std::vector<std::size_t>& mine, bool replay);
   /// Restart: the lists of the uninterrupted run's last rebuild (see the restart constructor).
   void replay_rebuild(const io::Checkpoint& c);
+  /// Restart: servo walls' point and velocity from the checkpoint (at_rebuild: their point at the last
+  /// rebuild, for replay_rebuild()). InputError when the checkpoint lacks them.
+  void restore_servos(const io::Checkpoint& c, bool at_rebuild);
   /// Writes the row whose reduction is still in flight (ranks > 1), if any.
   void finish_row(FieldSink* sink);
   /// Collective: delivers pending output, then throws RunError(message).

@@ -219,6 +219,8 @@ class FrameWriter {
     append(std::uint64_t(w.name.size()));
     append_raw(w.name.data(), w.name.size());
     for (const Vec3* v : {&w.position, &w.normal, &w.velocity, &w.force}) append(*v);
+    append(std::uint64_t(w.motion_state.size()));
+    for (const double v : w.motion_state) append(v);
     ++walls_;
   }
   /// Checks that every column was filled exactly once over; returns the frame's size in bytes.

@@ -72,10 +72,44 @@ class Walls {
             m.velocity[2] + w * (a[0] * ry - a[1] * rx)};
   }
 
+  /// Servo walls (motion type servo) have no closed form: their point and velocity are state, moved
+  /// by advance_servos() and steered by steer_servo(); move_to() leaves them where they are.
+  bool servo(std::size_t w) const { return walls_[w].motion.type == WallMotion::Type::servo; }
+  bool has_servo() const {
+    for (std::size_t w = 0; w < walls_.size(); ++w)
+      if (servo(w)) return true;
+    return false;
+  }
+  /// Moves each servo wall by its velocity over dt (a step's motion, before its forces).
+  void advance_servos(double dt) {
+    for (std::size_t w = 0; w < walls_.size(); ++w)
+      if (servo(w))
+        for (int d = 0; d < 3; ++d) point_[w][d] += velocity_[w][d] * dt;
+  }
+  /// Sets servo wall w's velocity for the next step from the force all the particles (every rank's
+  /// share summed) put on it now.
+  void steer_servo(std::size_t w, const std::array<double, 3>& total_force) {
+    const auto& n = walls_[w].normal;
+    const double fn = -(total_force[0] * n[0] + total_force[1] * n[1] + total_force[2] * n[2]);
+    const double v = walls_[w].motion.servo.speed(fn);
+    velocity_[w] = {v * n[0], v * n[1], v * n[2]};
+  }
+  /// Where wall w was at the last rebuild (a servo wall's restart state).
+  std::array<double, 3> point_at_rebuild(std::size_t w) const {
+    return w < point_at_rebuild_.size() ? point_at_rebuild_[w] : point_[w];
+  }
+  /// Restart: a servo wall's state as a checkpoint holds it.
+  void restore_servo(std::size_t w, const std::array<double, 3>& point,
+                     const std::array<double, 3>& velocity) {
+    point_[w] = point;
+    velocity_[w] = velocity;
+  }
+
   /// Moves the walls to their positions at time t.
   void move_to(double t) {
     velocity_.resize(walls_.size());
     for (std::size_t w = 0; w < walls_.size(); ++w) {
+      if (servo(w)) continue;
       const auto u = walls_[w].motion.displacement_at(t);
       for (int d = 0; d < 3; ++d) point_[w][d] = walls_[w].point[d] + u[d];
       velocity_[w] = walls_[w].motion.velocity_at(t);
@@ -93,11 +127,12 @@ class Walls {
     }
   }
 
-  /// Power the walls put into the particles at time t (this rank's share): -F_wall . v_wall.
-  double power(double t) const {
+  /// Power the walls put into the particles over the step that ended at the last move_to() (this
+  /// rank's share): -F_wall . v_wall (a servo wall's velocity of that step: call before steer_servo()).
+  double power() const {
     double pw = 0;
     for (std::size_t w = 0; w < walls_.size(); ++w) {
-      const auto v = walls_[w].motion.velocity_at(t);
+      const auto& v = velocity_[w];
       pw -= force_[w][0] * v[0] + force_[w][1] * v[1] + force_[w][2] * v[2];
     }
     for (const auto& m : meshes_) pw += m.power;
@@ -115,6 +150,10 @@ class Walls {
       auto& c = candidates_[w];
       c.clear();
       for (std::size_t i = 0; i < p.n_owned; ++i) {
+        if (!spec.bond_tags.empty() && spec.bonds(p.tag[i])) {  // tied to the wall wherever it is
+          c.push_back(static_cast<std::int32_t>(i));
+          continue;
+        }
         const double d = (p.x[i] - point_[w][0]) * spec.normal[0] + (p.y[i] - point_[w][1]) * spec.normal[1] +
                          (p.z[i] - point_[w][2]) * spec.normal[2];
         if (d >= double(p.radius[i]) + skin) continue;

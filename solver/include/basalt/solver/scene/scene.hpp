@@ -42,8 +42,15 @@ struct WallSpec {
   std::string model = "elastic";          ///< the registry name of its wall model (interaction = "...")
   std::any params;                        ///< Model::Params
   TagFilter tags;                         ///< particle tags the wall touches (empty: all)
+  /// interaction = "bonded": tags of the particles tied to the wall (candidates wherever they are).
+  TagFilter bond_tags;
   WallMotion motion;
 
+  bool bonds(std::int64_t tag) const {
+    for (const auto t : bond_tags)
+      if (t == tag) return true;
+    return false;
+  }
   template <class Model>
   const typename Model::Params& params_of() const {
     return std::any_cast<const typename Model::Params&>(params);
@@ -83,6 +90,7 @@ struct FieldSpec {
     total_energy,
     bond_count,
     wall_force,
+    wall_position,
     rotational_kinetic_energy,
     sliding_contacts,
     runout,
@@ -91,7 +99,9 @@ struct FieldSpec {
   Type type = Type::energy;
   std::string term = "kinetic_energy";  ///< energy only: the ledger term
   std::int64_t every = 1;
-  std::string wall;  ///< wall_force only
+  std::string wall;  ///< wall_force and wall_position only
+  /// wall_force and wall_position: three columns <name>_<wall>_x, _y, _z.
+  bool per_wall() const { return type == Type::wall_force || type == Type::wall_position; }
   /// runout: the distance along `direction` from `origin` that `percentile` % of the particles do not
   /// pass (100: the farthest particle).
   std::array<double, 3> origin{0, 0, 0}, direction{1, 0, 0};
@@ -108,6 +118,8 @@ struct FieldSpec {
         return "bond_count";
       case Type::wall_force:
         return "wall_force";
+      case Type::wall_position:
+        return "wall_position";
       case Type::rotational_kinetic_energy:
         return "rotational_kinetic_energy";
       case Type::sliding_contacts:
