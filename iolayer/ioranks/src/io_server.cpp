@@ -255,7 +255,11 @@ class Server {
     for (const auto& p : pieces) job.append(p);
     if (!queue_) {  // failed at the start (reported then)
       ++local_.pictures_due;
-      ++local_.pictures_skipped;
+      if (++local_.pictures_skipped <= 20)
+        local_.pictures_skipped_steps +=
+            fmt::format("{}{}", local_.pictures_skipped > 1 ? ", " : "", job.step);
+      else if (local_.pictures_skipped == 21)
+        local_.pictures_skipped_steps += ", ...";
       return;
     }
     if (const auto skipped = queue_->offer(std::move(job)); skipped && ++skip_lines_ <= 5)

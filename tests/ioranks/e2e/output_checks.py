@@ -236,7 +236,8 @@ def picture_ok(png, width, height):
     near = lambda c, tol: int(np.sum(np.all(np.abs(a - np.array(c)) <= tol, axis=2)))
     scene = a.shape[0] * a.shape[1]
     background, low, high = near(BACKGROUND, 3), near(LOW, 30), near(HIGH, 30)
-    if scene - background < scene // 10 or low < 30 or high < 30:
+    least = max(10, scene // 2000)  # 30 pixels of a 320x240 picture, fewer for a smaller one
+    if scene - background < scene // 10 or low < least or high < least:
         print(f"{png}: {scene - background} of {scene} pixels not background, {low} near the low end, "
               f"{high} near the high end of the colour map: blank or one-coloured")
         return False
