@@ -33,8 +33,10 @@ vtkDataArray* find(vtkPolyData& pd, const std::string& field, int& component) {
 }
 
 /// Three scalar arrays <field>_x, <field>_y, <field>_z (a vector the frame stores by components, such as
-/// the scene's angular_velocity_x/_y/_z), or false.
+/// the scene's angular_velocity_x/_y/_z), or false; also false with a <field>_w (a quaternion, such as
+/// orientation, whose x, y, z part has no magnitude worth drawing).
 bool components_of(vtkPolyData& pd, const std::string& field, vtkDataArray* c[3]) {
+  if (pd.GetPointData()->GetArray((field + "_w").c_str()) != nullptr) return false;
   for (int k = 0; k < 3; ++k) {
     c[k] = pd.GetPointData()->GetArray((field + "_" + static_cast<char>('x' + k)).c_str());
     if (c[k] == nullptr || c[k]->GetNumberOfComponents() != 1) return false;

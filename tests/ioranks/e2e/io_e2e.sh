@@ -314,11 +314,12 @@ case $case_name in
   pictures_skipped)
     # Pictures asked for faster than the I/O rank draws them (every step): the run is not held up, the
     # pictures that cannot keep up are skipped and counted, and the report lists them; the count of PNGs
-    # still equals the steps asked for less those skipped.
+    # still equals the steps asked for less those skipped. (Both ends of the colour map are not asked of
+    # these pictures: at steps 1-2 only a few spheres on the base move; the case "pictures" checks them.)
     steps=$(seq -s, 1 60)
     must_run 3 --io-ranks 1 --steps 60 --render-every 1 --render "size=160x120" --output "$W/out"
     cat "$W/last.log"
-    $CHECK pictures "$W/out" "$steps" "$W/last.log" 160x120 || fail "the pictures and the report disagree"
+    $CHECK pictures "$W/out" "$steps" "$W/last.log" 160x120 any || fail "the pictures and the report disagree"
     grep -Eq "pictures .* [1-9][0-9]* skipped \(steps .*a newer frame came" "$W/last.log" || fail "no picture was skipped"
     grep -q "basalt-run: picture of step [0-9]* skipped" "$W/last.log" || fail "the skips were not logged as they happened"
     wait_s=$(sed -nE 's/.*compute ranks waited ([0-9.]+) s for output.*/\1/p' "$W/last.log")
