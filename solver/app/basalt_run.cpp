@@ -459,7 +459,9 @@ int run_world(int argc, char** argv) {
 int main(int argc, char** argv) {
   // A file-size limit (ulimit -f) must make the write fail with EFBIG, named, not kill the rank.
   std::signal(SIGXFSZ, SIG_IGN);
-  MPI_Init(&argc, &argv);
+  // FUNNELED: I/O rank 0's picture thread (in-situ pictures) makes no MPI call, only the main thread does.
+  int provided = MPI_THREAD_SINGLE;
+  MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
   // SIGTERM / SIGINT (mpirun forwards them to every rank): the compute ranks stop together at their next
   // agreement point (at most 32 steps on), the output computed so far is written, and the exit status
   // is 128 + the signal's number, after the message.
