@@ -1,7 +1,7 @@
 // basalt-run: runs a scene (TOML) on P compute ranks with Q dedicated I/O ranks.
 //   mpirun -np P+Q basalt-run scenes/wave.toml [--io-ranks Q] [--geometry FILE] [--steps N] [--output DIR]
 //          [--dims x,y,z] [--checkpoint-every N] [--frames-every N] [--fields-every N]
-//          [--restart FILE|DIR] [--quiet] [--force-dt]
+//          [--restart FILE|DIR] [--quiet] [--force-dt] [--render-every N [--render SPEC]]
 // The only code that touches MPI_COMM_WORLD: it creates the output folder (world rank 0, a failure
 // stops every rank before anything starts) and splits the world into compute and I/O ranks. Compute
 // rank 0 prints progress, a summary of the time per step and the output report (docs/io-ranks.md).
@@ -31,6 +31,7 @@
 #include "basalt/solver/simulation.hpp"
 #include "basalt/version.hpp"
 #include "client_sink.hpp"
+#include "picture_module.hpp"
 #include "restart_support.hpp"
 
 namespace fs = std::filesystem;
@@ -44,7 +45,8 @@ struct Cli {
   std::int64_t steps = -1;
   bool quiet = false, force_dt = false, force_overlap = false;
   int io_ranks = 0;
-  std::int64_t checkpoint_every = -1, frames_every = -1, fields_every = -1;
+  std::int64_t checkpoint_every = -1, frames_every = -1, fields_every = -1, render_every = -1;
+  std::optional<std::string> render;
   double throttle_mbps = 0;
   int frames_in_flight = 0;
 };
@@ -135,6 +137,21 @@ void print_report(const io::OutputReport& r, int n_io) {
   std::string text = fmt::format("output ({}):\n", n_io > 0 ? fmt::format("{} I/O rank(s)", n_io)
                                                             : std::string("written by the compute ranks"));
   text += kind("checkpoints", r.checkpoints) + kind("frames", r.frames) + kind("fields", r.fields);
+  if (r.pictures_due > 0) {
+    text += fmt::format(
+        "  {:<12} {:>5} files {:>12}  draw  {:8.3f} s ({:.3f} s per picture, longest {:.3f} s); {} of {} "
+        "drawn, {} skipped",
+        "pictures", r.pictures.files, mb(r.pictures.bytes), r.pictures.write_seconds,
+        r.pictures.write_seconds / double(std::max<std::uint64_t>(1, r.pictures.files)),
+        r.picture_max_seconds, r.pictures.files, r.pictures_due, r.pictures_skipped);
+    if (r.pictures_skipped > 0)
+      text +=
+          fmt::format(" (steps {}: {})", r.pictures_skipped_steps,
+                      r.error ? "not drawn after the error below"
+                              : "a newer frame came while each waited to be drawn; the I/O rank draws slower "
+                                "than pictures are asked for");
+    text += "\n";
+  }
   text += fmt::format("  compute ranks waited {:.4f} s for output", r.compute_wait_seconds);
   if (n_io > 0)
     text += fmt::format("; I/O rank CPU time {:.3f} s over {:.3f} s wall ({:.1f} %)", r.io_cpu_seconds,
@@ -314,6 +331,15 @@ int run_world(int argc, char** argv) {
       ->check(kNonNegative);
   app.add_option("--fields-every", cli.fields_every, "every field saver every N steps (0 = off)")
       ->check(kNonNegative);
+  app.add_option(
+         "--render-every", cli.render_every,
+         "in-situ PNG picture every N steps, drawn by I/O rank 0 while the run goes on (needs --io-ranks "
+         ">= 1; 0 = off; docs/io-ranks.md)")
+      ->check(kNonNegative);
+  app.add_option(
+      "--render", cli.render,
+      "the pictures' settings: KEY=VALUE,... with keys color, cut, view, range, size, as basalt-view "
+      "render's options (e.g. \"color=velocity_z,cut=y\"); overrides output.render");
   app.add_option("--restart", cli.restart,
                  "continue from a checkpoint, or from the latest complete one in a folder");
   app.add_option("--frames-in-flight", cli.frames_in_flight, "frames a compute rank may have posted (bound)")
@@ -357,6 +383,23 @@ int run_world(int argc, char** argv) {
   if (cli.fields_every > 0)
     for (auto& f : scene.fields) f.every = cli.fields_every;
   if (cli.frames_in_flight > 0) scene.frames_in_flight = cli.frames_in_flight;
+  // In-situ pictures: the spec is checked here on every rank, before anything starts.
+  if (cli.render_every >= 0) scene.render_every = cli.render_every;
+  if (cli.render) scene.render = *cli.render;
+  io::RenderSpec render_spec;
+  try {
+    render_spec = io::parse_render_spec(scene.render, cli.render ? "--render" : "output.render");
+  } catch (const std::invalid_argument& e) {
+    throw InputError(e.what());
+  }
+  if (cli.render && scene.render_every == 0)
+    throw InputError("--render: no pictures asked for: give --render-every N (or output.render_every)");
+  if (scene.render_every > 0 && cli.io_ranks == 0)
+    throw InputError(fmt::format(
+        "{} {}: in-situ pictures need an I/O rank (--io-ranks 1 or more): I/O rank 0 draws them while the "
+        "compute ranks go on, which never wait for a picture; without I/O ranks, write checkpoints and draw "
+        "them afterwards (basalt-view render out/ckpt_*.h5 -o pictures/)",
+        cli.render_every > 0 ? "--render-every" : "output.render_every", scene.render_every));
   if (!cli.preset.empty()) {  // docs/stability.md, "Presets": the error and speed measured for each
     scene.precision = cli.preset == "fast" ? "float" : "double";
     scene.dt = 0;
@@ -409,6 +452,7 @@ int run_world(int argc, char** argv) {
   cfg.continue_on_error = scene.output_continue_on_error;
   cfg.throttle_mb_per_s = cli.throttle_mbps;
   cfg.append_fields = ckpt.has_value();
+  cfg.render_every = scene.render_every;
   const auto vtk = io::make_vtk_frame_writer(
       io::Units{scene.units.length, scene.units.time, scene.units.force, io::Units{}.mass},
       ckpt ? ckpt->time : -1.0);
@@ -424,8 +468,12 @@ int run_world(int argc, char** argv) {
     ~Free() { io::free_layout(l); }
   } free_layout{layout};
   if (layout.is_io) {
-    // I/O ranks print nothing but errors (compute rank 0 prints the report).
-    io::IoServer server(layout, cfg, vtk);
+    // I/O ranks print nothing but errors (compute rank 0 prints the report). I/O rank 0 draws the
+    // pictures: only it loads the render module (VTK rendering, OpenGL, X), and only when asked.
+    io::Pictures pictures;
+    if (cfg.render_every > 0 && layout.world_rank == layout.n_compute)
+      pictures = basalt::run::load_picture_module(render_spec);
+    io::IoServer server(layout, cfg, vtk, std::move(pictures));
     const auto report = server.run();
     return report.error && !cfg.continue_on_error ? 1 : 0;
   }
@@ -439,7 +487,9 @@ int run_world(int argc, char** argv) {
 int main(int argc, char** argv) {
   // A file-size limit (ulimit -f) must make the write fail with EFBIG, named, not kill the rank.
   std::signal(SIGXFSZ, SIG_IGN);
-  MPI_Init(&argc, &argv);
+  // FUNNELED: I/O rank 0's picture thread (in-situ pictures) makes no MPI call, only the main thread does.
+  int provided = MPI_THREAD_SINGLE;
+  MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
   // SIGTERM / SIGINT (mpirun forwards them to every rank): the compute ranks stop together at their next
   // agreement point (at most 32 steps on), the output computed so far is written, and the exit status
   // is 128 + the signal's number, after the message.

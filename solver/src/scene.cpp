@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "basalt/io/mesh_file.hpp"
+#include "basalt/io/render_options.hpp"
 #include "basalt/solver/models/registry.hpp"
 
 namespace basalt::solver {
@@ -327,6 +328,17 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
     (void)t.boolean_or("exact_restart", true);
     // Checkpoint compression: checked here, applied by the I/O layer, which reads it from the scene text.
     (void)t.choice_or("compression", {"none", "fast", "small"}, "none");
+    s.render_every = t.integer_or("render_every", 0);
+    if (s.render_every < 0)
+      t.fail("render_every", fmt::format("must be >= 0 (0 = off), got {}", s.render_every));
+    s.render = t.string_or("render", "");
+    try {
+      (void)io::parse_render_spec(s.render, "output.render");
+    } catch (const std::invalid_argument& e) {
+      std::string what = e.what();  // "output.render cut ...": fail() names output.render itself
+      if (what.rfind("output.render ", 0) == 0) what.erase(0, 14);
+      t.fail("render", what);
+    }
     s.frames_in_flight = t.integer_or("frames_in_flight", 2);
     if (s.frames_in_flight < 1)
       t.fail("frames_in_flight", fmt::format("must be >= 1, got {}", s.frames_in_flight));

@@ -21,8 +21,13 @@ SimulationFrame<Real>::SimulationFrame(const Simulation<Real>& sim, std::uint32_
     h.rebuild_step = sim.rebuild_step_;
     h.rebuild_pending = sim.bond_broke_;
   }
-  std::size_t m = bonds.n_both_owned + sim.broken_.size();
-  for (std::size_t k = bonds.n_both_owned; k < bonds.size(); ++k) m += owns_ghost_bond(k) ? 1 : 0;
+  // A frame only for an in-situ picture carries no bonds (pictures draw particles).
+  with_bonds_ = (kinds & (io::kFrameCheckpoint | io::kFrameVtk)) != 0;
+  std::size_t m = 0;
+  if (with_bonds_) {
+    m = bonds.n_both_owned + sim.broken_.size();
+    for (std::size_t k = bonds.n_both_owned; k < bonds.size(); ++k) m += owns_ghost_bond(k) ? 1 : 0;
+  }
   h.bonds = m;
   if (kinds & io::kFrameCheckpoint)
     for (const auto* c : sim.forces_.history_computes())
@@ -99,7 +104,7 @@ void SimulationFrame<Real>::write(io::FrameWriter& w) const {
   // Bonds with both ends owned come first and go as they are; the bond tag carries the solver's
   // interaction group (restart).
   const auto& b = sim_.bonds_;
-  const std::size_t both = b.n_both_owned;
+  const std::size_t both = with_bonds_ ? b.n_both_owned : 0;
   w.column(Column::bond_a, std::span(b.a.data(), both));
   w.column(Column::bond_b, std::span(b.b.data(), both));
   w.column(Column::bond_rest_length, std::span(b.r0.data(), both));
@@ -108,7 +113,7 @@ void SimulationFrame<Real>::write(io::FrameWriter& w) const {
   else
     w.fill(Column::bond_group, 0, both, 0);
   std::size_t at = both;
-  for (std::size_t k = both; k < b.size(); ++k) {
+  for (std::size_t k = both; with_bonds_ && k < b.size(); ++k) {
     if (!owns_ghost_bond(k)) continue;
     w.set(Column::bond_a, at, b.a[k]);
     w.set(Column::bond_b, at, b.b[k]);
@@ -120,6 +125,7 @@ void SimulationFrame<Real>::write(io::FrameWriter& w) const {
   // Broken bonds: the bond driver records each once across ranks (same lower-id rule). Flag 2: it
   // broke at this very step (a restart from here restores it, docs/formats.md).
   for (const auto& broken : sim_.broken_) {
+    if (!with_bonds_) break;
     w.set(Column::bond_a, at, broken.a);
     w.set(Column::bond_b, at, broken.b);
     w.set(Column::bond_rest_length, at, broken.rest_length);

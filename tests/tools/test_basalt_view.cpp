@@ -727,3 +727,44 @@ TEST(BasaltView, MovieOfARunFolderIsAnAnimatedPngWithOneFramePerCheckpoint) {
   EXPECT_NE(bad.code, 0);
   EXPECT_NE(bad.out.find("no checkpoints"), std::string::npos) << bad.out;
 }
+
+TEST(BasaltView, ColoursACheckpointByItsParticleFieldsSuchAsAngularVelocity) {
+  // A checkpoint of a rotating scene stores angular_velocity_x/_y/_z as particle fields (column-collapse's
+  // rot_friction): each component, and the magnitude under the common name, colour the spheres. The
+  // lattice spins faster with x (and the other way in y, so the magnitude is not one component).
+  const fs::path dir = basalt::test::scratch_dir("view-render-fields");
+  basalt::io::Checkpoint c = lattice_checkpoint();
+  std::vector<double> wx, wy, wz;
+  for (const auto& p : c.geometry.position) {
+    wx.push_back(0.0);
+    wy.push_back(-0.5 * p[0]);
+    wz.push_back(p[0]);
+  }
+  c.particle_fields = {{"angular_velocity_x", wx}, {"angular_velocity_y", wy}, {"angular_velocity_z", wz}};
+  basalt::io::write_checkpoint(c, dir / "ckpt_000100.h5");
+
+  Outcome r = basalt_view(fmt_args("info", (dir / "ckpt_000100.h5").string()), dir);
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("angular_velocity_x, angular_velocity_y, angular_velocity_z"), std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find(", angular_velocity\n"), std::string::npos) << r.out;  // the magnitude
+
+  for (const std::string field : {"angular_velocity", "angular_velocity_z"}) {
+    const fs::path png = dir / (field + ".png");
+    r = basalt_view(fmt_args("render", (dir / "ckpt_000100.h5").string(), "-o", png.string(),
+                             "--size 400x300 --view -y --color " + field),
+                    dir);
+    ASSERT_EQ(r.code, 0) << r.out;
+    EXPECT_NE(r.out.find("coloured by " + field + ","), std::string::npos) << r.out;
+    // |omega| = 1.118 x, omega_z = x: from 0 at x = 0 to the top of the map at x = 11.
+    EXPECT_NE(r.out.find("values from 0 to " + std::string(field == "angular_velocity" ? "12.2" : "11")),
+              std::string::npos)
+        << r.out;
+    const Image img = read_png(png);
+    ASSERT_EQ(img.width, 400);
+    // Seen from -y, x runs left to right: blue on the left, red on the right, both in the scene.
+    EXPECT_GT(img.count_between(kLow, 30, 0.0, 0.4), 30) << field;
+    EXPECT_GT(img.count_between(kHigh, 30, 0.4, kSceneFraction), 30) << field;
+    EXPECT_EQ(img.count_between(kHigh, 30, 0.0, 0.3), 0) << field;
+  }
+}

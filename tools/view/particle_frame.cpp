@@ -13,6 +13,7 @@ namespace fs = std::filesystem;
 io::ParticleArrays ParticleSet::arrays() const {
   io::ParticleArrays a = io::arrays_of(geometry, displacement);
   a.velocity = velocity;
+  for (const auto& [name, values] : fields) a.fields.emplace_back(name, values);
   return a;
 }
 
@@ -33,6 +34,7 @@ ParticleSet from_checkpoint(io::Checkpoint c) {
   s.info = io::info_of(c);
   s.geometry = std::move(c.geometry);
   s.velocity = std::move(c.velocity);
+  s.fields = std::move(c.particle_fields);
   s.kind = "checkpoint";
   return s;
 }

@@ -19,6 +19,8 @@ struct ParticleSet {
   io::Geometry geometry;
   std::vector<io::Vec3> velocity;      ///< empty for a geometry
   std::vector<io::Vec3> displacement;  ///< filled when a reference was given
+  /// A checkpoint's optional particle fields (angular_velocity_x ..., the scene's), one value per particle.
+  std::vector<std::pair<std::string, std::vector<double>>> fields;
   io::FrameInfo info;
   std::string kind;  ///< "checkpoint" or "geometry"
 

@@ -14,6 +14,7 @@
 #include "checkpoint_step.hpp"
 #include "field_series.hpp"
 #include "messages.hpp"
+#include "picture_queue.hpp"
 #include "report_reduction.hpp"
 
 namespace basalt::io {
@@ -61,8 +62,12 @@ void split_pieces(std::span<const std::byte> bytes, std::vector<FramePiece>& out
 /// One I/O rank's run: what IoServer::run does, with its state.
 class Server {
  public:
-  Server(const RankLayout& layout, const OutputConfig& config, const VtkFrameWriter& vtk)
-      : L_(layout), cfg_(config), vtk_(vtk), io_index_(layout.world_rank - layout.n_compute) {}
+  Server(const RankLayout& layout, const OutputConfig& config, const VtkFrameWriter& vtk, Pictures& pictures)
+      : L_(layout),
+        cfg_(config),
+        vtk_(vtk),
+        pictures_(pictures),
+        io_index_(layout.world_rank - layout.n_compute) {}
 
   OutputReport run() {
     const double wall0 = MPI_Wtime();
@@ -71,6 +76,7 @@ class Server {
     receive_without_spinning(0, kTagInfo, L_.bridge, buffer_);
     info_ = deserialize_run_info(buffer_);
     open_fields();
+    start_pictures();
 
     int done = 0;
     Backoff backoff;
@@ -88,6 +94,12 @@ class Server {
       MPI_Get_count(&st, MPI_BYTE, &n);
       buffer_.resize(n);
       MPI_Mrecv(buffer_.data(), n, MPI_BYTE, &msg, MPI_STATUS_IGNORE);
+      if (queue_ && !pictures_failed_) {
+        if (auto e = queue_->error()) {
+          pictures_failed_ = true;
+          report_error(*e);
+        }
+      }
       switch (st.MPI_TAG) {
         case kTagFrame:
           add_piece(deserialize(buffer_));
@@ -106,6 +118,7 @@ class Server {
     if (!pending_.empty())
       report_error(fmt::format("I/O rank {}: step {} is missing pieces from some compute ranks", io_index_,
                                pending_.begin()->first));
+    finish_pictures();
     if (csv_) {
       local_.fields.files = 1;
       local_.fields.bytes = csv_->bytes();
@@ -193,7 +206,8 @@ class Server {
 
   /// Writes a step once every compute rank this I/O rank serves has sent its piece, then tells the
   /// compute ranks the outcome (acknowledge): the VTK piece to the ranks it serves, the checkpoint (I/O
-  /// rank 0 writes the file) to every compute rank.
+  /// rank 0 writes the file) to every compute rank. Checkpoints and pictures need every piece: the other
+  /// I/O ranks hand theirs to I/O rank 0. A picture gets no verdict: the compute ranks never wait for one.
   void add_piece(FramePiece piece) {
     const auto step = piece.step;
     auto& list = pending_[step];
@@ -204,6 +218,10 @@ class Server {
       const bool ok = write_vtk(list, step);
       for (int c : L_.served) acknowledge(c, step, ok);
     }
+    if (kinds & (kFrameCheckpoint | kFramePicture)) {
+      gather(list);
+      if (io_index_ == 0 && (kinds & kFramePicture)) offer_picture(list);
+    }
     if (kinds & kFrameCheckpoint) {
       take_queued_field_batches();
       const bool ok = write_checkpoint(list);
@@ -211,6 +229,85 @@ class Server {
         for (int c = 0; c < L_.n_compute; ++c) acknowledge(c, step, ok);
     }
     pending_.erase(step);
+  }
+
+  /// I/O ranks other than 0 send their pieces to I/O rank 0, which appends them to its own.
+  void gather(std::vector<FramePiece>& pieces) {
+    if (io_index_ != 0) {
+      concat_pieces(pieces, gathered_);
+      MPI_Request req;
+      MPI_Isend(gathered_.data(), checked_count(gathered_.size()), MPI_BYTE, 0, kTagGather, L_.io, &req);
+      wait_without_spinning(req);
+      return;
+    }
+    for (int q = 1; q < L_.n_io; ++q) {
+      receive_without_spinning(q, kTagGather, L_.io, gathered_);
+      split_pieces(gathered_, pieces);
+    }
+  }
+
+  /// I/O rank 0 with pictures asked for: the picture thread, or the reason there is none (an error).
+  void start_pictures() {
+    if (io_index_ != 0 || cfg_.render_every <= 0) return;
+    std::string why = pictures_.error;
+    if (why.empty() && !pictures_.draw) why = "no picture writer (basalt-run's render module was not loaded)";
+    if (why.empty()) {
+      std::error_code ec;
+      std::filesystem::create_directories(cfg_.dir / "pictures", ec);
+      if (ec)
+        why = fmt::format("{}: cannot create the pictures' folder: {}", (cfg_.dir / "pictures").string(),
+                          ec.message());
+    }
+    if (!why.empty()) {
+      pictures_failed_ = true;
+      report_error(why);
+      return;
+    }
+    queue_ = std::make_unique<PictureQueue>(std::move(pictures_.draw), cfg_.dir);
+  }
+
+  /// Hands the particles of a picture step to the picture thread, which never makes this loop wait.
+  void offer_picture(const std::vector<FramePiece>& pieces) {
+    PictureJob job;
+    job.step = pieces.front().step;
+    job.time = pieces.front().time;
+    job.units = info_.units;
+    for (const auto& p : pieces) job.append(p);
+    if (!queue_) {  // failed at the start (reported then)
+      ++local_.pictures_due;
+      if (++local_.pictures_skipped <= 20)
+        local_.pictures_skipped_steps +=
+            fmt::format("{}{}", local_.pictures_skipped > 1 ? ", " : "", job.step);
+      else if (local_.pictures_skipped == 21)
+        local_.pictures_skipped_steps += ", ...";
+      return;
+    }
+    if (const auto skipped = queue_->offer(std::move(job)); skipped && ++skip_lines_ <= 5)
+      fmt::print(stderr,
+                 "basalt-run: picture of step {} skipped: a newer frame (step {}) came while it waited to be "
+                 "drawn{}\n",
+                 *skipped, pieces.front().step, skip_lines_ == 5 ? " (further skips: see the report)" : "");
+  }
+
+  void finish_pictures() {
+    if (!queue_) return;
+    const PictureQueue::Stats st = queue_->finish();
+    if (auto e = queue_->error(); e && !pictures_failed_) {
+      pictures_failed_ = true;
+      report_error(*e);
+    }
+    local_.pictures.files += st.drawn;
+    local_.pictures.bytes += st.bytes;
+    local_.pictures.write_seconds += st.seconds;
+    local_.pictures_due += st.due;
+    local_.pictures_skipped += st.skipped;
+    local_.picture_max_seconds = st.max_seconds;
+    std::string steps;
+    for (std::size_t k = 0; k < st.skipped_steps.size() && k < 20; ++k)
+      steps += fmt::format("{}{}", k ? ", " : "", st.skipped_steps[k]);
+    if (st.skipped_steps.size() > 20) steps += ", ...";
+    local_.pictures_skipped_steps = steps;
+    queue_.reset();
   }
 
   /// The verdict on one step's output for compute rank `c`: the step, then the error text if it failed.
@@ -253,20 +350,10 @@ class Server {
     return !frames_failed_;
   }
 
-  /// One file per checkpoint: the other I/O ranks hand their pieces to I/O rank 0, which writes it.
-  /// False (on I/O rank 0) when checkpoints have failed (now or before).
+  /// One file per checkpoint, written by I/O rank 0 from every piece (gathered before). False (on I/O
+  /// rank 0) when checkpoints have failed (now or before).
   bool write_checkpoint(std::vector<FramePiece>& pieces) {
-    if (io_index_ != 0) {
-      concat_pieces(pieces, gathered_);
-      MPI_Request req;
-      MPI_Isend(gathered_.data(), checked_count(gathered_.size()), MPI_BYTE, 0, kTagGather, L_.io, &req);
-      wait_without_spinning(req);
-      return true;
-    }
-    for (int q = 1; q < L_.n_io; ++q) {
-      receive_without_spinning(q, kTagGather, L_.io, gathered_);
-      split_pieces(gathered_, pieces);
-    }
+    if (io_index_ != 0) return true;
     if (checkpoints_failed_) return false;
     try {
       write_checkpoint_step(pieces, info_, cfg_, local_.checkpoints);
@@ -291,7 +378,11 @@ class Server {
   const RankLayout& L_;
   const OutputConfig& cfg_;
   const VtkFrameWriter& vtk_;
+  Pictures& pictures_;
   const int io_index_;
+  std::unique_ptr<PictureQueue> queue_;
+  bool pictures_failed_ = false;
+  int skip_lines_ = 0;
   RunInfo info_;
   OutputReport local_;
   int errors_sent_ = 0;
@@ -304,9 +395,9 @@ class Server {
 
 }  // namespace
 
-IoServer::IoServer(const RankLayout& layout, OutputConfig config, VtkFrameWriter vtk)
-    : layout_(layout), config_(std::move(config)), vtk_(std::move(vtk)) {}
+IoServer::IoServer(const RankLayout& layout, OutputConfig config, VtkFrameWriter vtk, Pictures pictures)
+    : layout_(layout), config_(std::move(config)), vtk_(std::move(vtk)), pictures_(std::move(pictures)) {}
 
-OutputReport IoServer::run() { return Server(layout_, config_, vtk_).run(); }
+OutputReport IoServer::run() { return Server(layout_, config_, vtk_, pictures_).run(); }
 
 }  // namespace basalt::io

@@ -40,6 +40,8 @@ std::uint32_t OutputClient::frame_kinds(std::int64_t step) const {
   const auto& c = impl_->cfg;
   if (c.checkpoint_every > 0 && step % c.checkpoint_every == 0) k |= kFrameCheckpoint;
   if (c.frames_every > 0 && impl_->vtk && step % c.frames_every == 0) k |= kFrameVtk;
+  // Pictures are drawn by I/O rank 0 only (basalt-run refuses them with --io-ranks 0).
+  if (c.render_every > 0 && impl_->layout.n_io > 0 && step % c.render_every == 0) k |= kFramePicture;
   return k;
 }
 

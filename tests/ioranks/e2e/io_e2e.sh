@@ -318,6 +318,69 @@ case $case_name in
     mkdir -p "$W/empty"
     must_fail "--restart .*empty: no complete checkpoint" 1 --steps 10 --output "$W/o3" --restart "$W/empty"
     ;;
+  pictures)
+    # In-situ pictures (issue 15): I/O rank 0 draws a PNG every 50 steps (a frame only for the picture at
+    # 50 and 150, with the checkpoints at 100 and 200), on 2 compute ranks + 1 I/O rank, then on 2 + 2
+    # (I/O rank 1 hands its compute rank's particles to I/O rank 0). Each step asked for has its PNG or
+    # is in the report's skipped list; each PNG is not blank and shows both ends of the colour map; the
+    # checkpoints equal a run's without pictures (pictures never change the physics).
+    spec="color=velocity_z,cut=y,view=-y,size=320x240"
+    must_run 2 --steps 200 --checkpoint-every 100 --output "$W/plain"
+    for q in 1 2; do
+      must_run $((2 + q)) --io-ranks $q --steps 200 --checkpoint-every 100 --render-every 50 --render "$spec" \
+        --output "$W/q$q"
+      cat "$W/last.log"
+      $CHECK pictures "$W/q$q" 50,100,150,200 "$W/last.log" 320x240 || fail "--io-ranks $q: pictures wrong"
+      $CHECK same "$W/plain/ckpt_000200.h5" "$W/q$q/ckpt_000200.h5" || fail "--io-ranks $q: pictures changed the run"
+    done
+    # The same from the scene's keys.
+    sed 's|^\[output\]|[output]\nrender_every = 100\nrender = "color=speed,size=200x150"|' "$SCENE" >"$W/scene.toml"
+    SCENE=$W/scene.toml must_run 3 --io-ranks 1 --steps 200 --output "$W/keys"
+    $CHECK pictures "$W/keys" 100,200 "$W/last.log" 200x150 || fail "output.render_every: pictures wrong"
+    ;;
+  pictures_skipped)
+    # Pictures asked for faster than the I/O rank draws them (every step): the run is not held up, the
+    # pictures that cannot keep up are skipped and counted, and the report lists them; the count of PNGs
+    # still equals the steps asked for less those skipped. (Both ends of the colour map are not asked of
+    # these pictures: at steps 1-2 only a few spheres on the base move; the case "pictures" checks them.)
+    steps=$(seq -s, 1 60)
+    must_run 3 --io-ranks 1 --steps 60 --render-every 1 --render "size=160x120" --output "$W/out"
+    cat "$W/last.log"
+    $CHECK pictures "$W/out" "$steps" "$W/last.log" 160x120 any || fail "the pictures and the report disagree"
+    grep -Eq "pictures .* [1-9][0-9]* skipped \(steps .*a newer frame came" "$W/last.log" || fail "no picture was skipped"
+    grep -q "basalt-run: picture of step [0-9]* skipped" "$W/last.log" || fail "the skips were not logged as they happened"
+    wait_s=$(sed -nE 's/.*compute ranks waited ([0-9.]+) s for output.*/\1/p' "$W/last.log")
+    awk -v w="$wait_s" 'BEGIN { exit !(w < 1.0) }' || fail "the compute ranks waited $wait_s s for output"
+    ;;
+  pictures_bad_input)
+    # A bad spec names the key (command line and scene); pictures without an I/O rank are refused; an
+    # unknown field stops the run at the first picture, naming the field and what is available.
+    must_fail '--render "colr=velocity_z": unknown key "colr" \(keys: color, cut, view, range, size\)' 2 \
+      --io-ranks 1 --steps 10 --render-every 5 --render "colr=velocity_z" --output "$W/o"
+    must_fail '--render cut "w": expected x, y or z' 2 --io-ranks 1 --steps 10 --render-every 5 --render "cut=w" --output "$W/o"
+    must_fail '--render size "12": expected WIDTHxHEIGHT' 2 --io-ranks 1 --steps 10 --render-every 5 --render "size=12" --output "$W/o"
+    must_fail '--render: no pictures asked for: give --render-every' 2 --io-ranks 1 --steps 10 --render "cut=y" --output "$W/o"
+    must_fail '--render-every 5: in-situ pictures need an I/O rank \(--io-ranks 1 or more\)' 1 --steps 10 --render-every 5 --output "$W/o"
+    sed 's|^\[output\]|[output]\nrender_every = 5\nrender = "view=+w"|' "$SCENE" >"$W/bad.toml"
+    SCENE=$W/bad.toml must_fail 'bad.toml:[0-9]+: output.render: view "\+w": expected \+x' 2 --io-ranks 1 --steps 10 --output "$W/o"
+    sed 's|^\[output\]|[output]\nrender_every = 5|' "$SCENE" >"$W/q0.toml"
+    SCENE=$W/q0.toml must_fail 'output.render_every 5: in-situ pictures need an I/O rank' 1 --steps 10 --output "$W/o"
+    must_fail 'picture of step 5: render "color=spin": unknown colour field "spin"; available: .*velocity_z' 2 \
+      --io-ranks 1 --steps 10 --render-every 5 --render "color=spin" --output "$W/o"
+    ;;
+  pictures_on_demand)
+    # A run without pictures neither links nor loads VTK's rendering: basalt-run has no OpenGL, X or VTK
+    # rendering library among its dependencies, and runs with the render module made unloadable; with
+    # pictures, that module is what fails, named.
+    if ldd "$BASALT_RUN" | grep -Ei 'libvtkRendering|libGL|libX11|libvtkInteraction'; then
+      fail "basalt-run links rendering libraries (above)"
+    fi
+    ldd "$(dirname "$BASALT_RUN")/basalt-render-insitu.so" | grep -q libvtkRenderingOpenGL2 || fail "the module does not link VTK's OpenGL rendering"
+    export BASALT_RENDER_MODULE=$W/no-such-module.so
+    must_run 2 --io-ranks 1 --steps 20 --checkpoint-every 10 --output "$W/plain"
+    must_fail "cannot load the render module .*no-such-module.so" 2 --io-ranks 1 --steps 20 --render-every 10 --output "$W/pics"
+    unset BASALT_RENDER_MODULE
+    ;;
   io_rank_sleeps)
     # Rare output: the I/O rank's CPU time must stay a small part of the wall time (it sleeps).
     must_run 2 --io-ranks 1 --steps 600 --checkpoint-every 500 --output "$W/out"

@@ -19,6 +19,7 @@
                               gives the checkpoint's particle count, positions, velocity and radius; so
                               does each ckpt_<step>.xmf alone
 """
+import re
 import sys
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -219,6 +220,63 @@ def xdmf(folder, steps):
     return True
 
 
+# basalt-view's pictures (tests/tools/test_basalt_view.cpp): background, the ends of the colour map, and
+# the part of the width left of the colour bar.
+BACKGROUND, LOW, HIGH, SCENE = (82, 87, 110), (59, 76, 192), (180, 4, 38), 0.8
+
+
+def picture_ok(png, width, height, ends=True):
+    """The PNG has the size asked for, is not blank, and (with `ends`) shows both ends of the colour map in
+    the scene."""
+    from PIL import Image
+    img = Image.open(png).convert("RGB")
+    if img.size != (width, height):
+        print(f"{png}: {img.size}, expected {(width, height)}")
+        return False
+    a = np.asarray(img, dtype=int)[:, : int(SCENE * width)]
+    near = lambda c, tol: int(np.sum(np.all(np.abs(a - np.array(c)) <= tol, axis=2)))
+    scene = a.shape[0] * a.shape[1]
+    background, low, high = near(BACKGROUND, 3), near(LOW, 30), near(HIGH, 30)
+    least = max(10, scene // 2000)  # 30 pixels of a 320x240 picture, fewer for a smaller one
+    if scene - background < scene // 10 or (ends and (low < least or high < least)):
+        print(f"{png}: {scene - background} of {scene} pixels not background, {low} near the low end, "
+              f"{high} near the high end of the colour map: blank or one-coloured")
+        return False
+    return True
+
+
+def pictures(folder, steps, log, size, ends="ends"):
+    """In-situ pictures: one PNG per step asked for, or the step is in the report's skipped list, and
+    the report's counts agree with the files."""
+    folder, steps = Path(folder), [int(s) for s in steps.split(",")]
+    width, height = (int(v) for v in size.split("x"))
+    text = Path(log).read_text()
+    m = re.search(r"pictures +(\d+) files .* (\d+) of (\d+) drawn, (\d+) skipped(?: \(steps ([0-9, .]+):)?", text)
+    if not m:
+        print(f"{log}: no pictures line in the report")
+        return False
+    files, drawn, due, skipped = (int(m.group(k)) for k in range(1, 5))
+    listed = [int(v) for v in (m.group(5) or "").replace(" ", "").split(",") if v and v != "..."]
+    pngs = sorted((folder / "pictures").glob("*.png"))
+    made = [int(p.stem.split("_")[-1]) for p in pngs]
+    if due != len(steps) or files != drawn or drawn + skipped != due or len(pngs) != drawn:
+        print(f"{len(steps)} steps asked, report: {drawn} of {due} drawn, {skipped} skipped, {files} files; "
+              f"{len(pngs)} PNGs in {folder / 'pictures'}")
+        return False
+    if sorted(made + listed) != steps and not (len(listed) == 20 and set(made + listed) <= set(steps)):
+        print(f"asked {steps}; drawn {made}; skipped {listed}")
+        return False
+    if list((folder / "pictures").glob("*.partial")):
+        print("a .partial file is left")
+        return False
+    for png in pngs:
+        if not picture_ok(png, width, height, ends == "ends"):
+            return False
+    print(f"{drawn} pictures drawn (steps {made}), {skipped} skipped (steps {listed}); each {width}x{height}, "
+          f"not blank{', both ends of the colour map' if ends == 'ends' else ''}")
+    return True
+
+
 if __name__ == "__main__":
     cmd, args = sys.argv[1], sys.argv[2:]
     ok = {"same": lambda: same(*args), "close": lambda: close(args[0], args[1], float(args[2])),
@@ -226,5 +284,6 @@ if __name__ == "__main__":
           "contacts": lambda: contacts(args[0], int(args[1])),
           "old_lists": lambda: old_lists(args[0]), "break_overlap": lambda: break_overlap(args[0]),
           "strip_rebuild": lambda: strip_rebuild(args[0]), "pvd": lambda: pvd(args[0]),
-          "xdmf": lambda: xdmf(args[0], args[1]), "compressed": lambda: compressed(args[0])}[cmd]()
+          "xdmf": lambda: xdmf(args[0], args[1]), "compressed": lambda: compressed(args[0]),
+          "pictures": lambda: pictures(*args), "picture": lambda: picture_ok(args[0], int(args[1]), int(args[2]))}[cmd]()
     sys.exit(0 if ok else 1)

@@ -24,6 +24,7 @@ namespace basalt::io {
 enum FrameKind : std::uint32_t {
   kFrameCheckpoint = 1u << 0,  ///< write an HDF5 checkpoint of this step
   kFrameVtk = 1u << 1,         ///< write a VTK frame of this step
+  kFramePicture = 1u << 2,     ///< draw an in-situ picture of this step (I/O rank 0; pictures.hpp)
 };
 
 /// What a frame holds besides its columns' contents: sizes, clock, flags. What is constant for a run

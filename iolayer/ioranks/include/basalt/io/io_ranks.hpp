@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "basalt/io/frame.hpp"
+#include "basalt/io/pictures.hpp"
 
 namespace basalt::io {
 
@@ -60,6 +61,7 @@ struct OutputConfig {
   bool continue_on_error = false;  ///< a failed output stops the run unless this is set
   double throttle_mb_per_s = 0;    ///< benchmark only: make storage this slow on purpose (0 = off)
   bool append_fields = false;      ///< restart: continue an existing fields.csv instead of replacing it
+  std::int64_t render_every = 0;   ///< in-situ pictures (I/O ranks only, pictures.hpp); 0 = off
 };
 
 /// Per output kind: what was written and what it cost.
@@ -74,7 +76,13 @@ struct OutputReport {
   double io_cpu_seconds = 0;        ///< max over I/O ranks: CPU time (user + system) of the I/O process
   double io_wall_seconds = 0;       ///< max over I/O ranks: wall time of IoServer::run
   std::uint64_t frames_sent = 0;
-  std::optional<std::string> error;  ///< first output error, if any
+  /// In-situ pictures: files, bytes and drawing seconds (summed) on I/O rank 0; how many steps asked
+  /// for one, how many were skipped (a newer frame came while one waited to be drawn) and which.
+  OutputKindReport pictures;
+  std::uint64_t pictures_due = 0, pictures_skipped = 0;
+  double picture_max_seconds = 0;
+  std::string pictures_skipped_steps;  ///< "300, 500" (at most 20 listed)
+  std::optional<std::string> error;    ///< first output error, if any
 };
 
 /// Writes a VTK frame: the pieces this writer holds, as piece `piece_index` of `n_pieces`.
@@ -121,16 +129,24 @@ class OutputClient {
   std::optional<std::string> error_;
 };
 
+/// In-situ pictures for I/O rank 0 (with OutputConfig::render_every): the writer, or why there is none
+/// (the module could not be loaded, no X server): then the run stops with that error at its start.
+struct Pictures {
+  PictureWriter draw;
+  std::string error;
+};
+
 /// I/O side: runs until every compute rank has finished; returns the world-wide report.
 class IoServer {
  public:
-  IoServer(const RankLayout& layout, OutputConfig config, VtkFrameWriter vtk = {});
+  IoServer(const RankLayout& layout, OutputConfig config, VtkFrameWriter vtk = {}, Pictures pictures = {});
   OutputReport run();
 
  private:
   RankLayout layout_;
   OutputConfig config_;
   VtkFrameWriter vtk_;
+  Pictures pictures_;
 };
 
 /// Waits for a request while sleeping between tests (Open MPI busy-polls in MPI_Wait).

@@ -30,6 +30,7 @@ class SimulationFrame final : public io::FrameSource {
   std::vector<io::WallState> walls_;
   /// Checkpoints: history of the pair models that keep one ([k] of the k-th such model).
   std::vector<ContactRecords> history_;
+  bool with_bonds_ = true;  ///< false for a frame that is only an in-situ picture
 };
 
 extern template class SimulationFrame<double>;

@@ -178,7 +178,9 @@ struct Scene {
   std::int64_t checkpoint_every = 0;      ///< HDF5 checkpoint every N steps (0 = off)
   std::int64_t frames_every = 0;          ///< VTK frame every N steps (0 = off)
   bool output_continue_on_error = false;  ///< on_error = "continue": a failed output does not stop the run
-  std::int64_t frames_in_flight = 2;      ///< per compute rank: frames posted but not yet received
+  std::int64_t render_every = 0;          ///< in-situ picture every N steps (I/O ranks; 0 = off)
+  std::string render;  ///< the pictures' spec, "color=velocity_z,cut=y" (io::parse_render_spec)
+  std::int64_t frames_in_flight = 2;  ///< per compute rank: frames posted but not yet received
 };
 
 /// A scene's largest size in bytes (10 MB): its text is stored in every checkpoint.

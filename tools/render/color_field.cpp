@@ -32,6 +32,18 @@ vtkDataArray* find(vtkPolyData& pd, const std::string& field, int& component) {
   return nullptr;
 }
 
+/// Three scalar arrays <field>_x, <field>_y, <field>_z (a vector the frame stores by components, such as
+/// the scene's angular_velocity_x/_y/_z), or false; also false with a <field>_w (a quaternion, such as
+/// orientation, whose x, y, z part has no magnitude worth drawing).
+bool components_of(vtkPolyData& pd, const std::string& field, vtkDataArray* c[3]) {
+  if (pd.GetPointData()->GetArray((field + "_w").c_str()) != nullptr) return false;
+  for (int k = 0; k < 3; ++k) {
+    c[k] = pd.GetPointData()->GetArray((field + "_" + static_cast<char>('x' + k)).c_str());
+    if (c[k] == nullptr || c[k]->GetNumberOfComponents() != 1) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 std::vector<std::string> color_fields(vtkPolyData& pd) {
@@ -48,12 +60,35 @@ std::vector<std::string> color_fields(vtkPolyData& pd) {
       for (const char* c : {"_x", "_y", "_z"}) names.push_back(name + c);
     }
   }
+  // A vector stored as three scalar arrays: its magnitude under the common name.
+  vtkDataArray* c[3];
+  for (std::size_t i = 0, n = names.size(); i < n; ++i) {
+    const std::string& name = names[i];
+    if (name.size() > 2 && name.compare(name.size() - 2, 2, "_x") == 0) {
+      const std::string base = name.substr(0, name.size() - 2);
+      if (std::find(names.begin(), names.end(), base) == names.end() && components_of(pd, base, c))
+        names.push_back(base);
+    }
+  }
   return names;
 }
 
 vtkSmartPointer<vtkDoubleArray> color_values(vtkPolyData& pd, const std::string& field) {
   int component = -1;
   vtkDataArray* a = find(pd, field, component);
+  vtkDataArray* parts[3];
+  if (a == nullptr && components_of(pd, field, parts)) {  // the magnitude of a vector stored by components
+    auto out = vtkSmartPointer<vtkDoubleArray>::New();
+    out->SetName(field.c_str());
+    const vtkIdType n = parts[0]->GetNumberOfTuples();
+    out->SetNumberOfTuples(n);
+    for (vtkIdType i = 0; i < n; ++i) {
+      double s = 0;
+      for (auto* p : parts) s += p->GetComponent(i, 0) * p->GetComponent(i, 0);
+      out->SetValue(i, std::sqrt(s));
+    }
+    return out;
+  }
   if (a == nullptr) {
     std::string hint;
     if (field == "displacement")

@@ -169,9 +169,13 @@ void AnimatedPng::add(vtkRenderWindow& window) {
     if (added_ == 0) {
       chunk("IDAT", c.data);
     } else {
-      std::vector<unsigned char> fdat;
-      put32(fdat, sequence_++);
-      fdat.insert(fdat.end(), c.data.begin(), c.data.end());
+      // The sequence number, then the frame's image data (sized first: GCC 12 warns, wrongly, of an
+      // over-read when a 4-byte vector grows by insert in the position-independent build).
+      std::vector<unsigned char> fdat(4 + c.data.size());
+      const std::uint32_t seq = sequence_++;
+      for (int k = 0; k < 4; ++k)
+        fdat[static_cast<std::size_t>(k)] = static_cast<unsigned char>(seq >> (24 - 8 * k));
+      if (!c.data.empty()) std::memcpy(fdat.data() + 4, c.data.data(), c.data.size());
       chunk("fdAT", fdat);
     }
   }

@@ -30,6 +30,7 @@ std::string quantity_units(const std::string& name, const io::Units& u) {
   if (contains(name, "energy") || contains(name, "work")) return energy_units(u);
   if (contains(name, "force")) return u.force;
   if (contains(name, "momentum")) return mass_units(u) + "\u00b7" + velocity_units(u);
+  if (contains(name, "angular_velocity") || contains(name, "angular_speed")) return "rad/" + u.time;
   if (contains(name, "velocity") || contains(name, "speed")) return velocity_units(u);
   if (name == "mass" || contains(name, "_mass")) return mass_units(u);
   if (name == "radius" || contains(name, "displacement") || contains(name, "position") || name == "x" ||

@@ -6,7 +6,7 @@
 
 #include <vector>
 
-#include "options.hpp"
+#include "render_types.hpp"
 
 namespace basalt::view {
 

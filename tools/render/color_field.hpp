@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "basalt/io/geometry.hpp"
-#include "options.hpp"
+#include "render_types.hpp"
 
 namespace basalt::view {
 
