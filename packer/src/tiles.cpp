@@ -1,9 +1,11 @@
 // Split packs: tiles packed in four colour rounds on several threads (docs/packer.md, "Tiles and threads").
 //
 // Why the result is exact across tile borders:
-//  * Tile (i, j) has colour (i mod 2) + 2 (j mod 2). Its centres lie in the tile widened by rmax towards
-//    the neighbours of a lower colour (along an axis where its index is odd); tiles are at least 4 rmax
-//    wide, so two tiles of one colour keep their centres more than 2 rmax apart: they never touch.
+//  * Tile (i, j) has colour (i mod 2) + 2 (j mod 2). Its centres lie in the tile widened by rmax on every
+//    side (within the box); tiles are at least 4 rmax wide, so two tiles of one colour keep their centres
+//    at least 2 rmax apart: they never touch. (Widened only towards earlier neighbours, the first colour's
+//    tiles had no room along their open sides and packed their interiors denser: mean coordination 6.20
+//    there against 6.62 in the last colour's, a pattern with the tiles' period in the bonded network.)
 //  * A tile is packed only after its (up to eight) neighbours of lower colour; their spheres within
 //    2 rmax of its centre range are obstacles in its grid and triangulation, so it places nothing that
 //    overlaps them (the same overlap test as inside one tile). Tiles further away cannot be reached.
@@ -75,7 +77,7 @@ TileLayout tile_layout(const Volume& volume, const PackOptions& o) {
 
 Packing pack_tiles(const Volume& volume, const PackOptions& opt, const TileLayout& L) {
   const int nt = L.count();
-  const double e = opt.rmax;  // widening towards earlier neighbours
+  const double e = opt.rmax;  // widening of every tile's centre range
   const double band = 2 * opt.rmax + opt.overlap_tolerance + 1e-9 * opt.rmax;  // obstacles kept
   auto index = [&](int i, int j) { return j * L.n[0] + i; };
   auto colour = [](int i, int j) { return (i & 1) + 2 * (j & 1); };
@@ -93,9 +95,8 @@ Packing pack_tiles(const Volume& volume, const PackOptions& opt, const TileLayou
       const int idx[2] = {i, j};
       for (int a = 0; a < 2; ++a) {
         const int ax = L.axis[a], k = idx[a];
-        const double widen = (k & 1) ? e : 0.0;
-        r.lo[ax] = std::max(L.box.lo[ax], edge(a, k) - widen);
-        r.hi[ax] = std::min(L.box.hi[ax], edge(a, k + 1) + widen);
+        r.lo[ax] = std::max(L.box.lo[ax], edge(a, k) - e);
+        r.hi[ax] = std::min(L.box.hi[ax], edge(a, k + 1) + e);
         m *= edge(a, k + 1) - edge(a, k);
       }
       const int third = 3 - L.axis[0] - L.axis[1];

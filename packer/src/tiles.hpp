@@ -19,7 +19,7 @@ struct PartSpec {
   /// (kFill, no seeding), so that filling one tile does not take the voids its neighbours' radii need.
   enum Stage { kWhole, kPowerLaw, kFill } stage = kWhole;
   std::uint64_t seed = 1;
-  /// Only centres within this box are placed (a tile, widened into its earlier neighbours).
+  /// Only centres within this box are placed (a tile, widened by rmax on every side).
   Bounds centre_range{{-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}, {HUGE_VAL, HUGE_VAL, HUGE_VAL}};
   /// Spheres placed before (earlier neighbours near the tile): obstacles, not part of the result.
   const Packing* fixed = nullptr;
