@@ -18,6 +18,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "basalt/io/geometry.hpp"
@@ -136,30 +137,41 @@ void check_expected_count(const basalt::packer::Volume& volume, const basalt::pa
       ram > 0 ? fmt::format(" (this machine has {})", human_bytes(ram)) : std::string(), limit));
 }
 
+/// Progress on stderr: a bar redrawn in place on a terminal; otherwise (a log file, a batch job) a plain
+/// line every 30 s. Nothing for packs shorter than two seconds. Called from one thread at a time.
 class ProgressBar {
  public:
-  explicit ProgressBar(bool enabled) : enabled_(enabled && isatty(fileno(stderr))) {}
+  explicit ProgressBar(bool enabled) : enabled_(enabled), tty_(isatty(fileno(stderr)) != 0) {}
   void update(double f) {
     if (!enabled_) return;
     const double t = seconds();
-    if (t < 2.0 || t - last_ < 0.2) return;
+    if (t < 2.0 || t - last_ < (tty_ ? 0.2 : 30.0)) return;
     last_ = t;
     shown_ = true;
-    const int width = 40, fill = static_cast<int>(std::lround(f * width));
     const double eta = f > 0.02 ? t * (1 - f) / f : 0;
+    if (!tty_) {
+      std::fprintf(stderr, "basalt-pack: packing %3.0f%%, %.0f s, ~%.0f s left\n", 100 * f, t, eta);
+      std::fflush(stderr);
+      return;
+    }
+    const int width = 40, fill = static_cast<int>(std::lround(f * width));
     std::fprintf(stderr, "\r[%s%s] %3.0f%%  %.0f s, ~%.0f s left ", std::string(fill, '#').c_str(),
                  std::string(width - fill, '.').c_str(), 100 * f, t, eta);
     std::fflush(stderr);
   }
   void finish() {
-    if (shown_) std::fprintf(stderr, "\n");
+    if (shown_ && tty_) std::fprintf(stderr, "\n");
+  }
+  /// A plain line for the slow steps after packing (bonding, writing) of a pack that showed progress.
+  void step(const char* what) {
+    if (shown_) std::fprintf(stderr, "basalt-pack: %s (%.0f s)\n", what, seconds());
   }
   double seconds() const {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   }
 
  private:
-  bool enabled_;
+  bool enabled_, tty_;
   bool shown_ = false;
   double last_ = 0;
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
@@ -189,6 +201,7 @@ int main(int argc, char** argv) {
   bool lattice = false;
   std::string seed_text = "1";
   double max_spheres = 1e7;
+  aopt.threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
 
   auto* box = app.add_subcommand("box", "an axis-aligned box from --origin to --origin + --size");
   box->add_option("--size", size, "edge lengths X,Y,Z")->required();
@@ -243,7 +256,10 @@ int main(int argc, char** argv) {
                     "solid fraction placed at random before void filling")
         ->capture_default_str();
     sub->add_option("--bins", aopt.histogram_bins, "radius histogram bins")->capture_default_str();
-    sub->add_option("--threads", aopt.threads, "threads for bonding and statistics")->capture_default_str();
+    sub->add_option("--threads", aopt.threads,
+                    "threads for packing (boxes at least 20 rmax wide are packed in tiles), bonding and "
+                    "statistics; the file does not depend on it")
+        ->capture_default_str();
     sub->add_flag("--record-time", record_time,
                   "also store the pack time and date in the file (then the file differs from run to run)");
     sub->add_flag("-q,--quiet", quiet, "print nothing but errors");
@@ -258,7 +274,8 @@ int main(int argc, char** argv) {
     if (!(aopt.bond_tolerance >= 0) || !std::isfinite(aopt.bond_tolerance))
       throw PackError(fmt::format("--bond-tolerance must be >= 0, got {}", aopt.bond_tolerance));
     if (aopt.histogram_bins < 1) throw PackError("--bins must be >= 1");
-    if (aopt.threads < 1) throw PackError("--threads must be >= 1");
+    if (aopt.threads < 1) throw PackError(fmt::format("--threads must be >= 1, got {}", aopt.threads));
+    popt.threads = aopt.threads;
     basalt::packer::check_options(popt);
     for (const auto& t : tag_texts) aopt.tags.push_back(basalt::packer::parse_tag_layer(t));
     check_output(output);
@@ -281,16 +298,20 @@ int main(int argc, char** argv) {
     ProgressBar bar(!quiet);
     popt.progress = [&](double f) { bar.update(f); };
     if (lattice && popt.exponent) throw PackError("--lattice and --exponent exclude each other");
-    const auto packing =
+    auto packing =
         lattice ? basalt::packer::lattice_packing(*volume, popt) : basalt::packer::pack(*volume, popt);
     bar.finish();
     const double pack_seconds = bar.seconds();
+    bar.step("packed; bonding");
     basalt::packer::AssemblyStats st;
     auto geometry = basalt::packer::assemble(*volume, packing, popt, aopt, st);
     const double total_seconds = bar.seconds();
+    // The geometry holds the spheres now: free the packing's copy before writing (memory at 8.7 M spheres).
+    packing.centre = {};
+    packing.radius = {};
 
-    // The command line without the output name (and -q), so that the same arguments give the same bytes
-    // whatever the file is called.
+    // The command line without the output name (and -q, --threads), so that the same arguments give the same
+    // bytes whatever the file is called.
     std::string command = "basalt-pack";
     for (int i = 1; i < argc; ++i) {
       const std::string arg = argv[i];
@@ -300,6 +321,11 @@ int main(int argc, char** argv) {
       }
       if (arg.rfind("--output=", 0) == 0 || (arg.rfind("-o", 0) == 0 && arg.size() > 2)) continue;
       if (arg == "-q" || arg == "--quiet") continue;  // changes nothing in the file
+      if (arg == "--threads") {                       // nor does the thread count
+        ++i;
+        continue;
+      }
+      if (arg.rfind("--threads=", 0) == 0) continue;
       command += " " + arg;
     }
     const auto low = basalt::packer::low_fraction_report(*volume, popt, packing, st.solid_fraction);
@@ -315,6 +341,7 @@ int main(int argc, char** argv) {
       std::strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
       geometry.attributes["created"] = date;
     }
+    bar.step("bonded; writing");
     basalt::io::write_geometry(geometry, output);
 
     if (!quiet) {

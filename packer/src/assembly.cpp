@@ -4,11 +4,13 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <atomic>
 #include <charconv>
 #include <cmath>
 #include <limits>
 #include <numbers>
 #include <thread>
+#include <utility>
 
 #include "basalt/packer/error.hpp"
 
@@ -16,17 +18,22 @@ namespace basalt::packer {
 
 namespace {
 
-struct Pair {
-  std::uint32_t i, j;
-  double gap;
+/// What the pair search found: bonds (i < j, in order of i then j) and the pair statistics.
+struct PairScan {
+  std::vector<basalt::io::Bond> bonds;
+  std::size_t touching = 0;    ///< pairs with gap <= max_gap
+  double largest_overlap = 0;  ///< max over those pairs of -gap (0 when none overlaps)
 };
 
-/// Every pair (i < j) with gap <= max_gap, in order of i then j. Cell lists in CSR form; the index range
-/// is split between threads and the pieces are joined in order, so the result does not depend on them.
-std::vector<Pair> close_pairs(const std::vector<Vec3>& centre, const std::vector<double>& radius,
-                              double max_gap, int threads) {
+/// Every pair (i < j) with gap <= max_gap, from cell lists in CSR form; bonds are stored only when
+/// `keep_bonds`. The index range is cut into chunks of 32 Ki spheres that the threads take in turn;
+/// chunks are joined in index order (each freed as it is joined), so the result does not depend on
+/// the threads, and no list of all pairs with their gaps is ever held (16 B a pair: 0.5 GB at 8.7 M
+/// spheres).
+PairScan close_pairs(const std::vector<Vec3>& centre, const std::vector<double>& radius, double max_gap,
+                     bool keep_bonds, std::int32_t bond_tag, int threads) {
   const std::size_t n = centre.size();
-  std::vector<Pair> result;
+  PairScan result;
   if (n < 2) return result;
   Vec3 lo = centre[0], hi = centre[0];
   double rmax = 0;
@@ -46,43 +53,63 @@ std::vector<Pair> close_pairs(const std::vector<Vec3>& centre, const std::vector
   auto key = [&](int a, int b, int c) { return (static_cast<std::size_t>(c) * dims[1] + b) * dims[0] + a; };
   const std::size_t ncells = static_cast<std::size_t>(dims[0]) * dims[1] * dims[2];
   std::vector<std::uint32_t> start(ncells + 1, 0), order(n);
-  std::vector<std::size_t> cell_of(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    cell_of[i] = key(coord(centre[i][0], 0), coord(centre[i][1], 1), coord(centre[i][2], 2));
-    ++start[cell_of[i] + 1];
-  }
-  for (std::size_t c = 0; c < ncells; ++c) start[c + 1] += start[c];
   {
+    std::vector<std::uint32_t> cell_of(n);  // < 2^32 cells: at most 512^3
+    for (std::size_t i = 0; i < n; ++i) {
+      cell_of[i] = static_cast<std::uint32_t>(
+          key(coord(centre[i][0], 0), coord(centre[i][1], 1), coord(centre[i][2], 2)));
+      ++start[cell_of[i] + 1];
+    }
+    for (std::size_t c = 0; c < ncells; ++c) start[c + 1] += start[c];
     std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
     for (std::size_t i = 0; i < n; ++i) order[fill[cell_of[i]]++] = static_cast<std::uint32_t>(i);
   }
-  threads = std::max(1, std::min(threads, static_cast<int>(n / 10000) + 1));
-  std::vector<std::vector<Pair>> parts(threads);
-  auto work = [&](int t) {
-    const std::size_t begin = n * t / threads, end = n * (t + 1) / threads;
-    auto& out = parts[t];
-    for (std::size_t i = begin; i < end; ++i) {
-      const int ci[3] = {coord(centre[i][0], 0), coord(centre[i][1], 1), coord(centre[i][2], 2)};
-      const std::size_t first = out.size();
-      for (int c = std::max(0, ci[2] - 1); c <= std::min(dims[2] - 1, ci[2] + 1); ++c)
-        for (int b = std::max(0, ci[1] - 1); b <= std::min(dims[1] - 1, ci[1] + 1); ++b)
-          for (int a = std::max(0, ci[0] - 1); a <= std::min(dims[0] - 1, ci[0] + 1); ++a) {
-            const std::size_t k = key(a, b, c);
-            for (std::uint32_t s = start[k]; s < start[k + 1]; ++s) {
-              const std::uint32_t j = order[s];
-              if (j <= i) continue;
-              const double g = norm(centre[i] - centre[j]) - radius[i] - radius[j];
-              if (g <= max_gap) out.push_back({static_cast<std::uint32_t>(i), j, g});
+  constexpr std::size_t kChunk = 32768;
+  const std::size_t chunks = (n + kChunk - 1) / kChunk;
+  std::vector<PairScan> parts(chunks);
+  std::atomic<std::size_t> next{0};
+  auto work = [&] {
+    std::vector<std::pair<std::uint32_t, double>> row;
+    for (std::size_t ch = next++; ch < chunks; ch = next++) {
+      PairScan& out = parts[ch];
+      for (std::size_t i = ch * kChunk; i < std::min(n, (ch + 1) * kChunk); ++i) {
+        const int ci[3] = {coord(centre[i][0], 0), coord(centre[i][1], 1), coord(centre[i][2], 2)};
+        row.clear();
+        for (int c = std::max(0, ci[2] - 1); c <= std::min(dims[2] - 1, ci[2] + 1); ++c)
+          for (int b = std::max(0, ci[1] - 1); b <= std::min(dims[1] - 1, ci[1] + 1); ++b)
+            for (int a = std::max(0, ci[0] - 1); a <= std::min(dims[0] - 1, ci[0] + 1); ++a) {
+              const std::size_t k = key(a, b, c);
+              for (std::uint32_t s = start[k]; s < start[k + 1]; ++s) {
+                const std::uint32_t j = order[s];
+                if (j <= i) continue;
+                const double g = norm(centre[i] - centre[j]) - radius[i] - radius[j];
+                if (g <= max_gap) row.push_back({j, g});
+              }
             }
-          }
-      std::sort(out.begin() + first, out.end(), [](const Pair& x, const Pair& y) { return x.j < y.j; });
+        std::sort(row.begin(), row.end());
+        for (const auto& [j, g] : row) {
+          ++out.touching;
+          out.largest_overlap = std::max(out.largest_overlap, -g);
+          if (keep_bonds)
+            out.bonds.push_back({static_cast<std::int64_t>(i), static_cast<std::int64_t>(j), bond_tag});
+        }
+      }
     }
   };
+  threads = std::max(1, std::min<int>(threads, static_cast<int>(chunks)));
   std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t) pool.emplace_back(work, t);
-  work(0);
+  for (int t = 1; t < threads; ++t) pool.emplace_back(work);
+  work();
   for (auto& th : pool) th.join();
-  for (auto& p : parts) result.insert(result.end(), p.begin(), p.end());
+  std::size_t total = 0;
+  for (const auto& p : parts) total += p.bonds.size();
+  result.bonds.reserve(total);
+  for (auto& p : parts) {
+    result.touching += p.touching;
+    result.largest_overlap = std::max(result.largest_overlap, p.largest_overlap);
+    result.bonds.insert(result.bonds.end(), p.bonds.begin(), p.bonds.end());
+    p = PairScan{};
+  }
   return result;
 }
 
@@ -173,20 +200,19 @@ basalt::io::Geometry assemble(const Volume& volume, const Packing& packing, cons
   basalt::io::Geometry g;
   const std::size_t n = packing.size();
   const auto tags = region_tags(volume, packing.centre, packing.radius, options.tags);
-  for (std::size_t i = 0; i < n; ++i)
-    g.add_particle(static_cast<std::int64_t>(i), packing.centre[i], packing.radius[i], tags[i]);
+  g.id.resize(n);
+  for (std::size_t i = 0; i < n; ++i) g.id[i] = static_cast<std::int64_t>(i);
+  g.position.assign(packing.centre.begin(), packing.centre.end());
+  g.radius = packing.radius;
+  g.tag = tags;
   // Touching (and bonded, when bonds are on) = gap within the bond tolerance.
   const double bond_tol = options.bond_tolerance;
-  const auto pairs = close_pairs(packing.centre, packing.radius, std::max(bond_tol, 0.0), options.threads);
+  auto scan = close_pairs(packing.centre, packing.radius, std::max(bond_tol, 0.0), options.bonds,
+                          options.bond_tag, options.threads);
   st = AssemblyStats{};
-  std::size_t touching = 0;
-  for (const Pair& p : pairs) {
-    st.largest_overlap = std::max(st.largest_overlap, -p.gap);
-    if (p.gap <= bond_tol) {
-      ++touching;
-      if (options.bonds) g.add_bond(p.i, p.j, options.bond_tag);
-    }
-  }
+  st.largest_overlap = scan.largest_overlap;
+  const std::size_t touching = scan.touching;
+  g.bonds = std::move(scan.bonds);
   const Bounds b = volume.bounds();
   g.box_min = b.lo;
   g.box_max = b.hi;

@@ -12,6 +12,7 @@
 #include "basalt/packer/error.hpp"
 #include "basalt/packer/random.hpp"
 #include "sphere_grid.hpp"
+#include "tiles.hpp"
 
 namespace basalt::packer {
 
@@ -172,22 +173,30 @@ LowFractionReport low_fraction_report(const Volume& volume, const PackOptions& o
   return rep;
 }
 
-Packing pack(const Volume& volume, const PackOptions& opt) {
-  check_options(opt);
+namespace detail {
+
+Packing pack_part(const Volume& volume, const PackOptions& opt, const PartSpec& part) {
   const Bounds b = volume.bounds();
-  for (int k = 0; k < 3; ++k)
-    if (b.hi[k] - b.lo[k] < 2 * opt.rmin)
-      throw PackError(fmt::format("the volume ({}) is too small for one sphere of radius rmin = {}",
-                                  volume.description(), opt.rmin));
   Packing out;
   detail::SphereGrid grid(b, opt.rmax);
-  Random rng(opt.seed);
+  // Obstacles placed before (a tile's neighbours): first in `out`, in the grid and the triangulation, and
+  // removed again at the end.
+  const std::size_t fixed = part.fixed ? part.fixed->size() : 0;
+  if (fixed) {
+    out.centre = part.fixed->centre;
+    out.radius = part.fixed->radius;
+    for (std::size_t i = 0; i < fixed; ++i) grid.add(out.centre[i], out.radius[i]);
+  }
+  Random rng(part.seed);
   std::vector<double> radii;
   detail::FillContext ctx{volume, opt, grid, out};
   ctx.rng = &rng;
-  if (opt.exponent) {
+  ctx.centre_range = part.centre_range;
+  if (part.stage == PartSpec::kFill) {
+    ctx.expected_solid = std::max(0.7 - opt.target_fraction, 0.05) * volume.measure();
+  } else if (opt.exponent) {
     radii =
-        power_law_radii(opt.rmin, opt.rmax, *opt.exponent, opt.target_fraction * volume.measure(), opt.seed);
+        power_law_radii(opt.rmin, opt.rmax, *opt.exponent, opt.target_fraction * volume.measure(), part.seed);
     out.requested = radii.size();
     ctx.radii = &radii;
     out.seeds = seed_randomly(
@@ -201,21 +210,48 @@ Packing pack(const Volume& volume, const PackOptions& opt) {
         grid, out, rng);
     ctx.expected_solid = 0.7 * volume.measure();
   }
-  if (out.seeds == 0) {
+  if (out.seeds == 0 && part.stage != PartSpec::kFill) {
     // Nothing of the first size fits: is there room for even one sphere of radius rmin?
     out.seeds = seed_randomly(
         volume, opt, 1.0, [&](std::size_t) { return opt.rmin; }, 1, grid, out, rng);
-    if (out.seeds == 0)
+    if (out.seeds == 0 && fixed == 0)
       throw PackError(fmt::format("the volume ({}) is too small for one sphere of radius rmin = {}",
                                   volume.description(), opt.rmin));
-    if (opt.exponent) {  // the small sphere replaces the smallest drawn radius (if any was drawn)
+    if (opt.exponent && out.seeds > 0) {  // the small sphere replaces the smallest drawn radius (if any)
       if (!radii.empty()) radii.pop_back();
       out.requested = radii.size() + 1;
     }
   }
-  for (double r : out.radius) ctx.placed_solid += 4.0 / 3.0 * std::numbers::pi * r * r * r;
+  for (std::size_t i = fixed; i < out.size(); ++i)
+    ctx.placed_solid += 4.0 / 3.0 * std::numbers::pi * out.radius[i] * out.radius[i] * out.radius[i];
   detail::fill_voids(ctx);
   out.not_placed = ctx.not_placed;
+  if (fixed) {
+    out.centre.erase(out.centre.begin(), out.centre.begin() + static_cast<std::ptrdiff_t>(fixed));
+    out.radius.erase(out.radius.begin(), out.radius.begin() + static_cast<std::ptrdiff_t>(fixed));
+  }
+  out.centre.shrink_to_fit();
+  out.radius.shrink_to_fit();
+  return out;
+}
+
+}  // namespace detail
+
+Packing pack(const Volume& volume, const PackOptions& opt) {
+  check_options(opt);
+  const Bounds b = volume.bounds();
+  for (int k = 0; k < 3; ++k)
+    if (b.hi[k] - b.lo[k] < 2 * opt.rmin)
+      throw PackError(fmt::format("the volume ({}) is too small for one sphere of radius rmin = {}",
+                                  volume.description(), opt.rmin));
+  Packing out;
+  if (const auto layout = detail::tile_layout(volume, opt); layout.count() > 1) {
+    out = detail::pack_tiles(volume, opt, layout);
+  } else {
+    detail::PartSpec whole;
+    whole.seed = opt.seed;
+    out = detail::pack_part(volume, opt, whole);
+  }
   if (opt.progress) opt.progress(1.0);
   return out;
 }

@@ -105,6 +105,14 @@ struct FillContext {
   std::size_t not_placed = 0;      ///< power-law mode: radii for which no void was left
   Random* rng = nullptr;           ///< for the room probes after filling (the seeding's stream)
   std::size_t probed_spheres = 0;  ///< spheres placed where a probe found room the triangulation missed
+  /// A tile of a split pack (docs/packer.md, "Tiles"): only centres within this box are placed here (the
+  /// volume's own boundary still applies). Unbounded for a pack in one piece.
+  Bounds centre_range{{-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}, {HUGE_VAL, HUGE_VAL, HUGE_VAL}};
+  bool in_range(const Vec3& c) const {
+    for (int k = 0; k < 3; ++k)
+      if (!(c[k] >= centre_range.lo[k] && c[k] <= centre_range.hi[k])) return false;
+    return true;
+  }
 };
 
 /// Places spheres into the voids left between out's spheres until none of radius >= rmin is left

@@ -348,7 +348,7 @@ class Filler {
     Vec3 near{0, 0, 0};
     for (int i = 0; i < 4; ++i) near = near + 0.25 * to_vec(c->vertex(i)->point().point());
     auto ball = capacity_ball(co, near);
-    if (!ball || ball->r < rmin_) return;
+    if (!ball || ball->r < rmin_ || !ctx_.in_range(ball->c)) return;
     const double cap = std::min(ball->r, vol_.signed_distance(ball->c));
     if (!(cap >= rmin_ * (1 - 1e-12))) return;
     if (!ctx_.radii) {
@@ -389,6 +389,7 @@ class Filler {
       candidates_.push_back({v.centre, rho});
     }
     for (const Ball& ball : candidates_) {
+      if (!ctx_.in_range(ball.c)) continue;
       if (vol_.signed_distance(ball.c) < ball.r - tol_) continue;
       if (ctx_.grid.overlaps(ball.c, ball.r, tol_)) continue;
       commit(ball, v.cell);

@@ -45,6 +45,7 @@ class BoxVolume final : public Volume {
   std::vector<std::string> piece_names() const override {
     return {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"};
   }
+  bool fills_bounds() const override { return true; }
 
  private:
   Vec3 lo_, hi_;

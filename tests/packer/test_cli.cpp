@@ -241,3 +241,21 @@ TEST(Cli, AnUnknownShapeOrANegativeSeedIsNamed) {
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_EQ(basalt::io::read_geometry(dir / "x.h5").attributes.at("seed"), "18446744073709551615");
 }
+
+TEST(Cli, ThreadCountChangesNothingInTheFile) {
+  // 20 x 20 mm with rmax 0.5: 4 x 4 tiles packed on 1 and on 3 threads (docs/packer.md, "Tiles and threads").
+  const auto dir = basalt::test::scratch_dir("packer-cli-threads");
+  std::string bytes[2];
+  for (int k = 0; k < 2; ++k) {
+    const auto out = dir / ("slab" + std::to_string(k) + ".h5");
+    const auto r = run("box --size 20,20,3 --rmin 0.25 --rmax 0.5 --exponent 2.2 --fill --seed 4 --threads " +
+                       std::to_string(1 + 2 * k) + " -o " + out.string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    bytes[k] = slurp(out);
+  }
+  EXPECT_GT(bytes[0].size(), 10000u);
+  EXPECT_TRUE(bytes[0] == bytes[1]) << "--threads 1 and --threads 3 wrote different files";
+  const auto bad = run("box --size 5,5,5 --rmin 0.2 --rmax 1 --threads 0 -o " + (dir / "x.h5").string());
+  EXPECT_EQ(bad.status, 1);
+  EXPECT_TRUE(contains(bad.output, "--threads must be >= 1, got 0")) << bad.output;
+}

@@ -35,7 +35,12 @@ struct PackOptions {
   double overlap_tolerance = 1e-6;
   /// Solid fraction reached by random seeding before void filling starts.
   double seed_fraction = 0.2;
-  /// Called now and then with an estimate of the work done, in [0, 1].
+  /// Threads packing tiles of a split pack at the same time; the result does not depend on it.
+  int threads = 1;
+  /// A box at least two tiles wide is split into tiles of about this width across its two longest axes
+  /// (docs/packer.md, "Tiles and threads"); 0: 10 rmax; < 0: never split. At least 4 rmax.
+  double tile_width = 0;
+  /// Called now and then with an estimate of the work done, in [0, 1] (from any thread, one at a time).
   std::function<void(double)> progress;
 };
 

@@ -48,6 +48,9 @@ class Volume {
   virtual Plane tangent_plane(int id, const Vec3& x) const = 0;
   /// Names of the pieces for region tags: e.g. {"xmin", ...}; "surface" always means every piece.
   virtual std::vector<std::string> piece_names() const = 0;
+  /// True when the volume is its bounding box (an axis-aligned box): the packer can then split it into
+  /// tiles whose volumes are known exactly and pack them in parallel (docs/packer.md, "Tiles").
+  virtual bool fills_bounds() const { return false; }
 };
 
 /// Axis-aligned box [lo, hi]. Faces: 0 xmin, 1 xmax, 2 ymin, 3 ymax, 4 zmin, 5 zmax.
