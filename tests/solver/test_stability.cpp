@@ -266,3 +266,51 @@ TEST(Precision, FloatWaveAgreesWithDouble) {
   EXPECT_LT(worst_late, 1.5e-3);
   EXPECT_GT(l2, 0.0) << "float and double gave identical bits: the float path was not taken";
 }
+
+// The wave's arrival saver (mean_vz_above, used by tools/bench/accuracy_study.py): the mean vertical
+// velocity of the particles above z, against the particles themselves, on any number of ranks.
+TEST(WaveArrival, MeanVzAboveIsTheMeanOverTheParticlesAboveZ) {
+  Scene scene = wave_scene();
+  for (const double z : {2.0, 100.0}) {
+    FieldSpec f;
+    f.type = FieldSpec::Type::mean_vz_above;
+    f.z = z;
+    scene.fields.push_back(f);
+  }
+  RunOptions opt;
+  opt.quiet = true;
+  Simulation<double> sim(scene, cube1(), basalt::test::world(), opt);
+  basalt::test::MemorySink sink;
+  sink.begin(field_columns(scene));
+  sim.run(300, &sink);
+  const auto& p = sim.particles();
+  double sum = 0, count = 0;
+  for (std::size_t i = 0; i < p.n_owned; ++i)
+    if (p.z[i] > 2.0) {
+      sum += p.vz[i];
+      count += 1;
+    }
+  sum = sim.comm().sum(sum);
+  count = sim.comm().sum(count);
+  if (basalt::test::rank() != 0) return;
+  ASSERT_EQ(sink.columns.size(), 3u);
+  EXPECT_EQ(sink.columns[1], "mean_vz_above");
+  ASSERT_GT(count, 1000.0);
+  const double mean = sum / count;
+  EXPECT_GT(std::abs(mean), 1e-4) << "the pulse has reached z = 2 by 0.3 ms";
+  EXPECT_NEAR(*sink.rows.back()[1], mean, 1e-12 * std::abs(mean));
+  EXPECT_EQ(*sink.rows.back()[2], 0.0) << "no particle above z = 100";
+}
+
+TEST(WaveArrival, MeanVzAboveNeedsZ) {
+  const std::string base =
+      "[run]\ndt = 1e-3\nsteps = 1\nskin = 0.1\n[[output.fields]]\ntype = \"mean_vz_above\"\n";
+  std::string msg;
+  try {
+    basalt::test::scene_from(base);
+  } catch (const InputError& e) {
+    msg = e.what();
+  }
+  EXPECT_NE(msg.find("output.fields[0].z: missing"), std::string::npos) << msg;
+  EXPECT_NO_THROW(basalt::test::scene_from(base + "z = 14.0\n"));
+}
