@@ -210,7 +210,9 @@ void Simulation<Real>::estimate_critical_step(bool fresh) {
       lambda = std::max(lambda, rq);
       if (converged) break;
     }
-    if (fresh)  // x0 back to the float positions of the rebuild
+    // x0 back to the values rebuild() gives it (simulation_rebuild.cpp: keep the two in step; main's
+    // 15d704e makes them relative to the skin origin, float(x - skin_origin), which a merge must copy).
+    if (fresh)
       for (std::size_t i = 0; i < n; ++i) {
         p_.x0[i] = float(p_.x[i]);
         p_.y0[i] = float(p_.y[i]);
