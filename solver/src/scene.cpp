@@ -359,7 +359,8 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
             {"rotational_kinetic_energy", FieldSpec::Type::rotational_kinetic_energy},
             {"sliding_contacts", FieldSpec::Type::sliding_contacts},
             {"runout", FieldSpec::Type::runout},
-            {"mass_below", FieldSpec::Type::mass_below}};
+            {"mass_below", FieldSpec::Type::mass_below},
+            {"mean_vz_above", FieldSpec::Type::mean_vz_above}};
         for (const auto& kind : kOther) allowed.push_back(kind.first);
         FieldSpec f;
         const std::string type = tf.choice_or("type", allowed, "");
@@ -384,7 +385,7 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
           for (const auto& w : s.mesh_walls) found = found || w.name == f.wall;
           if (!found) tf.fail("wall", fmt::format("no wall named \"{}\" (planar or mesh)", f.wall));
         }
-        if (f.type == FieldSpec::Type::mass_below) {
+        if (f.type == FieldSpec::Type::mass_below || f.type == FieldSpec::Type::mean_vz_above) {
           f.z = tf.number("z");
           if (!std::isfinite(f.z)) tf.fail("z", "must be finite");
         }

@@ -99,6 +99,19 @@ bool Simulation<Real>::field_partials(const std::vector<double>& pe, std::vector
         local.push_back(mass);
         break;
       }
+      case FieldSpec::Type::mean_vz_above: {
+        // Collective: the count above z over all ranks, so that the ranks' partials sum to the mean
+        // (0 when no particle is above z).
+        double sum = 0, count = 0;
+        for (std::size_t i = 0; i < p_.n_owned; ++i)
+          if (double(p_.z[i]) > f.z && p_.inv_mass[i] > 0) {
+            sum += double(p_.vz[i]);
+            count += 1;
+          }
+        const double total = comm().size() > 1 ? comm().sum(count) : count;
+        local.push_back(total > 0 ? sum / total : 0.0);
+        break;
+      }
     }
   }
   return any;

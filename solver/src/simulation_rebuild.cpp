@@ -84,6 +84,16 @@ std::vector<std::uint32_t> Simulation<Real>::resolve_bonds() {
 }
 
 template <class Real>
+void Simulation<Real>::set_skin_reference() {
+  const auto& o = p_.skin_origin = skin_origin(dec_->box_min(), dec_->box_max());
+  for (std::size_t i = 0; i < p_.n_owned; ++i) {
+    p_.x0[i] = float(double(p_.x[i]) - o[0]);
+    p_.y0[i] = float(double(p_.y[i]) - o[1]);
+    p_.z0[i] = float(double(p_.z[i]) - o[2]);
+  }
+}
+
+template <class Real>
 void Simulation<Real>::rebuild() {
   Stopwatch sw;
   auto error = check_finite();
@@ -108,12 +118,7 @@ void Simulation<Real>::rebuild() {
   times_.communication += sw.lap();
   const auto bond_bucket_end = resolve_bonds();
   forces_.rebuild_lists(p_, bond_bucket_end, bonds_, scene_.skin, contact_cutoff_);
-  const auto& o = p_.skin_origin = skin_origin(dec_->box_min(), dec_->box_max());
-  for (std::size_t i = 0; i < p_.n_owned; ++i) {
-    p_.x0[i] = float(double(p_.x[i]) - o[0]);
-    p_.y0[i] = float(double(p_.y[i]) - o[1]);
-    p_.z0[i] = float(double(p_.z[i]) - o[2]);
-  }
+  set_skin_reference();
   if (p_.with_exact_rebuild) {  // exact copies for the checkpoints (x0 is float); memory only then
     p_.xr.assign(p_.x.begin(), p_.x.begin() + static_cast<std::ptrdiff_t>(p_.n_owned));
     p_.yr.assign(p_.y.begin(), p_.y.begin() + static_cast<std::ptrdiff_t>(p_.n_owned));
@@ -206,6 +211,7 @@ void Simulation<Real>::check_start(bool fresh) {
   template void Simulation<R>::spatial_sort();                             \
   template std::vector<std::uint32_t> Simulation<R>::resolve_bonds();      \
   template void Simulation<R>::rebuild();                                  \
+  template void Simulation<R>::set_skin_reference();                       \
   template void Simulation<R>::check_start(bool);
 BASALT_INSTANTIATE(double)
 BASALT_INSTANTIATE(float)

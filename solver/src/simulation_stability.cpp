@@ -59,13 +59,23 @@ void Simulation<Real>::estimate_critical_step(bool fresh) {
     return k;
   };
 
-  // The bound: per owned particle 2 sum of its springs to particles + sum of its walls' springs.
-  std::vector<double> ks(n, 0.0);
+  // The bound: per owned particle 2 sum of its springs to particles + sum of its walls' springs. The
+  // sums go to the force arrays (overwritten by the next force computation anyway) in double, and to a
+  // scratch vector in float: no full-size copy beside the solver's arrays (peak memory).
+  std::vector<double> ks_scratch(sizeof(Real) >= sizeof(double) ? 0 : n, 0.0);
+  Real* const ks_real = p_.fx.data();
+  const auto add_k = [&](std::size_t i, double k) {
+    if constexpr (sizeof(Real) >= sizeof(double))
+      ks_real[i] += Real(k);
+    else
+      ks_scratch[i] += k;
+  };
+  if constexpr (sizeof(Real) >= sizeof(double)) std::fill(p_.fx.begin(), p_.fx.begin() + long(n), Real(0));
   for (std::size_t b = 0; b < bonds_.size(); ++b) {
     const auto i = static_cast<std::size_t>(bonds_.ia[b]), j = static_cast<std::size_t>(bonds_.ib[b]);
     const double k = 2 * k_of(0, std::max(double(p_.radius[i]), double(p_.radius[j])));
-    ks[i] += k;
-    if (j < n) ks[j] += k;
+    add_k(i, k);
+    if (j < n) add_k(j, k);
   }
   const auto touching = [&](std::size_t i, std::size_t j) {
     const double dx = double(p_.x[i]) - double(p_.x[j]), dy = double(p_.y[i]) - double(p_.y[j]),
@@ -79,8 +89,8 @@ void Simulation<Real>::estimate_critical_step(bool fresh) {
         const auto j = static_cast<std::size_t>(list->neigh[q]);
         if (!touching(i, j)) continue;
         const double k = 2 * k_of(1, std::max(double(p_.radius[i]), double(p_.radius[j])));
-        ks[i] += k;
-        if (j < n) ks[j] += k;
+        add_k(i, k);
+        if (j < n) add_k(j, k);
       }
   }
   const auto& walls = forces_.walls();
@@ -91,68 +101,107 @@ void Simulation<Real>::estimate_critical_step(bool fresh) {
       const auto i = static_cast<std::size_t>(ci);
       const double d = (double(p_.x[i]) - pt[0]) * nrm[0] + (double(p_.y[i]) - pt[1]) * nrm[1] +
                        (double(p_.z[i]) - pt[2]) * nrm[2];
-      if (d < double(p_.radius[i]) || walls.spec(w).bonds(p_.tag[i])) ks[i] += k_of(2, double(p_.radius[i]));
+      if (d < double(p_.radius[i]) || walls.spec(w).bonds(p_.tag[i])) add_k(i, k_of(2, double(p_.radius[i])));
     }
   }
   double bound2 = 0;
-  for (std::size_t i = 0; i < n; ++i) bound2 = std::max(bound2, ks[i] * double(p_.inv_mass[i]));
+  for (std::size_t i = 0; i < n; ++i) {
+    const double ks = sizeof(Real) >= sizeof(double) ? double(ks_real[i]) : ks_scratch[i];
+    bound2 = std::max(bound2, ks * double(p_.inv_mass[i]));
+  }
   bound2 = comm().max(bound2);
-  std::vector<double>().swap(ks);
+  std::vector<double>().swap(ks_scratch);
   st.dt_bound = stability::critical_step(bound2);
 
-  // Power iterations on M^-1 K: K v = (F(x) - F(x + e v)) / e from the force field itself. The
-  // products need the ghosts' perturbed positions: a ghost update per iteration, as in a step.
+  // Power iterations on M^-1 K, each product K u from the force field, K u = (F(x) - F(x + delta u)) /
+  // delta: F(x) is computed again for each product and negated in the force arrays, where F(x + delta u)
+  // then adds onto it, so no forces are stored (two evaluations per product; central differences,
+  // at the same cost, would drop the O(delta) bias, ~1e-7 here, far below the tolerance, but move the
+  // printed estimates' last digits). The iteration vector is kept in float in the float positions of
+  // the last rebuild (p_.x0, equal to float(x) right after it; restored at the end) or, after a
+  // restart (x0 then belongs to the checkpoint's rebuild), in a float scratch vector. The positions
+  // are not copied: each perturbation is a multiple of the ulp of its coordinate and stays within its
+  // binade, so x -> x + d -> x is exact (the few coordinates near zero or a power of two, where that
+  // fails, are kept in a side list). The products need the ghosts' perturbed positions: a ghost update per
+  // force evaluation, as in a step. Peak memory: docs/bench/build_ab_granular.md.
   double lambda = 0;
   st.iterations = 0;
   if (bound2 > 0) {
     const bool parallel = comm().size() > 1;
-    const std::vector<Real> x0(p_.x.begin(), p_.x.begin() + long(n)),
-        y0(p_.y.begin(), p_.y.begin() + long(n)), z0(p_.z.begin(), p_.z.begin() + long(n));
+    std::vector<float> scratch(fresh ? 0 : 3 * n);
+    float* const sv[3] = {fresh ? p_.x0.data() : scratch.data(), fresh ? p_.y0.data() : scratch.data() + n,
+                          fresh ? p_.z0.data() : scratch.data() + 2 * n};
+    Real* const pos[3] = {p_.x.data(), p_.y.data(), p_.z.data()};
+    Real* const frc[3] = {p_.fx.data(), p_.fy.data(), p_.fz.data()};
+    const double delta = stability::perturbation<Real>() * st.rmin;
+    // Coordinates whose ulp is the same over [c - 2 delta, c + 2 delta] move by a multiple of it,
+    // exactly; the others (within 2 delta of zero or of a power of two: a plane of particles at z = 0,
+    // say) keep their value in a side list, sorted by 3 i + d.
+    const auto movable = [&](Real c) {
+      const double a = std::abs(double(c));
+      return a > 4 * delta && stability::ulp(Real(a - 2 * delta)) == stability::ulp(Real(a + 2 * delta));
+    };
+    std::vector<std::size_t> side_at;
+    std::vector<Real> side_value;
+    for (std::size_t i = 0; i < n; ++i)
+      for (int d = 0; d < 3; ++d) {
+        sv[d][i] = float(stability::start_component(p_.id[i], d));
+        if (!movable(pos[d][i])) {
+          side_at.push_back(3 * i + std::size_t(d));
+          side_value.push_back(pos[d][i]);
+        }
+      }
     // Bonds already beyond their break strain break here, as in the first force computation without
     // the estimate (a restart at the step they broke replays exactly that); the perturbed ones must not.
-    compute_forces<false>();
+    compute_forces<false>();  // also F(x) for the first product
     const std::size_t broken_before = broken_.size();
-    const std::vector<double> f0x(p_.fx.begin(), p_.fx.begin() + long(n)),
-        f0y(p_.fy.begin(), p_.fy.begin() + long(n)), f0z(p_.fz.begin(), p_.fz.begin() + long(n));
-    std::vector<double> vx(n), vy(n), vz(n);
-    for (std::size_t i = 0; i < n; ++i) {
-      vx[i] = stability::start_component(p_.id[i], 0);
-      vy[i] = stability::start_component(p_.id[i], 1);
-      vz[i] = stability::start_component(p_.id[i], 2);
-    }
-    const double delta = stability::perturbation<Real>() * st.rmin;
     std::vector<double> sums(2);
+    double vmax = 0;
     for (int it = 0; it < stability::kMaxIterations; ++it) {
-      double vmax = 0;
-      for (std::size_t i = 0; i < n; ++i)
-        vmax = std::max({vmax, std::abs(vx[i]), std::abs(vy[i]), std::abs(vz[i])});
+      vmax = 0;
+      for (int d = 0; d < 3; ++d)
+        for (std::size_t i = 0; i < n; ++i) vmax = std::max(vmax, double(std::abs(sv[d][i])));
       vmax = comm().max(vmax);
       if (!(vmax > 0) || !std::isfinite(vmax)) break;
-      for (std::size_t i = 0; i < n; ++i) {  // |v| <= 1, the perturbation at most delta
-        vx[i] /= vmax;
-        vy[i] /= vmax;
-        vz[i] /= vmax;
-        p_.x[i] = Real(double(x0[i]) + delta * vx[i]);
-        p_.y[i] = Real(double(y0[i]) + delta * vy[i]);
-        p_.z[i] = Real(double(z0[i]) + delta * vz[i]);
-      }
+      if (it > 0) compute_forces<false>();  // F(x) (the first one is above)
+      for (int d = 0; d < 3; ++d)
+        for (std::size_t i = 0; i < n; ++i) frc[d][i] = -frc[d][i];
+      forces_zeroed_ = true;  // the next evaluation adds F(x + d) onto -F(x)
+      // x + d: delta v / vmax, rounded to a multiple of the coordinate's ulp where it is movable.
+      for (std::size_t i = 0, k = 0; i < n; ++i)
+        for (int d = 0; d < 3; ++d) {
+          const double want = delta * double(sv[d][i]) / vmax;
+          if (k < side_at.size() && side_at[k] == 3 * i + std::size_t(d)) {
+            pos[d][i] = Real(double(side_value[k++]) + want);
+          } else {
+            const Real q = stability::ulp(pos[d][i]);
+            pos[d][i] += Real(std::nearbyint(want / double(q))) * q;
+          }
+        }
       if (parallel) halo_->update_ghosts(p_);
       compute_forces<false>();
       sums[0] = sums[1] = 0;
-      for (std::size_t i = 0; i < n; ++i) {
-        // The perturbation actually applied (rounded to Real) and K times it.
-        const double ux = (double(p_.x[i]) - double(x0[i])) / delta,
-                     uy = (double(p_.y[i]) - double(y0[i])) / delta,
-                     uz = (double(p_.z[i]) - double(z0[i])) / delta;
-        const double wx = (f0x[i] - double(p_.fx[i])) / delta, wy = (f0y[i] - double(p_.fy[i])) / delta,
-                     wz = (f0z[i] - double(p_.fz[i])) / delta;
+      for (std::size_t i = 0, k = 0; i < n; ++i) {
         const double im = double(p_.inv_mass[i]);
-        sums[0] += ux * wx + uy * wy + uz * wz;
-        sums[1] += (ux * ux + uy * uy + uz * uz) / im;
-        vx[i] = wx * im;
-        vy[i] = wy * im;
-        vz[i] = wz * im;
+        for (int d = 0; d < 3; ++d) {
+          // The perturbation actually applied (then undone, exactly) and K times it.
+          double dd;
+          if (k < side_at.size() && side_at[k] == 3 * i + std::size_t(d)) {
+            dd = double(pos[d][i]) - double(side_value[k]);
+            pos[d][i] = side_value[k++];
+          } else {
+            const Real q = stability::ulp(pos[d][i]);  // the same at x + d as at x
+            const Real step = Real(std::nearbyint(delta * double(sv[d][i]) / vmax / double(q))) * q;
+            pos[d][i] -= step;
+            dd = double(step);
+          }
+          const double u = dd / delta, w = -double(frc[d][i]) / delta;
+          sums[0] += u * w;
+          sums[1] += u * u / im;
+          sv[d][i] = float(w * im);
+        }
       }
+      if (parallel) halo_->update_ghosts(p_);
       comm().sum_all(sums);
       ++st.iterations;
       if (!(sums[1] > 0)) break;
@@ -161,11 +210,8 @@ void Simulation<Real>::estimate_critical_step(bool fresh) {
       lambda = std::max(lambda, rq);
       if (converged) break;
     }
-    // Back to the positions and forces of the start (the caller computes them again as it needs).
-    std::copy(x0.begin(), x0.end(), p_.x.begin());
-    std::copy(y0.begin(), y0.end(), p_.y.begin());
-    std::copy(z0.begin(), z0.end(), p_.z.begin());
-    if (parallel) halo_->update_ghosts(p_);
+    // x0 back to the values rebuild() gives it (the same function sets both).
+    if (fresh) set_skin_reference();
     if (broken_.size() != broken_before)
       throw InputError(fmt::format(
           "the critical-step estimate broke {} bond(s) by perturbing positions by {:.3g}: bonds this close "

@@ -175,6 +175,9 @@ class Simulation {
   /// between unbonded particles or into a wall; warns (rank 0) of the deepest overlap above 10 %.
   void check_start(bool fresh);
   void rebuild();
+  /// x0 = the owned positions relative to skin_origin (of the decomposition box), as float: the skin
+  /// criterion's reference, set at every rebuild (and restored after the critical-step estimate).
+  void set_skin_reference();
   /// Bonds to local indices, in canonical order; returns the bond buckets (Bonds::order_canonically).
   std::vector<std::uint32_t> resolve_bonds();
   void spatial_sort();

@@ -83,7 +83,8 @@ struct MeshWallSpec {
 
 /// One field saver ([[output.fields]]): a term of the energy ledger (kinetic_energy, the potentials,
 /// wall_work_in, a body force's potential), the total mechanical energy, the bond count, or a wall's
-/// force (planar or mesh wall), or the mass of the particles below a height (mass_below: discharge).
+/// force (planar or mesh wall), the mass of the particles below a height (mass_below: discharge), or
+/// the mean vertical velocity of the particles above a height (mean_vz_above: a wave's arrival).
 struct FieldSpec {
   enum class Type {
     energy,
@@ -94,7 +95,8 @@ struct FieldSpec {
     rotational_kinetic_energy,
     sliding_contacts,
     runout,
-    mass_below
+    mass_below,
+    mean_vz_above
   };
   Type type = Type::energy;
   std::string term = "kinetic_energy";  ///< energy only: the ledger term
@@ -106,7 +108,7 @@ struct FieldSpec {
   /// pass (100: the farthest particle).
   std::array<double, 3> origin{0, 0, 0}, direction{1, 0, 0};
   double percentile = 100;
-  double z = 0;  ///< mass_below only: particles whose centre is below this height
+  double z = 0;  ///< mass_below, mean_vz_above: particles whose centre is below / above this height
   /// The column name (wall_force: the prefix of three columns).
   std::string name() const {
     switch (type) {
@@ -126,6 +128,8 @@ struct FieldSpec {
         return "sliding_contacts";
       case Type::mass_below:
         return "mass_below";
+      case Type::mean_vz_above:
+        return "mean_vz_above";
       case Type::runout:
         return percentile >= 100 ? std::string("runout_max")
                                  : "runout_p" + std::to_string(static_cast<int>(std::lround(percentile)));

@@ -12,7 +12,9 @@
 //    quotient rises towards omega_max^2 from below: 2 / omega_power is at least the true step.
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
+#include <type_traits>
 
 namespace basalt::solver::stability {
 
@@ -30,6 +32,21 @@ inline double start_component(std::int64_t id, int d) {
   k = (k ^ (k >> 27)) * 0x94D049BB133111EBull;
   k ^= k >> 31;
   return double(k >> 11) * 0x1.0p-53 * 2.0 - 1.0;
+}
+
+/// The spacing of the floating-point numbers at |c| for a normal c (the distance to the next one away
+/// from zero): 2^(exponent of c - mantissa bits), from the exponent bits alone.
+template <class Real>
+Real ulp(Real c) {
+  using Bits = std::conditional_t<sizeof(Real) == 8, std::uint64_t, std::uint32_t>;
+  constexpr int kMantissa = std::numeric_limits<Real>::digits - 1;
+  constexpr Bits kExponent = ((Bits(1) << (sizeof(Real) * 8 - 1)) - 1) & ~((Bits(1) << kMantissa) - 1);
+  Bits b;
+  std::memcpy(&b, &c, sizeof b);
+  b &= kExponent;  // |c| rounded down to a power of two
+  Real p;
+  std::memcpy(&p, &b, sizeof p);
+  return p * std::numeric_limits<Real>::epsilon();
 }
 
 /// Power iterations stop when the Rayleigh quotient changed by less than this (relative) between
