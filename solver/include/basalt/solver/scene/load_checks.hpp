@@ -7,6 +7,8 @@
 // force tags no particle has, a bond_tag no bond has) are warnings: they would silently do nothing.
 #include <mpi.h>
 
+#include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -14,6 +16,30 @@
 #include "basalt/solver/scene/scene.hpp"
 
 namespace basalt::solver {
+
+/// What the checks need of the particles and bonds, so that ranks each holding a slice of a geometry can
+/// combine theirs (merge_summaries) and check the whole: the same numbers as from the whole geometry.
+struct GeometrySummary {
+  std::size_t particles = 0;
+  bool has_mass = false;
+  double m_min = std::numeric_limits<double>::infinity();      ///< masses as the checks compute them
+  double m_min_pow = std::numeric_limits<double>::infinity();  ///< masses as the solver computes them
+  double rmin = std::numeric_limits<double>::infinity(), rmax = 0;
+  std::vector<std::int64_t> tags;         ///< particle tags present, sorted, unique
+  std::vector<std::int64_t> bond_tags;    ///< bond tags present, sorted, unique
+  std::optional<std::string> mass_error;  ///< the first particle (file order) with an unusable mass
+};
+
+/// The summary of `g`'s particles and bonds (either may be a slice of a file's rows).
+GeometrySummary summarize_geometry(const Scene& scene, const io::Geometry& g, const std::string& source);
+/// Collective over `comm`: the summary of the union of every rank's slices (mass error: the lowest rank's).
+GeometrySummary merge_summaries(const GeometrySummary& local, MPI_Comm comm);
+/// Throws InputError for derived quantities that are not finite or not usable; returns the warnings.
+std::vector<std::string> check_scene_with_summary(const Scene& scene, const GeometrySummary& s,
+                                                  const std::string& source);
+/// check_scene_with_summary on every rank (all hold the same summary, so all throw alike); rank 0 prints
+/// the warnings on stderr.
+void run_load_checks(const Scene& scene, const GeometrySummary& s, const std::string& source, MPI_Comm comm);
 
 /// Throws InputError for derived quantities that are not finite or not usable; returns the warnings
 /// (one line each). `source` names where the particles came from (geometry file or checkpoint).
