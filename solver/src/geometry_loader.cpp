@@ -27,11 +27,6 @@ struct BondRecord {
   std::int32_t tag;
 };
 
-/// A request for a particle: its id and the bond row that asks (named in errors).
-struct Request {
-  std::int64_t id, row;
-};
-
 /// Runs f on this rank; an exception on any rank becomes the same InputError on every rank.
 template <class F>
 void agreed(const Comm& comm, F&& f) {
@@ -150,57 +145,61 @@ io::Geometry GeometryLoader::local_part(const Decomposition& dec) {
   std::vector<io::Bond> bonds;
   agreed(comm_, [&, bb = bb, be = be] { bonds = file_.read_bonds(bb, be); });
   stats_.bond_rows = bonds.size();
-  std::vector<std::vector<Request>> ask(p);
+  // Each end id is asked once of the slice holding it; ids sorted, so the answers come back in that order.
+  std::vector<std::int64_t> end_ids;
+  end_ids.reserve(2 * bonds.size());
   std::optional<std::string> error;
   for (std::size_t k = 0; k < bonds.size(); ++k)
     for (const auto id : {bonds[k].a, bonds[k].b}) {
-      const int r = slice_of(id);
-      if (r < 0) {
+      if (slice_of(id) < 0) {
         if (!error)
           error = fmt::format("{}: /bonds/pairs: bond {} refers to particle id {}, which does not exist",
                               file, bb + k, id);
         continue;
       }
-      ask[static_cast<std::size_t>(r)].push_back({id, static_cast<std::int64_t>(bb + k)});
+      end_ids.push_back(id);
     }
   if (auto e = comm_.agree_error(error)) throw InputError(*e);
+  std::sort(end_ids.begin(), end_ids.end());
+  end_ids.erase(std::unique(end_ids.begin(), end_ids.end()), end_ids.end());
+  end_ids.shrink_to_fit();
+  std::vector<std::vector<std::int64_t>> ask(p);
+  for (const auto id : end_ids) ask[static_cast<std::size_t>(slice_of(id))].push_back(id);
   std::vector<std::size_t> asked_counts;
-  const auto asked = comm_.exchange(ask, &asked_counts);
+  std::vector<std::int64_t> asked = comm_.exchange(ask, &asked_counts);
+  std::vector<std::vector<std::int64_t>>(p).swap(ask);
   std::vector<std::vector<std::int32_t>> answer(p);
   {
     std::size_t q = 0;
     for (std::size_t r = 0; r < p; ++r)
       for (std::size_t j = 0; j < asked_counts[r]; ++j, ++q) {
-        const auto at = std::lower_bound(slice_.id.begin(), slice_.id.end(), asked[q].id);
-        if (at == slice_.id.end() || *at != asked[q].id) {
-          if (!error)
-            error = fmt::format("{}: /bonds/pairs: bond {} refers to particle id {}, which does not exist",
-                                file, asked[q].row, asked[q].id);
-          answer[r].push_back(-1);
-          continue;
-        }
-        answer[r].push_back(owner[static_cast<std::size_t>(at - slice_.id.begin())]);
+        const auto at = std::lower_bound(slice_.id.begin(), slice_.id.end(), asked[q]);
+        answer[r].push_back(at == slice_.id.end() || *at != asked[q]
+                                ? -1
+                                : owner[static_cast<std::size_t>(at - slice_.id.begin())]);
       }
   }
+  std::vector<std::int64_t>().swap(asked);
+  const auto owners = comm_.exchange(answer);  // owners[i]: the owner of end_ids[i]
+  std::vector<std::vector<std::int32_t>>(p).swap(answer);
+  const auto owner_of = [&](std::int64_t id) {
+    return owners[static_cast<std::size_t>(std::lower_bound(end_ids.begin(), end_ids.end(), id) - end_ids.begin())];
+  };
+  for (std::size_t k = 0; k < bonds.size() && !error; ++k)
+    for (const auto id : {bonds[k].a, bonds[k].b})
+      if (owner_of(id) < 0 && !error)
+        error = fmt::format("{}: /bonds/pairs: bond {} refers to particle id {}, which does not exist", file,
+                            bb + k, id);
   if (auto e = comm_.agree_error(error)) throw InputError(*e);
-  std::vector<std::size_t> answered_counts;
-  const auto owners = comm_.exchange(answer, &answered_counts);
-  // Answers come back per slice rank in the order asked: walk the requests the same way.
-  std::vector<std::size_t> next(p, 0), start(p, 0);
-  for (std::size_t r = 1; r < p; ++r) start[r] = start[r - 1] + answered_counts[r - 1];
   std::vector<std::vector<BondRecord>> send(p);
   for (std::size_t k = 0; k < bonds.size(); ++k) {
-    int o[2];
-    int e = 0;
-    for (const auto id : {bonds[k].a, bonds[k].b}) {
-      const auto r = static_cast<std::size_t>(slice_of(id));
-      o[e++] = owners[start[r] + next[r]++];
-    }
+    const int o[2] = {owner_of(bonds[k].a), owner_of(bonds[k].b)};
     const BondRecord rec{bonds[k].a, bonds[k].b, static_cast<std::int64_t>(bb + k), bonds[k].tag};
     send[static_cast<std::size_t>(o[0])].push_back(rec);
     if (o[1] != o[0]) send[static_cast<std::size_t>(o[1])].push_back(rec);
   }
   std::vector<io::Bond>().swap(bonds);
+  std::vector<std::int64_t>().swap(end_ids);
   std::vector<BondRecord> mine = comm_.exchange(send);  // in file order, like the particles
   std::vector<std::vector<BondRecord>>(p).swap(send);
   stats_.bonds = mine.size();
