@@ -183,7 +183,8 @@ io::Geometry GeometryLoader::local_part(const Decomposition& dec) {
   const auto owners = comm_.exchange(answer);  // owners[i]: the owner of end_ids[i]
   std::vector<std::vector<std::int32_t>>(p).swap(answer);
   const auto owner_of = [&](std::int64_t id) {
-    return owners[static_cast<std::size_t>(std::lower_bound(end_ids.begin(), end_ids.end(), id) - end_ids.begin())];
+    return owners[static_cast<std::size_t>(std::lower_bound(end_ids.begin(), end_ids.end(), id) -
+                                           end_ids.begin())];
   };
   for (std::size_t k = 0; k < bonds.size() && !error; ++k)
     for (const auto id : {bonds[k].a, bonds[k].b})
