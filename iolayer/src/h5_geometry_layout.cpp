@@ -104,8 +104,7 @@ void write_geometry_layout(Writer& w, const Geometry& g, Names extra_reserved) {
   }
 }
 
-Geometry read_geometry_layout(const Reader& r, Names extra_reserved) {
-  Geometry g;
+void read_geometry_attributes(const Reader& r, Names extra_reserved, Geometry& g) {
   g.units.length = r.string_attribute("/", "length_unit");
   g.units.time = r.string_attribute("/", "time_unit");
   g.units.force = r.string_attribute("/", "force_unit");
@@ -133,6 +132,11 @@ Geometry read_geometry_layout(const Reader& r, Names extra_reserved) {
       r.fail(root_attribute(name), "provenance attributes must be strings");
     g.attributes[name] = r.string_attribute("/", name);
   }
+}
+
+Geometry read_geometry_layout(const Reader& r, Names extra_reserved) {
+  Geometry g;
+  read_geometry_attributes(r, extra_reserved, g);
 
   // Particles: every per-particle dataset has one row per id.
   r.require_group("/particles");

@@ -25,6 +25,10 @@ void check_schema(const Reader& r, const std::string& schema, int version);
 /// `extra_reserved`: root attributes the calling schema writes itself (provenance may not use them).
 void write_geometry_layout(Writer& w, const Geometry& g, Names extra_reserved);
 
+/// Reads and checks the root attributes write_geometry_layout wrote (units, box, periodic, provenance)
+/// into `g`, no particle or bond data.
+void read_geometry_attributes(const Reader& r, Names extra_reserved, Geometry& g);
+
 /// Reads and checks what write_geometry_layout wrote; every error names the dataset or attribute.
 /// Root string attributes that are neither the geometry's nor in `extra_reserved` become provenance.
 Geometry read_geometry_layout(const Reader& r, Names extra_reserved);

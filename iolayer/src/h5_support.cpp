@@ -184,6 +184,26 @@ void Reader::read_raw(const std::string& dataset, hid_t mem_type, void* out) con
     fail(dataset, "cannot read the values (file damaged, or a value out of range for its type)");
 }
 
+void Reader::read_rows_raw(const std::string& dataset, hid_t mem_type, std::size_t row, std::size_t count,
+                           std::size_t columns, void* out) const {
+  if (count == 0) return;
+  Handle ds(H5Dopen2(id(), dataset.c_str(), H5P_DEFAULT), H5Dclose);
+  if (!ds.valid()) fail(dataset, "cannot open dataset");
+  Handle file_space(H5Dget_space(ds.get()), H5Sclose);
+  const int rank = columns == 0 ? 1 : 2;
+  const hsize_t start[2] = {static_cast<hsize_t>(row), 0};
+  const hsize_t size[2] = {static_cast<hsize_t>(count), static_cast<hsize_t>(columns)};
+  if (H5Sselect_hyperslab(file_space.get(), H5S_SELECT_SET, start, nullptr, size, nullptr) < 0)
+    fail(dataset, fmt::format("cannot select rows {} to {}", row, row + count));
+  Handle mem_space(H5Screate_simple(rank, size, nullptr), H5Sclose);
+  Handle dxpl(H5Pcreate(H5P_DATASET_XFER), H5Pclose);
+  H5Pset_type_conv_cb(dxpl.get(), abort_on_overflow, nullptr);
+  if (H5Dread(ds.get(), mem_type, mem_space.get(), file_space.get(), dxpl.get(), out) < 0)
+    fail(dataset,
+         fmt::format("cannot read rows {} to {} (file damaged, or a value out of range for its type)", row,
+                     row + count));
+}
+
 bool Reader::has_attribute(const std::string& object, const std::string& name) const {
   if (!exists(object)) return false;
   const htri_t r = H5Aexists_by_name(id(), object.c_str(), name.c_str(), H5P_DEFAULT);

@@ -134,6 +134,13 @@ class Reader {
   void read_into(const std::string& dataset, T* out) const {
     read_raw(dataset, Type<T>::mem(), out);
   }
+  /// Reads rows [row, row + count) of a dataset of `columns` columns (0: one-dimensional) into `out`
+  /// (a hyperslab: only those rows are read from the file).
+  template <class T>
+  void read_rows_into(const std::string& dataset, std::size_t row, std::size_t count, std::size_t columns,
+                      T* out) const {
+    read_rows_raw(dataset, Type<T>::mem(), row, count, columns, out);
+  }
   template <class T>
   std::vector<T> read(const std::string& dataset, std::size_t columns = 0) const {
     std::vector<T> v(rows<T>(dataset, columns) * (columns ? columns : 1));
@@ -164,6 +171,8 @@ class Reader {
  private:
   std::size_t checked_rows(const std::string& dataset, H5T_class_t cls, std::size_t columns) const;
   void read_raw(const std::string& dataset, hid_t mem_type, void* out) const;
+  void read_rows_raw(const std::string& dataset, hid_t mem_type, std::size_t row, std::size_t count,
+                     std::size_t columns, void* out) const;
   void read_numeric_attribute(const std::string& object, const std::string& name, H5T_class_t cls,
                               hid_t mem_type, std::size_t count, void* out) const;
   Handle open_attribute(const std::string& object, const std::string& name) const;

@@ -13,6 +13,7 @@
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -21,6 +22,7 @@
 
 #include "basalt/io/checkpoint.hpp"
 #include "basalt/io/geometry.hpp"
+#include "basalt/io/geometry_rows.hpp"
 #include "basalt/io/io_ranks.hpp"
 #include "basalt/io/vtk_frame_writer.hpp"
 #include "basalt/solver/core/errors.hpp"
@@ -31,6 +33,7 @@
 #include "basalt/solver/simulation.hpp"
 #include "basalt/version.hpp"
 #include "client_sink.hpp"
+#include "geometry_input.hpp"
 #include "picture_module.hpp"
 #include "restart_support.hpp"
 
@@ -43,7 +46,7 @@ namespace {
 struct Cli {
   std::string scene_file, geometry, output, dims_text, restart, precision, preset;
   std::int64_t steps = -1;
-  bool quiet = false, force_dt = false, force_overlap = false;
+  bool quiet = false, force_dt = false, force_overlap = false, whole_geometry = false;
   int io_ranks = 0;
   std::int64_t checkpoint_every = -1, frames_every = -1, fields_every = -1, render_every = -1;
   std::optional<std::string> render;
@@ -183,17 +186,42 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
       info.periodic = ckpt->geometry.periodic;
       info.units = ckpt->geometry.units;
     } else {
-      auto g = io::read_geometry(scene.geometry);
-      if (root && (g.units.length != scene.units.length || g.units.time != scene.units.time ||
-                   g.units.force != scene.units.force))
+      // Each compute rank reads a slice of the file's rows and the ranks route them to their owners; a
+      // .geo is first converted to HDF5 once, by compute rank 0 (docs/formats.md, "Start-up").
+      const fs::path file = basalt::run::geometry_as_h5(scene.geometry, cfg.dir, comm, cli.quiet);
+      std::optional<io::GeometryFile> rows;
+      std::optional<std::string> open_error;
+      try {
+        rows.emplace(file);
+      } catch (const std::exception& e) {
+        open_error = e.what();
+      }
+      if (auto e = comm.agree_error(open_error)) throw InputError(*e);
+      const auto& h = rows->header();
+      if (root && (h.units.length != scene.units.length || h.units.time != scene.units.time ||
+                   h.units.force != scene.units.force))
         fmt::print(stderr, "warning: the geometry declares units {}, {}, {}; the scene {}, {}, {}\n",
-                   g.units.length, g.units.time, g.units.force, scene.units.length, scene.units.time,
+                   h.units.length, h.units.time, h.units.force, scene.units.length, scene.units.time,
                    scene.units.force);
-      info.box_min = g.box_min;
-      info.box_max = g.box_max;
-      info.periodic = g.periodic;
-      info.units = g.units;
-      sim = std::make_unique<Simulation<Real>>(scene, std::move(g), layout.compute, options);
+      info.box_min = h.box_min;
+      info.box_max = h.box_max;
+      info.periodic = h.periodic;
+      info.units = h.units;
+      if (cli.whole_geometry) {  // the former start-up, kept as the check of the one above
+        rows.reset();
+        sim = std::make_unique<Simulation<Real>>(scene, io::read_geometry(file), layout.compute, options);
+      } else {
+        sim = std::make_unique<Simulation<Real>>(scene, *rows, layout.compute, options);
+      }
+      if (std::getenv("BASALT_DEBUG_LOAD")) {
+        const auto& ls = sim->load_stats();
+        fmt::print(
+            "load: compute rank {} read {} particle rows and {} bond rows of {} and {}; holds {} owned "
+            "particles, {} far bond ends, {} bonds\n",
+            comm.rank(), ls.particle_rows, ls.bond_rows, h.particles, h.bonds, ls.owned, ls.ghost_ends,
+            ls.bonds);
+        std::fflush(stdout);
+      }
     }
     info.attributes = basalt::run::restart_attributes(sim->restart_layout());
     info.attributes["code_version"] = std::string(basalt::kVersion);
@@ -355,6 +383,9 @@ int run_world(int argc, char** argv) {
                  "floating-point type of the solver: double or float; overrides run.precision")
       ->check(CLI::IsMember({"double", "float"}));
   app.add_flag("--quiet", cli.quiet, "no progress line");
+  app.add_flag("--whole-geometry", cli.whole_geometry,
+               "every compute rank reads the whole geometry file (the former start-up; a check of the "
+               "sliced reading, which gives the same run)");
   app.add_flag("--force-dt", cli.force_dt, "run even when dt exceeds the critical time step");
   app.add_flag("--force-overlap", cli.force_overlap,
                "start even when particles overlap by more than half a radius (each other or a wall)");

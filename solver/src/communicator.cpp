@@ -1,5 +1,8 @@
 #include "basalt/solver/parallel/communicator.hpp"
 
+#include <climits>
+#include <stdexcept>
+
 namespace basalt::solver {
 
 Comm::Comm(MPI_Comm comm) : comm_(comm) {
@@ -82,6 +85,43 @@ std::optional<std::string> Comm::agree_error(const std::optional<std::string>& l
 }
 
 void Comm::barrier() const { MPI_Barrier(comm_); }
+
+std::size_t Comm::prepare_exchange(const std::vector<std::size_t>& send_counts, std::vector<int>& sc,
+                                   std::vector<int>& sd, std::vector<int>& rc, std::vector<int>& rd,
+                                   std::vector<std::size_t>& recv_counts) const {
+  const auto p = static_cast<std::size_t>(size_);
+  sc.assign(p, 0);
+  sd.assign(p, 0);
+  rc.assign(p, 0);
+  rd.assign(p, 0);
+  long long sent = 0;
+  for (std::size_t r = 0; r < p && r < send_counts.size(); ++r) {
+    sc[r] = static_cast<int>(send_counts[r]);
+    sd[r] = static_cast<int>(sent);
+    sent += static_cast<long long>(send_counts[r]);
+  }
+  MPI_Alltoall(sc.data(), 1, MPI_INT, rc.data(), 1, MPI_INT, comm_);
+  long long received = 0;
+  recv_counts.assign(p, 0);
+  for (std::size_t r = 0; r < p; ++r) {
+    rd[r] = static_cast<int>(received);
+    recv_counts[r] = static_cast<std::size_t>(rc[r]);
+    received += rc[r];
+  }
+  // Displacements are ints in elements of the exchanged record type.
+  if (sent > INT_MAX || received > INT_MAX)
+    throw std::length_error("Comm::exchange: more than 2^31 records to or from one rank");
+  return static_cast<std::size_t>(received);
+}
+
+void Comm::alltoallv(const void* send, const std::vector<int>& sc, const std::vector<int>& sd, void* recv,
+                     const std::vector<int>& rc, const std::vector<int>& rd, std::size_t bytes) const {
+  MPI_Datatype record = MPI_DATATYPE_NULL;
+  MPI_Type_contiguous(static_cast<int>(bytes), MPI_BYTE, &record);
+  MPI_Type_commit(&record);
+  MPI_Alltoallv(send, sc.data(), sd.data(), record, recv, rc.data(), rd.data(), record, comm_);
+  MPI_Type_free(&record);
+}
 
 AsyncSum::~AsyncSum() {
   if (active_) MPI_Wait(&request_, MPI_STATUS_IGNORE);

@@ -35,6 +35,14 @@ Decomposition::Decomposition(const Comm& comm, std::array<int, 3> dims, const st
     lo_[d] = c == 0 ? -std::numeric_limits<double>::infinity() : box_min_[d] + c * w;
     hi_[d] = c == dims_[d] - 1 ? std::numeric_limits<double>::infinity() : box_min_[d] + (c + 1) * w;
   }
+  rank_table_.resize(static_cast<std::size_t>(dims_[0] * dims_[1] * dims_[2]));
+  for (int i = 0; i < dims_[0]; ++i)
+    for (int j = 0; j < dims_[1]; ++j)
+      for (int k = 0; k < dims_[2]; ++k) {
+        const int c[3] = {i, j, k};
+        MPI_Cart_rank(cart_raw_, c,
+                      &rank_table_[static_cast<std::size_t>((i * dims_[1] + j) * dims_[2] + k)]);
+      }
 }
 
 Decomposition::~Decomposition() {

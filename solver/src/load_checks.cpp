@@ -12,6 +12,7 @@
 
 #include "basalt/solver/core/errors.hpp"
 #include "basalt/solver/models/registry.hpp"
+#include "basalt/solver/parallel/communicator.hpp"
 
 namespace basalt::solver {
 
@@ -42,32 +43,88 @@ double norm(const std::array<double, 3>& v) {
 
 }  // namespace
 
-std::vector<std::string> check_scene_with_geometry(const Scene& scene, const io::Geometry& g,
-                                                   const std::string& source) {
-  std::vector<std::string> warnings;
-  if (g.size() == 0) return warnings;
-
-  // Masses: given by the geometry (or checkpoint), or density x 4/3 pi r^3.
-  double m_min = std::numeric_limits<double>::infinity(), rmin = m_min, rmax = 0;
+GeometrySummary summarize_geometry(const Scene& scene, const io::Geometry& g, const std::string& source) {
+  GeometrySummary s;
+  s.particles = g.size();
+  s.has_mass = g.has_mass();
   for (std::size_t i = 0; i < g.size(); ++i) {
     const double r = g.radius[i];
     const double m = g.has_mass() ? g.mass[i] : scene.density * 4.0 / 3.0 * std::numbers::pi * r * r * r;
     if (!(m > 0) || !std::isfinite(m) || !std::isfinite(1 / m)) {
       if (g.has_mass())
-        throw InputError(fmt::format(
+        s.mass_error = fmt::format(
             "{}: particle id {} has the mass {}: a mass must be finite and > 0, with a finite inverse",
-            source, g.id[i], m));
-      throw InputError(fmt::format(
-          "material.density = {} gives particle id {} (radius {}) the mass {} (density x 4/3 pi r^3): a mass "
-          "must be finite and > 0, with a finite inverse; give the density in the scene's units ({}, {}, {})",
-          scene.density, g.id[i], r, m, scene.units.length, scene.units.time, scene.units.force));
+            source, g.id[i], m);
+      else
+        s.mass_error = fmt::format(
+            "material.density = {} gives particle id {} (radius {}) the mass {} (density x 4/3 pi r^3): a "
+            "mass must be finite and > 0, with a finite inverse; give the density in the scene's units ({}, "
+            "{}, {})",
+            scene.density, g.id[i], r, m, scene.units.length, scene.units.time, scene.units.force);
+      return s;
     }
-    m_min = std::min(m_min, m);
-    rmin = std::min(rmin, r);
-    rmax = std::max(rmax, r);
+    s.m_min = std::min(s.m_min, m);
+    s.m_min_pow = std::min(
+        s.m_min_pow,
+        g.has_mass() ? g.mass[i] : scene.density * 4.0 / 3.0 * std::numbers::pi * std::pow(g.radius[i], 3));
+    s.rmin = std::min(s.rmin, r);
+    s.rmax = std::max(s.rmax, r);
+    s.xmax = std::max(
+        {s.xmax, std::abs(g.position[i][0]), std::abs(g.position[i][1]), std::abs(g.position[i][2])});
   }
-  const std::string mass_source = g.has_mass() ? fmt::format("the masses of {}", source)
-                                               : fmt::format("material.density = {}", scene.density);
+  s.tags.assign(g.tag.begin(), g.tag.end());
+  std::sort(s.tags.begin(), s.tags.end());
+  s.tags.erase(std::unique(s.tags.begin(), s.tags.end()), s.tags.end());
+  for (const auto& b : g.bonds) s.bond_tags.push_back(b.tag);
+  std::sort(s.bond_tags.begin(), s.bond_tags.end());
+  s.bond_tags.erase(std::unique(s.bond_tags.begin(), s.bond_tags.end()), s.bond_tags.end());
+  return s;
+}
+
+namespace {
+std::vector<std::int64_t> union_of(const std::vector<std::int64_t>& mine, MPI_Comm comm) {
+  int n = static_cast<int>(mine.size()), p = 1;
+  MPI_Comm_size(comm, &p);
+  std::vector<int> counts(static_cast<std::size_t>(p)), displs(static_cast<std::size_t>(p), 0);
+  MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, comm);
+  for (std::size_t r = 1; r < counts.size(); ++r) displs[r] = displs[r - 1] + counts[r - 1];
+  std::vector<std::int64_t> all(static_cast<std::size_t>(displs.back() + counts.back()));
+  MPI_Allgatherv(mine.data(), n, MPI_INT64_T, all.data(), counts.data(), displs.data(), MPI_INT64_T, comm);
+  std::sort(all.begin(), all.end());
+  all.erase(std::unique(all.begin(), all.end()), all.end());
+  return all;
+}
+}  // namespace
+
+GeometrySummary merge_summaries(const GeometrySummary& local, MPI_Comm comm) {
+  GeometrySummary s = local;
+  const Comm c(comm);
+  if (c.size() == 1) return s;
+  s.mass_error = c.agree_error(local.mass_error);
+  s.particles = static_cast<std::size_t>(c.sum(static_cast<long long>(local.particles)));
+  s.m_min = c.min(local.m_min);
+  s.m_min_pow = c.min(local.m_min_pow);
+  s.rmin = c.min(local.rmin);
+  s.rmax = c.max(local.rmax);
+  s.xmax = c.max(local.xmax);
+  s.tags = union_of(local.tags, comm);
+  s.bond_tags = union_of(local.bond_tags, comm);
+  return s;
+}
+
+std::vector<std::string> check_scene_with_geometry(const Scene& scene, const io::Geometry& g,
+                                                   const std::string& source) {
+  return check_scene_with_summary(scene, summarize_geometry(scene, g, source), source);
+}
+
+std::vector<std::string> check_scene_with_summary(const Scene& scene, const GeometrySummary& s,
+                                                  const std::string& source) {
+  std::vector<std::string> warnings;
+  if (s.particles == 0) return warnings;
+  if (s.mass_error) throw InputError(*s.mass_error);
+  const double m_min = s.m_min, rmin = s.rmin, rmax = s.rmax;
+  const std::string mass_source = s.has_mass ? fmt::format("the masses of {}", source)
+                                             : fmt::format("material.density = {}", scene.density);
   const double dt = scene.dt;
 
   // Springs: k dt^2 / m (the step's change of velocity per unit of velocity) and the energy of an
@@ -116,9 +173,7 @@ std::vector<std::string> check_scene_with_geometry(const Scene& scene, const io:
   }
 
   // Scene parts that match nothing: warnings, since a run may use a scene for several geometries.
-  std::vector<std::int64_t> tags(g.tag.begin(), g.tag.end());
-  std::sort(tags.begin(), tags.end());
-  tags.erase(std::unique(tags.begin(), tags.end()), tags.end());
+  const auto& tags = s.tags;
   auto missing = [&](const TagFilter& filter) {
     std::vector<std::int64_t> out;
     for (auto t : filter)
@@ -147,8 +202,7 @@ std::vector<std::string> check_scene_with_geometry(const Scene& scene, const io:
     warn_tags(fmt::format("body_forces \"{}\":", b.name), b.tags, "the force acts on no particle with it");
   for (const auto& grp : scene.bonds) {
     if (!grp.bond_tag) continue;
-    const bool found = std::any_of(g.bonds.begin(), g.bonds.end(),
-                                   [&](const io::Bond& b) { return b.tag == *grp.bond_tag; });
+    const bool found = std::binary_search(s.bond_tags.begin(), s.bond_tags.end(), *grp.bond_tag);
     if (!found)
       warnings.push_back(
           fmt::format("interactions \"{}\": bond_tag = {}: no bond of {} has that tag, so the "
@@ -158,40 +212,19 @@ std::vector<std::string> check_scene_with_geometry(const Scene& scene, const io:
   return warnings;
 }
 
-namespace {
-
-/// The largest |coordinate| and the smallest radius of a geometry.
-struct Reach {
-  double xmax = 0, rmin = std::numeric_limits<double>::infinity();
-};
-
-Reach reach_of(const io::Geometry& g) {
-  Reach r;
-  for (std::size_t i = 0; i < g.size(); ++i) {
-    const auto& x = g.position[i];
-    r.xmax = std::max({r.xmax, std::abs(x[0]), std::abs(x[1]), std::abs(x[2])});
-    r.rmin = std::min(r.rmin, g.radius[i]);
-  }
-  return r;
+double strain_resolution(const GeometrySummary& s, double epsilon) {
+  return s.particles == 0 ? 0.0 : epsilon * s.xmax / (2 * s.rmin);
 }
 
-}  // namespace
-
-double strain_resolution(const io::Geometry& g, double epsilon) {
-  const Reach r = reach_of(g);
-  return g.size() == 0 ? 0.0 : epsilon * r.xmax / (2 * r.rmin);
-}
-
-std::string check_precision(const io::Geometry& g, double epsilon, const std::string& precision,
+std::string check_precision(const GeometrySummary& s, double epsilon, const std::string& precision,
                             const std::string& source) {
-  const double res = strain_resolution(g, epsilon);
+  const double res = strain_resolution(s, epsilon);
   if (!(res > kResolutionWarn)) return {};
-  const Reach r = reach_of(g);
   const std::string what = fmt::format(
       "{}: coordinates reach |x| = {:.3g} with a smallest radius of {:.3g}: in {} a distance between "
       "particles "
       "there is rounded to a strain of {:.2g} (epsilon |x| / 2 r_min)",
-      source, r.xmax, r.rmin, precision, res);
+      source, s.xmax, s.rmin, precision, res);
   const std::string remedy =
       precision == "float"
           ? "run in double (--precision double) or move the geometry nearer the origin"
@@ -204,10 +237,10 @@ std::string check_precision(const io::Geometry& g, double epsilon, const std::st
                      kResolutionWarn, remedy);
 }
 
-void run_load_checks(const Scene& scene, const io::Geometry& g, const std::string& source, MPI_Comm comm,
+void run_load_checks(const Scene& scene, const GeometrySummary& s, const std::string& source, MPI_Comm comm,
                      double epsilon, const std::string& precision) {
-  auto warnings = check_scene_with_geometry(scene, g, source);
-  if (auto w = check_precision(g, epsilon, precision, source); !w.empty()) warnings.push_back(std::move(w));
+  auto warnings = check_scene_with_summary(scene, s, source);
+  if (auto w = check_precision(s, epsilon, precision, source); !w.empty()) warnings.push_back(std::move(w));
   int rank = 0;
   MPI_Comm_rank(comm, &rank);
   if (rank == 0)

@@ -33,22 +33,54 @@ bool tags_match(const TagFilter& t, std::int64_t ta, std::int64_t tb) {
 }  // namespace
 
 template <class Real>
-Simulation<Real>::Simulation(const Scene& scene, io::Geometry g, MPI_Comm comm, const RunOptions& options)
-    : scene_(scene), options_(options), forces_(scene) {
+void Simulation<Real>::start(const Scene& scene) {
   configure_particles();
-  if (g.size() == 0)
-    throw InputError(fmt::format("{}: the geometry has no particles", scene.geometry.string()));
   if (scene.bonds.size() > 254) throw InputError("interactions: at most 254 bond groups");
   const bool se = scene.integrator == Integrator::symplectic_euler;
   kick1_ = Real(se ? scene.dt : scene.dt / 2);
   kick2_ = Real(se ? 0.0 : scene.dt / 2);
   rebuild_limit2_ = 0.25 * scene.skin * scene.skin;
-  run_load_checks(scene, g, scene.geometry.string(), comm, kEpsilon, kPrecision);
-  check_stability(g);
-  distribute(g, comm);
+}
+
+template <class Real>
+Simulation<Real>::Simulation(const Scene& scene, io::Geometry g, MPI_Comm comm, const RunOptions& options)
+    : scene_(scene), options_(options), forces_(scene) {
+  if (g.size() == 0)
+    throw InputError(fmt::format("{}: the geometry has no particles", scene.geometry.string()));
+  start(scene);
+  const auto summary = summarize_geometry(scene, g, scene.geometry.string());
+  run_load_checks(scene, summary, scene.geometry.string(), comm, kEpsilon, kPrecision);
+  check_stability(summary);
+  const GeometryExtent extent = extent_of(g);
+  decompose(extent, comm);
+  distribute(g, extent);
   rebuild();
   check_start(true);
   estimate_critical_step(true);  // simulation_stability.cpp; may set dt (run.dt_fraction)
+  start_ledger(compute_forces<true>());
+}
+
+template <class Real>
+Simulation<Real>::Simulation(const Scene& scene, const io::GeometryFile& file, MPI_Comm comm,
+                             const RunOptions& options)
+    : scene_(scene), options_(options), forces_(scene) {
+  if (file.header().particles == 0)
+    throw InputError(fmt::format("{}: the geometry has no particles", scene.geometry.string()));
+  start(scene);
+  const Comm all(comm);
+  GeometryLoader loader(file, all);
+  // The checks see the whole geometry through the slices' summaries (mins, maxima and tag sets are exact).
+  const auto summary =
+      merge_summaries(summarize_geometry(scene, loader.slice(), scene.geometry.string()), comm);
+  run_load_checks(scene, summary, scene.geometry.string(), comm, kEpsilon, kPrecision);
+  check_stability(summary);
+  decompose(loader.extent(), comm);
+  io::Geometry part = loader.local_part(*dec_);
+  load_stats_ = loader.stats();
+  distribute(part, loader.extent());
+  rebuild();
+  check_start(true);
+  estimate_critical_step(true);
   start_ledger(compute_forces<true>());
 }
 
@@ -85,25 +117,27 @@ std::int64_t Simulation<Real>::bond_count() const {
 }
 
 template <class Real>
-void Simulation<Real>::distribute(io::Geometry& g, MPI_Comm comm) {
+void Simulation<Real>::decompose(const GeometryExtent& e, MPI_Comm comm) {
   // The decomposition starts from the packing's bounding box; outer ranks own half-infinite regions.
-  std::array<double, 3> lo{}, hi{};
-  lo.fill(std::numeric_limits<double>::infinity());
-  hi.fill(-std::numeric_limits<double>::infinity());
-  double rmax = 0;
-  for (std::size_t i = 0; i < g.size(); ++i) {
-    for (int d = 0; d < 3; ++d) {
-      lo[d] = std::min(lo[d], g.position[i][d] - g.radius[i]);
-      hi[d] = std::max(hi[d], g.position[i][d] + g.radius[i]);
-    }
-    rmax = std::max(rmax, g.radius[i]);
-  }
-  dec_ = std::make_unique<Decomposition>(Comm(comm), options_.dims, lo, hi);
+  dec_ = std::make_unique<Decomposition>(Comm(comm), options_.dims, e.lo, e.hi);
   halo_ = std::make_unique<Halo<Real>>(*dec_);
-  n_global_ = static_cast<std::int64_t>(g.size());
-  ids_.configure(g.id.front(), g.id.back(), g.size());
+}
 
-  // Which bond group takes each geometry bond (first match), and the longest bond.
+template <class Real>
+void Simulation<Real>::distribute(io::Geometry& g, const GeometryExtent& e) {
+  const double rmax = e.rmax;
+  n_global_ = e.n;
+  ids_.configure(e.first_id, e.last_id, static_cast<std::size_t>(e.n));
+  std::vector<char> owned(g.size(), 0);
+  std::size_t n_mine = 0;
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    const auto& x = g.position[i];
+    owned[i] = dec_->owns(x[0], x[1], x[2]);
+    n_mine += static_cast<std::size_t>(owned[i]);
+  }
+
+  // Which bond group takes each geometry bond (first match), and the longest bond. Each bond is counted
+  // by the rank owning its first end (once across ranks, whether g is the whole geometry or a part).
   constexpr std::uint8_t kNone = 255;
   std::vector<std::uint8_t> bond_group(g.bonds.size(), kNone);
   double longest = 0;
@@ -118,13 +152,15 @@ void Simulation<Real>::distribute(io::Geometry& g, MPI_Comm comm) {
       bond_group[k] = static_cast<std::uint8_t>(gi);
       break;
     }
+    if (!owned[ia]) continue;
     if (bond_group[k] == kNone) {
       ++unassigned;
       continue;
     }
     longest = std::max(longest, distance(g.position[ia], g.position[ib]));
   }
-  unassigned_bonds_ = unassigned;
+  longest = comm().max(longest);
+  unassigned_bonds_ = static_cast<std::size_t>(comm().sum(static_cast<long long>(unassigned)));
   ghost_width_ = std::max(forces_.has_pairs() ? 2 * rmax : 0.0, longest) + scene_.skin;
   contact_cutoff_ = 2 * rmax + scene_.skin;
   if (dec_->min_interior_width() < ghost_width_)
@@ -133,13 +169,6 @@ void Simulation<Real>::distribute(io::Geometry& g, MPI_Comm comm) {
         "{:.4g} (longest interaction + skin); use fewer ranks or other --dims (now {}x{}x{})",
         dec_->min_interior_width(), ghost_width_, dec_->dims()[0], dec_->dims()[1], dec_->dims()[2]));
 
-  std::vector<char> owned(g.size(), 0);
-  std::size_t n_mine = 0;
-  for (std::size_t i = 0; i < g.size(); ++i) {
-    const auto& x = g.position[i];
-    owned[i] = dec_->owns(x[0], x[1], x[2]);
-    n_mine += static_cast<std::size_t>(owned[i]);
-  }
   // Bonds with an owned end, then particles; each part of the geometry is released once copied, so
   // the geometry and the solver's copy never coexist in full (peak memory).
   std::size_t n_bonds = 0;

@@ -30,8 +30,9 @@ Simulation<Real>::Simulation(const Scene& scene, const io::Checkpoint& c, const 
   kick1_ = Real(se ? scene_.dt : scene_.dt / 2);
   kick2_ = Real(se ? 0.0 : scene_.dt / 2);
   rebuild_limit2_ = 0.25 * scene.skin * scene.skin;
-  run_load_checks(scene, c.geometry, "the checkpoint", comm, kEpsilon, kPrecision);
-  check_stability(c.geometry);
+  const auto summary = summarize_geometry(scene, c.geometry, "the checkpoint");
+  run_load_checks(scene, summary, "the checkpoint", comm, kEpsilon, kPrecision);
+  check_stability(summary);
   distribute_checkpoint(c, layout, comm);
   restore_servos(c, !c.position_at_rebuild.empty());
   if (!c.position_at_rebuild.empty()) {

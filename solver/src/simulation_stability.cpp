@@ -16,19 +16,11 @@
 namespace basalt::solver {
 
 template <class Real>
-void Simulation<Real>::check_stability(const io::Geometry& g) {
+void Simulation<Real>::check_stability(const GeometrySummary& s) {
   // What the geometry alone tells: the smallest mass and radius, and the former one-spring estimate
   // 2 sqrt(m_min / k_max) (printed for comparison). The network's estimate needs the lists:
   // estimate_critical_step(), after the first rebuild.
-  double m_min = std::numeric_limits<double>::infinity(), rmax = 0,
-         rmin = std::numeric_limits<double>::infinity();
-  for (std::size_t i = 0; i < g.size(); ++i) {
-    const double m =
-        g.has_mass() ? g.mass[i] : scene_.density * 4.0 / 3.0 * std::numbers::pi * std::pow(g.radius[i], 3);
-    m_min = std::min(m_min, m);
-    rmax = std::max(rmax, g.radius[i]);
-    rmin = std::min(rmin, g.radius[i]);
-  }
+  const double m_min = s.m_min_pow, rmax = s.rmax, rmin = s.rmin;
   stability_.m_min = m_min;
   stability_.k_max = forces_.max_stiffness(rmax);
   stability_.rmin = rmin;
@@ -296,9 +288,9 @@ void Simulation<Real>::check_blowup() {
   stop(parallel ? comm().broadcast(msg, who) : msg);
 }
 
-#define BASALT_INSTANTIATE(R)                                        \
-  template void Simulation<R>::check_stability(const io::Geometry&); \
-  template void Simulation<R>::estimate_critical_step(bool);         \
+#define BASALT_INSTANTIATE(R)                                           \
+  template void Simulation<R>::check_stability(const GeometrySummary&); \
+  template void Simulation<R>::estimate_critical_step(bool);            \
   template void Simulation<R>::check_blowup();
 BASALT_INSTANTIATE(double)
 BASALT_INSTANTIATE(float)

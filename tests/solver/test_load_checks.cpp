@@ -230,7 +230,7 @@ TEST(LoadChecks, PrecisionOfFarCoordinates) {
   auto at = [](double d) {
     basalt::io::Geometry g = pair_geometry();
     for (auto& x : g.position) x[0] += d;
-    return g;
+    return summarize_geometry(scene_from(kRun), g, "pair.geo");
   };
   constexpr double kFloat = 1.1920929e-7, kDouble = 2.220446049250313e-16;
   EXPECT_NEAR(strain_resolution(at(99), kFloat), kFloat * 100 / 1.0, 1e-12);

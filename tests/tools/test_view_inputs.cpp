@@ -11,6 +11,7 @@
 
 #include "basalt/io/geometry.hpp"
 #include "color_field.hpp"
+#include "convert_command.hpp"
 #include "field_series.hpp"
 #include "options.hpp"
 #include "particle_selection.hpp"
@@ -246,4 +247,29 @@ TEST(RenderSeries, CheckpointsOfAFolderInStepOrder) {
   EXPECT_EQ(found[1].filename(), "ckpt_000200.h5");
   EXPECT_EQ(found[2].filename(), "ckpt_1000.h5");
   EXPECT_TRUE(checkpoints_in(dir / "missing").empty());
+}
+
+TEST(ViewConvert, GeoToH5AndBackKeepsEveryValue) {
+  // basalt-view convert in.geo -o out.h5: the HDF5 basalt-run's ranks read in slices, with the same values.
+  namespace fs = std::filesystem;
+  const fs::path dir = basalt::test::scratch_dir("view-convert-geo");
+  const fs::path geo = basalt::test::reference_dir() / "cube1.geo";
+  basalt::view::ConvertOptions o;
+  o.inputs = {geo};
+  o.output = dir / "cube1.h5";
+  o.quiet = true;
+  basalt::view::convert(o);
+  const auto a = basalt::io::read_geometry(geo), b = basalt::io::read_geometry(dir / "cube1.h5");
+  EXPECT_EQ(a.id, b.id);
+  EXPECT_EQ(a.position, b.position);
+  EXPECT_EQ(a.radius, b.radius);
+  EXPECT_EQ(a.tag, b.tag);
+  EXPECT_EQ(a.bonds, b.bonds);
+  o.inputs = {dir / "cube1.h5"};
+  o.output = dir / "back.geo";
+  basalt::view::convert(o);
+  EXPECT_EQ(basalt::io::read_geometry(dir / "back.geo").position, a.position);
+  o.inputs = {geo, geo};
+  o.output = dir / "two.h5";
+  EXPECT_THROW(basalt::view::convert(o), std::invalid_argument);
 }

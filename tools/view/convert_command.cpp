@@ -3,9 +3,11 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cctype>
 #include <stdexcept>
 #include <system_error>
 
+#include "basalt/io/geometry.hpp"
 #include "basalt/io/vtk_frames.hpp"
 #include "options.hpp"
 #include "particle_frame.hpp"
@@ -26,6 +28,22 @@ void convert(const ConvertOptions& o) {
     if (in.extension() == ".vtp" || in.extension() == ".pvtp")
       throw std::invalid_argument(
           fmt::format("{}: already a VTK file; convert reads checkpoints and geometries", in.string()));
+  // Geometry to geometry: a .geo (ESyS-Particle) to .h5, which basalt-run's ranks read in slices, or back.
+  const auto geometry_ext = [](const fs::path& p) {
+    std::string e = p.extension().string();
+    std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return std::tolower(c); });
+    return e == ".h5" || e == ".hdf5" || e == ".geo";
+  };
+  if (geometry_ext(o.output)) {
+    if (o.inputs.size() != 1)
+      throw std::invalid_argument(
+          fmt::format("{} inputs: a geometry output takes one geometry input", o.inputs.size()));
+    const io::Geometry g = io::read_geometry(o.inputs[0]);
+    io::write_geometry(g, o.output);
+    if (!o.quiet)
+      fmt::print("wrote {} ({} particles, {} bonds)\n", o.output.string(), g.size(), g.bonds.size());
+    return;
+  }
   if (o.output.extension() == ".vtp") {
     if (o.inputs.size() != 1)
       throw std::invalid_argument(

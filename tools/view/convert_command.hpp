@@ -1,5 +1,6 @@
 #pragma once
-// basalt-view convert: checkpoints/geometries to VTK (.vtp for one, .pvd + one .vtp each for many).
+// basalt-view convert: checkpoints/geometries to VTK (.vtp for one, .pvd + one .vtp each for many), or a
+// geometry to another geometry format (.geo <-> .h5).
 #include <filesystem>
 #include <optional>
 #include <vector>
@@ -8,7 +9,7 @@ namespace basalt::view {
 
 struct ConvertOptions {
   std::vector<std::filesystem::path> inputs;
-  std::filesystem::path output;  ///< .vtp (one input) or .pvd (any number)
+  std::filesystem::path output;  ///< .vtp (one input), .pvd (any number), .h5/.geo (one geometry)
   std::optional<std::filesystem::path> reference;
   bool quiet = false;
 };

@@ -82,10 +82,14 @@ int main(int argc, char** argv) {
 
   bv::ConvertOptions c;
   std::string convert_reference;
-  auto* convert =
-      app.add_subcommand("convert", "Write VTK XML for ParaView: one input to .vtp, many to a .pvd series");
+  auto* convert = app.add_subcommand(
+      "convert",
+      "Write VTK XML for ParaView (one input to .vtp, many to a .pvd series), or a geometry to "
+      "another geometry format (.geo to .h5 for basalt-run, .h5 to .geo for ESyS-Particle)");
   convert->add_option("files", c.inputs, "checkpoints (.h5) or geometries (.h5/.geo)")->required();
-  convert->add_option("-o,--output", c.output, "frame.vtp (one input) or series.pvd (any number)")
+  convert
+      ->add_option("-o,--output", c.output,
+                   "frame.vtp (one input), series.pvd (any number), or a geometry .h5/.geo (one geometry)")
       ->required();
   convert->add_option("--reference", convert_reference,
                       "initial geometry/checkpoint: adds a displacement array");

@@ -105,7 +105,7 @@ class Server {
           add_piece(deserialize(buffer_));
           break;
         case kTagFields:
-          add_field_batch();
+          add_field_batch(st.MPI_SOURCE);
           break;
         case kTagDone:
           ++done;
@@ -156,9 +156,10 @@ class Server {
     fields_failed_ = !csv_ && io_index_ == 0 && cfg_.fields_every > 0;
   }
 
-  /// Sums a batch of rows [step, time, due flags..., partials...] into the rows of their steps; appends
-  /// the rows every compute rank has sent, in step order (every rank sends its rows in order).
-  void add_field_batch() {
+  /// Keeps a batch of rows [step, time, due flags..., partials...] from compute rank `source`; appends the
+  /// rows every compute rank has sent, in step order (every rank sends its rows in order), each summed in
+  /// compute-rank order whatever order the batches arrived in: the same bits in every run.
+  void add_field_batch(int source) {
     const std::size_t n_fields = cfg_.field_names.size();
     const std::size_t width = 2 + 2 * n_fields;
     const std::size_t count = buffer_.size() / sizeof(double);
@@ -167,14 +168,18 @@ class Server {
     for (std::size_t r = 0; r + width <= count; r += width) {
       const auto step = static_cast<std::int64_t>(values[r]);
       auto& row = rows_[step];
-      if (row.sum.empty()) row.sum.assign(width, 0.0);
-      row.sum[0] = values[r];
-      row.sum[1] = values[r + 1];
-      for (std::size_t k = 2; k < width; ++k) row.sum[k] += values[r + k];
+      if (row.parts.empty()) row.parts.assign(static_cast<std::size_t>(L_.n_compute) * width, 0.0);
+      std::memcpy(row.parts.data() + static_cast<std::size_t>(source) * width, values.data() + r,
+                  width * sizeof(double));
       ++row.count;
     }
     while (!rows_.empty() && rows_.begin()->second.count == L_.n_compute) {
-      if (csv_ && !fields_failed_) csv_->append_wire_row(rows_.begin()->second.sum.data(), n_fields);
+      const auto& parts = rows_.begin()->second.parts;
+      std::vector<double> sum(parts.begin(), parts.begin() + static_cast<std::ptrdiff_t>(width));
+      std::fill(sum.begin() + 2, sum.end(), 0.0);
+      for (int c = 0; c < L_.n_compute; ++c)
+        for (std::size_t k = 2; k < width; ++k) sum[k] += parts[static_cast<std::size_t>(c) * width + k];
+      if (csv_ && !fields_failed_) csv_->append_wire_row(sum.data(), n_fields);
       rows_.erase(rows_.begin());
     }
     if (csv_ && !fields_failed_) try {
@@ -371,7 +376,7 @@ class Server {
   std::deque<Ack> acks_;  // verdicts in flight (a deque: their buffers must not move)
 
   struct Row {
-    std::vector<double> sum;  // [step, time, due flags summed, values summed]
+    std::vector<double> parts;  // per compute rank: [step, time, due flags, partial values]
     int count = 0;
   };
 

@@ -141,6 +141,24 @@ case $case_name in
     $CHECK close "$W/straight/ckpt_000200.h5" "$W/a/ckpt_000200.h5" 1e-9 || fail "np 2 -> 1 drifted"
     $CHECK close "$W/straight/ckpt_000200.h5" "$W/b/ckpt_000200.h5" 1e-9 || fail "np 2 -> 3+1 drifted"
     ;;
+  restart_np3_to_np2)
+    # A 3-rank run continued on 2 ranks (+ 1 I/O rank): energies and state within 1e-9 of the 3-rank run.
+    must_run 3 --steps 200 --checkpoint-every 100 --fields-every 1 --output "$W/straight"
+    must_run 3 --steps 100 --checkpoint-every 100 --fields-every 1 --output "$W/split"
+    must_run 3 --io-ranks 1 --steps 100 --checkpoint-every 100 --fields-every 1 --output "$W/split" --restart "$W/split"
+    grep -q "on 2 compute rank" "$W/last.log" || fail "the restart did not run on 2 compute ranks"
+    $CHECK close "$W/straight/ckpt_000200.h5" "$W/split/ckpt_000200.h5" 1e-9 || fail "np 3 -> 2+1 drifted"
+    /usr/bin/python3 - "$W/straight/fields.csv" "$W/split/fields.csv" <<'PY' || fail "np 3 -> 2+1: energies differ by more than 1e-9"
+import sys
+rows = [[l.split(",") for l in open(f).read().split()[1:]] for f in sys.argv[1:]]
+assert len(rows[0]) == len(rows[1]) == 200, [len(r) for r in rows]
+scale = max(abs(float(r[2])) for r in rows[0])
+worst = max(abs(float(a[2]) - float(b[2])) / scale for a, b in zip(*rows) if a[0] == b[0])
+assert all(a[0] == b[0] for a, b in zip(*rows))
+print(f"kinetic energy over 200 steps: largest difference {worst:.3g} of the largest value")
+assert worst <= 1e-9
+PY
+    ;;
   fields_q0_q1)
     must_run 2 --io-ranks 0 --steps 150 --fields-every 1 --output "$W/q0"
     must_run 3 --io-ranks 1 --steps 150 --fields-every 1 --output "$W/q1"

@@ -24,7 +24,9 @@
 #include "basalt/solver/output/field_sink.hpp"
 #include "basalt/solver/output/output_sink.hpp"
 #include "basalt/solver/parallel/decomposition.hpp"
+#include "basalt/solver/parallel/geometry_loader.hpp"
 #include "basalt/solver/parallel/halo.hpp"
+#include "basalt/solver/scene/load_checks.hpp"
 #include "basalt/solver/scene/scene.hpp"
 #include "basalt/solver/timers.hpp"
 
@@ -72,6 +74,11 @@ class Simulation {
   /// geometry is taken by value and released part by part as it is copied: pass std::move(g) to keep
   /// peak memory low. Throws InputError (bad scene/geometry combination, unstable dt) on every rank alike.
   Simulation(const Scene& scene, io::Geometry geometry, MPI_Comm comm, const RunOptions& options = {});
+
+  /// The same run from a geometry file that no rank reads whole (basalt-run's start-up): each rank reads
+  /// a slice of its rows and the ranks route them to their owners (parallel/geometry_loader.hpp). Gives
+  /// exactly the state of the constructor above given the whole file; load_stats() tells what was read.
+  Simulation(const Scene& scene, const io::GeometryFile& file, MPI_Comm comm, const RunOptions& options = {});
 
   /// Continues a run from a checkpoint (simulation_restart.cpp): particles, velocities, masses,
   /// bonds with their rest lengths, step and time; the decomposition from `layout`. Replays the
@@ -141,6 +148,8 @@ class Simulation {
   void state_changed();
   /// Collective: rebuilds the lists now (migrating particles), then recomputes forces.
   void force_rebuild();
+  /// Rows this rank read and records it received at start-up (zeros when given a whole geometry).
+  const LoadStats& load_stats() const { return load_stats_; }
   /// Bytes held by the solver's arrays on this rank (capacity, not RSS).
   std::size_t memory_bytes() const;
 
@@ -151,7 +160,13 @@ class Simulation {
   friend class SimulationFrame<Real>;
   /// With BASALT_FRAME_TIMES=1: prints this rank's median/min/max time to pack and submit a frame.
   void report_frame_times(std::vector<double> seconds) const;
-  void distribute(io::Geometry& g, MPI_Comm comm);
+  /// The common start of both constructors, before the particles exist (kicks, limits).
+  void start(const Scene& scene);
+  /// The rank grid over the geometry's box.
+  void decompose(const GeometryExtent& e, MPI_Comm comm);
+  /// Takes this rank's particles and bonds from `g`: the whole geometry, or this rank's part of it
+  /// (GeometryLoader::local_part); the same particles and bonds in the same order either way.
+  void distribute(io::Geometry& g, const GeometryExtent& e);
   /// Which optional particle fields the scene needs (both constructors, before any particle exists).
   void configure_particles();
   /// Zeroes the forces and torques of fixed particles (scene particles.fixed_tags).
@@ -164,7 +179,7 @@ class Simulation {
   /// This rank's value of ledger term t (potentials from pe).
   double term_value(std::size_t t, const std::vector<double>& pe) const;
   void progress(std::int64_t done, std::int64_t total, double seconds) const;
-  void check_stability(const io::Geometry& g);
+  void check_stability(const GeometrySummary& s);
   /// Collective, after the first rebuild (simulation_stability.cpp): the network's critical step, dt
   /// from run.dt_fraction (fresh starts), and the refusal above it unless forced.
   void estimate_critical_step(bool fresh);
@@ -246,6 +261,7 @@ class Simulation {
   std::vector<double> ledger0_;  ///< the ledger's global values at the start (the guard's reference)
   double wall_work_in_ = 0;      ///< this rank's share of the positive work done by walls
   PhaseTimes times_;
+  LoadStats load_stats_;
   double ghost_wait_ = 0;
   double ke_local_ = 0;         ///< this rank's kinetic energy, valid while ke_fresh_
   bool ke_fresh_ = false;       ///< set when the second half-kick computed ke_local_ this step

@@ -4,8 +4,10 @@
 #include <mpi.h>
 
 #include <array>
+#include <cstddef>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace basalt::solver {
@@ -34,8 +36,43 @@ class Comm {
   /// Collective: if any rank has an error, every rank gets the message of the lowest such rank.
   std::optional<std::string> agree_error(const std::optional<std::string>& local) const;
   void barrier() const;
+  /// Collective personalised exchange (MPI_Alltoallv): sends out[r] to rank r and returns what every rank
+  /// sent this one, concatenated in rank order; `counts` (if given) receives how many came from each rank.
+  template <class T>
+  std::vector<T> exchange(const std::vector<std::vector<T>>& out,
+                          std::vector<std::size_t>* counts = nullptr) const {
+    static_assert(std::is_trivially_copyable_v<T>, "exchange sends raw bytes");
+    std::vector<std::size_t> send_counts(out.size());
+    std::size_t total = 0;
+    for (std::size_t r = 0; r < out.size(); ++r) total += send_counts[r] = out[r].size();
+    std::vector<T> send;
+    send.reserve(total);
+    for (const auto& v : out) send.insert(send.end(), v.begin(), v.end());
+    std::vector<std::size_t> recv_counts;
+    std::vector<T> recv;
+    exchange_raw(send.data(), send_counts, sizeof(T), recv_counts,
+                 [&](std::size_t n) { return static_cast<void*>((recv.resize(n), recv.data())); });
+    if (counts) *counts = std::move(recv_counts);
+    return recv;
+  }
 
  private:
+  template <class F>
+  void exchange_raw(const void* send, const std::vector<std::size_t>& send_counts, std::size_t bytes,
+                    std::vector<std::size_t>& recv_counts, F&& allocate) const {
+    std::vector<int> sc, sd, rc, rd;
+    const std::size_t n = prepare_exchange(send_counts, sc, sd, rc, rd, recv_counts);
+    void* recv = allocate(n);
+    alltoallv(send, sc, sd, recv, rc, rd, bytes);
+  }
+  /// Counts and displacements for alltoallv (exchanges the counts); returns the number of elements to
+  /// receive.
+  std::size_t prepare_exchange(const std::vector<std::size_t>& send_counts, std::vector<int>& sc,
+                               std::vector<int>& sd, std::vector<int>& rc, std::vector<int>& rd,
+                               std::vector<std::size_t>& recv_counts) const;
+  void alltoallv(const void* send, const std::vector<int>& sc, const std::vector<int>& sd, void* recv,
+                 const std::vector<int>& rc, const std::vector<int>& rd, std::size_t bytes) const;
+
   MPI_Comm comm_;
   int rank_ = 0;
   int size_ = 1;

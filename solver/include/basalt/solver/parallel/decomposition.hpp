@@ -6,6 +6,7 @@
 
 #include <array>
 #include <limits>
+#include <vector>
 
 #include "basalt/solver/parallel/communicator.hpp"
 
@@ -33,6 +34,11 @@ class Decomposition {
   double hi(int d) const { return hi_[d]; }
   /// Grid coordinate along d of the rank owning coordinate v.
   int coord_of(int d, double v) const;
+  /// The rank owning a point (the one whose owns() is true for it).
+  int rank_of(double x, double y, double z) const {
+    return rank_table_[static_cast<std::size_t>((coord_of(0, x) * dims_[1] + coord_of(1, y)) * dims_[2] +
+                                                coord_of(2, z))];
+  }
   bool owns(double x, double y, double z) const {
     return x >= lo_[0] && x < hi_[0] && y >= lo_[1] && y < hi_[1] && z >= lo_[2] && z < hi_[2];
   }
@@ -47,6 +53,7 @@ class Decomposition {
   std::array<std::array<int, 2>, 3> nb_{};
   std::array<double, 3> box_min_{}, box_max_{};
   std::array<double, 3> lo_{}, hi_{};
+  std::vector<int> rank_table_;  ///< rank of grid coordinates (x * dims[1] + y) * dims[2] + z
 };
 
 }  // namespace basalt::solver
