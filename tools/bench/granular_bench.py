@@ -190,8 +190,9 @@ def energies(code, log):
     cols = None
     for line in open(log):
         w = line.split()
-        if w[:1] == ["Step"] and "c_ke" in w:
-            cols = (w.index("c_ke"), w.index("c_rke"))
+        if w[:1] == ["Step"] and ("c_ke" in w or "ke" in w):  # LIGGGHTS prints the compute's name alone
+            ke = "c_ke" if "c_ke" in w else "ke"
+            cols = (w.index(ke), w.index("c_rke" if ke == "c_ke" else "rke"))
             continue
         if cols and len(w) > max(cols) and w[0].isdigit():
             try:
