@@ -42,10 +42,14 @@ class BodyDriver final : public ForceCompute<Real> {
   }
 
  private:
+  /// A model that neither reads angular velocities nor writes torques (gravity, linear damping) skips
+  /// the rotational state (its inertia costs two divisions per particle).
+  static constexpr bool kTurns = (Model::reads & kAngularVelocity) != 0 || (Model::writes & kTorque) != 0;
+
   template <bool Energy, bool Advance>
   double loop(Particles<Real>& p) {
     double e = 0, d = 0;
-    const bool rot = p.with_rotation;
+    const bool rot = kTurns && p.with_rotation;
     BodyState<Real> b{};
     b.dt = dt_;
     for (std::size_t g = 0; g < coeffs_.size(); ++g) {

@@ -196,85 +196,118 @@ class PairDriver final : public ForceCompute<Real> {
 
   /// Velocity-dependent models: the pair's kinematics in, a force vector, its point of action and a
   /// couple out; torques only when the particles rotate. Dissipated energy accumulates on real steps
-  /// (once per pair across ranks, as the energies).
+  /// (once per pair across ranks, as the energies). Rotation and one group for all pairs are
+  /// template arguments (no per-pair test of either); particle i's force and torque add up in
+  /// registers and reach memory once per row.
   template <bool Energy, bool Newton, bool Advance>
   double loop_kinematic(Particles<Real>& p, const PairList& list, History* hist) {
+    const bool one = coeffs_.size() == 1;
+    if (p.with_rotation)
+      return one ? rows<Energy, Newton, Advance, true, true>(p, list, hist)
+                 : rows<Energy, Newton, Advance, true, false>(p, list, hist);
+    return one ? rows<Energy, Newton, Advance, false, true>(p, list, hist)
+               : rows<Energy, Newton, Advance, false, false>(p, list, hist);
+  }
+
+  template <bool Energy, bool Newton, bool Advance, bool Rot, bool One>
+  double rows(Particles<Real>& p, const PairList& list, [[maybe_unused]] History* hist) {
     double energy = 0, dissipated = 0;
     std::size_t sliding = 0;
-    const bool rot = p.with_rotation;
+    const std::size_t n = p.n_owned;
     const std::uint32_t* __restrict off = list.offset.data();
     const std::int32_t* __restrict nb = list.neigh.data();
+    const Real* __restrict x = p.x.data();
+    const Real* __restrict y = p.y.data();
+    const Real* __restrict z = p.z.data();
+    const Real* __restrict rad = p.radius.data();
+    const Real* __restrict im = p.inv_mass.data();
+    const Real* __restrict vx = p.vx.data();
+    const Real* __restrict vy = p.vy.data();
+    const Real* __restrict vz = p.vz.data();
+    const std::int64_t* __restrict id = p.id.data();
+    Real* __restrict fx = p.fx.data();
+    Real* __restrict fy = p.fy.data();
+    Real* __restrict fz = p.fz.data();
+    [[maybe_unused]] const Real* __restrict wx = Rot ? p.wx.data() : nullptr;
+    [[maybe_unused]] const Real* __restrict wy = Rot ? p.wy.data() : nullptr;
+    [[maybe_unused]] const Real* __restrict wz = Rot ? p.wz.data() : nullptr;
+    [[maybe_unused]] Real* __restrict tx = Rot ? p.tx.data() : nullptr;
+    [[maybe_unused]] Real* __restrict ty = Rot ? p.ty.data() : nullptr;
+    [[maybe_unused]] Real* __restrict tz = Rot ? p.tz.data() : nullptr;
+    const Coeffs c0 = coeffs_.empty() ? Coeffs{} : coeffs_[0];
+    const auto coeffs_of = [&](std::size_t i, std::size_t j) -> const Coeffs& {
+      if constexpr (One) return c0;
+      return coeffs_[static_cast<std::size_t>(group_of(p.tag[i], p.tag[j]))];
+    };
     ContactKinematics<Real> k{};
     k.dt = dt_;
-    for (std::size_t i = 0; i < p.n_owned; ++i) {
-      const Real ri = p.radius[i];
+    for (std::size_t i = 0; i < n; ++i) {
+      if (off[i] == off[i + 1]) continue;  // most rows of the ghost list
+      const Real xi = x[i], yi = y[i], zi = z[i], ri = rad[i], imi = im[i];
+      const Real vxi = vx[i], vyi = vy[i], vzi = vz[i];
+      Real fxi = 0, fyi = 0, fzi = 0, txi = 0, tyi = 0, tzi = 0;
+      if constexpr (Rot) k.wix = wx[i], k.wiy = wy[i], k.wiz = wz[i];
       for (auto e = off[i]; e < off[i + 1]; ++e) {
         const auto j = static_cast<std::size_t>(nb[e]);
-        k.dx = p.x[i] - p.x[j];
-        k.dy = p.y[i] - p.y[j];
-        k.dz = p.z[i] - p.z[j];
-        const Real r2 = k.dx * k.dx + k.dy * k.dy + k.dz * k.dz;
-        const Real rsum = ri + p.radius[j];
+        const Real dx = xi - x[j], dy = yi - y[j], dz = zi - z[j];
+        const Real r2 = dx * dx + dy * dy + dz * dz;
+        const Real rj = rad[j], rsum = ri + rj;
         History none{};
         History& h = kHistory ? hist[e] : none;
         if (!(r2 < rsum * rsum)) {
           if constexpr (kHistory && Advance) {
             // What the history still held is lost with it (a shear spring's energy): dissipated.
-            if (Newton || p.id[i] < p.id[j])
-              dissipated += Model::parting_energy(
-                  coeffs_.size() == 1 ? coeffs_[0]
-                                      : coeffs_[static_cast<std::size_t>(group_of(p.tag[i], p.tag[j]))],
-                  h);
+            if (Newton || id[i] < id[j]) dissipated += Model::parting_energy(coeffs_of(i, j), h);
             Model::apart(h);
           }
           continue;
         }
-        const Coeffs& c = coeffs_.size() == 1
-                              ? coeffs_[0]
-                              : coeffs_[static_cast<std::size_t>(group_of(p.tag[i], p.tag[j]))];
+        const Coeffs& c = coeffs_of(i, j);
+        k.dx = dx, k.dy = dy, k.dz = dz;
         k.r = std::sqrt(r2);
-        k.ri = ri;
-        k.rj = p.radius[j];
-        k.imi = p.inv_mass[i];
-        k.imj = p.inv_mass[j];
-        k.vx = p.vx[i] - p.vx[j];
-        k.vy = p.vy[i] - p.vy[j];
-        k.vz = p.vz[i] - p.vz[j];
-        if (rot) {
-          k.wix = p.wx[i], k.wiy = p.wy[i], k.wiz = p.wz[i];
-          k.wjx = p.wx[j], k.wjy = p.wy[j], k.wjz = p.wz[j];
-        }
+        k.ri = ri, k.rj = rj;
+        k.imi = imi, k.imj = im[j];
+        k.vx = vxi - vx[j], k.vy = vyi - vy[j], k.vz = vzi - vz[j];
+        if constexpr (Rot) k.wjx = wx[j], k.wjy = wy[j], k.wjz = wz[j];
         ContactForce<Real> f;
         Model::template contact<Advance>(c, h, k, f);
-        p.fx[i] += f.fx;
-        p.fy[i] += f.fy;
-        p.fz[i] += f.fz;
+        fxi += f.fx;
+        fyi += f.fy;
+        fzi += f.fz;
         if constexpr (Newton) {
-          p.fx[j] -= f.fx;
-          p.fy[j] -= f.fy;
-          p.fz[j] -= f.fz;
+          fx[j] -= f.fx;
+          fy[j] -= f.fy;
+          fz[j] -= f.fz;
         }
-        if (rot) {
+        if constexpr (Rot) {
           // Arms: c - x_i = -arm_i n, c - x_j = (r - arm_i) n, n = d / r; torque = arm x force.
-          const Real si = -f.arm_i / k.r, sj = (k.r - f.arm_i) / k.r;
-          const Real cx = k.dy * f.fz - k.dz * f.fy, cy = k.dz * f.fx - k.dx * f.fz,
-                     cz = k.dx * f.fy - k.dy * f.fx;
-          p.tx[i] += si * cx + f.mx;
-          p.ty[i] += si * cy + f.my;
-          p.tz[i] += si * cz + f.mz;
+          const Real inv_r = Real(1) / k.r;  // the model's own 1 / r, computed once
+          const Real si = -f.arm_i * inv_r, sj = (k.r - f.arm_i) * inv_r;
+          const Real cx = dy * f.fz - dz * f.fy, cy = dz * f.fx - dx * f.fz, cz = dx * f.fy - dy * f.fx;
+          txi += si * cx + f.mx;
+          tyi += si * cy + f.my;
+          tzi += si * cz + f.mz;
           if constexpr (Newton) {
-            p.tx[j] -= sj * cx + f.mx;
-            p.ty[j] -= sj * cy + f.my;
-            p.tz[j] -= sj * cz + f.mz;
+            tx[j] -= sj * cx + f.mx;
+            ty[j] -= sj * cy + f.my;
+            tz[j] -= sj * cz + f.mz;
           }
         }
-        if (Newton || p.id[i] < p.id[j]) {
+        if (Newton || id[i] < id[j]) {
           if constexpr (Advance) {
             dissipated += f.dissipated;
             sliding += f.sliding;
           }
           if constexpr (Energy) energy += double(Model::energy(c, h, k));
         }
+      }
+      fx[i] += fxi;
+      fy[i] += fyi;
+      fz[i] += fzi;
+      if constexpr (Rot) {
+        tx[i] += txi;
+        ty[i] += tyi;
+        tz[i] += tzi;
       }
     }
     dissipated_ += dissipated;

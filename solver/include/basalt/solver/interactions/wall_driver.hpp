@@ -145,29 +145,55 @@ class WallDriver final : public ForceCompute<Real> {
 
   template <bool Energy, bool Advance>
   double loop_kinematic(Particles<Real>& p, Walls& walls) {
+    return p.with_rotation ? loop_kinematic<Energy, Advance, true>(p, walls)
+                           : loop_kinematic<Energy, Advance, false>(p, walls);
+  }
+
+  template <bool Energy, bool Advance, bool Rot>
+  double loop_kinematic(Particles<Real>& p, Walls& walls) {
     walls_ = &walls;
     double energy = 0, dissipated = 0;
     std::size_t sliding = 0;
-    const bool rot = p.with_rotation;
+    const Real* __restrict x = p.x.data();
+    const Real* __restrict y = p.y.data();
+    const Real* __restrict z = p.z.data();
+    const Real* __restrict rad = p.radius.data();
+    const Real* __restrict im = p.inv_mass.data();
+    const Real* __restrict vx = p.vx.data();
+    const Real* __restrict vy = p.vy.data();
+    const Real* __restrict vz = p.vz.data();
+    Real* __restrict fx = p.fx.data();
+    Real* __restrict fy = p.fy.data();
+    Real* __restrict fz = p.fz.data();
+    [[maybe_unused]] const Real* __restrict wx = Rot ? p.wx.data() : nullptr;
+    [[maybe_unused]] const Real* __restrict wy = Rot ? p.wy.data() : nullptr;
+    [[maybe_unused]] const Real* __restrict wz = Rot ? p.wz.data() : nullptr;
+    [[maybe_unused]] Real* __restrict tx = Rot ? p.tx.data() : nullptr;
+    [[maybe_unused]] Real* __restrict ty = Rot ? p.ty.data() : nullptr;
+    [[maybe_unused]] Real* __restrict tz = Rot ? p.tz.data() : nullptr;
     WallKinematics<Real> kin{};
     kin.dt = dt_;
     for (std::size_t k = 0; k < index_.size(); ++k) {
       const std::size_t w = index_[k];
       const auto& spec = walls.spec(w);
-      const auto& c = coeffs_[k];
+      const auto c = coeffs_[k];
       kin.nx = Real(spec.normal[0]), kin.ny = Real(spec.normal[1]), kin.nz = Real(spec.normal[2]);
       const auto& at = walls.point(w);
       const auto& vw = walls.velocity(w);
       const Real px = Real(at[0]), py = Real(at[1]), pz = Real(at[2]);
+      const Real vwx = Real(vw[0]), vwy = Real(vw[1]), vwz = Real(vw[2]);
       double wfx = 0, wfy = 0, wfz = 0;
       const auto& cand = walls.candidates(w);
       auto& hist = hist_[k];
       if (hist.size() != cand.size()) hist.assign(cand.size(), History{});
-      for (std::size_t ci = 0; ci < cand.size(); ++ci) {
-        const auto i = static_cast<std::size_t>(cand[ci]);
-        History& h = hist[ci];
-        kin.d = (p.x[i] - px) * kin.nx + (p.y[i] - py) * kin.ny + (p.z[i] - pz) * kin.nz;
-        kin.r = p.radius[i];
+      History* __restrict hs = hist.data();
+      const auto* __restrict ci_of = cand.data();
+      const std::size_t nc = cand.size();
+      for (std::size_t ci = 0; ci < nc; ++ci) {
+        const auto i = static_cast<std::size_t>(ci_of[ci]);
+        History& h = hs[ci];
+        kin.d = (x[i] - px) * kin.nx + (y[i] - py) * kin.ny + (z[i] - pz) * kin.nz;
+        kin.r = rad[i];
         if (!(kin.d < kin.r)) {
           if constexpr (Advance) {
             dissipated += Model::parting_energy(c, h);
@@ -175,18 +201,18 @@ class WallDriver final : public ForceCompute<Real> {
           }
           continue;
         }
-        kin.im = p.inv_mass[i];
-        kin.vx = p.vx[i] - Real(vw[0]), kin.vy = p.vy[i] - Real(vw[1]), kin.vz = p.vz[i] - Real(vw[2]);
-        if (rot) kin.wx = p.wx[i], kin.wy = p.wy[i], kin.wz = p.wz[i];
+        kin.im = im[i];
+        kin.vx = vx[i] - vwx, kin.vy = vy[i] - vwy, kin.vz = vz[i] - vwz;
+        if constexpr (Rot) kin.wx = wx[i], kin.wy = wy[i], kin.wz = wz[i];
         ContactForce<Real> f;
         Model::template contact<Advance>(c, h, kin, f);
-        p.fx[i] += f.fx;
-        p.fy[i] += f.fy;
-        p.fz[i] += f.fz;
-        if (rot) {  // (c - x) x F with c - x = -arm n
-          p.tx[i] += -f.arm_i * (kin.ny * f.fz - kin.nz * f.fy) + f.mx;
-          p.ty[i] += -f.arm_i * (kin.nz * f.fx - kin.nx * f.fz) + f.my;
-          p.tz[i] += -f.arm_i * (kin.nx * f.fy - kin.ny * f.fx) + f.mz;
+        fx[i] += f.fx;
+        fy[i] += f.fy;
+        fz[i] += f.fz;
+        if constexpr (Rot) {  // (c - x) x F with c - x = -arm n
+          tx[i] += -f.arm_i * (kin.ny * f.fz - kin.nz * f.fy) + f.mx;
+          ty[i] += -f.arm_i * (kin.nz * f.fx - kin.nx * f.fz) + f.my;
+          tz[i] += -f.arm_i * (kin.nx * f.fy - kin.ny * f.fx) + f.mz;
         }
         wfx -= double(f.fx);
         wfy -= double(f.fy);

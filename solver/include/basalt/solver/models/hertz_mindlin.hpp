@@ -57,10 +57,24 @@ inline double restitution(TableReader& t) {
   return e;
 }
 
+/// The loop's constants: E*, G*, beta, mu, and the dashpot factors -2 sqrt(5/6) beta sqrt(2 E*) and
+/// -2 sqrt(5/6) beta sqrt(8 G*) (gamma_n, gamma_t = these times sqrt(m* sqrt(R* d)): one square root
+/// per contact for both dashpots).
 template <class Real>
 struct Coeffs {
-  Real E_star, G_star, beta, mu;
+  Real E_star, G_star, beta, mu, damp_n, damp_t;
 };
+
+template <class Real>
+Coeffs<Real> coeffs(const Constants& c) {
+  const double k = -2 * 0.9128709291752769 * c.beta;  // -2 sqrt(5/6) beta >= 0
+  return {Real(c.E_star),
+          Real(c.G_star),
+          Real(c.beta),
+          Real(c.mu),
+          Real(k * std::sqrt(2 * c.E_star)),
+          Real(k * std::sqrt(8 * c.G_star))};
+}
 
 /// History: the shear displacement.
 struct History {
@@ -71,12 +85,13 @@ struct History {
 /// velocity u (on the first body, relative to the second), normal n; turns and loads the history
 /// when Advance; returns the force on the first body and the energy dissipated this step.
 template <bool Advance, class Real>
-void law(const Coeffs<Real>& c, History& h, Real R, Real m, Real d, Real nx, Real ny, Real nz, Real ux,
-         Real uy, Real uz, Real dt, ContactForce<Real>& f) {
+[[gnu::always_inline]] inline void law(const Coeffs<Real>& c, History& h, Real R, Real m, Real d, Real nx,
+                                       Real ny, Real nz, Real ux, Real uy, Real uz, Real dt,
+                                       ContactForce<Real>& f) {
   const Real root = std::sqrt(R * d);
-  const Real Sn = 2 * c.E_star * root, St = 8 * c.G_star * root;
-  const Real k = Real(-2) * Real(0.9128709291752769) * c.beta;  // -2 sqrt(5/6) beta >= 0
-  const Real gn = k * std::sqrt(Sn * m), gt = k * std::sqrt(St * m);
+  const Real St = 8 * c.G_star * root;
+  const Real q = std::sqrt(root * m);  // sqrt(S m) = sqrt(2 E*) q (normal), sqrt(8 G*) q (tangential)
+  const Real gn = c.damp_n * q, gt = c.damp_t * q;
   const Real un = ux * nx + uy * ny + uz * nz;
   const Real tx = ux - un * nx, ty = uy - un * ny, tz = uz - un * nz;
   const Real fn = Real(4.0 / 3.0) * c.E_star * root * d - gn * un;
@@ -166,8 +181,7 @@ struct HertzMindlin {
   }
   template <class Real>
   static Coeffs<Real> coeffs(const Params& p) {
-    const auto c = hertz::constants(p.material, p.material, p.e, p.mu);
-    return {Real(c.E_star), Real(c.G_star), Real(c.beta), Real(c.mu)};
+    return hertz::coeffs<Real>(hertz::constants(p.material, p.material, p.e, p.mu));
   }
   /// The tangent stiffness at an overlap of 5 % of rmax (for the critical time step estimate).
   static double max_stiffness(const Params& p, double rmax) {
@@ -188,12 +202,13 @@ struct HertzMindlin {
                       ContactForce<Real>& f) {
     const Real inv_r = Real(1) / k.r;
     const Real nx = k.dx * inv_r, ny = k.dy * inv_r, nz = k.dz * inv_r;
-    f.arm_i = k.r * k.ri / (k.ri + k.rj);
+    const Real inv_sum = Real(1) / (k.ri + k.rj);
+    f.arm_i = k.r * k.ri * inv_sum;
     const Real ai = f.arm_i, aj = k.r - f.arm_i;
     const Real ox = -(ai * k.wix + aj * k.wjx), oy = -(ai * k.wiy + aj * k.wjy),
                oz = -(ai * k.wiz + aj * k.wjz);
     const Real ux = k.vx + oy * nz - oz * ny, uy = k.vy + oz * nx - ox * nz, uz = k.vz + ox * ny - oy * nx;
-    const Real R = k.ri * k.rj / (k.ri + k.rj), m = Real(1) / (k.imi + k.imj);
+    const Real R = k.ri * k.rj * inv_sum, m = Real(1) / (k.imi + k.imj);
     hertz::law<Advance>(c, h, R, m, k.ri + k.rj - k.r, nx, ny, nz, ux, uy, uz, k.dt, f);
   }
   template <class Real>
@@ -240,8 +255,7 @@ struct HertzMindlinWall {
   }
   template <class Real>
   static Coeffs<Real> coeffs(const Params& p) {
-    const auto c = hertz::constants(p.particle, p.wall, p.e, p.mu);
-    return {Real(c.E_star), Real(c.G_star), Real(c.beta), Real(c.mu)};
+    return hertz::coeffs<Real>(hertz::constants(p.particle, p.wall, p.e, p.mu));
   }
   static double max_stiffness(const Params& p, double rmax) {
     const auto c = hertz::constants(p.particle, p.wall, p.e, p.mu);
