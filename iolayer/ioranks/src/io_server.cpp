@@ -205,7 +205,7 @@ class Server {
       MPI_Get_count(&st, MPI_BYTE, &n);
       buffer_.resize(static_cast<std::size_t>(n));
       MPI_Mrecv(buffer_.data(), n, MPI_BYTE, &msg, MPI_STATUS_IGNORE);
-      add_field_batch();
+      add_field_batch(st.MPI_SOURCE);
     }
   }
 
