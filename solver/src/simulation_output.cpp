@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
@@ -25,7 +26,7 @@ bool Simulation<Real>::field_partials(const std::vector<double>& pe, std::vector
   for (const auto& f : scene_.fields) {
     const bool d = step_ % f.every == 0;
     any = any || d;
-    const std::size_t width = f.type == FieldSpec::Type::wall_force ? 3 : 1;
+    const std::size_t width = f.width();
     for (std::size_t c = 0; c < width; ++c) due.push_back(d);
     if (!d) {
       local.insert(local.end(), width, 0.0);
@@ -74,6 +75,12 @@ bool Simulation<Real>::field_partials(const std::vector<double>& pe, std::vector
         std::size_t m = 0;  // a mesh wall (the scene checked the name)
         while (walls.mesh_spec(m).name != f.wall) ++m;
         local.insert(local.end(), walls.mesh_force(m).begin(), walls.mesh_force(m).end());
+        break;
+      }
+      case FieldSpec::Type::broken_bonds: {  // each break is recorded by one rank (bond drivers)
+        std::array<double, 4> n{};
+        for (const auto& b : broken_) n[std::min<std::size_t>(b.mode, 3)] += 1;
+        local.insert(local.end(), n.begin(), n.end());
         break;
       }
       case FieldSpec::Type::mass_below: {  // owned particles' share; the sink sums the ranks

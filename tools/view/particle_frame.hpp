@@ -19,6 +19,9 @@ struct ParticleSet {
   io::Geometry geometry;
   std::vector<io::Vec3> velocity;      ///< empty for a geometry
   std::vector<io::Vec3> displacement;  ///< filled when a reference was given
+  /// Bond damage (broken / initial bonds of each particle) of a checkpoint whose scene has breakable bonds
+  /// (its bonds_initial and bonds_broken fields); empty otherwise.
+  std::vector<double> damage;
   io::FrameInfo info;
   std::string kind;  ///< "checkpoint" or "geometry"
 

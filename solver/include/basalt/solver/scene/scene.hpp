@@ -86,7 +86,8 @@ struct FieldSpec {
     rotational_kinetic_energy,
     sliding_contacts,
     runout,
-    mass_below
+    mass_below,
+    broken_bonds  ///< four columns: bonds broken so far in tension, shear, bending, torsion
   };
   Type type = Type::energy;
   std::string term = "kinetic_energy";  ///< energy only: the ledger term
@@ -97,7 +98,9 @@ struct FieldSpec {
   std::array<double, 3> origin{0, 0, 0}, direction{1, 0, 0};
   double percentile = 100;
   double z = 0;  ///< mass_below only: particles whose centre is below this height
-  /// The column name (wall_force: the prefix of three columns).
+  /// Columns it writes: wall_force 3 (x, y, z), broken_bonds 4 (per failure mode), the others 1.
+  std::size_t width() const { return type == Type::wall_force ? 3 : (type == Type::broken_bonds ? 4 : 1); }
+  /// The column name (wall_force, broken_bonds: the prefix of their columns).
   std::string name() const {
     switch (type) {
       case Type::energy:
@@ -114,6 +117,8 @@ struct FieldSpec {
         return "sliding_contacts";
       case Type::mass_below:
         return "mass_below";
+      case Type::broken_bonds:
+        return "broken_bonds";
       case Type::runout:
         return percentile >= 100 ? std::string("runout_max")
                                  : "runout_p" + std::to_string(static_cast<int>(std::lround(percentile)));
