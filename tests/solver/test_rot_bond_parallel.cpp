@@ -122,7 +122,7 @@ TEST(RotBondParallel, CrushedSpecimenMatchesSerialRunThroughBreaks) {
     if (basalt::test::rank() != 0) continue;
     // Breaking is a threshold: once a bond at the margin breaks on one grid and not the other (force sums
     // in another order differ by rounding), the runs part ways. Until then they agree: the same broken
-    // bonds per mode at every row, the platen force to 1e-9; that stretch must hold the first 100 breaks.
+    // bonds per mode at every row, that stretch must hold the first 100 breaks.
     std::size_t same = 0;
     bool counts_agree = true;
     while (same < rows && counts_agree) {
