@@ -510,8 +510,9 @@ rest_length = "sum_of_radii"
     }
     std::printf("%-8s %zu steps: max deviation from ESyS %.3g (relative to each quantity's largest value)\n",
                 c.name, ref.size() - 1, worst);
-    // 1e-4: in the pure stretch and gap runs Basalt's spheres pick up a rounding-level spin (4e-7 rad/ms after
-    // 200 steps) where ESyS's stay exactly at 0; every driven quantity agrees to 1e-7 (docs/reference-runs.md).
+    // 1e-4: in the pure stretch and gap runs Basalt's spheres pick up a rounding-level spin (4e-7 rad/ms
+    // after 200 steps) where ESyS's stay exactly at 0; every driven quantity agrees to 1e-7
+    // (docs/reference-runs.md).
     EXPECT_LT(worst, 1e-4) << c.name << ": " << where;
     if (std::string(c.name) == "break") {
       ASSERT_EQ(sim.broken_bonds().size(), 1u);
