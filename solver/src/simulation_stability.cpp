@@ -109,7 +109,15 @@ void Simulation<Real>::estimate_critical_step(bool fresh) {
     const std::vector<Real> x0(p_.x.begin(), p_.x.begin() + long(n)),
         y0(p_.y.begin(), p_.y.begin() + long(n)), z0(p_.z.begin(), p_.z.begin() + long(n));
     // Bonds already beyond their break strain break here, as in the first force computation without
-    // the estimate (a restart at the step they broke replays exactly that); the perturbed ones must not.
+    // the estimate; the perturbed ones must not. The estimate leaves the bonds as it found them: the
+    // caller's force computation breaks those bonds (a restart at the step they broke replays exactly
+    // that), and a model whose breaking bond still acts in that step (rot_bond) applies its force then.
+    const bool breakable = forces_.bonds_can_break();
+    const Bonds<Real> bonds_at_start = breakable ? bonds_ : Bonds<Real>{};
+    const std::vector<std::int32_t> damage_at_start =
+        breakable ? p_.bonds_broken : std::vector<std::int32_t>{};
+    const std::size_t broken_at_start = broken_.size();
+    const bool bond_broke_at_start = bond_broke_;
     compute_forces<false>();
     const std::size_t broken_before = broken_.size();
     const std::vector<double> f0x(p_.fx.begin(), p_.fx.begin() + long(n)),
@@ -161,7 +169,7 @@ void Simulation<Real>::estimate_critical_step(bool fresh) {
       lambda = std::max(lambda, rq);
       if (converged) break;
     }
-    // Back to the positions and forces of the start (the caller computes them again as it needs).
+    // Back to the positions of the start (the caller computes the forces again).
     std::copy(x0.begin(), x0.end(), p_.x.begin());
     std::copy(y0.begin(), y0.end(), p_.y.begin());
     std::copy(z0.begin(), z0.end(), p_.z.begin());
@@ -171,7 +179,12 @@ void Simulation<Real>::estimate_critical_step(bool fresh) {
           "the critical-step estimate broke {} bond(s) by perturbing positions by {:.3g}: bonds this close "
           "to breaking at the start are not supported",
           broken_.size() - broken_before, delta));
-    compute_forces<false>();
+    if (breakable) {
+      bonds_ = bonds_at_start;
+      p_.bonds_broken = damage_at_start;
+      broken_.erase(broken_.begin() + static_cast<std::ptrdiff_t>(broken_at_start), broken_.end());
+      bond_broke_ = bond_broke_at_start;
+    }
   }
   st.dt_power = stability::critical_step(lambda);
   // The power iterations approach omega_max from below (2 / omega_power >= the true step, by a few
