@@ -63,9 +63,12 @@ void Checkpoint::validate(const fs::path& source) const {
       throw FormatError(
           source, "/bonds/rest_length",
           fmt::format("bond {}: rest length must be finite and >= 0, got {}", k, bond_rest_length[k]));
-    if (bond_broken[k] > 2)
-      throw FormatError(source, "/bonds/broken",
-                        fmt::format("bond {}: flag must be 0, 1 or 2, got {}", k, bond_broken[k]));
+    // Bits 0-1: 0 intact, 1 broken, 2 broke at this step; bits 2-3: the failure mode of a broken bond.
+    if ((bond_broken[k] & 3) > 2 || bond_broken[k] > 15 || ((bond_broken[k] & 3) == 0 && bond_broken[k] != 0))
+      throw FormatError(
+          source, "/bonds/broken",
+          fmt::format("bond {}: flag must be 0, or 1 or 2 plus 4 x the failure mode (0-3), got {}", k,
+                      bond_broken[k]));
   }
   for (const auto& [name, values] : particle_fields) {
     const auto where = "/particles/" + name;

@@ -250,7 +250,7 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
     for (const auto* list : {&s.bonds, &s.contacts})
       for (const auto& g : *list) {
         const ModelEntry* m = find_model(g.model, g.kind);
-        if (m && (m->reads & kAngularVelocity) && !needs) needs = &g;
+        if (m && (m->reads & (kAngularVelocity | kOrientation)) && !needs) needs = &g;
       }
     if (needs && rotation == false)
       throw InputError(
@@ -360,7 +360,8 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
             {"sliding_contacts", FieldSpec::Type::sliding_contacts},
             {"runout", FieldSpec::Type::runout},
             {"mass_below", FieldSpec::Type::mass_below},
-            {"mean_vz_above", FieldSpec::Type::mean_vz_above}};
+            {"mean_vz_above", FieldSpec::Type::mean_vz_above},
+            {"broken_bonds", FieldSpec::Type::broken_bonds}};
         for (const auto& kind : kOther) allowed.push_back(kind.first);
         FieldSpec f;
         const std::string type = tf.choice_or("type", allowed, "");
@@ -429,6 +430,11 @@ Scene parse_scene(const fs::path& file) {
 std::vector<std::string> field_columns(const Scene& scene) {
   std::vector<std::string> cols;
   for (const auto& f : scene.fields) {
+    if (f.type == FieldSpec::Type::broken_bonds) {
+      for (const char* m : {"tension", "shear", "bending", "torsion"})
+        cols.push_back(fmt::format("broken_bonds_{}", m));
+      continue;
+    }
     if (!f.per_wall()) {
       cols.push_back(f.name());
       continue;

@@ -130,7 +130,7 @@ void SimulationFrame<Real>::write(io::FrameWriter& w) const {
     w.set(Column::bond_b, at, broken.b);
     w.set(Column::bond_rest_length, at, broken.rest_length);
     w.set(Column::bond_group, at, broken.group);
-    w.set(Column::bond_broken, at, broken.step == sim_.step_ ? 2 : 1);
+    w.set(Column::bond_broken, at, std::uint8_t((broken.step == sim_.step_ ? 2 : 1) | (broken.mode << 2)));
     ++at;
   }
   std::size_t c = 0;

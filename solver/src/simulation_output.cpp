@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
@@ -25,7 +26,7 @@ bool Simulation<Real>::field_partials(const std::vector<double>& pe, std::vector
   for (const auto& f : scene_.fields) {
     const bool d = step_ % f.every == 0;
     any = any || d;
-    const std::size_t width = f.per_wall() ? 3 : 1;
+    const std::size_t width = f.width();
     for (std::size_t c = 0; c < width; ++c) due.push_back(d);
     if (!d) {
       local.insert(local.end(), width, 0.0);
@@ -90,6 +91,12 @@ bool Simulation<Real>::field_partials(const std::vector<double>& pe, std::vector
         }
         if (comm().rank() != 0) x = {0, 0, 0};
         local.insert(local.end(), x.begin(), x.end());
+        break;
+      }
+      case FieldSpec::Type::broken_bonds: {  // each break is recorded by one rank (bond drivers)
+        std::array<double, 4> n{};
+        for (const auto& b : broken_) n[std::min<std::size_t>(b.mode, 3)] += 1;
+        local.insert(local.end(), n.begin(), n.end());
         break;
       }
       case FieldSpec::Type::mass_below: {  // owned particles' share; the sink sums the ranks

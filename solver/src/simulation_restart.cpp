@@ -90,7 +90,8 @@ void Simulation<Real>::distribute_checkpoint(const io::Checkpoint& c, const Rest
   for (std::size_t k = 0; k < g.bonds.size(); ++k) {
     const auto& b = g.bonds[k];
     const auto ia = static_cast<std::size_t>(g.index_of(b.a)), ib = static_cast<std::size_t>(g.index_of(b.b));
-    if (c.bond_broken[k] == 1 || (c.bond_broken[k] == 2 && !replay)) {
+    const int state = c.bond_broken[k] & 3;
+    if (state == 1 || (state == 2 && !replay)) {
       // Kept on record (once, by the rank owning the lower id) so later checkpoints still list it.
       const std::size_t lower = b.a < b.b ? ia : ib;
       if (owned[lower]) {
@@ -98,7 +99,9 @@ void Simulation<Real>::distribute_checkpoint(const io::Checkpoint& c, const Rest
         const auto& pb = g.position[ib];
         const double len = std::sqrt((pa[0] - pb[0]) * (pa[0] - pb[0]) + (pa[1] - pb[1]) * (pa[1] - pb[1]) +
                                      (pa[2] - pb[2]) * (pa[2] - pb[2]));
-        broken_.push_back({b.a, b.b, len, c.bond_rest_length[k]});
+        BrokenBond r{b.a, b.b, len, c.bond_rest_length[k]};
+        r.mode = static_cast<std::uint8_t>(c.bond_broken[k] >> 2);
+        broken_.push_back(r);
       }
       continue;
     }
@@ -160,7 +163,7 @@ void Simulation<Real>::restore_particle_fields(const io::Checkpoint& c, const st
   // basalt-run): count them from its bonds, broken ones included.
   const bool derive = !missing.empty();
   for (std::size_t k = 0; k < g.bonds.size(); ++k) {
-    const auto flag = c.bond_broken[k];
+    const auto flag = c.bond_broken[k] & 3;
     for (const auto id : {g.bonds[k].a, g.bonds[k].b}) {
       const auto i = local_of(id);
       if (i < 0) continue;

@@ -144,7 +144,15 @@ void Simulation<Real>::estimate_critical_step(bool fresh) {
         }
       }
     // Bonds already beyond their break strain break here, as in the first force computation without
-    // the estimate (a restart at the step they broke replays exactly that); the perturbed ones must not.
+    // the estimate; the perturbed ones must not. The estimate leaves the bonds as it found them: the
+    // caller's force computation breaks those bonds (a restart at the step they broke replays exactly
+    // that), and a model whose breaking bond still acts in that step (rot_bond) applies its force then.
+    const bool breakable = forces_.bonds_can_break();
+    const Bonds<Real> bonds_at_start = breakable ? bonds_ : Bonds<Real>{};
+    const std::vector<std::int32_t> damage_at_start =
+        breakable ? p_.bonds_broken : std::vector<std::int32_t>{};
+    const std::size_t broken_at_start = broken_.size();
+    const bool bond_broke_at_start = bond_broke_;
     compute_forces<false>();  // also F(x) for the first product
     const std::size_t broken_before = broken_.size();
     std::vector<double> sums(2);
@@ -202,14 +210,20 @@ void Simulation<Real>::estimate_critical_step(bool fresh) {
       lambda = std::max(lambda, rq);
       if (converged) break;
     }
-    // x0 back to the values rebuild() gives it (the same function sets both).
+    // x0 back to the values rebuild() gives it (the same function sets both). The forces hold the last
+    // product: the callers compute them again.
     if (fresh) set_skin_reference();
     if (broken_.size() != broken_before)
       throw InputError(fmt::format(
           "the critical-step estimate broke {} bond(s) by perturbing positions by {:.3g}: bonds this close "
           "to breaking at the start are not supported",
           broken_.size() - broken_before, delta));
-    compute_forces<false>();
+    if (breakable) {
+      bonds_ = bonds_at_start;
+      p_.bonds_broken = damage_at_start;
+      broken_.erase(broken_.begin() + static_cast<std::ptrdiff_t>(broken_at_start), broken_.end());
+      bond_broke_ = bond_broke_at_start;
+    }
   }
   st.dt_power = stability::critical_step(lambda);
   // The power iterations approach omega_max from below (2 / omega_power >= the true step, by a few

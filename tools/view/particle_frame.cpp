@@ -1,6 +1,8 @@
 #include "particle_frame.hpp"
 
 #include <fmt/format.h>
+#include <vtkDoubleArray.h>
+#include <vtkPointData.h>
 
 #include <system_error>
 
@@ -29,8 +31,42 @@ ParticleSet from_geometry(io::Geometry g) {
   return s;
 }
 
+/// broken / initial bonds per particle from two particle arrays (0 for a particle that had no bond).
+std::vector<double> damage_of(const std::vector<double>& initial, const std::vector<double>& broken) {
+  std::vector<double> d(initial.size(), 0.0);
+  for (std::size_t i = 0; i < d.size() && i < broken.size(); ++i)
+    if (initial[i] > 0) d[i] = broken[i] / initial[i];
+  return d;
+}
+
+/// Adds a "damage" point array to a frame that has bonds_initial and bonds_broken arrays.
+void add_damage(vtkPolyData& pd) {
+  auto* pdat = pd.GetPointData();
+  vtkDataArray* ini = pdat->GetArray("bonds_initial");
+  vtkDataArray* brk = pdat->GetArray("bonds_broken");
+  if (!ini || !brk || pdat->GetArray("damage")) return;
+  std::vector<double> a(static_cast<std::size_t>(ini->GetNumberOfTuples())), b(a.size());
+  for (vtkIdType i = 0; i < ini->GetNumberOfTuples(); ++i) {
+    a[static_cast<std::size_t>(i)] = ini->GetTuple1(i);
+    b[static_cast<std::size_t>(i)] = brk->GetTuple1(i);
+  }
+  const auto d = damage_of(a, b);
+  auto arr = vtkSmartPointer<vtkDoubleArray>::New();
+  arr->SetName("damage");
+  arr->SetNumberOfTuples(static_cast<vtkIdType>(d.size()));
+  for (std::size_t i = 0; i < d.size(); ++i) arr->SetValue(static_cast<vtkIdType>(i), d[i]);
+  pdat->AddArray(arr);
+}
+
 ParticleSet from_checkpoint(io::Checkpoint c) {
   ParticleSet s;
+  const std::vector<double>* initial = nullptr;
+  const std::vector<double>* broken = nullptr;
+  for (const auto& [name, values] : c.particle_fields) {
+    if (name == "bonds_initial") initial = &values;
+    if (name == "bonds_broken") broken = &values;
+  }
+  if (initial && broken) s.damage = damage_of(*initial, *broken);
   s.info = io::info_of(c);
   s.geometry = std::move(c.geometry);
   s.velocity = std::move(c.velocity);
@@ -78,10 +114,19 @@ Frame read_frame(const fs::path& file, const std::optional<fs::path>& reference)
     if (reference)
       throw io::FormatError(file, "", "--reference applies to checkpoints and geometries, not to VTK files");
     auto pd = io::read_polydata(file);
+    add_damage(*pd);
     return {pd, io::info_of(*pd), "VTK frame"};
   }
   const ParticleSet s = read_particles(file, reference);
-  return {io::to_polydata(s.arrays(), s.info), s.info, s.kind};
+  auto pd = io::to_polydata(s.arrays(), s.info);
+  if (!s.damage.empty()) {
+    auto arr = vtkSmartPointer<vtkDoubleArray>::New();
+    arr->SetName("damage");
+    arr->SetNumberOfTuples(static_cast<vtkIdType>(s.damage.size()));
+    for (std::size_t i = 0; i < s.damage.size(); ++i) arr->SetValue(static_cast<vtkIdType>(i), s.damage[i]);
+    pd->GetPointData()->AddArray(arr);
+  }
+  return {pd, s.info, s.kind};
 }
 
 }  // namespace basalt::view

@@ -21,6 +21,9 @@ struct ParticleSet {
   std::vector<io::Vec3> displacement;  ///< filled when a reference was given
   /// A checkpoint's optional particle fields (angular_velocity_x ..., the scene's), one value per particle.
   std::vector<std::pair<std::string, std::vector<double>>> fields;
+  /// Bond damage (broken / initial bonds of each particle) of a checkpoint whose scene has breakable bonds
+  /// (its bonds_initial and bonds_broken fields); empty otherwise.
+  std::vector<double> damage;
   io::FrameInfo info;
   std::string kind;  ///< "checkpoint" or "geometry"
 

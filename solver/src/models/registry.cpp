@@ -13,6 +13,7 @@
 #include "basalt/solver/interactions/bonded_wall_driver.hpp"
 #include "basalt/solver/interactions/mesh_wall_driver.hpp"
 #include "basalt/solver/interactions/pair_driver.hpp"
+#include "basalt/solver/interactions/rot_bond_driver.hpp"
 #include "basalt/solver/interactions/wall_driver.hpp"
 #include "basalt/solver/models/bonded_wall.hpp"
 #include "basalt/solver/models/contact_age.hpp"
@@ -24,6 +25,7 @@
 #include "basalt/solver/models/linear_bond.hpp"
 #include "basalt/solver/models/linear_elastic.hpp"
 #include "basalt/solver/models/rolling_friction.hpp"
+#include "basalt/solver/models/rot_bond.hpp"
 
 namespace basalt::solver {
 
@@ -31,7 +33,12 @@ namespace {
 
 template <class Real, class Model>
 std::unique_ptr<ForceCompute<Real>> make(const Scene& s) {
-  if constexpr (Model::kind == ModelKind::bond) return std::make_unique<BondDriver<Real, Model>>(s.bonds);
+  if constexpr (Model::kind == ModelKind::bond) {
+    if constexpr (requires { Model::rotational; })
+      return std::make_unique<RotBondDriver<Real, Model>>(s.bonds);
+    else
+      return std::make_unique<BondDriver<Real, Model>>(s.bonds);
+  }
   if constexpr (Model::kind == ModelKind::pair) return std::make_unique<PairDriver<Real, Model>>(s.contacts);
   if constexpr (Model::kind == ModelKind::wall) {
     if constexpr (requires { Model::bonded; })
@@ -98,6 +105,7 @@ ModelEntry entry() {
 const std::vector<ModelEntry>& model_registry() {
   static const std::vector<ModelEntry> models{
       entry<LinearBond>(),         // bond
+      entry<RotBond>(),            // bond, ESyS RotBond/BrittleBeam (Wang et al. 2006)
       entry<LinearElastic>(),      // pair
       entry<ContactAge>(),         // pair, test model for contact history
       entry<Friction>(),           // pair, ESyS NRotFriction

@@ -42,7 +42,8 @@ struct Checkpoint {
 
   // Bond state, one entry per geometry.bonds entry.
   std::vector<double> bond_rest_length;
-  /// 0 intact; 1 broken (broken bonds are kept so ids stay stable); 2 broke at this very step
+  /// 0 intact; 1 broken (broken bonds are kept so ids stay stable); 2 broke at this very step; a broken
+  /// bond adds 4 x its failure mode (0 tension, 1 shear, 2 bending, 3 torsion)
   std::vector<std::uint8_t> bond_broken;
 
   std::vector<WallState> walls;

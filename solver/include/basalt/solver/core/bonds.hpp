@@ -58,6 +58,23 @@ struct Bonds {
     apply(ib);
   }
 
+  /// Removes the bonds at the ascending positions `gone`, keeping the others' order and n_both_owned.
+  void erase(const std::vector<std::size_t>& gone) {
+    std::vector<std::uint32_t> keep;
+    keep.reserve(size() - gone.size());
+    std::size_t g = 0, n2 = 0;
+    for (std::size_t k = 0; k < size(); ++k) {
+      if (g < gone.size() && gone[g] == k) {
+        ++g;
+        continue;
+      }
+      if (k < n_both_owned) ++n2;
+      keep.push_back(static_cast<std::uint32_t>(k));
+    }
+    permute(keep);
+    n_both_owned = n2;
+  }
+
   /// Puts the bonds in their canonical order, a function of their local ends alone (ia the owned end,
   /// ib the other; both owned: ia < ib): both ends owned first, each part in memory order of its owned
   /// end (a counting sort, O(bonds)), then by the other end within a bucket. So the bond order, and

@@ -22,7 +22,7 @@
 namespace basalt::solver {
 
 /// Groups of arrays a scene may leave out (Particles::enabled()).
-enum class FieldGroup { core, exact_rebuild, damage, rotation };
+enum class FieldGroup { core, exact_rebuild, damage, rotation, bond_frame };
 
 /// What an array of Particles is (for_each_array()).
 struct ArrayInfo {
@@ -79,6 +79,11 @@ struct Particles {
   std::vector<Real> tx, ty, tz;
   std::vector<Real> qw, qx, qy, qz;
   bool with_rotation = false;
+  /// Optional (with_bond_frame: rotational bonds, ESyS "RotBond"/"BrittleBeam"): each particle's position
+  /// at the start of the run (ESyS's initial position), from which a bond's reference direction and length
+  /// follow (x_b0 - x_a0); ghosts have it, and with it ghosts carry orientations refreshed every step.
+  std::vector<Real> xi, yi, zi;
+  bool with_bond_frame = false;
   /// Ghosts carry velocities (and angular velocities with rotation), refreshed every step with their
   /// positions: set when a model reads the velocities of both particles of a pair (friction, damping).
   bool ghost_velocity = false;
@@ -87,7 +92,8 @@ struct Particles {
   bool enabled(const ArrayInfo& a) const {
     return a.group == FieldGroup::core || (a.group == FieldGroup::exact_rebuild && with_exact_rebuild) ||
            (a.group == FieldGroup::damage && with_damage) ||
-           (a.group == FieldGroup::rotation && with_rotation);
+           (a.group == FieldGroup::rotation && with_rotation) ||
+           (a.group == FieldGroup::bond_frame && with_bond_frame);
   }
 
   /// Calls f(ArrayInfo, vector&) for every array, in a fixed order.
@@ -105,11 +111,18 @@ struct Particles {
   Real inverse_inertia(std::size_t i) const { return Real(2.5) * inv_mass[i] / (radius[i] * radius[i]); }
 
   /// The arrays a ghost refresh sends every step, in order: positions, then with ghost_velocity the
-  /// velocities and (with rotation) angular velocities.
+  /// velocities and (with rotation) angular velocities, then with rotational bonds (with_bond_frame) the
+  /// orientations.
   template <class P>
   static auto step_arrays(P& p) {
-    std::array<decltype(&p.x), 9> a{&p.x, &p.y, &p.z, &p.vx, &p.vy, &p.vz, &p.wx, &p.wy, &p.wz};
-    const std::size_t n = !p.ghost_velocity ? 3 : (p.with_rotation ? 9 : 6);
+    std::array<decltype(&p.x), 13> a{&p.x, &p.y, &p.z, &p.vx, &p.vy, &p.vz, &p.wx, &p.wy, &p.wz};
+    std::size_t n = !p.ghost_velocity ? 3 : (p.with_rotation ? 9 : 6);
+    if (p.with_bond_frame) {
+      a[n++] = &p.qw;
+      a[n++] = &p.qx;
+      a[n++] = &p.qy;
+      a[n++] = &p.qz;
+    }
     return std::pair{a, n};
   }
 
@@ -154,6 +167,11 @@ struct Particles {
     vz[i] = pvz;
     inv_mass[i] = im;
     if (with_rotation) qw[i] = 1;
+    if (with_bond_frame) {
+      xi[i] = px;
+      yi[i] = py;
+      zi[i] = pz;
+    }
     x0[i] = float(double(px) - skin_origin[0]);
     y0[i] = float(double(py) - skin_origin[1]);
     z0[i] = float(double(pz) - skin_origin[2]);
@@ -233,18 +251,21 @@ struct Particles {
         exact{"position_at_rebuild", false, false, G::exact_rebuild},
         initial{"bond_damage", false, true, G::damage, "bonds_initial"},
         broken{"bond_damage", false, true, G::damage, "bonds_broken"},
-        trq{"torque", false, false, G::rotation},
-        ori{"orientation", false, true, G::rotation, "orientation_w"},
-        ori_x{"orientation", false, true, G::rotation, "orientation_x"},
-        ori_y{"orientation", false, true, G::rotation, "orientation_y"},
-        ori_z{"orientation", false, true, G::rotation, "orientation_z"};
+        trq{"torque", false, false, G::rotation};
     // Velocities (and inverse masses: effective masses of dashpots) go to ghosts when a model reads both
     // particles' velocities.
-    const bool gv = p.ghost_velocity;
+    const bool gv = p.ghost_velocity, go = p.with_bond_frame;
     const ArrayInfo vel{"velocity", gv, true, G::core}, im{"inverse_mass", gv, true, G::core},
         ang_x{"angular_velocity", gv, true, G::rotation, "angular_velocity_x"},
         ang_y{"angular_velocity", gv, true, G::rotation, "angular_velocity_y"},
-        ang_z{"angular_velocity", gv, true, G::rotation, "angular_velocity_z"};
+        ang_z{"angular_velocity", gv, true, G::rotation, "angular_velocity_z"},
+        ori{"orientation", go, true, G::rotation, "orientation_w"},
+        ori_x{"orientation", go, true, G::rotation, "orientation_x"},
+        ori_y{"orientation", go, true, G::rotation, "orientation_y"},
+        ori_z{"orientation", go, true, G::rotation, "orientation_z"},
+        init_x{"initial_position", go, true, G::bond_frame, "initial_position_x"},
+        init_y{"initial_position", go, true, G::bond_frame, "initial_position_y"},
+        init_z{"initial_position", go, true, G::bond_frame, "initial_position_z"};
     f(pos, p.x), f(pos, p.y), f(pos, p.z);
     f(rad, p.radius);
     f(ident, p.id);
@@ -258,6 +279,7 @@ struct Particles {
     f(ang_x, p.wx), f(ang_y, p.wy), f(ang_z, p.wz);
     f(trq, p.tx), f(trq, p.ty), f(trq, p.tz);
     f(ori, p.qw), f(ori_x, p.qx), f(ori_y, p.qy), f(ori_z, p.qz);
+    f(init_x, p.xi), f(init_y, p.yi), f(init_z, p.zi);
   }
 };
 

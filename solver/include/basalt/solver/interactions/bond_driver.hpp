@@ -49,7 +49,7 @@ class BondDriver final : public ForceCompute<Real> {
       e = energy ? dispatch<true, true>(s) : dispatch<false, true>(s);
     } else {
       e = energy ? dispatch<true, false>(s) : dispatch<false, false>(s);
-      if (!gone_.empty()) remove(s.bonds, gone_);
+      if (!gone_.empty()) s.bonds.erase(gone_);
       gone_.clear();
     }
     return e;
@@ -93,8 +93,7 @@ class BondDriver final : public ForceCompute<Real> {
             ++p.bonds_broken[i];
             if constexpr (BothOwned) ++p.bonds_broken[j];
           }
-          if (BothOwned || p.id[i] < p.id[j])
-            s.broken.push_back({bonds.a[k], bonds.b[k], double(r), double(r0), -1, bonds.group_of(k)});
+          if (BothOwned || p.id[i] < p.id[j]) s.broken.push_back(record(s, k, i, j, r, r0));
           continue;
         }
       }
@@ -113,20 +112,21 @@ class BondDriver final : public ForceCompute<Real> {
     return energy;
   }
 
-  static void remove(Bonds<Real>& bonds, const std::vector<std::size_t>& gone) {
-    std::vector<std::uint32_t> keep;
-    keep.reserve(bonds.size() - gone.size());
-    std::size_t g = 0, n2 = 0;
-    for (std::size_t k = 0; k < bonds.size(); ++k) {
-      if (g < gone.size() && gone[g] == k) {
-        ++g;
-        continue;
-      }
-      if (k < bonds.n_both_owned) ++n2;
-      keep.push_back(static_cast<std::uint32_t>(k));
-    }
-    bonds.permute(keep);
-    bonds.n_both_owned = n2;
+  /// The break record of bond k (ends i, j): a tension failure at the spheres' contact point.
+  static BrokenBond record(const ForceState<Real>& s, std::size_t k, std::size_t i, std::size_t j, Real r,
+                           Real r0) {
+    const auto& p = s.p;
+    const double w = double(p.radius[i]) / (double(p.radius[i]) + double(p.radius[j]));
+    return {s.bonds.a[k],
+            s.bonds.b[k],
+            double(r),
+            double(r0),
+            -1,
+            s.bonds.group_of(k),
+            0,
+            double(p.x[i]) + w * (double(p.x[j]) - double(p.x[i])),
+            double(p.y[i]) + w * (double(p.y[j]) - double(p.y[i])),
+            double(p.z[i]) + w * (double(p.z[j]) - double(p.z[i]))};
   }
 
   std::vector<typename Model::Params> params_;

@@ -21,8 +21,10 @@ namespace basalt::solver {
 struct BrokenBond {
   std::int64_t a, b;
   double length, rest_length;
-  std::int64_t step = -1;  ///< the step it broke at (set by the simulation)
-  std::uint8_t group = 0;  ///< its interaction group: a restart at that very step restores the bond
+  std::int64_t step = -1;      ///< the step it broke at (set by the simulation)
+  std::uint8_t group = 0;      ///< its interaction group: a restart at that very step restores the bond
+  std::uint8_t mode = 0;       ///< how it failed (BondFailure: 0 tension, 1 shear, 2 bending, 3 torsion)
+  double x = 0, y = 0, z = 0;  ///< where: the contact point of the two spheres at the break
 };
 
 /// What the force computes act on during a step.

@@ -43,6 +43,8 @@ class ForceField {
   double rest_length(std::size_t g, double ri, double rj, double r) const {
     return bond_compute_ ? bond_compute_->rest_length(g, ri, rj, r) : r;
   }
+  /// Whether a bond model turns with its particles (rotational bonds: Particles::with_bond_frame).
+  bool needs_bond_frame() const { return bond_compute_ && (bond_compute_->reads() & kOrientation); }
   /// Whether some bond can break (the scene then keeps each particle's bond damage).
   bool bonds_can_break() const { return bond_compute_ && bond_compute_->can_break(); }
   Walls& walls() { return walls_; }

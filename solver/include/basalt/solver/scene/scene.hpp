@@ -96,7 +96,8 @@ struct FieldSpec {
     sliding_contacts,
     runout,
     mass_below,
-    mean_vz_above
+    mean_vz_above,
+    broken_bonds  ///< four columns: bonds broken so far in tension, shear, bending, torsion
   };
   Type type = Type::energy;
   std::string term = "kinetic_energy";  ///< energy only: the ledger term
@@ -109,7 +110,10 @@ struct FieldSpec {
   std::array<double, 3> origin{0, 0, 0}, direction{1, 0, 0};
   double percentile = 100;
   double z = 0;  ///< mass_below, mean_vz_above: particles whose centre is below / above this height
-  /// The column name (wall_force: the prefix of three columns).
+  /// Columns it writes: wall_force and wall_position 3 (x, y, z), broken_bonds 4 (per failure mode), the
+  /// others 1.
+  std::size_t width() const { return per_wall() ? 3 : (type == Type::broken_bonds ? 4 : 1); }
+  /// The column name (wall_force, wall_position, broken_bonds: the prefix of their columns).
   std::string name() const {
     switch (type) {
       case Type::energy:
@@ -130,6 +134,8 @@ struct FieldSpec {
         return "mass_below";
       case Type::mean_vz_above:
         return "mean_vz_above";
+      case Type::broken_bonds:
+        return "broken_bonds";
       case Type::runout:
         return percentile >= 100 ? std::string("runout_max")
                                  : "runout_p" + std::to_string(static_cast<int>(std::lround(percentile)));

@@ -1,0 +1,350 @@
+#pragma once
+// Rotational bond between two rotating spheres: ESyS-Particle's "RotBond" / "BrittleBeam"
+// (ARotBondedInteraction::calcForces, CRotBondedInteraction::broken; Wang, Abe, Latham, Mora 2006,
+// "Implementation of particle-scale rotation in the 3-D lattice solid model", PAGEOPH 163) with its
+// conventions; LAMMPS's bond_style bpm/rotational carries the same four springs.
+//
+// Particle 1 is the bond's first end (a), 2 its second (b); q1, q2 their orientations (body -> world),
+// D = x2 - x1 at the start of the run (both orientations the identity then), L = |D|, r0 the rest length
+// (ESyS: r1 + r2; Basalt's default: L). In 1's body frame, rb = R1^T (x2 - x1):
+//   normal   Fr = kn (|rb| - r0) rb/|rb|                            (attractive when stretched)
+//   shear    Fst = ks r0 gamma, gamma the angle between rb and D, towards the offset of 2, with the
+//            couple Mst = -|Fst| (rb x D)/|rb x D|; and, from the relative rotation r = q1^-1 q2 seen in
+//            the frame qm that turns z onto rb: the bending angle theta and torsion angle psi,
+//   bending  Mb = kb theta / 2, with a shear force Fs = ks r0 theta / 2 and its couple (Wang eq. 16),
+//   torsion  Mt = kt psi about rb.
+// The shear couples go to the particles in proportion r1/(r1+r2), r2/(r1+r2) times |x2 - x1| (eq. 19).
+// Energy (ESyS's): Fn^2/2kn + Fs^2/2ks + Mt^2/2kt + Mb^2/2kb.
+//
+// Stiffnesses are given (kn, ks in force/length; kb, kt in moment/radian) or derived from Young's
+// modulus E and Poisson's ratio nu (ESyS "BrittleBeamPrms", always scaled per bond): with the bond radius
+// R = L/2 (radius_scaling = "mean", ESyS meanR_scaling=True) or min(r1, r2) ("min"), G = E / 2(1+nu):
+//   kn = pi E R^2/L, ks = pi G R^2/L, kb = pi E R^4/(4L), kt = pi G R^4/(2L).
+// Strengths from cohesion c and tan(phi) (scaled alike): Fn_max = pi c R^2/tan(phi), Fs_max = pi c R^2,
+// Mb_max = pi c R^3/(4 tan(phi)), Mt_max = pi c R^3/2; or given directly (max_normal_force, ...).
+// Failure (criterion = "esys", ESyS's direct Mohr-Coulomb): with Fn > 0 in tension,
+//   normal = Fn/Fn_max + beta1 Mb/Mb_max, shear = Fs/Fs_max + beta2 Mt/Mt_max,
+//   broken when normal > truncated or shear > 1 - normal;
+// criterion = "sum" (LAMMPS bpm/rotational): max(Fn, 0)/Fn_max + Fs/Fs_max + Mb/Mb_max + Mt/Mt_max >= 1.
+// The failure mode recorded is the largest of the four terms (tension, shear, bending, torsion).
+#include <array>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <string_view>
+
+#include "basalt/solver/models/model.hpp"
+#include "basalt/solver/scene/table_reader.hpp"
+
+namespace basalt::solver {
+
+/// How a bond failed (BrokenBond::mode; linear bonds break in tension).
+enum class BondFailure : std::uint8_t { tension = 0, shear = 1, bending = 2, torsion = 3 };
+inline constexpr std::array<std::string_view, 4> kBondFailureNames{"tension", "shear", "bending", "torsion"};
+
+namespace beam {
+
+template <class Real>
+struct Vec {
+  Real x = 0, y = 0, z = 0;
+  Vec operator+(const Vec& o) const { return {x + o.x, y + o.y, z + o.z}; }
+  Vec operator-(const Vec& o) const { return {x - o.x, y - o.y, z - o.z}; }
+  Vec operator*(Real s) const { return {x * s, y * s, z * s}; }
+  Real dot(const Vec& o) const { return x * o.x + y * o.y + z * o.z; }
+  Vec cross(const Vec& o) const { return {y * o.z - z * o.y, z * o.x - x * o.z, x * o.y - y * o.x}; }
+  Real norm() const { return std::sqrt(dot(*this)); }
+};
+
+template <class Real>
+struct Quat {
+  Real w = 1, x = 0, y = 0, z = 0;
+  Quat operator*(const Quat& o) const {  // Hamilton product
+    return {w * o.w - x * o.x - y * o.y - z * o.z, w * o.x + x * o.w + y * o.z - z * o.y,
+            w * o.y - x * o.z + y * o.w + z * o.x, w * o.z + x * o.y - y * o.x + z * o.w};
+  }
+  Quat inverse() const {
+    const Real n = w * w + x * x + y * y + z * z;
+    return {w / n, -x / n, -y / n, -z / n};
+  }
+  /// R^T v for the rotation R this quaternion stands for (body -> world): v in the body frame. Written
+  /// in the homogeneous form (w^2 + x^2 - y^2 - z^2 ...) as ESyS's Quaternion::to_matrix.
+  Vec<Real> to_body(const Vec<Real>& v) const {
+    const Real ww = w * w, xx = x * x, yy = y * y, zz = z * z;
+    return {(ww + xx - yy - zz) * v.x + 2 * (x * y + w * z) * v.y + 2 * (x * z - w * y) * v.z,
+            2 * (x * y - w * z) * v.x + (ww - xx + yy - zz) * v.y + 2 * (y * z + w * x) * v.z,
+            2 * (x * z + w * y) * v.x + 2 * (y * z - w * x) * v.y + (ww - xx - yy + zz) * v.z};
+  }
+  /// R v (the transpose of to_body's matrix).
+  Vec<Real> to_world(const Vec<Real>& v) const {
+    const Real ww = w * w, xx = x * x, yy = y * y, zz = z * z;
+    return {(ww + xx - yy - zz) * v.x + 2 * (x * y - w * z) * v.y + 2 * (x * z + w * y) * v.z,
+            2 * (x * y + w * z) * v.x + (ww - xx + yy - zz) * v.y + 2 * (y * z - w * x) * v.z,
+            2 * (x * z - w * y) * v.x + 2 * (y * z + w * x) * v.y + (ww - xx - yy + zz) * v.z};
+  }
+};
+
+/// The signed angle whose cosine is c and whose sine has the sign of s (0 for s = 0 or |c| >= 1).
+template <class Real>
+Real signed_angle(Real s, Real c) {
+  if (s == Real(0) || c >= Real(1) || c <= Real(-1)) return 0;
+  return s > 0 ? std::acos(c) : -std::acos(c);
+}
+
+}  // namespace beam
+
+struct RotBond {
+  static constexpr std::string_view name = "rot_bond";
+  static constexpr ModelKind kind = ModelKind::bond;
+  static constexpr bool rotational = true;
+  static constexpr std::string_view summary =
+      "normal, shear, bending and torsion springs of a beam between rotating spheres; Mohr-Coulomb or sum "
+      "failure (ESyS RotBond/BrittleBeam, Wang et al. 2006)";
+  static constexpr std::array keys{
+      KeyDoc{"youngs_modulus", "E, force/length^2: stiffnesses from E and nu per bond (ESyS BrittleBeam)"},
+      KeyDoc{"poissons_ratio", "nu, in (-1, 0.5] (with youngs_modulus; required)"},
+      KeyDoc{"radius_scaling",
+             "\"mean\" (R = L/2, default) or \"min\" (R = min(r1, r2)), with youngs_modulus"},
+      KeyDoc{"kn", "normal stiffness, force/length (instead of youngs_modulus, with ks, kb, kt)"},
+      KeyDoc{"ks", "shear stiffness, force/length"},
+      KeyDoc{"kb", "bending stiffness, moment/radian"},
+      KeyDoc{"kt", "torsion stiffness, moment/radian"},
+      KeyDoc{"cohesion",
+             "c, force/length^2: strengths per bond (with youngs_modulus; default: never breaks)"},
+      KeyDoc{"tan_friction_angle", "tan(phi) > 0 (with cohesion; ESyS tanAngle)"},
+      KeyDoc{"max_normal_force", "tensile strength, force (with kn...; default: infinite)"},
+      KeyDoc{"max_shear_force", "shear strength, force (default: infinite)"},
+      KeyDoc{"max_bending_moment", "bending strength, moment (default: infinite)"},
+      KeyDoc{"max_torsion_moment", "torsion strength, moment (default: infinite)"},
+      KeyDoc{"criterion", "\"esys\" (default: Mohr-Coulomb with cut-off) or \"sum\" (LAMMPS bpm/rotational)"},
+      KeyDoc{"truncated", "esys: tension cut-off of the normal term, > 0 (default 1)"},
+      KeyDoc{"beta1", "esys: weight of bending in the normal term, >= 0 (default 1)"},
+      KeyDoc{"beta2", "esys: weight of torsion in the shear term, >= 0 (default 1)"},
+      KeyDoc{"rest_length", "\"initial_distance\" (default) or \"sum_of_radii\" (ESyS)"},
+      KeyDoc{"tags", "[a, b]: bonds between particles tagged a and b (default: all)"},
+      KeyDoc{"bond_tag", "the geometry's bond tag this group takes (default: all)"}};
+  static constexpr Fields reads = kPosition | kId | kRadius | kOrientation;
+  static constexpr Fields writes = kForce | kTorque;
+
+  enum class RestLength { initial_distance, sum_of_radii };
+  enum class Criterion { esys, sum };
+  static constexpr double kInf = std::numeric_limits<double>::infinity();
+  struct Params {
+    bool scaled = false;  ///< stiffnesses and strengths per unit (ESyS scaling): from E, nu, c, tan(phi)
+    bool mean_radius = true;
+    double kn = 0, ks = 0, kb = 0, kt = 0;                              ///< scaled: pi E, pi G, pi E, pi G
+    double fn_max = kInf, fs_max = kInf, mb_max = kInf, mt_max = kInf;  ///< scaled: per unit R^2, R^3
+    Criterion criterion = Criterion::esys;
+    double truncated = 1, beta1 = 1, beta2 = 1;
+    RestLength rest_length = RestLength::initial_distance;
+  };
+  template <class Real>
+  struct Coeffs {
+    bool scaled, mean_radius;
+    Real kn, ks, kb, kt;
+    Real fn_max, fs_max, mb_max, mt_max;
+    bool sum;
+    Real truncated, beta1, beta2;
+  };
+  struct History {};  // rest length: the bond store; reference direction: the particles' initial positions
+
+  /// One bond's springs and strengths (after the per-bond scaling).
+  template <class Real>
+  struct BondCoeffs {
+    Real kn, ks, kb, kt;
+    Real ifn, ifs, imb, imt;  ///< 1 / strength (0: never)
+  };
+
+  static Params parse(TableReader& t) {
+    Params p;
+    const bool modulus = t.has("youngs_modulus");
+    if (modulus) {
+      for (const char* k : {"kn", "ks", "kb", "kt", "max_normal_force", "max_shear_force",
+                            "max_bending_moment", "max_torsion_moment"})
+        if (t.has(k))
+          t.fail(k, "give either youngs_modulus (with poissons_ratio) or kn, ks, kb, kt, not both");
+      p.scaled = true;
+      const double E = t.positive("youngs_modulus"), nu = t.number("poissons_ratio");
+      if (!(nu > -1 && nu <= 0.5)) t.fail("poissons_ratio", "must be in (-1, 0.5]");
+      const double G = E / (2 * (1 + nu)), pi = std::numbers::pi;
+      p.kn = pi * E, p.ks = pi * G, p.kb = pi * E, p.kt = pi * G;
+      p.mean_radius = t.choice_or("radius_scaling", {"mean", "min"}, "mean") == "mean";
+      if (t.has("cohesion")) {
+        const double c = t.positive("cohesion"), ta = t.positive("tan_friction_angle");
+        p.fn_max = pi * c / ta, p.fs_max = pi * c, p.mb_max = pi * c / ta, p.mt_max = pi * c;
+      } else if (t.has("tan_friction_angle")) {
+        t.fail("tan_friction_angle", "needs cohesion");
+      }
+    } else {
+      for (const char* k : {"poissons_ratio", "radius_scaling", "cohesion", "tan_friction_angle"})
+        if (t.has(k)) t.fail(k, "only with youngs_modulus");
+      p.kn = t.non_negative("kn"), p.ks = t.non_negative("ks"), p.kb = t.non_negative("kb");
+      p.kt = t.non_negative("kt");
+      if (t.has("max_normal_force")) p.fn_max = t.positive("max_normal_force");
+      if (t.has("max_shear_force")) p.fs_max = t.positive("max_shear_force");
+      if (t.has("max_bending_moment")) p.mb_max = t.positive("max_bending_moment");
+      if (t.has("max_torsion_moment")) p.mt_max = t.positive("max_torsion_moment");
+    }
+    p.criterion =
+        t.choice_or("criterion", {"esys", "sum"}, "esys") == "sum" ? Criterion::sum : Criterion::esys;
+    if (t.has("truncated")) p.truncated = t.positive("truncated");
+    if (t.has("beta1")) p.beta1 = t.non_negative("beta1");
+    if (t.has("beta2")) p.beta2 = t.non_negative("beta2");
+    p.rest_length =
+        t.choice_or("rest_length", {"initial_distance", "sum_of_radii"}, "initial_distance") == "sum_of_radii"
+            ? RestLength::sum_of_radii
+            : RestLength::initial_distance;
+    return p;
+  }
+  template <class Real>
+  static Coeffs<Real> coeffs(const Params& p) {
+    return {p.scaled,
+            p.mean_radius,
+            Real(p.kn),
+            Real(p.ks),
+            Real(p.kb),
+            Real(p.kt),
+            Real(p.fn_max),
+            Real(p.fs_max),
+            Real(p.mb_max),
+            Real(p.mt_max),
+            p.criterion == Criterion::sum,
+            Real(p.truncated),
+            Real(p.beta1),
+            Real(p.beta2)};
+  }
+  /// The stiffest spring (critical step): kn, or with scaling kn at the largest bond (R = rmax, L = 2 rmax);
+  /// the shear spring adds to it in the network.
+  static double max_stiffness(const Params& p, double rmax) {
+    return p.scaled ? (p.kn + p.ks) * rmax / 2 : p.kn + p.ks;
+  }
+  static bool breakable(const Params& p) {
+    return std::isfinite(p.fn_max) || std::isfinite(p.fs_max) || std::isfinite(p.mb_max) ||
+           std::isfinite(p.mt_max);
+  }
+  static double rest_length(const Params& p, double ri, double rj, double r) {
+    return p.rest_length == RestLength::sum_of_radii ? ri + rj : r;
+  }
+
+  /// A bond's springs and strengths from its initial length L and radii (ESyS CRotBondedInteraction's
+  /// constructor).
+  template <class Real>
+  static BondCoeffs<Real> bond_coeffs(const Coeffs<Real>& c, Real L, Real r1, Real r2) {
+    const auto inv = [](Real s) { return std::isfinite(s) ? Real(1) / s : Real(0); };
+    if (!c.scaled)
+      return {c.kn, c.ks, c.kb, c.kt, inv(c.fn_max), inv(c.fs_max), inv(c.mb_max), inv(c.mt_max)};
+    const Real R = c.mean_radius ? Real(0.5) * L : std::min(r1, r2);
+    const Real A = R * R, J = Real(0.5) * A * A, I = Real(0.5) * J;
+    return {c.kn * A / L,      c.ks * A / L,      c.kb * I / L,          c.kt * J / L,
+            inv(c.fn_max * A), inv(c.fs_max * A), inv(c.mb_max * I / R), inv(c.mt_max * J / R)};
+  }
+
+  /// What the bond sees: particle 1 and 2 (the bond's ends a, b).
+  template <class Real>
+  struct Geometry {
+    beam::Vec<Real> x1, x2;
+    beam::Quat<Real> q1, q2;
+    beam::Vec<Real> d;  ///< x2 - x1 at the start
+    Real r1, r2, r0;
+  };
+  /// Force on 1 (2 gets the opposite), moments on 1 and 2, and the four loads the criterion reads.
+  template <class Real>
+  struct Result {
+    beam::Vec<Real> f1, m1, m2;
+    Real fn;  ///< normal force, > 0 in tension
+    Real fs, mb, mt;
+  };
+
+  template <class Real>
+  static Result<Real> evaluate(const BondCoeffs<Real>& k, const Geometry<Real>& g) {
+    using V = beam::Vec<Real>;
+    using Q = beam::Quat<Real>;
+    const Real h = Real(0.5) * std::sqrt(Real(2));
+    const V rbp = g.x2 - g.x1;
+    const Real lp = rbp.norm();
+    const V rb = g.q1.to_body(rbp);
+    const Real nb = rb.norm(), r0 = g.r0;
+    const V fr = rb * (k.kn * (nb - r0) / nb);
+    // Shear from the turn of the line of centres away from D, in 1's frame.
+    const Real gc = rb.dot(g.d) / (nb * g.d.norm());
+    const Real gamma = (gc < Real(1) && gc > Real(-1)) ? std::acos(gc) : Real(0);
+    const V c0 = rb.cross(g.d), c1 = rb.cross(c0);
+    const Real n0 = c0.norm(), n1 = c1.norm();
+    const V fst = n1 != Real(0) ? c1 * (k.ks * r0 * gamma / n1) : V{};
+    const V mst = n0 != Real(0) ? c0 * (-fst.norm() / n0) : V{};
+    // qm turns z onto rb; r is the relative rotation seen in that frame.
+    Q qm{h * std::sqrt((nb + rb.z) / nb), 0, 0, 0};
+    const Real s = h * std::sqrt((nb - rb.z) / nb), rxy2 = rb.x * rb.x + rb.y * rb.y;
+    qm.x = -s, qm.y = s;
+    if (rxy2 != Real(0)) {
+      const Real rxy = std::sqrt(rxy2);
+      qm.x = -s * rb.y / rxy, qm.y = s * rb.x / rxy;
+    }
+    const Q r = qm.inverse() * (g.q1.inverse() * g.q2) * qm;
+    const Real t0 = r.w * r.w + r.z * r.z, t2 = r.x * r.x + r.y * r.y;
+    Real psi = 0;
+    if (t0 != Real(0)) {
+      const Real st = std::sqrt(t0);
+      psi = 2 * beam::signed_angle(r.z / st, r.w / st);
+    }
+    const V mtr = qm.to_world(V{0, 0, k.kt * psi});
+    V mbr{}, fsr{}, msr{};
+    if (t2 != Real(0)) {
+      const Real t1 = t0 - t2;
+      const Real theta = (t1 >= Real(1) || t1 <= Real(-1)) ? Real(0) : std::acos(t1);
+      Real cf, sf;
+      if (t0 == Real(0)) {
+        const Real q = std::sqrt(t2);
+        cf = r.y / q, sf = -r.x / q;
+      } else {
+        const Real q = std::sqrt(t0 * t2);
+        cf = (r.x * r.z + r.w * r.y) / q, sf = (r.y * r.z - r.w * r.x) / q;
+      }
+      const Real b = Real(0.5) * k.kb * theta, sh = Real(0.5) * k.ks * theta * r0;
+      mbr = qm.to_world(V{-b * sf, b * cf, 0});
+      fsr = qm.to_world(V{-sh * cf, -sh * sf, 0});
+      msr = qm.to_world(V{sh * sf, -sh * cf, 0});
+    }
+    const Real e1 = g.r1 / (g.r1 + g.r2), e2 = g.r2 / (g.r1 + g.r2);
+    const V ms = msr + mst, fs = fst + fsr;
+    Result<Real> out;
+    out.f1 = g.q1.to_world(fr + fs);
+    out.m1 = g.q1.to_world(mbr + mtr + ms * (e1 * lp));
+    out.m2 = g.q1.to_world(ms * (e2 * lp) - mbr - mtr);
+    out.fn = (lp < r0 ? Real(-1) : Real(1)) * fr.norm();
+    out.fs = fs.norm();
+    out.mb = mbr.norm();
+    out.mt = mtr.norm();
+    return out;
+  }
+
+  /// ESyS's potential energy of the bond for these loads.
+  template <class Real>
+  static double energy(const BondCoeffs<Real>& k, const Result<Real>& q) {
+    const auto e = [](double f, double s) { return s != 0 ? 0.5 * f * f / s : 0.0; };
+    return e(q.fn, k.kn) + e(q.fs, k.ks) + e(q.mt, k.kt) + e(q.mb, k.kb);
+  }
+
+  /// -1 when the bond holds, else the failure mode (BondFailure) under the group's criterion.
+  template <class Real>
+  static int failure(const Coeffs<Real>& c, const BondCoeffs<Real>& k, const Result<Real>& q) {
+    const Real tn = q.fn * k.ifn, ts = q.fs * k.ifs, tb = q.mb * k.imb, tt = q.mt * k.imt;
+    const Real wb = c.sum ? tb : c.beta1 * tb, wt = c.sum ? tt : c.beta2 * tt;
+    bool broken;
+    if (c.sum) {
+      broken = std::max(tn, Real(0)) + ts + tb + tt >= Real(1);
+    } else {
+      const Real normal = tn + wb, shear = ts + wt;
+      broken = normal > c.truncated || shear > Real(1) - normal;
+    }
+    if (!broken) return -1;
+    // The mode: the largest term of the criterion.
+    int mode = int(BondFailure::tension);
+    Real top = tn;
+    if (ts > top) top = ts, mode = int(BondFailure::shear);
+    if (wb > top) top = wb, mode = int(BondFailure::bending);
+    if (wt > top) mode = int(BondFailure::torsion);
+    return mode;
+  }
+};
+
+}  // namespace basalt::solver

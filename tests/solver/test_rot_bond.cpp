@@ -1,0 +1,522 @@
+// The rotational bond (models/rot_bond.hpp, ESyS RotBond/BrittleBeam): each mode's small-deformation
+// stiffness against the closed form, objectivity under a rigid turn, BrittleBeam's per-bond scaling, the
+// failure criteria per mode; and in runs of two spheres: normal and torsion oscillations at their closed-form
+// periods, energy conservation, and each mode breaking at its strength, recorded with its mode.
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <fstream>
+#include <numbers>
+#include <optional>
+#include <sstream>
+#include <string>
+
+#include "basalt/solver/models/rot_bond.hpp"
+#include "basalt/solver/simulation.hpp"
+#include "solver_helpers.hpp"
+#include "test_support.hpp"
+
+using namespace basalt::solver;
+using basalt::io::Geometry;
+using V = beam::Vec<double>;
+using Q = beam::Quat<double>;
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+Q axis_angle(V a, double theta) {
+  const double n = a.norm(), s = std::sin(theta / 2) / n;
+  return {std::cos(theta / 2), a.x * s, a.y * s, a.z * s};
+}
+
+RotBond::BondCoeffs<double> springs(double kn, double ks, double kb, double kt) {
+  return {kn, ks, kb, kt, 0, 0, 0, 0};
+}
+
+/// A bond along e of initial length L between radii r1, r2 (rest length L), unloaded.
+RotBond::Geometry<double> at_rest(V e, double L, double r1, double r2) {
+  RotBond::Geometry<double> g;
+  g.x1 = {0.1, -0.2, 0.3};
+  g.x2 = g.x1 + e * (L / e.norm());
+  g.d = g.x2 - g.x1;
+  g.r1 = r1, g.r2 = r2, g.r0 = L;
+  return g;
+}
+
+void expect_vec(V a, V b, double tol, const char* what) {
+  EXPECT_NEAR(a.x, b.x, tol) << what;
+  EXPECT_NEAR(a.y, b.y, tol) << what;
+  EXPECT_NEAR(a.z, b.z, tol) << what;
+}
+
+const auto kK = springs(1000, 400, 30, 20);
+const V kE{1, 2, -0.5};  // a bond direction off the axes (the frame qm is general)
+const double kL = 1.1, kR1 = 0.5, kR2 = 0.6;
+
+}  // namespace
+
+TEST(RotBondLaw, UnloadedAndRigidlyTurnedBondsCarryNothing) {
+  auto g = at_rest(kE, kL, kR1, kR2);
+  auto q = RotBond::evaluate(kK, g);
+  for (double v : {q.f1.norm(), q.m1.norm(), q.m2.norm(), q.fn, q.fs, q.mb, q.mt}) EXPECT_EQ(v, 0.0);
+  // A rigid turn of the pair (positions about x1 and both orientations): still nothing.
+  const Q R = axis_angle({0.3, -1, 0.7}, 0.8);
+  g.x2 = g.x1 + R.to_world(g.d);
+  g.q1 = g.q2 = R;
+  q = RotBond::evaluate(kK, g);
+  for (double v : {q.f1.norm(), q.m1.norm(), q.m2.norm(), q.fn, q.fs, q.mb, q.mt})
+    EXPECT_LT(std::abs(v), 1e-9);
+}
+
+TEST(RotBondLaw, NormalSpring) {
+  auto g = at_rest(kE, kL, kR1, kR2);
+  const V e = g.d * (1 / kL);
+  const double delta = 1e-4;
+  g.x2 = g.x2 + e * delta;  // stretched: pulls 1 towards 2
+  const auto q = RotBond::evaluate(kK, g);
+  expect_vec(q.f1, e * (kK.kn * delta), 1e-9, "force on 1");
+  EXPECT_NEAR(q.fn, kK.kn * delta, 1e-9);
+  EXPECT_LT(q.m1.norm() + q.m2.norm() + q.fs, 1e-9);
+  g.x2 = g.x2 - e * (2 * delta);  // compressed
+  EXPECT_NEAR(RotBond::evaluate(kK, g).fn, -kK.kn * delta, 1e-9);
+}
+
+TEST(RotBondLaw, ShearSpringFromAnOffset) {
+  auto g = at_rest(kE, kL, kR1, kR2);
+  const V e = g.d * (1 / kL), t = V{2, -1, 0} * (1 / std::sqrt(5.0));  // t perpendicular to e
+  ASSERT_NEAR(e.dot(t), 0, 1e-15);
+  const double delta = 1e-5;
+  g.x2 = g.x2 + t * delta;
+  const auto q = RotBond::evaluate(kK, g);
+  // F = ks r0 gamma, gamma = delta / L (r0 = L): ks delta towards the offset; the couple F |x2-x1|
+  // r_i/(r1+r2) on each, both turning the spheres the same way (about e x t).
+  // (to first order in delta / L = 1e-5: the stretch kn delta^2 / 2L and the turn of the line are second
+  // order)
+  const double tol = 1e-4 * kK.ks * delta;
+  expect_vec(q.f1, t * (kK.ks * delta), tol, "shear force on 1");
+  EXPECT_NEAR(q.fs, kK.ks * delta, tol);
+  const V axis = e.cross(t);
+  expect_vec(q.m1, axis * (kK.ks * delta * kL * kR1 / (kR1 + kR2)), tol, "couple on 1");
+  expect_vec(q.m2, axis * (kK.ks * delta * kL * kR2 / (kR1 + kR2)), tol, "couple on 2");
+  EXPECT_NEAR(q.fn, kK.kn * delta * delta / (2 * kL), 1e-2 * kK.kn * delta * delta / kL);
+  EXPECT_LT(q.mb + q.mt, 1e-12);
+}
+
+TEST(RotBondLaw, TorsionSpring) {
+  auto g = at_rest(kE, kL, kR1, kR2);
+  const V e = g.d * (1 / kL);
+  const double theta = 1e-4;
+  g.q2 = axis_angle(e, theta);
+  const auto q = RotBond::evaluate(kK, g);
+  EXPECT_NEAR(q.mt, kK.kt * theta, 1e-10);
+  expect_vec(q.m2, e * (-kK.kt * theta), 1e-10, "torsion moment on 2");
+  expect_vec(q.m1, e * (kK.kt * theta), 1e-10, "torsion moment on 1");
+  EXPECT_LT(q.f1.norm() + q.mb + q.fs, 1e-10);
+  // Turning 1 the same way as 2 removes it (relative rotation only).
+  g.q1 = g.q2;
+  g.x2 = g.x1 + g.q1.to_world(g.d);
+  EXPECT_LT(RotBond::evaluate(kK, g).mt, 1e-10);
+}
+
+TEST(RotBondLaw, BendingSpringCarriesHalfTheRelativeTurn) {
+  auto g = at_rest(kE, kL, kR1, kR2);
+  const V e = g.d * (1 / kL), n = V{2, -1, 0} * (1 / std::sqrt(5.0));
+  const double theta = 1e-4;
+  g.q2 = axis_angle(n, theta);
+  const auto q = RotBond::evaluate(kK, g);
+  // ESyS (Wang et al. eq. 16): Mb = kb theta / 2 about n, with a shear force ks r0 theta / 2.
+  EXPECT_NEAR(q.mb, 0.5 * kK.kb * theta, 1e-10);
+  EXPECT_NEAR(q.fs, 0.5 * kK.ks * kL * theta, 1e-10);
+  EXPECT_LT(q.mt + std::abs(q.fn), 1e-10);
+  // The bending moment opposes 2's turn: m2 has a component -kb theta / 2 along n beyond the shear couple.
+  const V shear_couple2 = e.cross(q.f1) * (kL * kR2 / (kR1 + kR2));
+  expect_vec(q.m2 + shear_couple2 * -1.0, n * (-0.5 * kK.kb * theta), 1e-10, "bending moment on 2");
+}
+
+TEST(RotBondLaw, LoadsAreObjective) {
+  // A general small deformation, then the same turned rigidly: same loads, turned force.
+  auto g = at_rest(kE, kL, kR1, kR2);
+  g.x2 = g.x2 + V{1e-4, -3e-5, 2e-5};
+  g.q1 = axis_angle({1, 0.2, 0.1}, 2e-4);
+  g.q2 = axis_angle({-0.3, 1, 0.4}, 3e-4);
+  const auto a = RotBond::evaluate(kK, g);
+  const Q R = axis_angle({0.5, 0.5, -1}, 1.3);
+  auto h = g;
+  h.x2 = h.x1 + R.to_world(g.x2 - g.x1);
+  h.q1 = R * g.q1;
+  h.q2 = R * g.q2;
+  const auto b = RotBond::evaluate(kK, h);
+  EXPECT_NEAR(a.fn, b.fn, 1e-9);
+  EXPECT_NEAR(a.fs, b.fs, 1e-9);
+  EXPECT_NEAR(a.mb, b.mb, 1e-9);
+  EXPECT_NEAR(a.mt, b.mt, 1e-9);
+  expect_vec(R.to_world(a.f1), b.f1, 1e-9, "turned force");
+  expect_vec(R.to_world(a.m2), b.m2, 1e-9, "turned moment");
+}
+
+TEST(RotBondLaw, BrittleBeamScalingPerBond) {
+  const auto scene = basalt::test::scene_from(R"(
+[run]
+dt = 1e-4
+steps = 0
+skin = 0.05
+[[interactions]]
+type = "rot_bond"
+youngs_modulus = 1e5
+poissons_ratio = 0.25
+cohesion = 100.0
+tan_friction_angle = 0.5
+)");
+  const auto c = RotBond::coeffs<double>(scene.bonds.at(0).params_of<RotBond>());
+  const double E = 1e5, G = E / 2.5, L = 1.2, R = L / 2, coh = 100, ta = 0.5;
+  const auto k = RotBond::bond_coeffs(c, L, 0.5, 0.7);
+  EXPECT_NEAR(k.kn, kPi * E * R * R / L, 1e-9 * k.kn);
+  EXPECT_NEAR(k.ks, kPi * G * R * R / L, 1e-9 * k.ks);
+  EXPECT_NEAR(k.kb, kPi * E * std::pow(R, 4) / (4 * L), 1e-9 * k.kb);
+  EXPECT_NEAR(k.kt, kPi * G * std::pow(R, 4) / (2 * L), 1e-9 * k.kt);
+  EXPECT_NEAR(1 / k.ifn, kPi * coh * R * R / ta, 1e-9 / k.ifn);
+  EXPECT_NEAR(1 / k.ifs, kPi * coh * R * R, 1e-9 / k.ifs);
+  EXPECT_NEAR(1 / k.imb, kPi * coh * R * R * R / (4 * ta), 1e-9 / k.imb);
+  EXPECT_NEAR(1 / k.imt, kPi * coh * R * R * R / 2, 1e-9 / k.imt);
+}
+
+TEST(RotBondLaw, FailureCriteriaPerMode) {
+  RotBond::Coeffs<double> c{};
+  c.truncated = 1, c.beta1 = 1, c.beta2 = 1;
+  const RotBond::BondCoeffs<double> k{1, 1, 1, 1, 1 / 10.0, 1 / 20.0, 1 / 3.0, 1 / 4.0};
+  const auto at = [&](double fn, double fs, double mb, double mt) {
+    RotBond::Result<double> q{};
+    q.fn = fn, q.fs = fs, q.mb = mb, q.mt = mt;
+    return RotBond::failure(c, k, q);
+  };
+  const double below = 0.999, above = 1.001;
+  for (bool sum : {false, true}) {
+    c.sum = sum;
+    EXPECT_EQ(at(10 * below, 0, 0, 0), -1);
+    EXPECT_EQ(at(10 * above, 0, 0, 0), int(BondFailure::tension));
+    EXPECT_EQ(at(0, 20 * below, 0, 0), -1);
+    EXPECT_EQ(at(0, 20 * above, 0, 0), int(BondFailure::shear));
+    EXPECT_EQ(at(0, 0, 3 * below, 0), -1);
+    EXPECT_EQ(at(0, 0, 3 * above, 0), int(BondFailure::bending));
+    EXPECT_EQ(at(0, 0, 0, 4 * below), -1);
+    EXPECT_EQ(at(0, 0, 0, 4 * above), int(BondFailure::torsion));
+  }
+  // ESyS: compression raises the shear strength (shear > 1 - normal); the sum ignores compression.
+  c.sum = false;
+  EXPECT_EQ(at(-5, 20 * 1.4, 0, 0), -1);
+  EXPECT_EQ(at(-5, 20 * 1.6, 0, 0), int(BondFailure::shear));
+  c.sum = true;
+  EXPECT_EQ(at(-5, 20 * above, 0, 0), int(BondFailure::shear));
+  // Combined: half the tensile strength and half the shear strength break under both criteria (the mode is
+  // the larger term).
+  EXPECT_EQ(at(5.01, 10.2, 0, 0), int(BondFailure::shear));
+  EXPECT_EQ(at(4.9, 10.0, 0, 0), -1);
+  c.sum = false;
+  EXPECT_EQ(at(5.01, 10.2, 0, 0), int(BondFailure::shear));
+  EXPECT_EQ(at(4.9, 10.0, 0, 0), -1);
+  // The tension cut-off: with truncated = 0.5, half the tensile strength alone breaks it.
+  c.truncated = 0.5;
+  EXPECT_EQ(at(5.01, 0, 0, 0), int(BondFailure::tension));
+  EXPECT_EQ(at(4.99, 0, 0, 0), -1);
+}
+
+// ---- Runs of two bonded rotating spheres ----
+
+namespace {
+
+Geometry bonded_pair(double r1, double r2, double d) {
+  Geometry g;
+  g.add_particle(1, {0, 0, 0}, r1);
+  g.add_particle(2, {d, 0, 0}, r2, 1);
+  g.add_bond(1, 2);
+  g.sort_by_id();
+  return g;
+}
+
+template <class Real>
+std::size_t index_of(const Particles<Real>& p, std::int64_t id) {
+  for (std::size_t i = 0; i < p.n_owned; ++i)
+    if (p.id[i] == id) return i;
+  ADD_FAILURE() << "no particle " << id;
+  return 0;
+}
+
+const char* kStiff = R"(
+[run]
+dt = 1e-4
+steps = 0
+skin = 0.05
+[[interactions]]
+type = "rot_bond"
+kn = 1000.0
+ks = 400.0
+kb = 30.0
+kt = 20.0
+rest_length = "sum_of_radii"
+)";
+
+double mass_of(double r) { return 4.0 / 3.0 * kPi * r * r * r; }
+
+/// Period of the first up-crossing pair of a series sampled every dt.
+double period_of(const std::vector<double>& u, double dt) {
+  std::vector<double> ups;
+  for (std::size_t k = 1; k < u.size(); ++k)
+    if (u[k - 1] < 0 && u[k] >= 0) ups.push_back((double(k) - 1 + u[k - 1] / (u[k - 1] - u[k])) * dt);
+  if (ups.size() < 2) return NAN;
+  return ups[1] - ups[0];
+}
+
+}  // namespace
+
+TEST(RotBondRun, NormalAndTorsionOscillateAtClosedFormPeriods) {
+  const double r1 = 0.5, r2 = 0.4, L = 0.9, dt = 1e-4;
+  const auto scene = basalt::test::scene_from(kStiff);
+  // Normal: stretched by delta; omega^2 = kn / reduced mass.
+  {
+    Simulation<double> sim(scene, bonded_pair(r1, r2, L + 1e-3), MPI_COMM_SELF);
+    std::vector<double> u;
+    for (int k = 0; k < 6000; ++k) {
+      sim.step();
+      const auto& p = sim.particles();
+      u.push_back(std::abs(p.x[index_of(p, 2)] - p.x[index_of(p, 1)]) - L);
+    }
+    const double mu = mass_of(r1) * mass_of(r2) / (mass_of(r1) + mass_of(r2));
+    EXPECT_NEAR(period_of(u, dt), 2 * kPi * std::sqrt(mu / 1000.0), 1e-4 * 2 * kPi * std::sqrt(mu / 1000.0));
+  }
+  // Torsion: opposite spins about the bond; omega^2 = kt (1/I1 + 1/I2), I = 2/5 m r^2.
+  {
+    Simulation<double> sim(scene, bonded_pair(r1, r2, L), MPI_COMM_SELF);
+    auto& p = sim.particles();
+    const auto a = index_of(p, 1), b = index_of(p, 2);
+    const double I1 = 0.4 * mass_of(r1) * r1 * r1, I2 = 0.4 * mass_of(r2) * r2 * r2;
+    p.wx[a] = 1e-2 / I1;  // equal and opposite angular momenta: the pair's centre stays still
+    p.wx[b] = -1e-2 / I2;
+    sim.state_changed();
+    std::vector<double> w;
+    for (int k = 0; k < 20000; ++k) {
+      sim.step();
+      w.push_back(p.wx[index_of(p, 2)]);
+    }
+    const double T = 2 * kPi / std::sqrt(20.0 * (1 / I1 + 1 / I2));
+    EXPECT_NEAR(period_of(w, dt), T, 1e-3 * T);
+  }
+}
+
+TEST(RotBondRun, EnergyInEachMode) {
+  // One mode at a time (stretch, twist, shear, bend), then all together: kinetic (with rotation) plus the
+  // bond's energy (ESyS's expression) over 20,000 steps of a free pair.
+  const double r1 = 0.5, r2 = 0.4, L = 0.9;
+  const auto scene = basalt::test::scene_from(std::string(kStiff) + R"(
+[output]
+[[output.fields]]
+type = "total_energy"
+)");
+  struct Case {
+    const char* name;
+    V v2, w1, w2;
+    double tol;
+  };
+  // Stretch and twist: ESyS's energy is the potential of its forces (kn delta^2/2, kt psi^2/2), conserved to
+  // the integrator's O(dt^2). Shear and bending: it is not (the bending moment kb theta/2 has the potential
+  // kb theta^2/4, ESyS reports kb theta^2/8; the shear force mixes the offset and the turn), so the reported
+  // total is only bounded (measured range: shear 4.5 %, bend 49 %, all 12 %; docs/validation-rock.md).
+  const Case cases[] = {{"stretch", {0.02, 0, 0}, {}, {}, 1e-4},
+                        {"twist", {}, {0.05, 0, 0}, {-0.05, 0, 0}, 1e-4},
+                        {"shear", {0, 0.02, 0}, {}, {}, 0.1},
+                        {"bend", {}, {0, 0, 0.05}, {0, 0, -0.05}, 0.6},
+                        {"all", {0.01, -0.03, 0.02}, {0.05, 0.03, 0}, {0, -0.04, 0.02}, 0.2}};
+  for (const auto& c : cases) {
+    Simulation<double> sim(scene, bonded_pair(r1, r2, L), MPI_COMM_SELF);
+    auto& p = sim.particles();
+    const auto a = index_of(p, 1), b = index_of(p, 2);
+    p.vx[b] = c.v2.x, p.vy[b] = c.v2.y, p.vz[b] = c.v2.z;
+    p.wx[a] = c.w1.x, p.wy[a] = c.w1.y, p.wz[a] = c.w1.z;
+    p.wx[b] = c.w2.x, p.wy[b] = c.w2.y, p.wz[b] = c.w2.z;
+    sim.state_changed();
+    basalt::test::MemorySink sink;
+    sink.begin(field_columns(scene));
+    for (int k = 0; k < 20000; ++k) sim.step(&sink);
+    const auto e = sink.column(0);
+    double lo = e[0], hi = e[0];
+    for (double v : e) lo = std::min(lo, v), hi = std::max(hi, v);
+    EXPECT_GT(e[0], 0);
+    std::printf("%-8s total energy range / initial: %.3g\n", c.name, (hi - lo) / e[0]);
+    EXPECT_LT((hi - lo) / e[0], c.tol) << c.name << ": total energy drifts";
+  }
+}
+
+namespace {
+
+/// Two fixed spheres (they move only with the velocities given), bond strengths from the scene; particle 2
+/// moves or turns at a constant rate. Returns the break record, or none.
+std::optional<BrokenBond> drive(const std::string& strengths, V v2, V w2, int steps) {
+  const auto scene = basalt::test::scene_from(std::string(kStiff) + strengths + R"(
+[particles]
+fixed_tags = [0, 1]
+)");
+  Simulation<double> sim(scene, bonded_pair(0.5, 0.5, 1.0), MPI_COMM_SELF);
+  auto& p = sim.particles();
+  const auto b = index_of(p, 2);
+  p.vx[b] = v2.x, p.vy[b] = v2.y, p.vz[b] = v2.z;
+  p.wx[b] = w2.x, p.wy[b] = w2.y, p.wz[b] = w2.z;
+  sim.state_changed();
+  for (int k = 0; k < steps && sim.broken_bonds().empty(); ++k) sim.step();
+  if (sim.broken_bonds().empty()) return std::nullopt;
+  return sim.broken_bonds()[0];
+}
+
+}  // namespace
+
+TEST(RotBondRun, EachModeBreaksAtItsStrength) {
+  // Rates: 1e-2 per ms at dt = 1e-4: the load grows by 1e-6 of its stiffness per step.
+  const double rate = 1e-2, dt = 1e-4;
+  struct Case {
+    const char* key;
+    double strength, per_step;  // load added per step
+    V v, w;
+    BondFailure mode;
+  };
+  const Case cases[] = {
+      {"max_normal_force", 2e-2, 1000 * rate * dt, {rate, 0, 0}, {}, BondFailure::tension},
+      {"max_shear_force", 1e-2, 400 * rate * dt, {0, rate, 0}, {}, BondFailure::shear},
+      {"max_bending_moment", 3e-4, 0.5 * 30 * rate * dt, {}, {0, 0, rate}, BondFailure::bending},
+      {"max_torsion_moment", 2e-4, 20 * rate * dt, {}, {rate, 0, 0}, BondFailure::torsion},
+  };
+  for (const auto& c : cases) {
+    const int expected = int(std::ceil(c.strength / c.per_step));  // first step whose load exceeds it
+    const auto rec = drive(fmt::format("{} = {}\n", c.key, c.strength), c.v, c.w, 2 * expected);
+    ASSERT_TRUE(rec.has_value()) << c.key << ": never broke";
+    EXPECT_EQ(rec->mode, std::uint8_t(c.mode)) << c.key;
+    EXPECT_NEAR(double(rec->step), expected, 1.0) << c.key;
+    EXPECT_EQ(rec->a, 1);
+    EXPECT_EQ(rec->b, 2);
+    EXPECT_NEAR(rec->x, 0.5, 0.01) << c.key << ": break position";
+  }
+}
+
+// ---- Against ESyS-Particle 2.3.5 (tools/esys/probe_rotbond.py, docs/data/esys-rotbond) ----
+
+namespace {
+
+struct EsysRow {
+  std::array<double, 13> v;  // x y z vx vy vz qw qx qy qz wx wy wz
+};
+
+/// rows[step][id - 1] of an ESyS probe's CSV.
+std::vector<std::array<EsysRow, 2>> read_esys(const std::string& file) {
+  std::ifstream in(file);
+  EXPECT_TRUE(in.good()) << file;
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::array<EsysRow, 2>> rows;
+  while (std::getline(in, line)) {
+    std::stringstream ss(line);
+    std::string cell;
+    std::vector<double> v;
+    while (std::getline(ss, cell, ',')) v.push_back(std::stod(cell));
+    const auto step = static_cast<std::size_t>(v[0]), id = static_cast<std::size_t>(v[1]);
+    if (rows.size() <= step) rows.resize(step + 1);
+    std::copy(v.begin() + 2, v.end(), rows[step][id - 1].v.begin());
+  }
+  return rows;
+}
+
+}  // namespace
+
+TEST(RotBondEsys, TwoSphereRunsMatchEsysParticle) {
+  // The probe's cases (tools/esys/probe_rotbond.py): bond direction, distance, initial motion, cohesion.
+  struct Case {
+    const char* name;
+    double d;
+    V e, v2, w2, w1;
+    double cohesion;
+  };
+  const Case cases[] = {
+      {"gap", 0.95, {1, 0, 0}, {}, {}, {}, 1e9},
+      {"stretch", 0.9, {1, 0, 0}, {0.05, 0, 0}, {}, {}, 1e9},
+      {"shear", 0.9, {1, 0, 0}, {0, 0.05, 0}, {}, {}, 1e9},
+      {"twist", 0.9, {1, 0, 0}, {}, {0.5, 0, 0}, {}, 1e9},
+      {"bend", 0.9, {1, 0, 0}, {}, {0, 0, 0.5}, {}, 1e9},
+      {"general", 0.92, {1, 2, -0.5}, {0.02, -0.03, 0.01}, {0.3, -0.2, 0.4}, {-0.1, 0.25, 0.05}, 1e9},
+      {"break", 0.9, {1, 0, 0}, {2.0, 0, 0}, {}, {}, 5.0},
+  };
+  for (const auto& c : cases) {
+    const auto ref = read_esys(
+        (basalt::test::source_dir() / "docs" / "data" / "esys-rotbond" / (std::string(c.name) + ".csv"))
+            .string());
+    ASSERT_GT(ref.size(), 10u) << c.name;
+    const auto scene = basalt::test::scene_from(fmt::format(R"(
+[particles]
+rotation = true
+[run]
+dt = 1e-3
+steps = 0
+skin = 0.05
+integrator = "symplectic_euler"
+[[interactions]]
+type = "rot_bond"
+youngs_modulus = 1000.0
+poissons_ratio = 0.25
+cohesion = {}
+tan_friction_angle = 1.0
+rest_length = "sum_of_radii"
+)",
+                                                            c.cohesion));
+    Geometry g;
+    const V x2 = c.e * (c.d / c.e.norm());
+    g.add_particle(1, {0, 0, 0}, 0.5);
+    g.add_particle(2, {x2.x, x2.y, x2.z}, 0.4);
+    g.add_bond(1, 2);
+    g.sort_by_id();
+    Simulation<double> sim(scene, g, MPI_COMM_SELF);
+    auto& p = sim.particles();
+    const auto a = index_of(p, 1), b = index_of(p, 2);
+    p.vx[b] = c.v2.x, p.vy[b] = c.v2.y, p.vz[b] = c.v2.z;
+    p.wx[b] = c.w2.x, p.wy[b] = c.w2.y, p.wz[b] = c.w2.z;
+    p.wx[a] = c.w1.x, p.wy[a] = c.w1.y, p.wz[a] = c.w1.z;
+    sim.state_changed();
+    // Scales: ESyS prints 9 digits; each quantity against its largest value over the run.
+    // Each quantity (position, velocity, orientation, angular velocity) against its largest component.
+    std::array<double, 13> scale{};
+    const auto group = [](std::size_t k) { return k < 3 ? 0 : k < 6 ? 1 : k < 10 ? 2 : 3; };
+    std::array<double, 4> gmax{};
+    for (const auto& row : ref)
+      for (const auto& r : row)
+        for (std::size_t k = 0; k < 13; ++k) gmax[group(k)] = std::max(gmax[group(k)], std::abs(r.v[k]));
+    // (velocities at least 0.01: components that stay at rounding noise, 1e-8 in ESyS's own twist run, are
+    // not compared relative to their noise)
+    for (std::size_t k = 0; k < 13; ++k) scale[k] = std::max(gmax[group(k)], 1e-2);
+    double worst = 0;
+    std::string where;
+    for (std::size_t step = 1; step < ref.size(); ++step) {
+      sim.step();
+      for (std::size_t n = 0; n < 2; ++n) {
+        const auto i = index_of(p, std::int64_t(n + 1));
+        const std::array<double, 13> mine{p.x[i],  p.y[i],  p.z[i],  p.vx[i], p.vy[i], p.vz[i], p.qw[i],
+                                          p.qx[i], p.qy[i], p.qz[i], p.wx[i], p.wy[i], p.wz[i]};
+        for (std::size_t k = 0; k < 13; ++k) {
+          if (scale[k] == 0) continue;
+          const double dev = std::abs(mine[k] - ref[step][n].v[k]) / std::max(scale[k], 1e-12);
+          if (dev > worst) {
+            worst = dev;
+            where = fmt::format("step {} particle {} column {}: ESyS {}, Basalt {}", step, n + 1, k,
+                                ref[step][n].v[k], mine[k]);
+          }
+        }
+      }
+    }
+    std::printf("%-8s %zu steps: max deviation from ESyS %.3g (relative to each quantity's largest value)\n",
+                c.name, ref.size() - 1, worst);
+    // 1e-4: in the pure stretch and gap runs Basalt's spheres pick up a rounding-level spin (4e-7 rad/ms
+    // after 200 steps) where ESyS's stay exactly at 0; every driven quantity agrees to 1e-7
+    // (docs/reference-runs.md).
+    EXPECT_LT(worst, 1e-4) << c.name << ": " << where;
+    if (std::string(c.name) == "break") {
+      ASSERT_EQ(sim.broken_bonds().size(), 1u);
+      EXPECT_EQ(sim.broken_bonds()[0].mode, std::uint8_t(BondFailure::tension));
+    }
+  }
+}
