@@ -1,0 +1,75 @@
+#!/usr/bin/env python3
+"""Kinetic-energy error of the wave scene when every coordinate (and the wall) is shifted by D, in double
+and in float, against the unshifted double run (docs/stability.md, "Coordinates far from the origin").
+
+    /usr/bin/python3 tools/bench/offset_precision.py --build build --geometry $BASALT_REFERENCE_DIR/cube1.geo \
+        [--steps 2000] [--work offset-work]
+
+Prints one row per (precision, D): L2 and max relative KE error, or basalt-run's last error line when it
+refuses or stops the run.
+"""
+import argparse
+import subprocess
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def shifted_geo(lines, d, out):
+    i0 = lines.index("Simple") + 2
+    n = int(lines[i0 - 1])
+    res = list(lines)
+    for k, line in enumerate(res):
+        if line.startswith("BoundingBox"):
+            res[k] = "BoundingBox " + " ".join("%.17g" % (float(x) + d) for x in line.split()[1:])
+    for k in range(i0, i0 + n):
+        p = res[k].split()
+        res[k] = " ".join(["%.17g" % (float(p[j]) + d) for j in range(3)] + p[3:])
+    out.write_text("\n".join(res))
+
+
+def run(a, work, lines, d, precision):
+    g, s, o = work / f"g{d:g}.geo", work / f"s{d:g}.toml", work / f"o_{d:g}_{precision}"
+    shifted_geo(lines, d, g)
+    scene = (ROOT / "scenes" / "wave.toml").read_text()
+    s.write_text(scene.replace("point = [0.0, 0.0, 0.0]", f"point = [{d:.17g}, {d:.17g}, {d:.17g}]"))
+    r = subprocess.run([str(Path(a.build) / "bin" / "basalt-run"), str(s), "--geometry", str(g), "--steps",
+                        str(a.steps), "--output", str(o), "--quiet", "--precision", precision],
+                       capture_output=True, text=True)
+    if r.returncode:
+        return None, r.stderr.strip().split("\n")[-1][:160]
+    return np.genfromtxt(o / "fields.csv", delimiter=",", names=True)["kinetic_energy"], ""
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--build", default="build")
+    ap.add_argument("--geometry", required=True)
+    ap.add_argument("--steps", type=int, default=2000)
+    ap.add_argument("--work", default="offset-work")
+    a = ap.parse_args()
+    work = Path(a.work)
+    work.mkdir(parents=True, exist_ok=True)
+    lines = Path(a.geometry).read_text().split("\n")
+    ref, msg = run(a, work, lines, 0.0, "double")
+    if ref is None:
+        raise SystemExit(f"the unshifted run failed: {msg}")
+    print("| precision | D | KE L2 relative | KE max relative |")
+    print("| --- | --- | --- | --- |")
+    for precision, offsets in [("double", [1e3, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12]),
+                               ("float", [0, 10, 100, 1e3, 1e4])]:
+        for d in offsets:
+            ke, msg = run(a, work, lines, float(d), precision)
+            if ke is None:
+                print(f"| {precision} | {d:g} | {msg} | |")
+                continue
+            m = min(len(ke), len(ref))
+            l2 = np.sqrt(np.sum((ke[:m] - ref[:m]) ** 2) / np.sum(ref[:m] ** 2))
+            mx = np.max(np.abs(ke[:m] - ref[:m])) / np.max(ref[:m])
+            print(f"| {precision} | {d:g} | {l2:.2e} | {mx:.2e} |")
+
+
+if __name__ == "__main__":
+    main()
