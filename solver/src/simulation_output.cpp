@@ -186,9 +186,9 @@ void Simulation<Real>::run(std::int64_t steps, OutputSink& out) {
     Stopwatch sw;
     const std::uint32_t kinds = out.frame_kinds(step_);
     if (kinds != 0) {
-      // No checkpoint or frame from a state with non-finite values: the last complete checkpoint stays
-      // the newest, a valid restart point.
-      auto bad = check_finite();
+      // No checkpoint or frame from a state with non-finite values or blown up (simulation_stability.cpp):
+      // the last complete checkpoint stays the newest, a valid restart point.
+      auto bad = check_frame_state();
       if (parallel) bad = comm().agree_error(bad);
       if (bad)
         throw RunError(

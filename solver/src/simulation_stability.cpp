@@ -302,9 +302,43 @@ void Simulation<Real>::check_blowup() {
   stop(parallel ? comm().broadcast(msg, who) : msg);
 }
 
-#define BASALT_INSTANTIATE(R)                                           \
-  template void Simulation<R>::check_stability(const GeometrySummary&); \
-  template void Simulation<R>::estimate_critical_step(bool);            \
+template <class Real>
+std::optional<std::string> Simulation<Real>::check_frame_state() const {
+  if (auto bad = check_finite()) return bad;
+  // A state that blew up but is still finite (speeds of 1e122) would pass check_finite and be saved
+  // as a valid restart point, with check_blowup stopping the run only at the next step's rebuild. A
+  // particle whose speed moves it farther in one step than check_blowup's whole allowance (skin/2 +
+  // kBlowupRadii rmin, from any position within skin/2 of its last rebuild) trips that check at the
+  // next step for certain; refusing the frame now leaves the newest checkpoint a state that ran.
+  const double limit = scene_.skin + stability::kBlowupRadii * stability_.rmin;
+  const double vmax = limit / scene_.dt;
+  double worst = 0;
+  std::size_t wi = 0;
+  for (std::size_t i = 0; i < p_.n_owned; ++i) {
+    const double v2 = double(p_.vx[i]) * double(p_.vx[i]) + double(p_.vy[i]) * double(p_.vy[i]) +
+                      double(p_.vz[i]) * double(p_.vz[i]);
+    if (v2 > worst) {
+      worst = v2;
+      wi = i;
+    }
+  }
+  if (!(std::sqrt(worst) > vmax)) return std::nullopt;
+  const auto i = wi;
+  return fmt::format(
+      "step {}: blow-up: particle id {} has the speed {:.6g}, which moves it {:.6g} in one step of dt = "
+      "{:.6g} "
+      "(more than skin + {} x the smallest radius = {:.4g}): position ({:.6g}, {:.6g}, {:.6g}), velocity "
+      "({:.6g}, {:.6g}, {:.6g}). dt is {:.3g} x the critical time step {:.6g}{}",
+      step_, p_.id[i], std::sqrt(worst), std::sqrt(worst) * scene_.dt, scene_.dt, stability::kBlowupRadii,
+      limit, double(p_.x[i]), double(p_.y[i]), double(p_.z[i]), double(p_.vx[i]), double(p_.vy[i]),
+      double(p_.vz[i]), stability_.fraction, stability_.dt_critical,
+      stability_.fraction > 1 ? " (forced): lower dt" : "");
+}
+
+#define BASALT_INSTANTIATE(R)                                                   \
+  template std::optional<std::string> Simulation<R>::check_frame_state() const; \
+  template void Simulation<R>::check_stability(const GeometrySummary&);         \
+  template void Simulation<R>::estimate_critical_step(bool);                    \
   template void Simulation<R>::check_blowup();
 BASALT_INSTANTIATE(double)
 BASALT_INSTANTIATE(float)

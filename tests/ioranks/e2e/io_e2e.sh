@@ -483,19 +483,24 @@ PY
     done
     ;;
   blown_up_checkpoint)
-    # Issue 16: two bonded particles with a time step 22 x the critical one (forced) and no energy guard:
-    # the oscillation grows ~2,000-fold per step until the numbers overflow. No checkpoint is written from
-    # a state with non-finite values (the newest on disk stays a valid restart point), the run stops
-    # naming the particle, and the kinetic energy column never has an empty cell: inf and nan are written.
-    # The blow-up check (docs/stability.md) usually stops it first, naming the particle: either stop is clear.
-    printf '%s\n' "LSMGeometry 1.2" "BoundingBox 0 0 0 2 1 1" "PeriodicBoundaries 0 0 0" "Dimension 3D" \
-      "BeginParticles" "Simple" "2" "0.5 0.5 0.5 0.5 1 0" "1.4 0.5 0.5 0.5 2 0" "EndParticles" \
-      "BeginConnect" "1" "1 2 0" "EndConnect" >"$W/pair.geo"
-    cat >"$W/blowup.toml" <<'TOML'
+    # Issue 16: two bonded particles with a time step far above the critical one (forced) and no energy
+    # guard, so the oscillation grows every step. No checkpoint is written from a state with non-finite
+    # values, nor from a finite blown-up one (a particle so fast that its next step trips the blow-up
+    # check): the newest on disk stays a valid restart point; the run stops naming the particle, and the
+    # kinetic energy column never has an empty cell (inf and nan are written).
+    # Case "1.4 1.0": 31 x critical, stopped at step 1 by the blow-up check before any checkpoint.
+    # Case "1.51 0.05": 1.5 x critical; the step-1 checkpoint is sound, the step-2 state has the speed
+    # 10 (0.5 per step, the allowance is skin + 0.5 r = 0.35) and was saved before the frame check.
+    for cfg in "1.4 1.0" "1.51 0.05"; do
+      read -r x2 dt <<<"$cfg"
+      printf '%s\n' "LSMGeometry 1.2" "BoundingBox 0 0 0 2 1 1" "PeriodicBoundaries 0 0 0" "Dimension 3D" \
+        "BeginParticles" "Simple" "2" "0.5 0.5 0.5 0.5 1 0" "$x2 0.5 0.5 0.5 2 0" "EndParticles" \
+        "BeginConnect" "1" "1 2 0" "EndConnect" >"$W/pair.geo"
+      cat >"$W/blowup.toml" <<TOML
 [geometry]
 file = "pair.geo"
 [run]
-dt = 1.0
+dt = $dt
 steps = 400
 skin = 0.1
 force_dt = true
@@ -510,16 +515,18 @@ checkpoint_every = 1
 [[output.fields]]
 type = "kinetic_energy"
 TOML
-    for q in 0 1; do
-      np=$((1 + q))
-      "$MPIEXEC" -np $np "$BASALT_RUN" "$W/blowup.toml" --quiet --io-ranks $q --output "$W/q$q" >"$W/last.log" 2>&1
-      code=$?
-      cat "$W/last.log"
-      [ $code -ne 0 ] || fail "--io-ranks $q: the blown-up run exited 0"
-      grep -Eq "error: step [0-9]+: (particle id [12] went non-finite|blow-up: particle id [12] moved)" "$W/last.log" ||
-        fail "--io-ranks $q: no clear error"
-      last=$(ls "$W/q$q"/ckpt_*.h5 2>/dev/null | sort | tail -1)
-      /usr/bin/python3 - "$last" <<'PY' || fail "--io-ranks $q: $last holds non-finite values"
+      for q in 0 1; do
+        np=$((1 + q))
+        out="$W/q$q-$dt"
+        "$MPIEXEC" -np $np "$BASALT_RUN" "$W/blowup.toml" --quiet --io-ranks $q --output "$out" >"$W/last.log" 2>&1
+        code=$?
+        cat "$W/last.log"
+        [ $code -ne 0 ] || fail "dt $dt --io-ranks $q: the blown-up run exited 0"
+        grep -Eq "error: step [0-9]+: (particle id [12] went non-finite|blow-up: particle id [12] (moved|has the speed))" "$W/last.log" ||
+          fail "dt $dt --io-ranks $q: no clear error"
+        last=$(ls "$out"/ckpt_*.h5 2>/dev/null | sort | tail -1)
+        [ "$dt" = 1.0 ] || [ -n "$last" ] || fail "dt $dt --io-ranks $q: the sound step-1 checkpoint is missing"
+        /usr/bin/python3 - "$last" "$dt" <<'PY' || fail "dt $dt --io-ranks $q: $last holds a blown-up state"
 import sys, h5py, numpy as np
 if not sys.argv[1]:
     sys.exit(0)  # stopped before the first checkpoint: nothing was written from the blown-up state
@@ -527,15 +534,19 @@ with h5py.File(sys.argv[1], "r") as f:
     for name in ("position", "velocity"):
         if not np.isfinite(f["particles"][name][...]).all():
             sys.exit(f"{sys.argv[1]}: /particles/{name} is not finite")
+    v = np.linalg.norm(f["particles"]["velocity"][...], axis=1).max()
+    if v * float(sys.argv[2]) > 0.1 + 0.5 * 0.5:
+        sys.exit(f"{sys.argv[1]}: a blown-up state was saved: speed {v:g}")
 PY
-      # Every row has its kinetic energy; the last ones are inf or nan, written as such.
-      awk -F, 'NR > 1 && $3 == "" { print "empty cell: " $0; bad = 1 } END { exit bad }' "$W/q$q/fields.csv" ||
-        fail "--io-ranks $q: an empty kinetic-energy cell"
-      # When the run got as far as overflowing (the blow-up check did not stop it first), that shows.
-      if grep -q "went non-finite" "$W/last.log"; then
-        grep -Eq ',(inf|nan)$' "$W/q$q/fields.csv" || fail "--io-ranks $q: no inf or nan row although the energy overflowed"
-      fi
-      echo "--io-ranks $q: stopped (exit $code); newest checkpoint $last is finite; $(grep -Ec ',(inf|nan)$' "$W/q$q/fields.csv") inf/nan rows"
+        # Every row has its kinetic energy; the last ones are inf or nan, written as such.
+        awk -F, 'NR > 1 && $3 == "" { print "empty cell: " $0; bad = 1 } END { exit bad }' "$out/fields.csv" ||
+          fail "dt $dt --io-ranks $q: an empty kinetic-energy cell"
+        # When the run got as far as overflowing (the blow-up check did not stop it first), that shows.
+        if grep -q "went non-finite" "$W/last.log"; then
+          grep -Eq ',(inf|nan)$' "$out/fields.csv" || fail "dt $dt --io-ranks $q: no inf or nan row although the energy overflowed"
+        fi
+        echo "dt $dt --io-ranks $q: stopped (exit $code); newest checkpoint ${last:-none} is sound"
+      done
     done
     ;;
   *) fail "unknown case" ;;

@@ -197,6 +197,9 @@ class Simulation {
   std::vector<std::uint32_t> resolve_bonds();
   void spatial_sort();
   std::optional<std::string> check_finite() const;
+  /// Local, before a checkpoint or frame (simulation_stability.cpp): check_finite, and no particle so
+  /// fast that its next step moves it farther than check_blowup allows (a finite blown-up state).
+  std::optional<std::string> check_frame_state() const;
   /// Forces at the current positions; ghosts_in_flight: a ghost update was begun and is completed
   /// after the owned-only interactions.
   /// advance: a real step (contact history moves on); forces computed outside steps only read it.
