@@ -190,6 +190,26 @@ void Simulation<Real>::check_start(bool fresh) {
       }
     }
   }
+  // Mesh walls ([[mesh_walls]]): the deepest of a particle's contacts with the mesh's faces, edges and
+  // vertices (a centre on the surface overlaps by its whole radius).
+  std::vector<MeshContact> contacts;
+  for (std::size_t w = 0; w < walls.meshes(); ++w)
+    for (const auto i : walls.mesh_candidates(w)) {
+      const auto k = static_cast<std::size_t>(i);
+      contacts.clear();
+      walls.mesh(w).contacts({double(p_.x[k]), double(p_.y[k]), double(p_.z[k])}, double(p_.radius[k]),
+                             contacts);
+      for (const auto& c : contacts) {
+        const double overlap = c.overlap / double(p_.radius[k]);
+        if (overlap > worst) {
+          worst = overlap;
+          where = fmt::format(
+              "particle id {} overlaps mesh wall \"{}\" by {:.3g} of its radius (centre {:.6g} from the mesh "
+              "at ({:.6g}, {:.6g}, {:.6g}))",
+              p_.id[k], walls.mesh_spec(w).name, overlap, c.distance, c.point[0], c.point[1], c.point[2]);
+        }
+      }
+    }
   if (comm().size() > 1) error = comm().agree_error(error);
   if (error) throw InputError(*error);
   const auto [top, who] = comm().max_loc(worst);

@@ -3,6 +3,7 @@
 // other or a wall by more than half a radius are refused unless forced.
 #include <gtest/gtest.h>
 
+#include <fstream>
 #include <string>
 
 #include "basalt/solver/core/errors.hpp"
@@ -91,4 +92,24 @@ K = 100.0
   const auto msg = error_of(wall, two(1.0));  // centres at z = 0, 0.3 below the plane
   EXPECT_NE(msg.find("wall \"floor\""), std::string::npos) << msg;
   EXPECT_NE(msg.find("id 7"), std::string::npos) << msg;
+}
+
+TEST(StartChecks, ParticleDeepInAMeshWallIsRefusedNamingTheMesh) {
+  // A flat mesh floor (two triangles over [-2, 2]^2) at height h; the particles' centres are at z = 0
+  // with radius 0.5: h = 0.1 overlaps by 0.8 of the radius (refused unless forced), h = -0.45 by 0.1
+  // (accepted), h = -0.6 not at all.
+  const auto dir = basalt::test::scratch_dir("start-checks-mesh");
+  const auto floor = [&](double h) {
+    const auto file = dir / ("floor" + std::to_string(h) + ".obj");
+    std::ofstream out(file);
+    out << "v -2 -2 " << h << "\nv 2 -2 " << h << "\nv 2 2 " << h << "\nv -2 2 " << h
+        << "\nf 1 2 3\nf 1 3 4\n";
+    return kContacts + "[[mesh_walls]]\nname = \"floor\"\nfile = \"" + file.string() + "\"\nK = 100.0\n";
+  };
+  const auto msg = error_of(floor(0.1), two(1.0));
+  EXPECT_NE(msg.find("mesh wall \"floor\" by 0.8"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("force_overlap"), std::string::npos) << msg;
+  EXPECT_EQ(error_of(floor(0.1), two(1.0), /*force=*/true), "");
+  EXPECT_EQ(error_of(floor(-0.45), two(1.0)), "");
+  EXPECT_EQ(error_of(floor(-0.6), two(1.0)), "");
 }
