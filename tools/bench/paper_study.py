@@ -332,14 +332,20 @@ def step_model(a):
                 "latency_s": lat, "bandwidth_Bps": bw, "allreduce2_s": ar2, "fieldsaver_s_per_step_1rank": fields1,
                 "fieldsaver_s_per_step_2rank": fields2}
 
-    def project(row, L, B, compute_per_particle):
+    def project(row, L, B, compute_per_particle, once=False):
         P = int(row["subdomains"])
         owned = float(row["owned_max"])
         ghosts = float(row["ghosts_max"])
         msgs = float(row["messages_max"])
-        compute = compute_per_particle * (owned + GAMMA * ghosts)
+        # Interactions with a ghost end are computed on both ranks (Basalt today), or, once=True, on one of
+        # them (half of them on each side, on average) with the reaction sent back to the ghost's owner.
+        compute = compute_per_particle * (owned + (GAMMA / 2 if once else GAMMA) * ghosts)
         # Every step: up to 6 blocking sendrecv phases of x, y, z per ghost; the busiest rank's bytes cross.
         comm = msgs * L + float(row["bytes_step_max"]) / B
+        # Computing once adds the reverse exchange: the same phases backwards, a force (3 doubles, as many
+        # bytes as the positions) per ghost, and the force loop must wait for it before the kick.
+        if once:
+            comm *= 2
         # At a rebuild (every 1/rebuild_rate steps): migration and ghost build, each a count and a payload
         # message per phase; ghost records of 48 bytes.
         comm += rebuild_rate * (4 * msgs * L + ghosts * 48 / B)
@@ -360,6 +366,14 @@ def step_model(a):
         c_here, m_here, r_here = project(row, lat, bw, c_p)
         c_cl, m_cl, r_cl = project(row, CLUSTER_LATENCY_S, CLUSTER_BANDWIDTH_BPS, c_p)
         c_pp, m_pp, r_pp = project(row, CLUSTER_LATENCY_S, CLUSTER_BANDWIDTH_BPS, c_paper)
+        once_here = sum(project(row, lat, bw, c_p, once=True)) * PAPER_STEPS
+        once_cl = sum(project(row, CLUSTER_LATENCY_S, CLUSTER_BANDWIDTH_BPS, c_p, once=True)) * PAPER_STEPS
+        # The gamma above which computing once pays: half the cross work saved equals the reverse exchange.
+        ghosts = float(row["ghosts_max"])
+        rev_here = float(row["messages_max"]) * lat + float(row["bytes_step_max"]) / bw
+        rev_cl = float(row["messages_max"]) * CLUSTER_LATENCY_S + float(row["bytes_step_max"]) / CLUSTER_BANDWIDTH_BPS
+        gamma_here = 2 * rev_here / (c_p * ghosts) if ghosts else float("inf")
+        gamma_cl = 2 * rev_cl / (c_p * ghosts) if ghosts else float("inf")
         rows.append({"n": int(row["n"]), "ranks": P, "particles": int(row["particles"]),
                      "owned_max": float(row["owned_max"]), "ghosts_max": float(row["ghosts_max"]),
                      "bytes_step_max": float(row["bytes_step_max"]), "messages_max": int(float(row["messages_max"])),
@@ -367,7 +381,9 @@ def step_model(a):
                      "here_T10k_s": (c_here + m_here + r_here) * PAPER_STEPS,
                      "cluster_compute_s": c_cl, "cluster_comm_s": m_cl, "cluster_reduce_s": r_cl,
                      "cluster_T10k_s": (c_cl + m_cl + r_cl) * PAPER_STEPS,
-                     "paperspeed_T10k_s": (c_pp + m_pp + r_pp) * PAPER_STEPS})
+                     "paperspeed_T10k_s": (c_pp + m_pp + r_pp) * PAPER_STEPS,
+                     "here_once_T10k_s": once_here, "cluster_once_T10k_s": once_cl,
+                     "gamma_breakeven_here": gamma_here, "gamma_breakeven_cluster": gamma_cl})
     with open(os.path.join(a.data, "model.csv"), "w", newline="") as f:
         w = csv.DictWriter(f, list(rows[0].keys()))
         w.writeheader()
@@ -394,6 +410,19 @@ def step_model(a):
                  "speed with cluster L, B {:+.1%}; the paper measured {:+.1%}.".format(
                      growth["here_T10k_s"], growth["cluster_T10k_s"], growth["paperspeed_T10k_s"],
                      PAPER_POINTS[1000] / PAPER_POINTS[27] - 1))
+    lines.append("")
+    lines.append("Interactions across ranks computed once (reaction sent back) against twice (today), per "
+                 "10,000 steps:")
+    lines.append("")
+    lines.append("| ranks | ghost fraction (max rank) | twice, this machine (s) | once, this machine (s) | twice, "
+                 "cluster (s) | once, cluster (s) | once pays above gamma (this machine / cluster) |")
+    lines.append("| --- | --- | --- | --- | --- | --- | --- |")
+    for r in rows:
+        if r["ghosts_max"] == 0:
+            continue
+        lines.append(f"| {r['ranks']} | {r['ghosts_max'] / r['owned_max']:.2f} | {r['here_T10k_s']:.2f} | "
+                     f"{r['here_once_T10k_s']:.2f} | {r['cluster_T10k_s']:.2f} | {r['cluster_once_T10k_s']:.2f} | "
+                     f"{r['gamma_breakeven_here']:.2f} / {r['gamma_breakeven_cluster']:.2f} |")
     lines.append("")
     lines.append("Measured inputs: " + ", ".join(f"{k} = {v:.4g}" for k, v in measured.items()))
     md = "\n".join(lines) + "\n"
