@@ -27,16 +27,8 @@ ForceField<Real>::ForceField(const Scene& scene)
     pair_group_compute_.push_back(static_cast<int>(k));
   }
   pairs_take_all_ = scene.contacts.size() == 1 && scene.contacts[0].tags.empty();
-  // Checkpoints store all contact histories in one table of one width.
-  std::size_t width = 0;
-  for (const auto* c : history_computes_) {
-    const auto b = c->history_bytes();
-    if (b && width && b != width)
-      throw InputError(
-          "interactions: contact models with histories of different sizes in one scene are not supported "
-          "yet");
-    width = std::max(width, b);
-  }
+  // Checkpoints store all contact histories in one table as wide as the widest history; narrower ones
+  // are padded with zeros (SimulationFrame) and read back at their own width (restart).
 
   // The ledger: every scene has the standard terms (a saver of one nothing fills saves zeros); body
   // forces add theirs.

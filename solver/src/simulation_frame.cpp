@@ -1,7 +1,9 @@
 // Writes a compute rank's frame straight into the output buffer (see simulation_frame.hpp).
 #include "basalt/solver/output/simulation_frame.hpp"
 
+#include <algorithm>
 #include <span>
+#include <vector>
 
 namespace basalt::solver {
 
@@ -35,7 +37,7 @@ SimulationFrame<Real>::SimulationFrame(const Simulation<Real>& sim, std::uint32_
         history_.emplace_back();
         c->history_records(p, history_.back());
         h.contacts += history_.back().size();
-        h.contact_width = static_cast<std::uint32_t>(history_.back().width);
+        h.contact_width = std::max(h.contact_width, static_cast<std::uint32_t>(history_.back().width));
       }
   // The scene's optional particle fields that frames carry (Particles' array list).
   p.for_each_array([&](const ArrayInfo& a, const auto&) { h.fields += !a.output.empty() && p.enabled(a); });
@@ -139,7 +141,15 @@ void SimulationFrame<Real>::write(io::FrameWriter& w) const {
     w.column(Column::contact_a, r.a, c);
     w.column(Column::contact_b, r.b, c);
     w.fill(Column::contact_model, c, r.size(), static_cast<std::int32_t>(model));
-    w.column(Column::contact_history, r.values, c * header_.contact_width);
+    if (r.width == header_.contact_width) {
+      w.column(Column::contact_history, r.values, c * header_.contact_width);
+    } else {  // a narrower history than the table's (models of several widths): zeros after its own
+      std::vector<double> padded(r.size() * header_.contact_width, 0.0);
+      for (std::size_t k = 0; k < r.size(); ++k)
+        std::copy(r.at(k), r.at(k) + r.width,
+                  padded.begin() + static_cast<std::ptrdiff_t>(k * header_.contact_width));
+      w.column(Column::contact_history, padded, c * header_.contact_width);
+    }
     c += r.size();
   }
   for (const auto& wall : walls_) w.wall(wall);

@@ -115,17 +115,21 @@ void Simulation<Real>::distribute_checkpoint(const io::Checkpoint& c, const Rest
   }
   // Contact history of the contacts with an owned end waits for the (replayed) rebuild to find
   // their pairs in the lists.
+  // The table is as wide as the widest model's history; each model reads its own width from the front.
   std::vector<ContactRecords*> history;
+  std::size_t widest = 0;
   for (auto* pc : forces_.history_computes())
-    if (pc->pending()) history.push_back(pc->pending());
+    if (pc->pending()) {
+      history.push_back(pc->pending());
+      widest = std::max(widest, history.back()->width);
+    }
   for (std::size_t k = 0; k < c.contact_ids.size(); ++k) {
     const auto model = static_cast<std::size_t>(c.contact_model[k]);
-    if (model >= history.size() || c.contact_width != history[model]->width)
+    if (model >= history.size() || c.contact_width != widest)
       throw InputError(fmt::format(
           "the checkpoint's contact {}-{} has a history of {} values for contact model {}, but the scene's "
-          "contact models with history are {} ({} values)",
-          c.contact_ids[k][0], c.contact_ids[k][1], c.contact_width, model, history.size(),
-          history.empty() ? 0 : history.front()->width));
+          "contact models with history are {} (histories of up to {} values)",
+          c.contact_ids[k][0], c.contact_ids[k][1], c.contact_width, model, history.size(), widest));
     const auto ia = static_cast<std::size_t>(g.index_of(c.contact_ids[k][0]));
     const auto ib = static_cast<std::size_t>(g.index_of(c.contact_ids[k][1]));
     if (owned[ia] || (c.contact_ids[k][1] >= 0 && owned[ib]))  // a wall's id (< 0) has no index

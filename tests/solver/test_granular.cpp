@@ -487,8 +487,7 @@ TEST(RollingFriction, ResistsTheSpreadingOfAColumnAndKeepsTheLedger) {
   if (basalt::test::rank() != 0) return;
   // The collapsing column of the ledger test, with and without rolling resistance: the rolling couple
   // must hold the pile back (a shorter runout) while the ledger still balances.
-  // (An elastic floor: contact models with histories of different widths, here rolling_friction's 7 values
-  // and a frictional wall's 4, cannot share a scene yet.)
+  // (An elastic floor, so that the comparison isolates the grains' rolling couple.)
   auto plain = std::string(kColumnScene);
   const std::string floor = "interaction = \"friction\"\nK = 1000.0\nKs = 500.0\nmu = 0.5\n";
   plain.replace(plain.find(floor), floor.size(), "K = 1000.0\n");
