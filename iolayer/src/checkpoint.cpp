@@ -70,6 +70,22 @@ void Checkpoint::validate(const fs::path& source) const {
           fmt::format("bond {}: flag must be 0, or 1 or 2 plus 4 x the failure mode (0-3), got {}", k,
                       bond_broken[k]));
   }
+  if (!bond_break_position.empty()) {
+    const auto broken = static_cast<std::size_t>(
+        std::count_if(bond_broken.begin(), bond_broken.end(), [](std::uint8_t f) { return f != 0; }));
+    if (bond_break_position.size() != broken)
+      throw FormatError(source, "/bonds/break_position",
+                        fmt::format("{} rows for {} broken bonds (one per bond whose /bonds/broken is not 0)",
+                                    bond_break_position.size(), broken));
+    for (std::size_t k = 0; k < broken; ++k) {
+      const auto& x = bond_break_position[k];
+      const bool unknown = std::isnan(x[0]) && std::isnan(x[1]) && std::isnan(x[2]);
+      if (!unknown && !finite(x))
+        throw FormatError(
+            source, "/bonds/break_position",
+            fmt::format("row {}: a position must be finite, or NaN in all three (not known)", k));
+    }
+  }
   for (const auto& [name, values] : particle_fields) {
     const auto where = "/particles/" + name;
     if (name.empty() || name.find('/') != std::string::npos || name == "." || is_fixed_particle_dataset(name))

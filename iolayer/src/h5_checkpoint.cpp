@@ -87,6 +87,9 @@ void write_checkpoint(const Checkpoint& c, const fs::path& file, Compression com
   for (const auto& [name, values] : s->particle_fields) w.dataset("/particles/" + name, values);
   w.dataset("/bonds/rest_length", s->bond_rest_length);
   w.dataset("/bonds/broken", s->bond_broken);
+  if (!s->bond_break_position.empty())
+    w.dataset("/bonds/break_position", reinterpret_cast<const double*>(s->bond_break_position.data()),
+              s->bond_break_position.size(), 3);
   w.group("/walls");
   for (std::size_t i = 0; i < s->walls.size(); ++i) {
     const auto& wall = s->walls[i];
@@ -160,6 +163,11 @@ Checkpoint read_checkpoint_unguarded(const fs::path& file) {
   const auto brows = r.rows<std::uint8_t>("/bonds/broken");
   if (brows != m) r.fail("/bonds/broken", fmt::format("{} values for {} bonds", brows, m));
   c.bond_broken = r.read<std::uint8_t>("/bonds/broken");
+  if (r.exists("/bonds/break_position")) {
+    const auto rows = r.rows<double>("/bonds/break_position", 3);
+    c.bond_break_position.resize(rows);
+    if (rows) r.read_into("/bonds/break_position", reinterpret_cast<double*>(c.bond_break_position.data()));
+  }
 
   if (r.exists("/contacts/ids")) {
     const auto nc = r.rows<std::int64_t>("/contacts/ids", 2);

@@ -31,6 +31,7 @@ SimulationFrame<Real>::SimulationFrame(const Simulation<Real>& sim, std::uint32_
     for (std::size_t k = bonds.n_both_owned; k < bonds.size(); ++k) m += owns_ghost_bond(k) ? 1 : 0;
   }
   h.bonds = m;
+  h.breaks = with_bonds_ ? sim.broken_.size() : 0;  // the broken bonds come last, in broken_'s order
   if (kinds & io::kFrameCheckpoint)
     for (const auto* c : sim.forces_.history_computes())
       if (c->history_bytes() > 0) {
@@ -125,14 +126,18 @@ void SimulationFrame<Real>::write(io::FrameWriter& w) const {
   }
   w.fill(Column::bond_broken, 0, at, 0);
   // Broken bonds: the bond driver records each once across ranks (same lower-id rule). Flag 2: it
-  // broke at this very step (a restart from here restores it, docs/formats.md).
-  for (const auto& broken : sim_.broken_) {
-    if (!with_bonds_) break;
+  // broke at this very step (a restart from here restores it, docs/formats.md). Where it broke goes
+  // with it (pictures of cracks; NaN when a restart from an older checkpoint did not know).
+  for (std::size_t k = 0; with_bonds_ && k < sim_.broken_.size(); ++k) {
+    const auto& broken = sim_.broken_[k];
     w.set(Column::bond_a, at, broken.a);
     w.set(Column::bond_b, at, broken.b);
     w.set(Column::bond_rest_length, at, broken.rest_length);
     w.set(Column::bond_group, at, broken.group);
     w.set(Column::bond_broken, at, std::uint8_t((broken.step == sim_.step_ ? 2 : 1) | (broken.mode << 2)));
+    w.set(Column::break_x, k, broken.x);
+    w.set(Column::break_y, k, broken.y);
+    w.set(Column::break_z, k, broken.z);
     ++at;
   }
   std::size_t c = 0;

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "basalt/solver/core/errors.hpp"
 #include "basalt/solver/scene/load_checks.hpp"
@@ -87,8 +88,14 @@ void Simulation<Real>::distribute_checkpoint(const io::Checkpoint& c, const Rest
   // and the restart's first force computation breaks it again from the same positions.
   const bool replay = !c.position_at_rebuild.empty();
   restore_particle_fields(c, mine, replay);
-  for (std::size_t k = 0; k < g.bonds.size(); ++k) {
+  constexpr double unknown = std::numeric_limits<double>::quiet_NaN();
+  for (std::size_t k = 0, nb = 0; k < g.bonds.size(); ++k) {
     const auto& b = g.bonds[k];
+    // Where it broke: the checkpoint's row for it among its broken bonds (NaN when it has none).
+    const io::Vec3 where = c.bond_broken[k] == 0 || c.bond_break_position.empty()
+                               ? io::Vec3{unknown, unknown, unknown}
+                               : c.bond_break_position[nb];
+    nb += c.bond_broken[k] != 0 ? 1 : 0;
     const auto ia = static_cast<std::size_t>(g.index_of(b.a)), ib = static_cast<std::size_t>(g.index_of(b.b));
     const int state = c.bond_broken[k] & 3;
     if (state == 1 || (state == 2 && !replay)) {
@@ -101,6 +108,9 @@ void Simulation<Real>::distribute_checkpoint(const io::Checkpoint& c, const Rest
                                      (pa[2] - pb[2]) * (pa[2] - pb[2]));
         BrokenBond r{b.a, b.b, len, c.bond_rest_length[k]};
         r.mode = static_cast<std::uint8_t>(c.bond_broken[k] >> 2);
+        r.x = where[0];
+        r.y = where[1];
+        r.z = where[2];
         broken_.push_back(r);
       }
       continue;

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <limits>
 
 #include "basalt/io/checkpoint.hpp"
 #include "io_test_util.hpp"
@@ -339,4 +340,33 @@ TEST(Checkpoint, ParticleFieldsAndContactHistoryRoundTripSortedWithTheIds) {
   bad = c;
   bad.contact_history[3] = std::nan("");
   expect_format_error([&] { write_checkpoint(bad, dir / "bad.h5"); }, {"/contacts/history"});
+}
+
+TEST(Checkpoint, BreakPositionsRoundTripOnePerBrokenBond) {
+  // /bonds/break_position: where each broken bond broke, one row per bond whose flag is not 0, in bond
+  // order; a row of NaN is "not known". Written only when known: a run without breaks has no dataset.
+  const auto dir = basalt::test::scratch_dir("ckpt-break-position");
+  Checkpoint c = sample_checkpoint();
+  c.bond_broken = {0, 1 | (1 << 2), 0, 2 | (3 << 2)};
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  c.bond_break_position = {{1.5, 2.25, -3.0000000000000004}, {nan, nan, nan}};
+  write_checkpoint(c, dir / "ckpt_1.h5");
+  const Checkpoint back = read_checkpoint(dir / "ckpt_1.h5");
+  EXPECT_EQ(back.bond_broken, c.bond_broken);
+  ASSERT_EQ(back.bond_break_position.size(), 2u);
+  EXPECT_EQ(back.bond_break_position[0], c.bond_break_position[0]);
+  EXPECT_TRUE(std::isnan(back.bond_break_position[1][0]) && std::isnan(back.bond_break_position[1][2]));
+
+  write_checkpoint(sample_checkpoint(), dir / "ckpt_2.h5");
+  EXPECT_TRUE(read_checkpoint(dir / "ckpt_2.h5").bond_break_position.empty());
+
+  Checkpoint bad = c;
+  bad.bond_break_position.pop_back();
+  expect_format_error([&] { write_checkpoint(bad, dir / "ckpt_3.h5"); },
+                      {"ckpt_3.h5: /bonds/break_position: 1 rows for 2 broken bonds"});
+  bad = c;
+  bad.bond_break_position[1][0] = 4.0;  // partly NaN: neither a position nor "not known"
+  expect_format_error([&] { write_checkpoint(bad, dir / "ckpt_3.h5"); },
+                      {"/bonds/break_position: row 1: a position must be finite"});
+  EXPECT_FALSE(fs::exists(dir / "ckpt_3.h5"));
 }

@@ -3,6 +3,7 @@
 // particles and bonds by id and refuses duplicates.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
 #include <limits>
 
@@ -305,4 +306,38 @@ TEST(Frame, ParticleFieldsAndContactsTravelAndAssemble) {
   // A piece that lacks a field the others have cannot be assembled.
   back[0].fields.clear();
   EXPECT_THROW(assemble(back, info), std::runtime_error);
+}
+
+TEST(Frame, BreakPositionsTravelAndAssembleWithTheirBonds) {
+  // Piece 1 holds a broken bond (and where it broke); piece 0 an intact bond and a broken one whose
+  // position is not known (NaN). Assembled, the rows follow the bonds' (a, b) order.
+  auto p0 = make_piece(0, 3, 7), p1 = make_piece(1, 3, 7);
+  p1.bond_break_position = {{1.25, -2.5, 3.0000000000000004}};
+  p0.bonds.push_back({p0.id[1], p0.id[2], 7});
+  p0.bond_rest_length.push_back(1.0);
+  p0.bond_broken.push_back(2 | (2 << 2));
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  p0.bond_break_position = {{nan, nan, nan}};
+  std::vector<FramePiece> pieces;
+  for (const auto* p : {&p0, &p1}) {
+    std::vector<std::byte> bytes;
+    serialize(*p, bytes);
+    pieces.push_back(deserialize(bytes));
+  }
+  ASSERT_EQ(pieces[0].bond_break_position.size(), 1u);
+  EXPECT_TRUE(std::isnan(pieces[0].bond_break_position[0][0]));
+  ASSERT_EQ(pieces[1].bond_break_position.size(), 1u);
+  EXPECT_EQ(pieces[1].bond_break_position[0], p1.bond_break_position[0]);
+  const Checkpoint c = assemble(pieces, RunInfo{});
+  ASSERT_EQ(c.bond_broken.size(), 3u);
+  // Bonds sorted by (a, b): piece 0's (96, 98), piece 1's (97, 99), piece 0's (98, 100).
+  EXPECT_EQ(c.bond_broken, (std::vector<std::uint8_t>{2 | (2 << 2), 1, 0}));
+  ASSERT_EQ(c.bond_break_position.size(), 2u);
+  EXPECT_TRUE(std::isnan(c.bond_break_position[0][1]));
+  EXPECT_EQ(c.bond_break_position[1], p1.bond_break_position[0]);
+
+  // A piece whose break positions do not match its broken bonds is refused before it is sent.
+  p1.bond_break_position.push_back({0, 0, 0});
+  std::vector<std::byte> bytes;
+  EXPECT_THROW(serialize(p1, bytes), std::invalid_argument);
 }

@@ -10,6 +10,19 @@ mkdir -p "$dir/b"
 cp "$dir/a/ckpt_$(printf %06d "$n").h5" "$dir/b/"
 head -n $((n / 10 + 1)) "$dir/a/fields.csv" > "$dir/b/fields.csv"
 "$run" "$scene" --geometry "$geo" --steps "$n" --checkpoint-every "$n" --fields-every 10 --output "$dir/b" --restart "$dir/b" --quiet >/dev/null
+# Where the broken bonds broke (/bonds/break_position, for pictures of cracks) survives the restart: the
+# final checkpoints list the same broken bonds at the same positions, those restored from the checkpoint
+# as well as those that broke after it.
+last="ckpt_$(printf %06d $((2 * n))).h5"
+if h5ls "$dir/a/$last/bonds/break_position" >/dev/null 2>&1; then
+  for ds in /bonds/broken /bonds/break_position; do
+    if ! h5diff "$dir/a/$last" "$dir/b/$last" "$ds" >/dev/null 2>&1; then
+      echo "FAIL: $ds of $last differs after the restart"
+      exit 1
+    fi
+  done
+  echo "PASS: $last's /bonds/broken and /bonds/break_position equal the uninterrupted run's"
+fi
 if cmp -s "$dir/a/fields.csv" "$dir/b/fields.csv"; then
   echo "PASS: the restarted run's $(wc -l < "$dir/b/fields.csv") rows equal the uninterrupted run's"
 else

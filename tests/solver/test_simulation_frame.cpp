@@ -7,6 +7,7 @@
 #include <mpi.h>
 
 #include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <numeric>
 #include <sstream>
@@ -111,6 +112,20 @@ void check_frame_equals_state() {
     flags.push_back(q.bond_broken[k]);
     EXPECT_GT(q.bond_rest_length[k], 0.0);
   }
+  // Where each broken bond broke travels with it: the solver's break record (the contact point of the
+  // two spheres at the break), one row per broken bond, in the order of the broken bonds.
+  const auto& records = sim.broken_bonds();
+  EXPECT_EQ(q.bond_break_position.size(), records.size());
+  std::size_t misplaced = 0, row = 0;
+  for (std::size_t k = 0; k < q.bonds.size() && row < records.size(); ++k) {
+    if (q.bond_broken[k] == 0) continue;
+    const auto& r = records[row];
+    const auto& x = q.bond_break_position[row++];
+    const bool same = q.bonds[k].a == r.a && q.bonds[k].b == r.b && x[0] == r.x && x[1] == r.y &&
+                      x[2] == r.z && std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2]);
+    misplaced += same ? 0 : 1;
+  }
+  EXPECT_EQ(misplaced, 0u) << "of " << records.size() << " break positions are not the solver's records";
   const auto all_pairs = gather(pairs);
   const auto all_flags = gather(flags);
   std::size_t walls = q.walls.size();

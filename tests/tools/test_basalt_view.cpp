@@ -15,7 +15,9 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <limits>
 #include <sstream>
+#include <utility>
 
 #include "basalt/io/checkpoint.hpp"
 #include "basalt/io/vtk_frames.hpp"
@@ -767,4 +769,111 @@ TEST(BasaltView, ColoursACheckpointByItsParticleFieldsSuchAsAngularVelocity) {
     EXPECT_GT(img.count_between(kHigh, 30, 0.4, kSceneFraction), 30) << field;
     EXPECT_EQ(img.count_between(kHigh, 30, 0.0, 0.3), 0) << field;
   }
+}
+
+namespace {
+
+/// Pixels of the crack colour (yellow, lit or shaded: red and green high, blue low), which no colour of the
+/// cool-to-warm map nor the background comes near, with x0_fraction * width <= x < x1_fraction * width.
+int crack_pixels(const Image& img, double x0_fraction = 0.0, double x1_fraction = 1.0) {
+  int n = 0;
+  for (int y = 0; y < img.height; ++y)
+    for (int x = static_cast<int>(x0_fraction * img.width); x < static_cast<int>(x1_fraction * img.width);
+         ++x) {
+      const Rgb& p = img.pixels[static_cast<std::size_t>(y * img.width + x)];
+      if (p[0] > 150 && p[1] > 120 && p[2] < 60 && p[1] < p[0]) ++n;
+    }
+  return n;
+}
+
+/// The 12x12x12 lattice with bonds between x-neighbours; those between x = 5 and x = 6 (144) broken.
+/// `where`: the recorded break positions' x (none recorded when NaN).
+basalt::io::Checkpoint cracked_lattice(bool broken, double where) {
+  basalt::io::Checkpoint c = lattice_checkpoint();
+  for (int k = 0; k < 12; ++k)
+    for (int j = 0; j < 12; ++j)
+      for (int i = 0; i + 1 < 12; ++i) {
+        const std::int64_t a = k * 144 + j * 12 + i;
+        c.geometry.bonds.push_back({a, a + 1, 0});
+        c.bond_rest_length.push_back(1.0);
+        const bool cracked = broken && i == 5;
+        c.bond_broken.push_back(cracked ? std::uint8_t(1 | (1 << 2)) : std::uint8_t(0));
+        if (cracked && !std::isnan(where)) c.bond_break_position.push_back({where, 1.0 * j, 1.0 * k});
+      }
+  return c;
+}
+
+}  // namespace
+
+TEST(BasaltView, DrawsBrokenBondsWhereTheyBrokeInTheirOwnColour) {
+  // Seen from -y, x runs left to right across the scene (the left 84 % of the image, centre at 0.42); the
+  // 12 broken bonds along y behind each other show as one point each.
+  const fs::path dir = basalt::test::scratch_dir("view-render-cracks");
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  basalt::io::write_checkpoint(cracked_lattice(true, 5.5), dir / "ckpt_000100.h5");   // broke in the middle
+  basalt::io::write_checkpoint(cracked_lattice(true, 1.5), dir / "ckpt_000200.h5");   // recorded near x = 1.5
+  basalt::io::write_checkpoint(cracked_lattice(true, nan), dir / "ckpt_000300.h5");   // not recorded
+  basalt::io::write_checkpoint(cracked_lattice(false, nan), dir / "ckpt_000400.h5");  // bonds, none broken
+  const auto render = [&](const std::string& file, const std::string& options) {
+    return basalt_view(fmt_args("render", (dir / file).string(), "-o", (dir / "out.png").string(),
+                                "--size 400x300 --view -y " + options),
+                       dir);
+  };
+
+  // Default: drawn, since the checkpoint has broken bonds; all of them in a vertical band at x = 5.5.
+  Outcome r = render("ckpt_000100.h5", "");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("; 144 broken bonds, 144 drawn;"), std::string::npos) << r.out;
+  Image img = read_png(dir / "out.png");
+  ASSERT_EQ(img.width, 400);
+  EXPECT_GT(crack_pixels(img, 0.36, 0.48), 40);
+  EXPECT_EQ(crack_pixels(img, 0.0, 0.36) + crack_pixels(img, 0.48, 1.0), 0);
+  EXPECT_GT(img.count(kLow, 30, kSceneFraction), 100);  // the particles are still drawn
+
+  // The recorded position, not the ends' present contact point (x = 5.5), places them.
+  r = render("ckpt_000200.h5", "");
+  ASSERT_EQ(r.code, 0) << r.out;
+  img = read_png(dir / "out.png");
+  EXPECT_GT(crack_pixels(img, 0.0, 0.3), 40);
+  EXPECT_EQ(crack_pixels(img, 0.3, 1.0), 0);
+  // Without a record: at the ends' contact point now, and said so.
+  r = render("ckpt_000300.h5", "");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("144 without a recorded break position"), std::string::npos) << r.out;
+  img = read_png(dir / "out.png");
+  EXPECT_GT(crack_pixels(img, 0.36, 0.48), 40);
+  EXPECT_EQ(crack_pixels(img, 0.0, 0.36) + crack_pixels(img, 0.48, 1.0), 0);
+
+  // The cut keeps the half behind it (y >= 5.5 seen from -y): 72 of the 144.
+  r = render("ckpt_000100.h5", "--cut y");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("; 144 broken bonds, 72 drawn;"), std::string::npos) << r.out;
+  EXPECT_GT(crack_pixels(read_png(dir / "out.png"), 0.36, 0.48), 40);
+
+  // Off on request, and nothing to draw without broken bonds: no crack colour, no count.
+  for (const auto& [file, option] : {std::pair{"ckpt_000100.h5", "--no-cracks"}, {"ckpt_000400.h5", ""}}) {
+    r = render(file, option);
+    ASSERT_EQ(r.code, 0) << r.out;
+    EXPECT_EQ(r.out.find("broken bonds"), std::string::npos) << r.out;
+    img = read_png(dir / "out.png");
+    EXPECT_EQ(crack_pixels(img), 0) << file << " " << option;
+    EXPECT_GT(img.count(kLow, 30, kSceneFraction), 100);
+  }
+  // --cracks on a checkpoint without broken bonds draws none and says 0.
+  r = render("ckpt_000400.h5", "--cracks");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("; 0 broken bonds, 0 drawn;"), std::string::npos) << r.out;
+
+  // Only the cracks: no particles (neither end of the map) and no colour bar.
+  r = render("ckpt_000100.h5", "--only-cracks --crack-radius 0.3");
+  ASSERT_EQ(r.code, 0) << r.out;
+  img = read_png(dir / "out.png");
+  EXPECT_GT(crack_pixels(img, 0.36, 0.48), 300);
+  EXPECT_EQ(img.count(kLow, 30) + img.count(kHigh, 30), 0);
+
+  r = render("ckpt_000100.h5", "--crack-radius -1");
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.out.find("--crack-radius"), std::string::npos) << r.out;
+  r = render("ckpt_000100.h5", "--cracks --no-cracks");
+  EXPECT_NE(r.code, 0);
 }

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <vtkActor.h>
 #include <vtkCamera.h>
+#include <vtkCellArray.h>
 #include <vtkColorTransferFunction.h>
 #include <vtkFloatArray.h>
 #include <vtkGlyph3DMapper.h>
@@ -78,10 +79,34 @@ std::string describe_clock(const io::FrameInfo& info, const std::string& kind) {
 
 const char* kColourArray = "basalt-view colour";
 
+/// The broken bonds the cut keeps, as points (one vertex cell each) less `centre`.
+vtkSmartPointer<vtkPolyData> crack_points(const std::vector<io::Vec3>& cracks,
+                                          const std::optional<CutPlane>& cut, const double centre[3]) {
+  auto points = vtkSmartPointer<vtkPoints>::New();
+  points->SetDataTypeToDouble();
+  auto verts = vtkSmartPointer<vtkCellArray>::New();
+  for (const auto& x : cracks) {
+    if (cut && !cut->keeps(x[static_cast<std::size_t>(cut->axis)])) continue;
+    const vtkIdType id = points->InsertNextPoint(x[0] - centre[0], x[1] - centre[1], x[2] - centre[2]);
+    verts->InsertNextCell(1, &id);
+  }
+  auto out = vtkSmartPointer<vtkPolyData>::New();
+  out->SetPoints(points);
+  out->SetVerts(verts);
+  return out;
+}
+
+/// "1234 broken bonds" and, with a cut, how many lie in the half drawn.
+std::string crack_caption(const Prepared& p, bool cut) {
+  if (!p.cracks) return {};
+  return cut ? fmt::format("{} broken bonds, {} in the half drawn", p.cracks_total, p.cracks_shown)
+             : fmt::format("{} broken bonds", p.cracks_total);
+}
+
 }  // namespace
 
 Prepared prepare(vtkSmartPointer<vtkPolyData> polydata, const io::FrameInfo& info, const std::string& kind,
-                 const fs::path& input, const DrawOptions& o) {
+                 const fs::path& input, const DrawOptions& o, const std::vector<io::Vec3>& cracks) {
   Prepared p;
   p.input = input;
   p.info = info;
@@ -143,6 +168,21 @@ Prepared prepare(vtkSmartPointer<vtkPolyData> polydata, const io::FrameInfo& inf
   const double pad = rr[1];
   p.fit = {b[0] - centre[0] - pad, b[1] - centre[0] + pad, b[2] - centre[1] - pad,
            b[3] - centre[1] + pad, b[4] - centre[2] - pad, b[5] - centre[2] + pad};
+
+  // Broken bonds: drawn when asked, or by default when there are any.
+  const bool with_cracks = o.cracks == Cracks::on || o.cracks == Cracks::only ||
+                           (o.cracks == Cracks::automatic && !cracks.empty());
+  if (with_cracks) {
+    std::optional<CutPlane> plane;
+    if (o.cut) plane = cut_plane(full, *o.cut, o.view);
+    p.cracks = crack_points(cracks, plane, centre);
+    p.cracks_total = cracks.size();
+    p.cracks_shown = static_cast<std::size_t>(p.cracks->GetNumberOfPoints());
+    double mean = 0;
+    for (vtkIdType i = 0; i < radius->GetNumberOfTuples(); ++i) mean += radius->GetComponent(i, 0);
+    p.crack_radius = o.crack_radius.value_or(0.3 * mean / static_cast<double>(radius->GetNumberOfTuples()));
+    p.only_cracks = o.cracks == Cracks::only;
+  }
   return p;
 }
 
@@ -156,6 +196,7 @@ Painter::Painter(ImageSize size, int panels, DrawOptions o) : size_(size), o_(st
   window_->SetOffScreenRendering(1);
   window_->SetMultiSamples(0);
   window_->SetSize(size.width, size.height);
+  window_->SetNumberOfLayers(2);  // layer 1: the cracks, over the particles
   font_ = std::max(10, size.height / 48);
   for (int i = 0; i < panels; ++i) {
     Panel pn;
@@ -183,12 +224,40 @@ Painter::Painter(ImageSize size, int panels, DrawOptions o) : size_(size), o_(st
     pn.mapper->SetScalarModeToUsePointData();
     pn.mapper->ScalarVisibilityOn();
     pn.mapper->UseLookupTableScalarRangeOn();
-    auto actor = vtkSmartPointer<vtkActor>::New();
-    actor->SetMapper(pn.mapper);
-    actor->GetProperty()->SetAmbient(0.15);
-    actor->GetProperty()->SetDiffuse(0.85);
-    actor->GetProperty()->SetSpecular(0.0);
-    pn.scene->AddActor(actor);
+    pn.particles = vtkSmartPointer<vtkActor>::New();
+    pn.particles->SetMapper(pn.mapper);
+    pn.particles->GetProperty()->SetAmbient(0.15);
+    pn.particles->GetProperty()->SetDiffuse(0.85);
+    pn.particles->GetProperty()->SetSpecular(0.0);
+    pn.scene->AddActor(pn.particles);
+    // Cracks on a layer of their own, drawn after the particles with a cleared depth buffer, so that every
+    // broken bond in the half drawn shows (over the particles, not hidden inside the packing).
+    pn.over = vtkSmartPointer<vtkRenderer>::New();
+    pn.over->SetLayer(1);
+    pn.over->SetViewport(i * w, 0, (i + 1) * w, 1);
+    pn.over->SetActiveCamera(pn.scene->GetActiveCamera());
+    pn.over->InteractiveOff();
+    if (o_.mapper == "imposter") {
+      pn.crack_mapper = vtkSmartPointer<vtkOpenGLSphereMapper>::New();
+    } else {
+      pn.crack_sphere = vtkSmartPointer<vtkSphereSource>::New();
+      pn.crack_sphere->SetThetaResolution(10);
+      pn.crack_sphere->SetPhiResolution(6);
+      auto glyphs = vtkSmartPointer<vtkGlyph3DMapper>::New();
+      glyphs->SetSourceConnection(pn.crack_sphere->GetOutputPort());
+      glyphs->ScalingOff();
+      glyphs->OrientOff();
+      pn.crack_mapper = glyphs;
+    }
+    pn.crack_mapper->ScalarVisibilityOff();
+    pn.cracks = vtkSmartPointer<vtkActor>::New();
+    pn.cracks->SetMapper(pn.crack_mapper);
+    pn.cracks->GetProperty()->SetColor(kCrackColour[0], kCrackColour[1], kCrackColour[2]);
+    pn.cracks->GetProperty()->SetAmbient(0.4);
+    pn.cracks->GetProperty()->SetDiffuse(0.6);
+    pn.cracks->GetProperty()->SetSpecular(0.0);
+    pn.cracks->VisibilityOff();
+    pn.over->AddActor(pn.cracks);
     pn.text = vtkSmartPointer<vtkTextActor>::New();
     white(pn.text->GetTextProperty(), font_);
     pn.text->GetTextProperty()->SetVerticalJustificationToTop();
@@ -196,6 +265,7 @@ Painter::Painter(ImageSize size, int panels, DrawOptions o) : size_(size), o_(st
     pn.text->SetDisplayPosition(static_cast<int>(i * w * size.width) + font_ / 2, size.height - font_ / 2);
     pn.scene->AddActor2D(pn.text);
     window_->AddRenderer(pn.scene);
+    window_->AddRenderer(pn.over);
     panels_.push_back(pn);
   }
   auto side = vtkSmartPointer<vtkRenderer>::New();
@@ -231,20 +301,39 @@ void Painter::draw(const std::vector<const Prepared*>& frames, const ColourScale
   white(bar_->GetTitleTextProperty(),
         std::max(7, std::min(font_, static_cast<int>(0.9 * bar_px_ / (0.6 * longest)))));
   extremes_->SetInput(fmt::format("min {:.4g}\nmax {:.4g}", scale.min, scale.max).c_str());
+  // Only cracks in every panel: no particles, so no colour bar either.
+  const bool bar =
+      std::any_of(frames.begin(), frames.end(), [](const Prepared* p) { return !p->only_cracks; });
+  bar_->SetVisibility(bar);
+  extremes_->SetVisibility(bar);
   for (std::size_t i = 0; i < panels_.size(); ++i) {
     const Prepared& p = *frames[i];
     Panel& pn = panels_[i];
     pn.mapper->SetLookupTable(lut);
     if (auto* m = vtkPolyDataMapper::SafeDownCast(pn.mapper)) m->SetInputData(p.shown);
     if (auto* g = vtkGlyph3DMapper::SafeDownCast(pn.mapper)) g->SetInputData(p.shown);
+    pn.particles->SetVisibility(!p.only_cracks);
+    pn.cracks->SetVisibility(p.cracks && p.cracks_shown > 0);
+    if (p.cracks) {
+      if (auto* m = vtkOpenGLSphereMapper::SafeDownCast(pn.crack_mapper)) {
+        m->SetInputData(p.cracks);
+        m->SetRadius(static_cast<float>(p.crack_radius));
+      }
+      if (auto* g = vtkGlyph3DMapper::SafeDownCast(pn.crack_mapper)) {
+        g->SetInputData(p.cracks);
+        pn.crack_sphere->SetRadius(p.crack_radius);
+      }
+    }
     const std::string cut = o_.cut ? fmt::format(" ({} behind the cut at {})", p.in_view,
                                                  std::string(1, static_cast<char>('x' + o_.cut->axis)))
                                    : std::string();
-    // A strip's panels say only their clock: the file names are in the command.
+    const std::string cracks =
+        p.cracks ? fmt::format("\n{}", crack_caption(p, o_.cut.has_value())) : std::string();
+    // A strip's panels say only their clock (and broken bonds): the file names are in the command.
     pn.text->SetInput(panels_.size() > 1
-                          ? describe_clock(p.info, p.kind).c_str()
-                          : fmt::format("{}\n{}: {} particles{}", describe_clock(p.info, p.kind),
-                                        p.input.filename().string(), p.total, cut)
+                          ? fmt::format("{}{}", describe_clock(p.info, p.kind), cracks).c_str()
+                          : fmt::format("{}\n{}: {} particles{}{}", describe_clock(p.info, p.kind),
+                                        p.input.filename().string(), p.total, cut, cracks)
                                 .c_str());
     // Camera: look at the centre of the whole frame (now the origin) from the requested side.
     auto* cam = pn.scene->GetActiveCamera();

@@ -12,19 +12,23 @@
 
 namespace basalt::view {
 
-std::vector<vtkIdType> cut_indices(vtkPolyData& pd, const Cut& cut, const ViewDirection& view) {
+CutPlane cut_plane(vtkPolyData& pd, const Cut& cut, const ViewDirection& view) {
   double b[6];
   pd.GetBounds(b);
-  const int axis = cut.axis;
-  const double value = cut.value.value_or(0.5 * (b[2 * axis] + b[2 * axis + 1]));
-  const bool keep_below = view.toward_camera[static_cast<std::size_t>(axis)] >= 0;
+  CutPlane c;
+  c.axis = cut.axis;
+  c.value = cut.value.value_or(0.5 * (b[2 * c.axis] + b[2 * c.axis + 1]));
+  c.keep_below = view.toward_camera[static_cast<std::size_t>(c.axis)] >= 0;
+  return c;
+}
+
+std::vector<vtkIdType> cut_indices(vtkPolyData& pd, const Cut& cut, const ViewDirection& view) {
+  const CutPlane plane = cut_plane(pd, cut, view);
   std::vector<vtkIdType> kept;
   const vtkIdType n = pd.GetNumberOfPoints();
   kept.reserve(static_cast<std::size_t>(n));
-  for (vtkIdType i = 0; i < n; ++i) {
-    const double c = pd.GetPoint(i)[axis];
-    if (keep_below ? c <= value : c >= value) kept.push_back(i);
-  }
+  for (vtkIdType i = 0; i < n; ++i)
+    if (plane.keeps(pd.GetPoint(i)[plane.axis])) kept.push_back(i);
   return kept;
 }
 

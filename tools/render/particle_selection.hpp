@@ -10,6 +10,16 @@
 
 namespace basalt::view {
 
+/// The cut plane of a frame: axis, where it sits (cut.value or the middle of the particles' bounding
+/// box) and which side is kept (the far side as seen from `view`, so the cut face looks at the camera).
+struct CutPlane {
+  int axis = 0;
+  double value = 0;
+  bool keep_below = true;
+  bool keeps(double coordinate) const { return keep_below ? coordinate <= value : coordinate >= value; }
+};
+CutPlane cut_plane(vtkPolyData& pd, const Cut& cut, const ViewDirection& view);
+
 /// Indices of the particles on the far side of the cut plane as seen from `view` (so the cut face
 /// looks at the camera); the plane sits at cut.value or the middle of the bounding box.
 std::vector<vtkIdType> cut_indices(vtkPolyData& pd, const Cut& cut, const ViewDirection& view);

@@ -60,6 +60,20 @@ int main(int argc, char** argv) {
       "--all", draw_all,
       "draw every particle, also those buried inside the packing (slower; same picture up to a few "
       "pixels)");
+  bool cracks = false, no_cracks = false, only_cracks = false;
+  auto* cracks_flag = render->add_flag(
+      "--cracks", cracks,
+      "draw broken bonds, one yellow point each where it broke, over the particles (default when a "
+      "checkpoint has broken bonds)");
+  auto* no_cracks_flag = render->add_flag("--no-cracks", no_cracks, "do not draw broken bonds");
+  auto* only_cracks_flag =
+      render->add_flag("--only-cracks", only_cracks, "draw the broken bonds alone, without the particles");
+  cracks_flag->excludes(no_cracks_flag)->excludes(only_cracks_flag);
+  no_cracks_flag->excludes(only_cracks_flag);
+  double crack_radius = 0;
+  auto* crack_radius_opt =
+      render->add_option("--crack-radius", crack_radius,
+                         "radius of a broken bond's point (default: 0.3 x the mean particle radius)");
   render->add_flag("-q,--quiet", r.quiet, "print nothing on success");
 
   bv::MovieOptions m;
@@ -125,6 +139,11 @@ int main(int argc, char** argv) {
       if (!reference.empty()) r.reference = reference;
       r.color = color;
       r.cull = !draw_all;
+      r.cracks = cracks        ? bv::Cracks::on
+                 : no_cracks   ? bv::Cracks::off
+                 : only_cracks ? bv::Cracks::only
+                               : bv::Cracks::automatic;
+      if (crack_radius_opt->count() > 0) r.crack_radius = crack_radius;
       bv::ensure_display();
       bv::render(r);
     } else if (movie->parsed()) {

@@ -4,6 +4,7 @@
 #include <vtkDoubleArray.h>
 #include <vtkPointData.h>
 
+#include <cmath>
 #include <system_error>
 
 #include "basalt/io/vtk_polydata.hpp"
@@ -60,6 +61,7 @@ void add_damage(vtkPolyData& pd) {
 
 ParticleSet from_checkpoint(io::Checkpoint c) {
   ParticleSet s;
+  s.cracks = crack_points(c, s.cracks_estimated);
   const std::vector<double>* initial = nullptr;
   const std::vector<double>* broken = nullptr;
   for (const auto& [name, values] : c.particle_fields) {
@@ -100,6 +102,29 @@ ParticleSet read_any(const fs::path& file) {
 
 }  // namespace
 
+std::vector<io::Vec3> crack_points(const io::Checkpoint& c, std::size_t& estimated) {
+  const auto& g = c.geometry;
+  std::vector<io::Vec3> out;
+  estimated = 0;
+  for (std::size_t k = 0, nb = 0; k < g.bonds.size() && k < c.bond_broken.size(); ++k) {
+    if (c.bond_broken[k] == 0) continue;
+    const std::size_t row = nb++;
+    if (row < c.bond_break_position.size() && std::isfinite(c.bond_break_position[row][0])) {
+      out.push_back(c.bond_break_position[row]);
+      continue;
+    }
+    const auto ia = g.index_of(g.bonds[k].a), ib = g.index_of(g.bonds[k].b);
+    if (ia < 0 || ib < 0) continue;  // the checkpoint's validation refuses this
+    const auto& xa = g.position[static_cast<std::size_t>(ia)];
+    const auto& xb = g.position[static_cast<std::size_t>(ib)];
+    const double ra = g.radius[static_cast<std::size_t>(ia)], rb = g.radius[static_cast<std::size_t>(ib)];
+    const double w = ra + rb > 0 ? ra / (ra + rb) : 0.5;
+    out.push_back({xa[0] + w * (xb[0] - xa[0]), xa[1] + w * (xb[1] - xa[1]), xa[2] + w * (xb[2] - xa[2])});
+    ++estimated;
+  }
+  return out;
+}
+
 ParticleSet read_particles(const fs::path& file, const std::optional<fs::path>& reference) {
   ParticleSet s = read_any(file);
   if (reference) {
@@ -115,7 +140,7 @@ Frame read_frame(const fs::path& file, const std::optional<fs::path>& reference)
       throw io::FormatError(file, "", "--reference applies to checkpoints and geometries, not to VTK files");
     auto pd = io::read_polydata(file);
     add_damage(*pd);
-    return {pd, io::info_of(*pd), "VTK frame"};
+    return {pd, io::info_of(*pd), "VTK frame", {}, 0};
   }
   const ParticleSet s = read_particles(file, reference);
   auto pd = io::to_polydata(s.arrays(), s.info);
@@ -126,7 +151,7 @@ Frame read_frame(const fs::path& file, const std::optional<fs::path>& reference)
     for (std::size_t i = 0; i < s.damage.size(); ++i) arr->SetValue(static_cast<vtkIdType>(i), s.damage[i]);
     pd->GetPointData()->AddArray(arr);
   }
-  return {pd, s.info, s.kind};
+  return {pd, s.info, s.kind, s.cracks, s.cracks_estimated};
 }
 
 }  // namespace basalt::view

@@ -24,6 +24,9 @@ struct ParticleSet {
   /// Bond damage (broken / initial bonds of each particle) of a checkpoint whose scene has breakable bonds
   /// (its bonds_initial and bonds_broken fields); empty otherwise.
   std::vector<double> damage;
+  /// A checkpoint's broken bonds, one point each where it broke (crack_points()); empty otherwise.
+  std::vector<io::Vec3> cracks;
+  std::size_t cracks_estimated = 0;  ///< of them, placed from the ends' current positions (no record)
   io::FrameInfo info;
   std::string kind;  ///< "checkpoint" or "geometry"
 
@@ -35,10 +38,19 @@ struct ParticleSet {
 ParticleSet read_particles(const std::filesystem::path& file,
                            const std::optional<std::filesystem::path>& reference);
 
+/// Where each broken bond of a checkpoint broke, one point per bond whose /bonds/broken is not 0, in bond
+/// order: its recorded break position (/bonds/break_position: the point between the two spheres on their
+/// line of centres, r1 / (r1 + r2) of the way from the first, at the step it broke), or, for a checkpoint
+/// without it (or a row of NaN), the same point from the two ends' positions in this checkpoint, counted
+/// in `estimated`.
+std::vector<io::Vec3> crack_points(const io::Checkpoint& c, std::size_t& estimated);
+
 struct Frame {
   vtkSmartPointer<vtkPolyData> polydata;
   io::FrameInfo info;
-  std::string kind;  ///< "checkpoint", "geometry" or "VTK frame"
+  std::string kind;              ///< "checkpoint", "geometry" or "VTK frame"
+  std::vector<io::Vec3> cracks;  ///< broken bonds (checkpoints)
+  std::size_t cracks_estimated = 0;
 };
 
 /// Any file basalt-view reads, as polydata (.vtp/.pvtp through VTK's readers).

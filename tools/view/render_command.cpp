@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <set>
 #include <stdexcept>
 #include <utility>
@@ -33,6 +34,8 @@ DrawOptions draw_options(const RenderOptions& o) {
   d.view = o.view;
   d.mapper = o.mapper;
   d.cull = o.cull;
+  d.cracks = o.cracks;
+  d.crack_radius = o.crack_radius;
   return d;
 }
 
@@ -40,7 +43,8 @@ DrawOptions draw_options(const RenderOptions& o) {
 Prepared prepare(const fs::path& input, const RenderOptions& o) {
   const auto t0 = Clock::now();
   Frame frame = read_frame(input, o.reference);
-  Prepared p = prepare(frame.polydata, frame.info, frame.kind, input, draw_options(o));
+  Prepared p = prepare(frame.polydata, frame.info, frame.kind, input, draw_options(o), frame.cracks);
+  if (p.cracks) p.cracks_estimated = frame.cracks_estimated;
   p.read_s = seconds_since(t0);
   return p;
 }
@@ -49,6 +53,26 @@ void check_options(const RenderOptions& o) {
   if (o.inputs.empty()) throw std::invalid_argument("nothing to render: give at least one file");
   if (o.mapper != "imposter" && o.mapper != "glyph")
     throw std::invalid_argument(fmt::format("--mapper \"{}\": expected imposter or glyph", o.mapper));
+  if (o.crack_radius && !(*o.crack_radius > 0 && std::isfinite(*o.crack_radius)))
+    throw std::invalid_argument(fmt::format("--crack-radius {}: expected a length > 0", *o.crack_radius));
+}
+
+/// "; 1234 broken bonds, 600 drawn" for the summary line (nothing when cracks are not drawn).
+std::string crack_text(const std::vector<Prepared>& frames) {
+  std::size_t total = 0, shown = 0, estimated = 0;
+  bool any = false;
+  for (const auto& f : frames) {
+    any = any || f.cracks;
+    total += f.cracks_total;
+    shown += f.cracks_shown;
+    estimated += f.cracks_estimated;
+  }
+  if (!any) return {};
+  std::string s = fmt::format("; {} broken bonds, {} drawn", total, shown);
+  if (estimated > 0)
+    s += fmt::format(" ({} without a recorded break position: at their ends' current contact point)",
+                     estimated);
+  return s;
 }
 
 bool is_folder_output(const fs::path& out) {
@@ -178,7 +202,7 @@ void render(const RenderOptions& o) {
   for (const auto& f : frames) {
     ptrs.push_back(&f);
     read_s += f.read_s;
-    drawn += f.shown->GetNumberOfPoints();
+    drawn += f.only_cracks ? 0 : f.shown->GetNumberOfPoints();  // --only-cracks draws no particle
   }
   const auto t1 = Clock::now();
   painter.draw(ptrs, scale);
@@ -188,14 +212,14 @@ void render(const RenderOptions& o) {
   const Prepared& f = frames.front();
   if (panels == 1)
     fmt::print(
-        "wrote {} ({}x{}, {} particles, {} in view, {} drawn, coloured by {}, {}; read {:.2f} s, draw {:.2f} "
-        "s)\n",
+        "wrote {} ({}x{}, {} particles, {} in view, {} drawn, coloured by {}, {}{}; read {:.2f} s, draw "
+        "{:.2f} s)\n",
         o.output.string(), size.width, size.height, f.total, f.in_view, drawn, f.field, scale_text(scale),
-        read_s, draw_s);
+        crack_text(frames), read_s, draw_s);
   else
-    fmt::print("wrote {} ({}x{}, {} panels, {} drawn, coloured by {}, {}; read {:.2f} s, draw {:.2f} s)\n",
-               o.output.string(), size.width, size.height, panels, drawn, f.field, scale_text(scale), read_s,
-               draw_s);
+    fmt::print("wrote {} ({}x{}, {} panels, {} drawn, coloured by {}, {}{}; read {:.2f} s, draw {:.2f} s)\n",
+               o.output.string(), size.width, size.height, panels, drawn, f.field, scale_text(scale),
+               crack_text(frames), read_s, draw_s);
 }
 
 void movie(const MovieOptions& m) {

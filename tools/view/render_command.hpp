@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "options.hpp"
+#include "painter.hpp"
 
 namespace basalt::view {
 
@@ -22,8 +23,10 @@ struct RenderOptions {
   std::optional<Cut> cut;
   std::optional<Range> range;  ///< default: 1st-99th percentile of the particles the cut keeps, all inputs
   std::optional<std::filesystem::path> reference;
-  std::string mapper = "imposter";  ///< "imposter" (GPU ray-cast spheres) or "glyph" (triangulated spheres)
-  bool cull = true;                 ///< skip particles buried inside the packing (hidden behind others)
+  std::string mapper = "imposter";    ///< "imposter" (GPU ray-cast spheres) or "glyph" (triangulated spheres)
+  bool cull = true;                   ///< skip particles buried inside the packing (hidden behind others)
+  Cracks cracks = Cracks::automatic;  ///< broken bonds: drawn by default when a checkpoint has any
+  std::optional<double> crack_radius;
   bool quiet = false;
 };
 

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <limits>
 #include <numeric>
 #include <stdexcept>
 #include <tuple>
@@ -80,6 +81,7 @@ void FramePiece::clear() {
   bonds.clear();
   bond_rest_length.clear();
   bond_broken.clear();
+  bond_break_position.clear();
   contact_ids.clear();
   contact_model.clear();
   contact_history.clear();
@@ -100,6 +102,10 @@ FrameHeader PieceSource::header() const {
   const std::size_t m = p_.bonds.size();
   if (p_.bond_rest_length.size() != m || p_.bond_broken.size() != m)
     throw std::invalid_argument("frame piece: bond arrays differ in length");
+  const auto broken = static_cast<std::size_t>(
+      std::count_if(p_.bond_broken.begin(), p_.bond_broken.end(), [](std::uint8_t f) { return f != 0; }));
+  if (!p_.bond_break_position.empty() && p_.bond_break_position.size() != broken)
+    throw std::invalid_argument("frame piece: break positions differ in number from the broken bonds");
   const std::size_t nc = p_.contact_ids.size();
   if (p_.contact_model.size() != nc || p_.contact_history.size() != nc * p_.contact_width)
     throw std::invalid_argument("frame piece: contact arrays differ in length");
@@ -116,6 +122,7 @@ FrameHeader PieceSource::header() const {
   h.contacts = nc;
   h.contact_width = static_cast<std::uint32_t>(p_.contact_width);
   h.fields = p_.fields.size();
+  h.breaks = p_.bond_break_position.size();
   h.inverse_mass = !p_.inv_mass.empty();
   h.with_rebuild = !p_.position_at_rebuild.empty();
   h.rebuild_step = p_.rebuild_step;
@@ -147,6 +154,12 @@ void PieceSource::write(FrameWriter& w) const {
   }
   w.column(Column::bond_rest_length, p_.bond_rest_length);
   w.column(Column::bond_broken, p_.bond_broken);
+  const std::size_t nb = p_.bond_break_position.size();
+  std::vector<double> b(nb);
+  for (std::size_t d = 0; d < 3; ++d) {
+    for (std::size_t k = 0; k < nb; ++k) b[k] = p_.bond_break_position[k][d];
+    w.column(static_cast<Column>(static_cast<int>(Column::break_x) + d), b);
+  }
   for (std::size_t k = 0; k < p_.contact_ids.size(); ++k) {
     w.set(Column::contact_a, k, p_.contact_ids[k][0]);
     w.set(Column::contact_b, k, p_.contact_ids[k][1]);
@@ -237,6 +250,12 @@ FramePiece deserialize(std::span<const std::byte> bytes) {
                   col.at<std::int32_t>(Column::bond_group, k)};
   col.all(Column::bond_rest_length, p.bond_rest_length);
   col.all(Column::bond_broken, p.bond_broken);
+  col.vec3(Column::break_x, p.bond_break_position);
+  if (!p.bond_break_position.empty() &&
+      p.bond_break_position.size() !=
+          static_cast<std::size_t>(std::count_if(p.bond_broken.begin(), p.bond_broken.end(),
+                                                 [](std::uint8_t f) { return f != 0; })))
+    throw std::runtime_error("frame: break positions differ in number from the broken bonds");
   p.contact_ids.resize(h.contacts);
   for (std::size_t k = 0; k < h.contacts; ++k)
     p.contact_ids[k] = {col.at<std::int64_t>(Column::contact_a, k),
@@ -386,14 +405,20 @@ Checkpoint assemble(std::vector<FramePiece>& pieces, const RunInfo& run) {
     Bond b;
     double rest;
     std::uint8_t broken;
+    Vec3 at;  ///< where a broken bond broke (NaN: not known)
   };
+  const bool with_breaks = std::any_of(pieces.begin(), pieces.end(),
+                                       [](const FramePiece& p) { return !p.bond_break_position.empty(); });
+  constexpr double nan = std::numeric_limits<double>::quiet_NaN();
   std::vector<BondRow> bonds;
   bonds.reserve(m);
   for (const auto& p : pieces)
-    for (std::size_t k = 0; k < p.bonds.size(); ++k) {
+    for (std::size_t k = 0, nb = 0; k < p.bonds.size(); ++k) {
       Bond b = p.bonds[k];
       if (b.a > b.b) std::swap(b.a, b.b);
-      bonds.push_back({b, p.bond_rest_length[k], p.bond_broken[k]});
+      Vec3 at{nan, nan, nan};
+      if (p.bond_broken[k] != 0 && !p.bond_break_position.empty()) at = p.bond_break_position[nb++];
+      bonds.push_back({b, p.bond_rest_length[k], p.bond_broken[k], at});
     }
   std::sort(bonds.begin(), bonds.end(), [](const BondRow& x, const BondRow& y) {
     return std::tie(x.b.a, x.b.b) < std::tie(y.b.a, y.b.b);
@@ -405,6 +430,7 @@ Checkpoint assemble(std::vector<FramePiece>& pieces, const RunInfo& run) {
     g.bonds.push_back(row.b);
     c.bond_rest_length.push_back(row.rest);
     c.bond_broken.push_back(row.broken);
+    if (with_breaks && row.broken != 0) c.bond_break_position.push_back(row.at);
   }
 
   // Contacts sorted by (model, pair), whatever rank listed them.

@@ -45,6 +45,12 @@ struct Checkpoint {
   /// 0 intact; 1 broken (broken bonds are kept so ids stay stable); 2 broke at this very step; a broken
   /// bond adds 4 x its failure mode (0 tension, 1 shear, 2 bending, 3 torsion)
   std::vector<std::uint8_t> bond_broken;
+  /// Optional (/bonds/break_position, float64 (B, 3)): where each broken bond broke, one row per bond
+  /// whose bond_broken is not 0, in bond order: the point between the two spheres on their line of
+  /// centres at the step it broke (r1 / (r1 + r2) of the way from the first; the midpoint for equal
+  /// radii), as the solver's break record holds it. A row of NaN: not known (the bond broke in a run
+  /// restarted from a checkpoint without break positions). Empty: none known.
+  std::vector<Vec3> bond_break_position;
 
   std::vector<WallState> walls;
 

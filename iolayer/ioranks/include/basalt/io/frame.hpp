@@ -43,6 +43,8 @@ struct FramePiece {
   std::vector<Bond> bonds;
   std::vector<double> bond_rest_length;
   std::vector<std::uint8_t> bond_broken;
+  /// Empty, or where each broken bond (bond_broken != 0) broke, in bond order (NaN: not known).
+  std::vector<Vec3> bond_break_position;
 
   // Contact history this rank is responsible for (each contact in exactly one piece).
   std::vector<std::array<std::int64_t, 2>> contact_ids;

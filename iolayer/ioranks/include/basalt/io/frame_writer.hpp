@@ -39,6 +39,9 @@ struct FrameHeader {
   std::uint64_t contacts = 0;       ///< length of the contact columns (contacts with a history)
   std::uint32_t contact_width = 0;  ///< float64 values of history per contact
   std::uint64_t fields = 0;         ///< optional particle fields after the walls (FrameWriter::field)
+  /// Length of the break-position columns: 0, or one row per broken bond (bond_broken != 0) in the
+  /// order of the bond columns (Checkpoint::bond_break_position).
+  std::uint64_t breaks = 0;
   /// true: Column::mass holds 1 / mass as the solver holds it (the reader derives the mass, and a
   /// restart gets the same bits); false: it holds the mass and there is no inverse mass.
   bool inverse_mass = true;
@@ -74,12 +77,15 @@ enum class Column : std::uint8_t {
   contact_b,
   contact_model,    ///< index of the pair model (among those with history)
   contact_history,  ///< contact_width values per contact
+  break_x,          ///< where the broken bonds broke (header.breaks rows)
+  break_y,
+  break_z,
 };
-inline constexpr std::size_t kColumns = static_cast<std::size_t>(Column::contact_history) + 1;
+inline constexpr std::size_t kColumns = static_cast<std::size_t>(Column::break_z) + 1;
 
 namespace wire {
 
-inline constexpr std::uint64_t kFrameMagic = 0x42534c5446524d35ULL;  // "BSLTFRM5"
+inline constexpr std::uint64_t kFrameMagic = 0x42534c5446524d36ULL;  // "BSLTFRM6"
 
 /// The header as it travels (all fields 8-byte slots: no padding).
 struct Header {
@@ -96,8 +102,9 @@ struct Header {
   std::uint64_t contacts = 0;
   std::uint64_t contact_width = 0;
   std::uint64_t fields = 0;
+  std::uint64_t breaks = 0;
 };
-static_assert(sizeof(Header) == 88 && std::is_trivially_copyable_v<Header>);
+static_assert(sizeof(Header) == 96 && std::is_trivially_copyable_v<Header>);
 inline constexpr std::uint32_t kInverseMass = 1u << 0;
 inline constexpr std::uint32_t kWithRebuild = 1u << 1;
 
@@ -123,7 +130,8 @@ constexpr Type type_of(Column c) {
 }
 constexpr std::size_t size_of(Type t) { return t == Type::u8 ? 1 : t == Type::i32 ? 4 : 8; }
 constexpr bool is_bond(Column c) { return c >= Column::bond_a && c <= Column::bond_broken; }
-constexpr bool is_contact(Column c) { return c >= Column::contact_a; }
+constexpr bool is_contact(Column c) { return c >= Column::contact_a && c <= Column::contact_history; }
+constexpr bool is_break(Column c) { return c >= Column::break_x; }
 constexpr bool is_rebuild(Column c) { return c >= Column::x_rebuild && c <= Column::z_rebuild; }
 constexpr std::size_t align8(std::size_t n) { return (n + 7) & ~std::size_t(7); }
 
@@ -137,7 +145,8 @@ struct Layout {
   explicit Layout(const Header& h) {
     // A frame never comes near 2^40 entries; larger counts are a damaged buffer.
     constexpr std::uint64_t kMax = std::uint64_t(1) << 40;
-    if (h.particles > kMax || h.bonds > kMax || h.contacts > kMax || h.contact_width > 64)
+    if (h.particles > kMax || h.bonds > kMax || h.contacts > kMax || h.contact_width > 64 ||
+        h.breaks > h.bonds)
       throw std::runtime_error("frame: impossible particle, bond or contact count");
     std::size_t at = sizeof(Header);
     for (std::size_t k = 0; k < kColumns; ++k) {
@@ -145,6 +154,7 @@ struct Layout {
       const bool present = !is_rebuild(c) || (h.flags & kWithRebuild);
       length[k] = !present                       ? 0
                   : is_bond(c)                   ? h.bonds
+                  : is_break(c)                  ? h.breaks
                   : c == Column::contact_history ? h.contacts * h.contact_width
                   : is_contact(c)                ? h.contacts
                                                  : h.particles;
@@ -251,6 +261,7 @@ class FrameWriter {
     wire_.contacts = h.contacts;
     wire_.contact_width = h.contact_width;
     wire_.fields = h.fields;
+    wire_.breaks = h.breaks;
     wire_.flags = (h.inverse_mass ? wire::kInverseMass : 0u) | (h.with_rebuild ? wire::kWithRebuild : 0u);
     wire_.rebuild_pending = h.rebuild_pending ? 1u : 0u;
     wire_.rebuild_step = h.rebuild_step;
