@@ -5,6 +5,7 @@
     basalt-run scenes/ucs-esys.toml --output out/ucs-esys
     /usr/bin/python3 tools/esys/compare_ucs.py out/ucs-esys [--esys docs/data/esys-ucs/ucs_base.csv]
         [--perturbed docs/data/esys-ucs/ucs_perturbed.csv] [--plot docs/img/ucs_esys.png]
+    (--basalt-run build/bin/basalt-run runs the scene into that folder first: the ctest solver_esys_ucs)
 
 Platen force F = the mean of the two walls' axial forces (ESyS's wall "Force" saver points the other way
 from Basalt's wall_force). Basalt's row of step n holds the forces ESyS computes in its step n + 1 (both
@@ -15,8 +16,8 @@ Checks (exit 1 when one fails):
   - the peak force within 5 %, and the broken bonds (initial count - bond_count) at the peak within 10 %.
 The peak checks need an ESyS series that passes its peak (F falls below 90 % of its maximum afterwards);
 on a series that stops before, they are reported as not available and the exit status is 2 when nothing
-failed. The same numbers for ESyS against its run with one particle moved by 1e-12 (--perturbed) show
-what the chaos of fracture alone does.
+failed. The same numbers for ESyS against its run with one particle moved by 1e-12 (--perturbed), or for
+Basalt against its own such run (--basalt-perturbed), show what the chaos of fracture alone does.
 """
 
 import argparse
@@ -81,7 +82,10 @@ def compare(ref, other, shift, floor, tol, label):
     # The window: up to half of the reference's peak; while the reference stops before its peak, up to half
     # of the compared run's (complete) peak, or the reference's end.
     fwin = fp if passed else (fo if passed_o else fp)
-    half = min((s for s in sorted(ref) if ref[s][0] >= 0.5 * fwin), default=max(ref))
+    half = min((s for s in sorted(ref) if ref[s][0] >= 0.5 * fwin), default=None)
+    if half is None:
+        print(f"{label}: the reference ends at step {max(ref)} below half of the peak: the window stops there")
+        half = max(ref)
     initial = ref[min(ref)][1]
     worst, where, n = 0.0, None, 0
     for s in sorted(other):
@@ -123,10 +127,20 @@ def main():
     ap.add_argument("run_dir", help="Basalt's output directory (fields.csv)")
     ap.add_argument("--esys", default=os.path.join(DATA, "ucs_base.csv"))
     ap.add_argument("--perturbed", default=os.path.join(DATA, "ucs_perturbed.csv"))
+    ap.add_argument("--basalt-perturbed", default="",
+                    help="a Basalt run of the scene with one particle moved by 1e-12: Basalt against itself")
+    ap.add_argument("--basalt-run", default="", help="run scenes/ucs-esys.toml with this binary into RUN_DIR first")
     ap.add_argument("--floor", type=float, default=0.05)
     ap.add_argument("--force-tol", type=float, default=0.01)
     ap.add_argument("--plot", default="")
     args = ap.parse_args()
+    if args.basalt_run:
+        import subprocess
+        scene = os.path.join(HERE, "..", "..", "scenes", "ucs-esys.toml")
+        cmd = [args.basalt_run, scene, "--output", args.run_dir, "--quiet"]
+        if subprocess.call(cmd) != 0:
+            print("FAIL: " + " ".join(cmd) + " exited non-zero")
+            return 1
     try:
         ref = esys_series(args.esys)
         mine = basalt_series(args.run_dir)
@@ -142,6 +156,9 @@ def main():
     if os.path.exists(args.perturbed):
         pert = esys_series(args.perturbed)
         compare(ref, pert, 0, args.floor, args.force_tol, "ESyS perturbed 1e-12 vs ESyS")
+    if args.basalt_perturbed:
+        compare(mine, basalt_series(args.basalt_perturbed), 0, args.floor, args.force_tol,
+                "Basalt perturbed 1e-12 vs Basalt")
     last = min(max(ref) - 1, max(mine))
     for s in (1000, 2000, 5000, 10000, 15000, 20000, last):
         e = at(ref, s + 1)
