@@ -186,6 +186,11 @@ def main():
         if pert:
             ax[1].semilogy(ps, [abs(pert[s][0] / ref[s][0] - 1) + 1e-12 if s in ref and ref[s][0] > 0 else None
                                 for s in ps], ":", label="ESyS perturbed vs ESyS")
+        if args.basalt_perturbed:
+            bp = basalt_series(args.basalt_perturbed)
+            qs = [s for s in ms if s in bp and mine[s][0] > 0]
+            ax[1].semilogy(qs, [abs(bp[s][0] / mine[s][0] - 1) + 1e-12 for s in qs], ":",
+                           label="Basalt, one particle moved by 1e-12, vs Basalt")
         ax[1].set_ylabel("relative difference of F")
         ax[1].set_xlabel("step")
         ax[1].legend()
