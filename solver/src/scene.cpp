@@ -54,7 +54,10 @@ WallMotion parse_motion(TableReader& t, const std::array<double, 3>& normal) {
     m.velocity = t.vec3("velocity");
     m.ramp_time = t.non_negative("ramp_time");
     m.start_time = t.number_or("start_time", 0.0);
-    if (!std::isfinite(m.start_time) || m.start_time < 0) t.fail("start_time", "must be >= 0 and finite");
+    // A negative t0 (at most ramp_time before the start) puts the run's start inside the ramp: ESyS's
+    // WallLoaderRunnable, a pre-time-step runnable, is matched by t0 = -dt/2 (docs/scenes.md).
+    if (!std::isfinite(m.start_time) || m.start_time < -m.ramp_time)
+      t.fail("start_time", "must be finite and >= -ramp_time");
   } else if (type == "servo") {
     m.type = WallMotion::Type::servo;
     const bool force = t.has("target_force"), stress = t.has("target_stress");

@@ -520,3 +520,64 @@ rest_length = "sum_of_radii"
     }
   }
 }
+
+TEST(RotBondEsys, BrokenPairIsAFrictionContactFromTheNextStep) {
+  // tools/esys/probe_ucs.py, case break_contact (ESyS-Particle 2.3.5, docs/reference-runs.md): two heavy
+  // spheres (m = 1e6) bonded at 0.89 < r1 + r2 = 0.9, BrittleBeam E = 1000, nu = 0.25, c = 1, tan phi = 1,
+  // FrictionPrms(E = 1000, nu = 0.25, mu 0.4/0.6) excluded against the bond, sphere 2 spinning about the bond
+  // at 1 rad/ms. ESyS: the bond's force acts last in its step 63 (the torsion of the state after step 62
+  // meets the criterion), and from step 64 the pair feels the friction contact -7.06856355 on sphere 1.
+  // Basalt computes the forces of ESyS's step n + 1 at the end of its step n.
+  const double pi = std::numbers::pi;
+  const auto scene = basalt::test::scene_from(fmt::format(R"(
+[particles]
+rotation = true
+[run]
+dt = 1e-3
+steps = 0
+skin = 0.05
+integrator = "symplectic_euler"
+[[interactions]]
+type = "rot_bond"
+youngs_modulus = 1000.0
+poissons_ratio = 0.25
+cohesion = 1.0
+tan_friction_angle = 1.0
+rest_length = "sum_of_radii"
+[[interactions]]
+type = "rot_friction"
+K = {:.17g}
+Ks = {:.17g}
+mu = 0.6
+mu_dynamic = 0.4
+scaling = true
+convention = "esys"
+)",
+                                                          pi * 1000.0, pi * 1000.0 / 2.5));
+  Geometry g;
+  g.add_particle(1, {0, 0, 0}, 0.5);
+  g.add_particle(2, {0.89, 0, 0}, 0.4);
+  g.mass = {1e6, 1e6};
+  g.add_bond(1, 2);
+  g.sort_by_id();
+  Simulation<double> sim(scene, g, MPI_COMM_SELF);
+  auto& p = sim.particles();
+  const auto a = index_of(p, 1), b = index_of(p, 2);
+  p.wx[b] = 1.0;
+  sim.state_changed();
+  const double kn = pi * 1000.0 * 0.445 * 0.445 / 0.89;
+  EXPECT_NEAR(p.fx[a], kn * (0.89 - 0.9), 1e-9);  // ESyS step 1: -6.99004365
+  std::vector<double> fx{p.fx[a]};
+  for (int n = 1; n <= 100; ++n) {
+    sim.step();
+    fx.push_back(p.fx[a]);
+  }
+  ASSERT_EQ(sim.broken_bonds().size(), 1u);
+  EXPECT_EQ(sim.broken_bonds()[0].step, 62);  // its loads are ESyS's step 63
+  EXPECT_EQ(sim.broken_bonds()[0].mode, std::uint8_t(BondFailure::torsion));
+  // The bond's force acts through Basalt's step 62, the contact's from step 63 (ESyS 64) on.
+  EXPECT_NEAR(fx[62], -6.99004, 1e-4);
+  EXPECT_NEAR(fx[63], -7.06856355, 1e-7);  // ESyS prints 9 digits
+  const double overlap = 0.9 - (p.x[b] - p.x[a]);
+  EXPECT_NEAR(fx[100], -pi * 1000.0 * 0.9 / 4 * overlap, 1e-9);  // still the contact at the end
+}

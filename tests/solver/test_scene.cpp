@@ -119,6 +119,9 @@ TEST(Scene, ImpossibleValues) {
   msg = with("normal = [0, 0, 2]", "normal = [0, 0, 0]");
   EXPECT_NE(msg.find("walls[0].normal: must have non-zero length"), std::string::npos) << msg;
   EXPECT_NE(msg.find("test.toml:16"), std::string::npos) << msg;
+  msg = with("motion = { type = \"half_sine\", amplitude = 0.1, period = 1.0 }",
+             "motion = { type = \"ramp\", velocity = [0, 0, 1], ramp_time = 0.1, start_time = -0.2 }");
+  EXPECT_NE(msg.find("start_time: must be finite and >= -ramp_time"), std::string::npos) << msg;
   msg = with("period = 1.0", "period = 0.0");
   EXPECT_NE(msg.find("walls[0].motion.period"), std::string::npos) << msg;
   msg = with("type = \"half_sine\"", "type = \"half-sine\"");

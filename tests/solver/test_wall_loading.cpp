@@ -79,23 +79,25 @@ TEST(RampMotion, PositionIsTheExactIntegralOfTheRampedSpeed) {
 }
 
 TEST(RampMotion, RampMatchesESySWallLoader) {
-  // ESyS's WallLoaderRunnable (pre-time-step, Nt counting its calls from 0) moves the wall by
-  // f V dt with f = Nt / rampTime while Nt < rampTime, then 1: after n steps the forces see
-  // V dt sum_{k<n} min(k / R, 1). Basalt's ramp with ramp_time = R dt and start_time = dt / 2 gives
-  // exactly that after the ramp, and V dt / (8 R) more during it.
+  // ESyS's WallLoaderRunnable (pre-time-step, Nt counting its calls from 0) moves the wall by f V dt with
+  // f = Nt / rampTime while Nt < rampTime, then 1, before the forces of the step: the forces of ESyS's step
+  // n + 1, computed from the particles after step n, see V dt sum_{k<=n} min(k / R, 1)
+  // (tools/esys/probe_ucs.py, wall_loader). Basalt computes those forces at the end of its step n, with the
+  // wall at time n dt: a ramp with ramp_time = R dt and start_time = -dt / 2 is exactly there after the
+  // ramp, and V dt / (8 R) further during it. (start_time = +dt / 2 would lag a whole step, V dt.)
   const double dt = 5e-5, V = 0.03;
   const int R = 2000;
   WallMotion m;
   m.type = WallMotion::Type::ramp;
   m.velocity = {0, 0, V};
   m.ramp_time = R * dt;
-  m.start_time = dt / 2;
-  double esys = 0;
-  for (int n = 1; n <= 3 * R; ++n) {
-    esys += V * dt * std::min(double(n - 1) / R, 1.0);
+  m.start_time = -dt / 2;
+  double esys = 0;  // the wall the forces of ESyS's step n + 1 see
+  for (int n = 0; n <= 3 * R; ++n) {
+    esys += V * dt * std::min(double(n) / R, 1.0);
     const double ours = m.displacement_at(n * dt)[2];
-    const double expected = n <= R ? esys + V * dt / (8.0 * R) : esys;
-    ASSERT_NEAR(ours, expected, 1e-12 * V * dt * n) << "step " << n;
+    const double expected = n < R ? esys + V * dt / (8.0 * R) : esys;
+    ASSERT_NEAR(ours, expected, 1e-12 * V * dt * (n + 1)) << "step " << n;
   }
 }
 

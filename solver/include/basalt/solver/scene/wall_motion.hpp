@@ -40,7 +40,7 @@ struct WallMotion {
   double amplitude = 0;
   double period = 1;
   double ramp_time = 0;   ///< ramp: T_r, the time from rest to the full velocity (0: a step)
-  double start_time = 0;  ///< ramp: t0, the wall rests before it
+  double start_time = 0;  ///< ramp: t0, the wall rests before it (>= -ramp_time: may precede the start)
   ServoControl servo;     ///< servo only
 
   /// ramp: the fraction of the full velocity at time t, and its integral from 0 to t.
