@@ -613,3 +613,57 @@ void coincident_restart() {
 }
 TEST(Coincident, RefusedAtARestart) { coincident_restart<double>(); }
 TEST(Coincident, RefusedAtARestartFloat) { coincident_restart<float>(); }
+
+// ---------------------------------------------------------------------------------------------------
+// Energy drift of a closed bonded block: cube1.geo's 48 particles in [0, 2.5)^3, bonds alone, random
+// velocities of 0.05, dt = 1e-3 (0.17 x critical), 1e5 steps on rank 0 (tools/bench/energy_drift.sh runs
+// 1e7: docs/stability.md). Measured (mean of the last tenth against the first): double -2.4e-5, float
+// 3.0e-3 (position increments v dt ~ 5e-5 rounded at |x| ~ 2); asserted with margins of 8 and 3.
+template <class Real>
+void short_drift(double bound) {
+  if (basalt::test::rank() != 0) return;
+  const auto full = basalt::io::read_geometry(basalt::test::reference_dir() / "cube1.geo");
+  const auto block = basalt::test::sub_cube(full, -1.0, 2.5);
+  ASSERT_EQ(block.size(), 48u);
+  RunOptions opt;
+  opt.quiet = true;
+  Simulation<Real> sim(basalt::test::scene_from(R"([run]
+dt = 1e-3
+steps = 0
+skin = 0.05
+energy_check_every = 0
+[[interactions]]
+type = "linear_bond"
+K = 1000.0
+)"),
+                       block, MPI_COMM_SELF, opt);
+  auto& p = sim.particles();
+  for (std::size_t i = 0; i < p.n_owned; ++i) {
+    const auto id = static_cast<std::uint64_t>(p.id[i]);
+    p.vx[i] = Real(0.05 * basalt::test::hash_unit(3 * id));
+    p.vy[i] = Real(0.05 * basalt::test::hash_unit(3 * id + 1));
+    p.vz[i] = Real(0.05 * basalt::test::hash_unit(3 * id + 2));
+  }
+  sim.state_changed();
+  const double e0 = basalt::test::total_energy(sim);
+  std::vector<double> e;
+  double worst = 0;
+  for (int b = 0; b < 100; ++b) {
+    sim.run(1000);
+    e.push_back(basalt::test::total_energy(sim));
+    worst = std::max(worst, std::abs(e.back() - e0) / e0);
+  }
+  double first = 0, last = 0;
+  for (std::size_t k = 0; k < 10; ++k) {
+    first += e[k] / 10;
+    last += e[e.size() - 1 - k] / 10;
+  }
+  const double drift = (last - first) / e0;
+  std::printf("%s, 1e5 steps: energy drift (last tenth - first tenth) %.3g, max excursion %.3g\n",
+              sizeof(Real) == 8 ? "double" : "float", drift, worst);
+  EXPECT_LT(std::abs(drift), bound);
+  EXPECT_LT(worst, 3e-3 + 2 * bound) << "bounded oscillation (measured 1.0e-3 in double)";
+  EXPECT_GT(sim.energies()[1], 0.1 * e0) << "energy went through the bonds";
+}
+TEST(EnergyDrift, ClosedBondedBlockOver1e5Steps) { short_drift<double>(2e-4); }
+TEST(EnergyDrift, ClosedBondedBlockOver1e5StepsFloat) { short_drift<float>(1e-2); }

@@ -235,3 +235,23 @@ TEST(ExtremesDomain, OneParticleOnManyRanks) {
   EXPECT_NEAR(s.x[0][0], 1 - 0.5 * sim.time(), 1e-12);
   EXPECT_NEAR(s.x[0][2], 3 - 1.0 * sim.time(), 1e-12);
 }
+
+// Empty subdomains that would be thinner than the ghost width (a rank grid of 4 or 8 along one axis over one
+// particle) are refused, naming the region's width, the ghost width and the grid.
+TEST(ExtremesDomain, RegionsThinnerThanTheGhostWidthAreRefused) {
+  if (basalt::test::size() < 4) GTEST_SKIP() << "needs 3 or more ranks along an axis";
+  Geometry g;
+  g.add_particle(3, {1, 2, 3}, 0.5);
+  RunOptions opt;
+  opt.quiet = true;
+  opt.dims = {basalt::test::size(), 1, 1};
+  std::string msg;
+  try {
+    Simulation<double> sim(basalt::test::scene_from(kBlockScene), g, basalt::test::world(), opt);
+  } catch (const InputError& e) {
+    msg = e.what();
+  }
+  EXPECT_NE(msg.find("too many ranks for this geometry"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("less than the ghost width 1.1"), std::string::npos) << msg;
+  EXPECT_NE(msg.find(std::to_string(basalt::test::size()) + "x1x1"), std::string::npos) << msg;
+}
