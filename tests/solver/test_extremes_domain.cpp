@@ -95,23 +95,23 @@ K = 1000.0
 
 }  // namespace
 
-// A bonded block of cube1.geo (0-4 mm) drifting at (4, 4, 4) mm/ms for 1,000 steps: it leaves its initial
+// A bonded block of cube1.geo (0-3.2 mm) drifting at (8, 8, 8) mm/ms for 500 steps: it leaves its initial
 // box (the decomposition's) and ends wholly in the region of the rank at the grid's far corner, every
-// other rank empty. The kinetic energy every 50 steps and the final positions agree with the serial run
+// other rank empty. The kinetic energy every 25 steps and the final positions agree with the serial run
 // to 1e-9 (rounding: forces are summed in another order on several ranks).
 TEST(ExtremesDomain, BlockDriftsIntoOneSubdomain) {
   static const Geometry block = [] {
     const auto full = basalt::io::read_geometry(basalt::test::reference_dir() / "cube1.geo");
-    return basalt::test::sub_cube(full, 0.0, 4.0);
+    return basalt::test::sub_cube(full, 0.0, 3.2);
   }();
   const auto scene = basalt::test::scene_from(kBlockScene);
   const std::int64_t first = block.id.front();
   const std::size_t n = static_cast<std::size_t>(block.id.back() - first + 1);
   Trace ref;
   if (basalt::test::rank() == 0)
-    ref = trace<double>(scene, block, MPI_COMM_SELF, {4, 4, 4}, first, n, 20, 50);
+    ref = trace<double>(scene, block, MPI_COMM_SELF, {8, 8, 8}, first, n, 20, 25);
   broadcast(ref, n, 20);
-  const auto t = trace<double>(scene, block, basalt::test::world(), {4, 4, 4}, first, n, 20, 50);
+  const auto t = trace<double>(scene, block, basalt::test::world(), {8, 8, 8}, first, n, 20, 25);
   EXPECT_EQ(t.total, static_cast<std::int64_t>(block.size()));
   std::size_t owned = 0;
   for (std::size_t k = 0; k < n; ++k) {
@@ -120,7 +120,7 @@ TEST(ExtremesDomain, BlockDriftsIntoOneSubdomain) {
     ++owned;
     for (std::size_t c = 0; c < 3; ++c)
       EXPECT_NEAR(t.end.x[k][c], ref.end.x[k][c], 1e-9 * (1 + std::abs(ref.end.x[k][c])));
-    EXPECT_GT(t.end.x[k][0] - block.position[block.index_of(first + std::int64_t(k))][0], 3.5);
+    EXPECT_GT(t.end.x[k][0] - block.position[std::size_t(block.index_of(first + std::int64_t(k)))][0], 3.5);
   }
   EXPECT_EQ(owned, block.size());
   EXPECT_EQ(t.ranks_with_particles, 1) << "every particle in one rank's region";
@@ -204,9 +204,12 @@ void flyer_case(double tol_x) {
 
 }  // namespace
 
-TEST(ExtremesDomain, ParticleFliesAMillionUnitsAway) { flyer_case<double>(1e-6); }
+TEST(ExtremesDomain, ParticleFliesAMillionUnitsAway) {
+  if (basalt::test::size() > 4) GTEST_SKIP() << "np 1, 2, 4 (5,200 steps at ~3 ms a step oversubscribed)";
+  flyer_case<double>(1e-6);
+}
 TEST(ExtremesDomain, ParticleFliesAMillionUnitsAwayFloat) {
-  if (basalt::test::size() > 4) GTEST_SKIP() << "float at np 1, 2, 4 (time)";
+  if (basalt::test::size() > 4) GTEST_SKIP() << "np 1, 2, 4 (time)";
   flyer_case<float>(5200 * 0.0625);
 }
 
@@ -227,9 +230,9 @@ TEST(ExtremesDomain, OneParticleOnManyRanks) {
   sim.state_changed();
   const double ke0 = sim.kinetic_energy();
   EXPECT_GT(ke0, 0.0);
-  sim.run(1000);
+  sim.run(500);
   EXPECT_EQ(sim.kinetic_energy(), ke0);
-  EXPECT_GE(sim.rebuilds(), 10);
+  EXPECT_GE(sim.rebuilds(), 8);
   const auto s = basalt::test::gather_state(sim, 3, 1);
   EXPECT_EQ(s.seen[0], 1);
   EXPECT_NEAR(s.x[0][0], 1 - 0.5 * sim.time(), 1e-12);

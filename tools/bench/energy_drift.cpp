@@ -1,7 +1,7 @@
 // energy_drift: the long-run energy drift of a closed bonded block (docs/stability.md, "Stability at the
 // extremes"; issue 13: 1e7 steps in double and float). The particles of cube1.geo in [0, --size)^3 (bonds
 // alone, then bonds and contacts; no walls, no damping) with random velocities of 0.05 mm/ms (with their
-// net momentum removed, "at rest", and as drawn, "drifting": the block then moves ~70 mm in 1e7 steps), dt =
+// net momentum removed, "at rest", and as drawn, "drifting": the block then moves ~120 mm in 1e7 steps), dt =
 // 1e-3 ms (0.17 x critical), run --steps steps; the total energy (kinetic + bond + contact) is sampled every
 // --every steps. Prints the least-squares slope of the energy per 1e6 steps (relative to the start), the
 // largest relative excursion, and the mean of the last tenth against the first tenth. One rank; precision
@@ -78,7 +78,7 @@ void run(const Geometry& block, bool contacts, bool at_rest, std::int64_t steps,
     p.vy[i] = Real(0.05 * hash_unit(3 * id + 1));
     p.vz[i] = Real(0.05 * hash_unit(3 * id + 2));
   }
-  if (at_rest) {  // no net momentum: the block stays where it is (else it drifts ~70 mm in 1e7 steps)
+  if (at_rest) {  // no net momentum: the block stays where it is (else it drifts ~120 mm in 1e7 steps)
     double m = 0, P[3] = {0, 0, 0};
     for (std::size_t i = 0; i < p.n_owned; ++i) {
       const double mi = 1 / double(p.inv_mass[i]);
