@@ -667,3 +667,34 @@ K = 1000.0
 }
 TEST(EnergyDrift, ClosedBondedBlockOver1e5Steps) { short_drift<double>(2e-4); }
 TEST(EnergyDrift, ClosedBondedBlockOver1e5StepsFloat) { short_drift<float>(1e-2); }
+
+// A float run whose particles move far from the origin during the run (the load check sees only the start):
+// cube1.geo's block in [0, 2.5)^3 (r_min 0.2) drifting at 40 mm/ms reaches |x| ~ 42 after 1,000 steps, where
+// float's strain resolution (eps |x| / 2 r_min = 1.2e-5) passes 1e-5: a warning names the step, |x|, the
+// resolution and the remedy, once. (This block heats 88-fold in 1e7 steps drifting, docs/stability.md.)
+TEST(FarFromOrigin, FloatWarnsWhenParticlesDriftFar) {
+  const auto full = basalt::io::read_geometry(basalt::test::reference_dir() / "cube1.geo");
+  const auto block = basalt::test::sub_cube(full, -1.0, 2.5);
+  RunOptions opt;
+  opt.quiet = true;
+  const auto scene = basalt::test::scene_from(kOneRun);
+  Simulation<float> sim(scene, block, basalt::test::world(), opt);
+  auto& p = sim.particles();
+  for (std::size_t i = 0; i < p.n_owned; ++i) p.vx[i] = p.vy[i] = p.vz[i] = 40.0f / std::sqrt(3.0f);
+  sim.state_changed();
+  testing::internal::CaptureStderr();
+  sim.run(500);  // |x| ~ 14: resolution 4e-6, silent
+  const std::string before = testing::internal::GetCapturedStderr();
+  testing::internal::CaptureStderr();
+  sim.run(1000);  // |x| ~ 37
+  const std::string after = testing::internal::GetCapturedStderr();
+  testing::internal::CaptureStderr();
+  sim.run(200);  // once
+  const std::string again = testing::internal::GetCapturedStderr();
+  EXPECT_EQ(before.find("warning"), std::string::npos) << before;
+  EXPECT_EQ(again.find("warning"), std::string::npos) << again;
+  if (basalt::test::rank() != 0) return;
+  EXPECT_NE(after.find("particles have reached |x| = "), std::string::npos) << after;
+  EXPECT_NE(after.find("with a smallest radius of 0.2"), std::string::npos) << after;
+  EXPECT_NE(after.find("run in double"), std::string::npos) << after;
+}
