@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <type_traits>
 
 #include "basalt/solver/core/errors.hpp"
 #include "basalt/solver/simulation.hpp"
@@ -132,11 +133,33 @@ void Simulation<Real>::rebuild() {
   rebuild_step_ = step_;
   bond_broke_ = false;
   ++rebuilds_;
+  if constexpr (std::is_same_v<Real, float>) warn_far_positions();
   if (std::getenv("BASALT_DEBUG_REBUILD"))
     fmt::print(stderr, "rank {} rebuild at step {} owned {} ghosts {} bonds {} (both owned {}) pairs {}+{}\n",
                comm().rank(), step_, p_.n_owned, p_.n_ghost(), bonds_.size(), bonds_.n_both_owned,
                forces_.own_pairs().pairs(), forces_.ghost_pairs().pairs());
   times_.neighbor += sw.lap();
+}
+
+template <class Real>
+void Simulation<Real>::warn_far_positions() {
+  if (far_warned_) return;
+  double xmax = 0;
+  for (std::size_t i = 0; i < p_.n_owned; ++i)
+    xmax = std::max({xmax, std::abs(double(p_.x[i])), std::abs(double(p_.y[i])), std::abs(double(p_.z[i]))});
+  xmax = comm().max(xmax);
+  const double resolution = kEpsilon * xmax / (2 * stability_.rmin);
+  if (!(resolution > kResolutionWarn)) return;
+  far_warned_ = true;
+  if (step_ == 0) return;  // at the start: the load check has warned (or refused) already
+  if (comm().rank() == 0)
+    fmt::print(
+        stderr,
+        "basalt-run: warning: step {}: particles have reached |x| = {:.4g} with a smallest radius of {:.4g}: "
+        "in float a distance between particles there is rounded to a strain of {:.2g} (epsilon |x| / 2 "
+        "r_min), above {:g}: expect the energy to drift (docs/stability.md, \"Energy drift over 1e7 "
+        "steps\"); run in double (--precision double)\n",
+        step_, xmax, stability_.rmin, resolution, kResolutionWarn);
 }
 
 template <class Real>
@@ -232,6 +255,7 @@ void Simulation<Real>::check_start(bool fresh) {
   template std::vector<std::uint32_t> Simulation<R>::resolve_bonds();      \
   template void Simulation<R>::rebuild();                                  \
   template void Simulation<R>::set_skin_reference();                       \
+  template void Simulation<R>::warn_far_positions();                       \
   template void Simulation<R>::check_start(bool);
 BASALT_INSTANTIATE(double)
 BASALT_INSTANTIATE(float)

@@ -190,6 +190,10 @@ class Simulation {
   /// between unbonded particles or into a wall; warns (rank 0) of the deepest overlap above 10 %.
   void check_start(bool fresh);
   void rebuild();
+  /// Float only, collective, at rebuilds until it warned: warns (rank 0, once) when the particles have moved
+  /// so far from the origin that float rounds a distance between two of the smallest to a strain above
+  /// kResolutionWarn (the load check sees only the start; docs/stability.md, "Energy drift over 1e7 steps").
+  void warn_far_positions();
   /// x0 = the owned positions relative to skin_origin (of the decomposition box), as float: the skin
   /// criterion's reference, set at every rebuild (and restored after the critical-step estimate).
   void set_skin_reference();
@@ -272,6 +276,7 @@ class Simulation {
   StabilityReport stability_;
   OutputSink* output_ = nullptr;   ///< set during run(steps, OutputSink&)
   std::int64_t rebuild_step_ = 0;  ///< step of the last rebuild (checkpoints store it with p_.xr, yr, zr)
+  bool far_warned_ = false;        ///< warn_far_positions() has warned (or the load check did at the start)
 };
 
 extern template class Simulation<double>;
