@@ -22,4 +22,4 @@ for f in "$build/findings/$t"/*; do
   echo "$(basename "$f") | $report | ${frame:-?}"
   case "$frame" in *basalt::*) places+=("basalt") ;; *libhdf5* | H5*) places+=("libhdf5") ;; *) places+=("other") ;; esac
 done
-printf '%s\n' "${places[@]}" | sort | uniq -c | sed 's/^/  findings whose first frame is in: /'
+printf '%s\n' "${places[@]}" | sort | uniq -c | while read -r n where; do echo "$t: $n finding(s) with their first frame in $where"; done
