@@ -77,6 +77,8 @@ for t in "${targets[@]}"; do
     cmd=("$build/tools/fuzz/$t" $((minutes * 60)) "$findings" "${seeds[@]}")
   fi
   if ! "${cmd[@]}" >"$build/$t.log" 2>&1; then status=1; fi
+  # Each fuzzing process (one per fork-mode job) leaves its scratch folder for the inputs.
+  rm -rf /dev/shm/basalt-"${t//_/-}"-* "${TMPDIR:-/tmp}"/basalt-"${t//_/-}"-*
   after=$(find "$findings" -type f | wc -l)
   if [ "$after" -gt "$before" ]; then
     status=1
