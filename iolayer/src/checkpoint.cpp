@@ -46,9 +46,19 @@ void Checkpoint::validate(const fs::path& source) const {
   if (!inv_mass.empty() && inv_mass.size() != n)
     throw FormatError(source, "/particles/inverse_mass",
                       fmt::format("{} inverse masses for {} particles", inv_mass.size(), n));
+  for (std::size_t i = 0; i < inv_mass.size(); ++i)
+    if (!std::isfinite(inv_mass[i]) || inv_mass[i] < 0)
+      throw FormatError(source, "/particles/inverse_mass",
+                        fmt::format("particle id {}: inverse mass must be finite and >= 0, got {}",
+                                    geometry.id[i], inv_mass[i]));
   if (!position_at_rebuild.empty() && position_at_rebuild.size() != n)
     throw FormatError(source, "/particles/position_at_rebuild",
                       fmt::format("{} rows for {} particles", position_at_rebuild.size(), n));
+  for (std::size_t i = 0; i < position_at_rebuild.size(); ++i)
+    if (!finite(position_at_rebuild[i]))
+      throw FormatError(
+          source, "/particles/position_at_rebuild",
+          fmt::format("particle id {}: position at the last rebuild is not finite", geometry.id[i]));
   if (!position_at_rebuild.empty() && (rebuild_step < 0 || rebuild_step > step))
     throw FormatError(
         source, "attribute 'rebuild_step' of /",
@@ -132,6 +142,8 @@ void Checkpoint::validate(const fs::path& source) const {
         {"position", &w.position}, {"normal", &w.normal}, {"velocity", &w.velocity}, {"force", &w.force}};
     for (const auto& [what, v] : vectors)
       if (!finite(*v)) throw FormatError(source, where, fmt::format("{} is not finite", what));
+    for (double v : w.motion_state)
+      if (!std::isfinite(v)) throw FormatError(source, where + "/motion_state", "a value is not finite");
     const auto& nv = w.normal;
     if (nv[0] == 0 && nv[1] == 0 && nv[2] == 0) throw FormatError(source, where, "normal is the zero vector");
   }

@@ -4,8 +4,10 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
+#include <limits>
 #include <vector>
 
 namespace basalt::io::h5 {
@@ -172,7 +174,32 @@ std::size_t Reader::checked_rows(const std::string& dataset, H5T_class_t cls, st
   if (!ok)
     fail(dataset, fmt::format("expected shape {}, found {}",
                               columns == 0 ? "(N)" : fmt::format("(N, {})", columns), shape_text(dims)));
+  check_storage(dataset, ds.get(), type.get(), dims);
   return static_cast<std::size_t>(dims[0]);
+}
+
+void Reader::check_storage(const std::string& dataset, hid_t ds, hid_t type,
+                           const std::vector<hsize_t>& dims) const {
+  // HDF5 answers a read of storage never written with fill values, so a file of a few KB can declare
+  // 2^40 values and have the reader allocate them all. Every value declared must be in the file: as
+  // many bytes stored as declared, or, through filters, at most kMaxFilterRatio times fewer (deflate's
+  // ratio cannot exceed about 1032:1). That bounds what a reader allocates by the file's size.
+  constexpr hsize_t max = std::numeric_limits<hsize_t>::max();
+  if (std::find(dims.begin(), dims.end(), hsize_t{0}) != dims.end()) return;  // no values
+  hsize_t values = 1;
+  for (auto d : dims) values = values > max / d ? max : values * d;
+  const hsize_t type_size = std::max<hsize_t>(H5Tget_size(type), 1);
+  const hsize_t declared = values > max / type_size ? max : values * type_size;
+  const hsize_t stored = H5Dget_storage_size(ds);
+  Handle dcpl(H5Dget_create_plist(ds), H5Pclose);
+  const int filters = dcpl.valid() ? H5Pget_nfilters(dcpl.get()) : 0;
+  const hsize_t ratio = filters > 0 ? kMaxFilterRatio : 1;
+  if (stored < declared / ratio + (declared % ratio != 0))
+    fail(dataset,
+         fmt::format("declares {} values ({} bytes) but the file holds {} bytes of them{}: the file is "
+                     "damaged or the dataset was never completely written",
+                     values, declared == max ? std::string("over 2^64") : std::to_string(declared), stored,
+                     filters > 0 ? " (compressed)" : ""));
 }
 
 void Reader::read_raw(const std::string& dataset, hid_t mem_type, void* out) const {

@@ -170,6 +170,11 @@ class Reader {
 
  private:
   std::size_t checked_rows(const std::string& dataset, H5T_class_t cls, std::size_t columns) const;
+  /// Refuses a dataset declaring more values than the file stores (see kMaxFilterRatio).
+  void check_storage(const std::string& dataset, hid_t ds, hid_t type,
+                     const std::vector<hsize_t>& dims) const;
+  /// The most a filtered (compressed) dataset may declare per byte stored: deflate's limit is about 1032:1.
+  static constexpr hsize_t kMaxFilterRatio = 1100;
   void read_raw(const std::string& dataset, hid_t mem_type, void* out) const;
   void read_rows_raw(const std::string& dataset, hid_t mem_type, std::size_t row, std::size_t count,
                      std::size_t columns, void* out) const;

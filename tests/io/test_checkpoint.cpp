@@ -156,6 +156,72 @@ TEST(Checkpoint, PositionsAtRebuildRoundTripSortedWithTheIds) {
   expect_format_error([&] { read_checkpoint(dir / "noattr.h5"); }, {"noattr.h5", "rebuild_step", "missing"});
 }
 
+namespace {
+
+// Overwrites value `k` (counted over all rows and columns) of an existing float64 dataset.
+void poke(hid_t f, const char* path, hsize_t k, double value) {
+  const hid_t ds = H5Dopen2(f, path, H5P_DEFAULT);
+  ASSERT_GE(ds, 0) << path;
+  const hid_t space = H5Dget_space(ds);
+  std::vector<double> v(static_cast<std::size_t>(H5Sget_simple_extent_npoints(space)));
+  ASSERT_GE(H5Dread(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()), 0);
+  v.at(k) = value;
+  ASSERT_GE(H5Dwrite(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()), 0);
+  H5Sclose(space);
+  H5Dclose(ds);
+}
+
+}  // namespace
+
+// Issue 16 (fuzzing the checkpoint reader): the inverse masses, the positions at the last rebuild and a
+// servo wall's motion state were read without a check, so a damaged checkpoint restarted with NaN
+// inverse masses (NaN accelerations from the first step) or positions that no rank owns. Each is now
+// refused on reading, naming the file, the dataset and the particle, and never written.
+TEST(Checkpoint, NonFiniteRestartStateIsRefused) {
+  const auto dir = basalt::test::scratch_dir("ckpt-nonfinite");
+  const auto file = dir / "ckpt_1700.h5";
+  Checkpoint c = sample_checkpoint();
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    c.inv_mass.push_back(1.0 / c.geometry.mass[i]);
+    c.position_at_rebuild.push_back(c.geometry.position[i]);
+  }
+  c.rebuild_step = 1650;
+  auto damaged = [&](const char* path, hsize_t k, double value) {
+    write_checkpoint(c, file);
+    edit_file(file, [&](hid_t f) { poke(f, path, k, value); });
+  };
+  // Stored sorted by id (3, 5, 8, 17, 40, 99): value 1 is id 5's, row 2 of an (N, 3) dataset is id 8's.
+  damaged("/particles/inverse_mass", 1, std::nan(""));
+  expect_format_error([&] { read_checkpoint(file); }, {"ckpt_1700.h5: /particles/inverse_mass: particle id "
+                                                       "5: inverse mass must be finite and >= 0, got nan"});
+  damaged("/particles/inverse_mass", 0, -0.5);
+  expect_format_error([&] { read_checkpoint(file); }, {"/particles/inverse_mass: particle id 3", "got -0.5"});
+  damaged("/particles/inverse_mass", 5, HUGE_VAL);
+  expect_format_error([&] { read_checkpoint(file); }, {"/particles/inverse_mass: particle id 99", "got inf"});
+  damaged("/particles/position_at_rebuild", 7, -HUGE_VAL);
+  expect_format_error([&] { read_checkpoint(file); },
+                      {"ckpt_1700.h5: /particles/position_at_rebuild: particle id 8: position at the last "
+                       "rebuild is not finite"});
+  damaged("/particles/position_at_rebuild", 17, std::nan(""));
+  expect_format_error([&] { read_checkpoint(file); }, {"/particles/position_at_rebuild: particle id 99"});
+  damaged("/walls/top/motion_state", 2, std::nan(""));
+  expect_format_error([&] { read_checkpoint(file); },
+                      {"ckpt_1700.h5: /walls/top/motion_state: a value is not finite"});
+  damaged("/walls/top/motion_state", 0, HUGE_VAL);
+  expect_format_error([&] { read_checkpoint(file); }, {"/walls/top/motion_state"});
+  // Zero inverse masses stay valid (a float run may round 1/m of a huge mass to 0).
+  c.inv_mass[2] = 0.0;
+  write_checkpoint(c, file);
+  EXPECT_EQ(read_checkpoint(file).inv_mass.size(), c.size());
+  // Nor can such a state be written.
+  c.inv_mass[2] = std::nan("");
+  expect_format_error([&] { write_checkpoint(c, dir / "bad.h5"); }, {"bad.h5: /particles/inverse_mass"});
+  c.inv_mass[2] = 1.0;
+  c.walls[0].motion_state[1] = -HUGE_VAL;
+  expect_format_error([&] { write_checkpoint(c, dir / "bad.h5"); }, {"bad.h5: /walls/top/motion_state"});
+  EXPECT_FALSE(fs::exists(dir / "bad.h5"));
+}
+
 TEST(Checkpoint, CompletionMarkIsRequired) {
   const auto dir = basalt::test::scratch_dir("ckpt-complete");
   const auto file = dir / "ckpt_5.h5";

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "basalt/io/geometry.hpp"
+#include "basalt/io/geometry_rows.hpp"
 #include "io_test_util.hpp"
 #include "test_support.hpp"
 
@@ -240,21 +241,88 @@ TEST_F(H5BadInput, BadRootAttributes) {
   expect_error({"cube.h5: attribute 'my_note' of /: provenance attributes must be strings"});
 }
 
-TEST_F(H5BadInput, DatasetLargerThanMemory) {
-  // A chunked dataset may declare 2^60 values without storing them: the reader must refuse it
-  // with an error naming the file instead of dying in the allocator.
+namespace {
+
+// A dataset declared with `dims` (chunked by `chunk` rows when chunk > 0, with deflate when `deflate`),
+// of which only the first `written` rows are written: HDF5 reads the rest as fill values.
+void declare_dataset(hid_t f, const std::string& path, hid_t type, std::vector<hsize_t> dims, hsize_t chunk,
+                     bool deflate, hsize_t written) {
+  if (H5Lexists(f, path.c_str(), H5P_DEFAULT) > 0) check(H5Ldelete(f, path.c_str(), H5P_DEFAULT), "delete");
+  const hid_t space = H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr);
+  const hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
+  if (chunk > 0) {
+    auto chunks = dims;
+    chunks[0] = chunk;
+    check(H5Pset_chunk(dcpl, static_cast<int>(dims.size()), chunks.data()), "chunk");
+    if (deflate) check(H5Pset_deflate(dcpl, 6), "deflate");
+  }
+  const hid_t ds = H5Dcreate2(f, path.c_str(), type, space, H5P_DEFAULT, dcpl, H5P_DEFAULT);
+  ASSERT_GE(ds, 0) << path;
+  if (written > 0) {
+    hsize_t width = 1;
+    for (std::size_t k = 1; k < dims.size(); ++k) width *= dims[k];
+    std::vector<double> values(written * width, 0.5);
+    auto count = dims;
+    count[0] = written;
+    const std::vector<hsize_t> start(dims.size(), 0);
+    const hid_t mem = H5Screate_simple(static_cast<int>(dims.size()), count.data(), nullptr);
+    check(H5Sselect_hyperslab(space, H5S_SELECT_SET, start.data(), nullptr, count.data(), nullptr), "select");
+    check(H5Dwrite(ds, H5T_NATIVE_DOUBLE, mem, space, H5P_DEFAULT, values.data()), "write");
+    H5Sclose(mem);
+  }
+  H5Dclose(ds);
+  H5Pclose(dcpl);
+  H5Sclose(space);
+}
+
+}  // namespace
+
+// Issue 16 (fuzzing): a file of a few KB may declare 2^31 values it does not hold (HDF5 reads storage never
+// written as fill values). The reader allocated them all (16 GiB here) before finding anything wrong;
+// now it refuses any dataset whose declared bytes the file does not store, naming the file and dataset,
+// before allocating, in read_h5 and in the sliced reader of basalt-run's start-up alike.
+TEST_F(H5BadInput, DeclaredValuesMustBeInTheFile) {
   edit_file(file_, [](hid_t f) {
-    check(H5Ldelete(f, "/particles/id", H5P_DEFAULT), "delete");
-    const hsize_t dims[1] = {hsize_t{1} << 60};
-    const hsize_t chunk[1] = {1024};
-    const hid_t space = H5Screate_simple(1, dims, nullptr);
-    const hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
-    H5Pset_chunk(dcpl, 1, chunk);
-    const hid_t ds = H5Dcreate2(f, "/particles/id", H5T_STD_I64LE, space, H5P_DEFAULT, dcpl, H5P_DEFAULT);
-    ASSERT_GE(ds, 0);
-    H5Dclose(ds);
-    H5Pclose(dcpl);
-    H5Sclose(space);
+    declare_dataset(f, "/particles/id", H5T_STD_I64LE, {hsize_t{1} << 31}, 1024, false, 0);
   });
-  expect_error({"cube.h5", "more values than this machine can address"});
+  expect_error(
+      {"cube.h5: /particles/id: declares 2147483648 values (17179869184 bytes) but the file holds 0 "
+       "bytes of them",
+       "damaged or the dataset was never completely written"});
+  expect_format_error([&] { GeometryFile f(file_); }, {"cube.h5: /particles/id: declares 2147483648 values"});
+
+  write_h5(ten_particles(), file_);  // contiguous, never written
+  edit_file(file_, [](hid_t f) {
+    declare_dataset(f, "/particles/position", H5T_IEEE_F64LE, {hsize_t{1} << 30, 3}, 0, false, 0);
+  });
+  expect_error(
+      {"cube.h5: /particles/position: declares 3221225472 values (25769803776 bytes) but the file "
+       "holds 0 bytes"});
+
+  write_h5(ten_particles(), file_);  // chunked, the first of three chunks written
+  edit_file(file_,
+            [](hid_t f) { declare_dataset(f, "/particles/radius", H5T_IEEE_F64LE, {10}, 4, false, 4); });
+  expect_error({"cube.h5: /particles/radius: declares 10 values (80 bytes) but the file holds 32 bytes"});
+
+  write_h5(ten_particles(), file_);  // compressed: one chunk of 2^40 declared values written
+  edit_file(file_, [](hid_t f) {
+    declare_dataset(f, "/bonds/tag", H5T_STD_I32LE, {hsize_t{1} << 40}, 1024, true, 1024);
+  });
+  expect_error({"cube.h5: /bonds/tag: declares 1099511627776 values (4398046511104 bytes)", "(compressed)"});
+
+  write_h5(ten_particles(), file_);  // beyond what a size_t can count
+  edit_file(file_, [](hid_t f) {
+    declare_dataset(f, "/statistics/huge", H5T_IEEE_F64LE, {hsize_t{1} << 62}, 1, false, 0);
+  });
+  expect_error({"cube.h5: /statistics/huge: declares 4611686018427387904 values (over 2^64 bytes)"});
+
+  write_h5(ten_particles(), file_);  // chunked and compressed, completely written: read as before
+  edit_file(file_,
+            [](hid_t f) { declare_dataset(f, "/particles/radius", H5T_IEEE_F64LE, {10}, 4, true, 10); });
+  const auto g = read_h5(file_);
+  EXPECT_EQ(g.radius, std::vector<double>(10, 0.5));
+  GeometryFile sliced(file_);
+  Geometry part;
+  sliced.read_particles(3, 7, part);
+  EXPECT_EQ(part.radius, std::vector<double>(4, 0.5));
 }
