@@ -14,6 +14,7 @@
 #include <cmath>
 #include <string>
 
+#include "basalt/solver/core/errors.hpp"
 #include "basalt/solver/parallel/balance.hpp"
 #include "basalt/solver/simulation.hpp"
 #include "solver_helpers.hpp"
@@ -68,6 +69,22 @@ TEST(BalancedCuts, CheckpointTextRoundTripsExactly) {
   EXPECT_FALSE(parse_cuts("1,2"));
   EXPECT_FALSE(parse_cuts("1;x;"));
   EXPECT_FALSE(parse_cuts("1;;;"));
+}
+
+TEST(BalanceScene, KeysAreReadAndBadValuesNamed) {
+  const std::string run = "[run]\ndt = 1e-3\nsteps = 1\nskin = 0.1\n";
+  const auto s = basalt::test::scene_from(run + "balance = \"count\"\nbalance_threshold = 1.5\n");
+  EXPECT_EQ(s.balance, "count");
+  EXPECT_EQ(s.balance_threshold, 1.5);
+  EXPECT_EQ(basalt::test::scene_from(run).balance, "none") << "off unless asked for";
+  for (const std::string bad : {"balance = \"rcb\"\n", "balance_threshold = 0.9\n"}) {
+    try {
+      (void)basalt::test::scene_from(run + bad);
+      ADD_FAILURE() << bad << " accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(bad.substr(0, bad.find(' '))), std::string::npos) << e.what();
+    }
+  }
 }
 
 namespace {
