@@ -69,6 +69,11 @@ void Simulation<Real>::balance_at_rebuild() {
   auto error = halo_->migrate(p_, bonds_, forces_.pending_history(), true);
   error = comm().agree_error(error);
   if (error) stop(*error);
+  const long long total = comm().sum(static_cast<long long>(p_.n_owned));
+  if (total != n_global_)
+    stop(
+        fmt::format("step {}: {} particles on the ranks after re-balancing, {} expected: particles were lost",
+                    step_, total, n_global_));
   ++rebalances_;
   imbalance_before_ = before;
   const double after = imbalance();
