@@ -1,7 +1,8 @@
 // basalt-run: runs a scene (TOML) on P compute ranks with Q dedicated I/O ranks.
 //   mpirun -np P+Q basalt-run scenes/wave.toml [--io-ranks Q] [--geometry FILE] [--steps N] [--output DIR]
 //          [--dims x,y,z] [--checkpoint-every N] [--frames-every N] [--fields-every N]
-//          [--restart FILE|DIR] [--quiet] [--force-dt] [--render-every N [--render SPEC]]
+//          [--restart FILE|DIR] [--balance none|count] [--balance-threshold X] [--quiet] [--force-dt]
+//          [--render-every N [--render SPEC]]
 // The only code that touches MPI_COMM_WORLD: it creates the output folder (world rank 0, a failure
 // stops every rank before anything starts) and splits the world into compute and I/O ranks. Compute
 // rank 0 prints progress, a summary of the time per step and the output report (docs/io-ranks.md).
@@ -52,6 +53,8 @@ struct Cli {
   std::optional<std::string> render;
   double throttle_mbps = 0;
   int frames_in_flight = 0;
+  std::string balance;
+  double balance_threshold = 0;
 };
 /// User + system CPU seconds of this process.
 double cpu_seconds() {
@@ -243,6 +246,12 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
   std::int64_t steps = scene.steps;
   if (ckpt) steps = cli.steps >= 0 ? cli.steps : std::max<std::int64_t>(0, scene.steps - ckpt->step);
   const auto& st = sim->stability();
+  const double imbalance_start = sim->imbalance();
+  const auto balance_setting = [&] {
+    return scene.balance == "count"
+               ? fmt::format("run.balance = \"count\", threshold {}", scene.balance_threshold)
+               : std::string("run.balance = \"none\"");
+  };
   if (root) {
     fmt::print(
         "basalt-run {}: {} particles, {} bonds on {} compute rank(s) ({}x{}x{}) + {} I/O rank(s), {} steps "
@@ -271,6 +280,9 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
                  scene.dt, st.fraction, scene.dt_safety,
                  st.fraction > 1 ? " (forced): expect the blow-up check to stop the run" : "");
     fmt::print("{}\n", fields_line(*sim));
+    if (comm.size() > 1)
+      fmt::print("balance: max/mean particles per rank {:.3f} at start ({})\n", imbalance_start,
+                 balance_setting());
     if (sim->unassigned_bonds() > 0)
       fmt::print(stderr, "warning: {} bonds of the geometry match no bond interaction and exert no force\n",
                  sim->unassigned_bonds());
@@ -312,6 +324,7 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
   const double parts[5] = {comm.max(t.forces), comm.max(t.neighbor), comm.max(t.communication),
                            comm.max(t.integration), comm.max(t.output)};
   const double mem = comm.sum(double(sim->memory_bytes()));
+  const double imbalance_end = sim->imbalance();
   if (root) {
     const double ps = double(sim->total_particles()) * double(steps) / std::max(loop, 1e-12);
     fmt::print(
@@ -329,6 +342,10 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
     fmt::print("{}\n", line);
     fmt::print("solver arrays: {:.1f} MB ({:.0f} bytes per particle)\n", mem / 1e6,
                mem / double(sim->total_particles()));
+    if (comm.size() > 1)
+      fmt::print(
+          "balance: max/mean particles per rank {:.3f} at start, {:.3f} at the end; {} re-balance(s) ({})\n",
+          imbalance_start, imbalance_end, sim->rebalances(), balance_setting());
     print_report(report, layout.n_io);
     if (cfg.fields_every > 0) fmt::print("fields: {}\n", (cfg.dir / "fields.csv").string());
     if (report.error)
@@ -382,6 +399,16 @@ int run_world(int argc, char** argv) {
   app.add_option("--precision", cli.precision,
                  "floating-point type of the solver: double or float; overrides run.precision")
       ->check(CLI::IsMember({"double", "float"}));
+  app.add_option(
+         "--balance", cli.balance,
+         "load balancing of the rank grid: none (even cuts) or count (cuts moved at rebuilds by particle "
+         "count; docs/solver.md); overrides run.balance")
+      ->check(CLI::IsMember({"none", "count"}));
+  app.add_option(
+         "--balance-threshold", cli.balance_threshold,
+         "re-balance when the busiest rank holds more than this x the mean particles (>= 1); overrides "
+         "run.balance_threshold")
+      ->check(CLI::Range(1.0, 1e300));
   app.add_flag("--quiet", cli.quiet, "no progress line");
   app.add_flag("--whole-geometry", cli.whole_geometry,
                "every compute rank reads the whole geometry file (the former start-up; a check of the "
@@ -437,6 +464,8 @@ int run_world(int argc, char** argv) {
     scene.dt_fraction = cli.preset == "fast" ? 0.5 : cli.preset == "balanced" ? 0.25 : 0.05;
   }
   if (!cli.precision.empty()) scene.precision = cli.precision;
+  if (!cli.balance.empty()) scene.balance = cli.balance;
+  if (cli.balance_threshold > 0) scene.balance_threshold = cli.balance_threshold;
 
   // A restart reads its checkpoint on every rank (so that a bad one stops all ranks alike, early).
   std::optional<io::Checkpoint> ckpt;

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "basalt/solver/core/errors.hpp"
+#include "basalt/solver/parallel/balance.hpp"
 
 namespace basalt::run {
 
@@ -87,7 +88,8 @@ std::map<std::string, std::string> restart_attributes(const solver::RestartLayou
   return {{"decomposition_box_min", vec_text(l.box_min)},
           {"decomposition_box_max", vec_text(l.box_max)},
           {"ghost_width", fmt::format("{:.17g}", l.ghost_width)},
-          {"contact_cutoff", fmt::format("{:.17g}", l.contact_cutoff)}};
+          {"contact_cutoff", fmt::format("{:.17g}", l.contact_cutoff)},
+          {"decomposition_cuts", solver::cuts_text(l.cuts[0], l.cuts[1], l.cuts[2])}};
 }
 
 solver::RestartLayout restart_layout_of(const io::Checkpoint& c, const fs::path& file) {
@@ -96,6 +98,16 @@ solver::RestartLayout restart_layout_of(const io::Checkpoint& c, const fs::path&
   l.box_max = vec(c, file, "decomposition_box_max");
   l.ghost_width = number(c, file, "ghost_width");
   l.contact_cutoff = number(c, file, "contact_cutoff");
+  // The cuts in force at the checkpoint (run.balance); an older checkpoint has the even grid's.
+  if (const auto it = c.geometry.attributes.find("decomposition_cuts"); it != c.geometry.attributes.end()) {
+    const auto cuts = solver::parse_cuts(it->second);
+    if (!cuts)
+      throw InputError(
+          fmt::format("{}: attribute 'decomposition_cuts' = \"{}\" is not three ';'-separated lists "
+                      "of numbers",
+                      file.string(), it->second));
+    l.cuts = *cuts;
+  }
   return l;
 }
 

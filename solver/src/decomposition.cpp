@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "basalt/solver/core/errors.hpp"
@@ -30,11 +31,11 @@ Decomposition::Decomposition(const Comm& comm, std::array<int, 3> dims, const st
   MPI_Cart_coords(cart_raw_, cart_.rank(), 3, coords_.data());
   for (int d = 0; d < 3; ++d) {
     MPI_Cart_shift(cart_raw_, d, 1, &nb_[d][0], &nb_[d][1]);
+    // The even split: the same arithmetic as before cuts could move (box_min + c w), bit for bit.
     const double w = (box_max_[d] - box_min_[d]) / dims_[d];
-    const int c = coords_[d];
-    lo_[d] = c == 0 ? -std::numeric_limits<double>::infinity() : box_min_[d] + c * w;
-    hi_[d] = c == dims_[d] - 1 ? std::numeric_limits<double>::infinity() : box_min_[d] + (c + 1) * w;
+    for (int c = 1; c < dims_[d]; ++c) cuts_[d].push_back(box_min_[d] + c * w);
   }
+  set_bounds();
   rank_table_.resize(static_cast<std::size_t>(dims_[0] * dims_[1] * dims_[2]));
   for (int i = 0; i < dims_[0]; ++i)
     for (int j = 0; j < dims_[1]; ++j)
@@ -45,22 +46,44 @@ Decomposition::Decomposition(const Comm& comm, std::array<int, 3> dims, const st
       }
 }
 
+void Decomposition::set_bounds() {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  for (int d = 0; d < 3; ++d) {
+    const auto c = static_cast<std::size_t>(coords_[d]);
+    lo_[d] = c == 0 ? -kInf : cuts_[d][c - 1];
+    hi_[d] = coords_[d] == dims_[d] - 1 ? kInf : cuts_[d][c];
+  }
+}
+
+void Decomposition::set_cuts(const std::array<std::vector<double>, 3>& cuts) {
+  for (int d = 0; d < 3; ++d) {
+    const auto& v = cuts[static_cast<std::size_t>(d)];
+    if (v.size() != static_cast<std::size_t>(dims_[d] - 1))
+      throw InputError(fmt::format("decomposition: {} cut(s) along {} for {} rank(s) along that axis",
+                                   v.size(), "xyz"[d], dims_[d]));
+    for (std::size_t k = 0; k < v.size(); ++k)
+      if (!std::isfinite(v[k]) || (k > 0 && !(v[k] > v[k - 1])))
+        throw InputError(
+            fmt::format("decomposition: the cuts along {} are not finite and increasing", "xyz"[d]));
+  }
+  cuts_ = cuts;
+  set_bounds();
+}
+
 Decomposition::~Decomposition() {
   if (cart_raw_ != MPI_COMM_NULL) MPI_Comm_free(&cart_raw_);
 }
 
 int Decomposition::coord_of(int d, double v) const {
-  const double w = (box_max_[d] - box_min_[d]) / dims_[d];
-  int c = 0;
-  // Same arithmetic as the region bounds, so ownership agrees with owns().
-  while (c < dims_[d] - 1 && v >= box_min_[d] + (c + 1) * w) ++c;
-  return c;
+  // The same cut values as the region bounds, so ownership agrees with owns().
+  const auto& cuts = cuts_[d];
+  return static_cast<int>(std::upper_bound(cuts.begin(), cuts.end(), v) - cuts.begin());
 }
 
 double Decomposition::min_interior_width() const {
   double m = std::numeric_limits<double>::infinity();
   for (int d = 0; d < 3; ++d)
-    if (dims_[d] > 2) m = std::min(m, (box_max_[d] - box_min_[d]) / dims_[d]);
+    for (std::size_t c = 1; c < cuts_[d].size(); ++c) m = std::min(m, cuts_[d][c] - cuts_[d][c - 1]);
   return m;
 }
 

@@ -126,55 +126,64 @@ void send_history(MPI_Comm comm, ContactRecords& h, const std::array<std::vector
 
 template <class Real>
 std::optional<std::string> Halo<Real>::migrate(Particles<Real>& p, Bonds<Real>& bonds,
-                                               const std::vector<ContactRecords*>& history) {
+                                               const std::vector<ContactRecords*>& history, bool far) {
   const MPI_Comm comm = dec_.comm().raw();
   std::optional<std::string> error;
   std::vector<std::int64_t> migrants;  // ids that left or arrived here
   const std::size_t record = p.record_bytes(false);
   for (int d = 0; d < 3; ++d) {
     if (dec_.dims()[d] == 1) continue;
-    const auto& c = axis(p, d);
-    std::array<std::vector<std::byte>, 2> out;
-    std::array<std::vector<std::int64_t>, 2> leaving_ids;
-    std::vector<std::size_t> leaving;
-    for (std::size_t i = 0; i < p.n_owned; ++i) {
-      const int side = c[i] < dec_.lo(d) ? 0 : (c[i] >= dec_.hi(d) ? 1 : -1);
-      if (side < 0) continue;
-      p.pack(i, false, out[side]);
-      leaving_ids[side].push_back(p.id[i]);
-      leaving.push_back(i);
-    }
-    std::array<std::vector<BondRecord>, 2> bout;
-    for (int side = 0; side < 2; ++side) {
-      auto& ids = leaving_ids[side];
-      if (ids.empty()) continue;
-      std::sort(ids.begin(), ids.end());
-      for (std::size_t k = 0; k < bonds.size(); ++k)
-        if (std::binary_search(ids.begin(), ids.end(), bonds.a[k]) ||
-            std::binary_search(ids.begin(), ids.end(), bonds.b[k]))
-          bout[side].push_back(BondRecord{bonds.a[k], bonds.b[k], double(bonds.r0[k]), bonds.group_of(k), 0});
-    }
-    for (auto* h : history)
-      if (h) send_history(comm, *h, leaving_ids, dec_.neighbor(d, 0), dec_.neighbor(d, 1));
-    for (auto it = leaving.rbegin(); it != leaving.rend(); ++it) p.swap_remove_owned(*it);
-    for (const auto& ids : leaving_ids) migrants.insert(migrants.end(), ids.begin(), ids.end());
-
-    for (int side = 0; side < 2; ++side) {
-      const int dest = dec_.neighbor(d, side), src = dec_.neighbor(d, 1 - side);
-      const auto in = sendrecv(comm, out[side], dest, src);
-      const auto bin = sendrecv(comm, bout[side], dest, src);
-      for (std::size_t at = 0; at < in.size(); at += record) {
-        p.unpack(in.data() + at, false);
-        const std::size_t i = p.n_owned - 1;
-        migrants.push_back(p.id[i]);
-        const double v = double(axis(p, d)[i]);
-        if (!(v >= dec_.lo(d) && v < dec_.hi(d)) && !error)
-          error = fmt::format(
-              "particle id {} at ({}, {}, {}) moved more than one rank's region between two neighbour-list "
-              "rebuilds (arrived at rank {} owning [{}, {}) along axis {})",
-              p.id[i], p.x[i], p.y[i], p.z[i], dec_.comm().rank(), dec_.lo(d), dec_.hi(d), "xyz"[d]);
+    // far: a particle that arrived outside this rank's slab goes on along the same axis in the next
+    // round (one hop per round), until no rank has such a particle.
+    for (bool again = true; again;) {
+      std::size_t outside = 0;
+      const auto& c = axis(p, d);
+      std::array<std::vector<std::byte>, 2> out;
+      std::array<std::vector<std::int64_t>, 2> leaving_ids;
+      std::vector<std::size_t> leaving;
+      for (std::size_t i = 0; i < p.n_owned; ++i) {
+        const int side = c[i] < dec_.lo(d) ? 0 : (c[i] >= dec_.hi(d) ? 1 : -1);
+        if (side < 0) continue;
+        p.pack(i, false, out[side]);
+        leaving_ids[side].push_back(p.id[i]);
+        leaving.push_back(i);
       }
-      for (const auto& b : bin) bonds.push(b.a, b.b, Real(b.r0), static_cast<std::uint8_t>(b.group));
+      std::array<std::vector<BondRecord>, 2> bout;
+      for (int side = 0; side < 2; ++side) {
+        auto& ids = leaving_ids[side];
+        if (ids.empty()) continue;
+        std::sort(ids.begin(), ids.end());
+        for (std::size_t k = 0; k < bonds.size(); ++k)
+          if (std::binary_search(ids.begin(), ids.end(), bonds.a[k]) ||
+              std::binary_search(ids.begin(), ids.end(), bonds.b[k]))
+            bout[side].push_back(
+                BondRecord{bonds.a[k], bonds.b[k], double(bonds.r0[k]), bonds.group_of(k), 0});
+      }
+      for (auto* h : history)
+        if (h) send_history(comm, *h, leaving_ids, dec_.neighbor(d, 0), dec_.neighbor(d, 1));
+      for (auto it = leaving.rbegin(); it != leaving.rend(); ++it) p.swap_remove_owned(*it);
+      for (const auto& ids : leaving_ids) migrants.insert(migrants.end(), ids.begin(), ids.end());
+
+      for (int side = 0; side < 2; ++side) {
+        const int dest = dec_.neighbor(d, side), src = dec_.neighbor(d, 1 - side);
+        const auto in = sendrecv(comm, out[side], dest, src);
+        const auto bin = sendrecv(comm, bout[side], dest, src);
+        for (std::size_t at = 0; at < in.size(); at += record) {
+          p.unpack(in.data() + at, false);
+          const std::size_t i = p.n_owned - 1;
+          migrants.push_back(p.id[i]);
+          const double v = double(axis(p, d)[i]);
+          if (v >= dec_.lo(d) && v < dec_.hi(d)) continue;
+          ++outside;
+          if (!far && !error)
+            error = fmt::format(
+                "particle id {} at ({}, {}, {}) moved more than one rank's region between two neighbour-list "
+                "rebuilds (arrived at rank {} owning [{}, {}) along axis {})",
+                p.id[i], p.x[i], p.y[i], p.z[i], dec_.comm().rank(), dec_.lo(d), dec_.hi(d), "xyz"[d]);
+        }
+        for (const auto& b : bin) bonds.push(b.a, b.b, Real(b.r0), static_cast<std::uint8_t>(b.group));
+      }
+      again = far && dec_.comm().max(double(outside)) > 0;
     }
   }
   settle_bonds(p, bonds, migrants);

@@ -5,6 +5,8 @@
 #include <span>
 #include <vector>
 
+#include "basalt/solver/parallel/balance.hpp"
+
 namespace basalt::solver {
 
 template <class Real>
@@ -23,6 +25,9 @@ SimulationFrame<Real>::SimulationFrame(const Simulation<Real>& sim, std::uint32_
     h.rebuild_step = sim.rebuild_step_;
     h.rebuild_pending = sim.bond_broke_;
   }
+  // The cuts in force since the last rebuild: a restart on as many ranks rebuilds this decomposition.
+  if ((kinds & io::kFrameCheckpoint) && sim.comm().rank() == 0)
+    attributes_["decomposition_cuts"] = cuts_text(sim.dec_->cuts(0), sim.dec_->cuts(1), sim.dec_->cuts(2));
   // A frame only for an in-situ picture carries no bonds (pictures draw particles).
   with_bonds_ = (kinds & (io::kFrameCheckpoint | io::kFrameVtk)) != 0;
   std::size_t m = 0;
@@ -161,6 +166,7 @@ void SimulationFrame<Real>::write(io::FrameWriter& w) const {
   p.for_each_array([&](const ArrayInfo& a, const auto& v) {
     if (!a.output.empty() && p.enabled(a)) w.field(a.output, std::span(v.data(), n));
   });
+  w.attributes(attributes_);
 }
 
 template class SimulationFrame<double>;

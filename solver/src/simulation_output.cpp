@@ -163,6 +163,7 @@ RestartLayout Simulation<Real>::restart_layout() const {
   r.box_max = dec_->box_max();
   r.ghost_width = ghost_width_;
   r.contact_cutoff = contact_cutoff_;
+  for (int d = 0; d < 3; ++d) r.cuts[static_cast<std::size_t>(d)] = dec_->cuts(d);
   return r;
 }
 

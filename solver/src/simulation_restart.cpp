@@ -48,6 +48,7 @@ Simulation<Real>::Simulation(const Scene& scene, const io::Checkpoint& c, const 
     if (!forces_.walls().empty()) forces_.walls().move_to(double(step_) * scene_.dt);
     rebuild();
   }
+  balance_paused_ = false;
   check_start(false);
   estimate_critical_step(false);  // simulation_stability.cpp
   start_ledger(compute_forces<true>());
@@ -58,6 +59,17 @@ void Simulation<Real>::distribute_checkpoint(const io::Checkpoint& c, const Rest
                                              MPI_Comm comm) {
   const auto& g = c.geometry;
   dec_ = std::make_unique<Decomposition>(Comm(comm), options_.dims, layout.box_min, layout.box_max);
+  // The checkpoint's cuts when they fit this rank grid (the same ranks along each axis): the replayed
+  // rebuild then finds every particle where the run had it and must not move them (balance_paused_).
+  // On another grid the cuts start even and a balanced run re-balances at that rebuild.
+  bool fits = true;
+  for (int d = 0; d < 3; ++d)
+    fits = fits &&
+           layout.cuts[static_cast<std::size_t>(d)].size() == static_cast<std::size_t>(dec_->dims()[d] - 1);
+  if (fits && !(layout.cuts[0].empty() && layout.cuts[1].empty() && layout.cuts[2].empty())) {
+    dec_->set_cuts(layout.cuts);
+    balance_paused_ = true;
+  }
   halo_ = std::make_unique<Halo<Real>>(*dec_);
   n_global_ = static_cast<std::int64_t>(g.size());
   ids_.configure(g.id.front(), g.id.back(), g.size());

@@ -124,6 +124,27 @@ TEST(Frame, AssembleSortsByIdAndKeepsState) {
   EXPECT_EQ(c.geometry.box_max[2], 15);
 }
 
+TEST(Frame, FrameAttributesTravelAndOverrideTheRunsInTheCheckpoint) {
+  // The decomposition's cuts change during a run: one piece carries them per frame, and they replace
+  // the value the run's information had at its start.
+  std::vector<FramePiece> pieces{make_piece(0, 4, 7), make_piece(1, 4, 7)};
+  pieces[0].attributes["decomposition_cuts"] = "7.25;;";
+  std::vector<std::byte> bytes;
+  serialize(pieces[0], bytes);
+  const auto back = deserialize(bytes);
+  EXPECT_EQ(back.attributes, pieces[0].attributes);
+  serialize(pieces[1], bytes);
+  EXPECT_TRUE(deserialize(bytes).attributes.empty());
+  bytes.resize(bytes.size() - sizeof(std::uint64_t));  // a frame that ends after its fields (older writer)
+  EXPECT_TRUE(deserialize(bytes).attributes.empty());
+  RunInfo info;
+  info.attributes = {{"decomposition_cuts", "7.5;;"}, {"ghost_width", "1.1"}};
+  pieces[0] = back;
+  const auto c = assemble(pieces, info);
+  EXPECT_EQ(c.geometry.attributes.at("decomposition_cuts"), "7.25;;");
+  EXPECT_EQ(c.geometry.attributes.at("ghost_width"), "1.1");
+}
+
 TEST(Frame, RunInfoRoundTripsWithTheTimeStep) {
   // Sent once at start: what is constant for the run, dt included (frames do not carry it).
   RunInfo info;
@@ -206,7 +227,8 @@ TEST(FrameWriter, FloatColumnsWidenExactly) {
   std::vector<std::byte> bytes;
   FrameWriter w(bytes, small_header(4, 2));
   fill_all(w, 4, 2);
-  EXPECT_EQ(w.finish(), bytes.size());
+  const auto size = w.finish();  // completes the frame (its attribute count): the size after it
+  EXPECT_EQ(size, bytes.size());
   const auto q = deserialize(bytes);
   ASSERT_EQ(q.size(), 4u);
   for (std::size_t i = 0; i < 4; ++i) {

@@ -87,6 +87,7 @@ void FramePiece::clear() {
   contact_history.clear();
   fields.clear();
   walls.clear();
+  attributes.clear();
 }
 
 FrameHeader PieceSource::header() const {
@@ -168,6 +169,7 @@ void PieceSource::write(FrameWriter& w) const {
   w.column(Column::contact_history, p_.contact_history);
   for (const auto& wall : p_.walls) w.wall(wall);
   for (const auto& [name, values] : p_.fields) w.field(name, std::span<const double>(values));
+  w.attributes(p_.attributes);
 }
 
 std::size_t serialize(const FrameSource& source, std::vector<std::byte>& out) {
@@ -288,7 +290,15 @@ FramePiece deserialize(std::span<const std::byte> bytes) {
     values.resize(p.id.size());
     r.raw(values.data(), values.size() * sizeof(double));
   }
-  if (!r.at_end()) throw std::runtime_error("frame: trailing bytes after the particle fields");
+  if (!r.at_end()) {  // the frame's own attributes (a frame from an older writer ends before them)
+    const auto n_attributes = r.value<std::uint64_t>();
+    if (n_attributes > bytes.size()) throw std::runtime_error("frame: attribute count overruns the buffer");
+    for (std::uint64_t k = 0; k < n_attributes; ++k) {
+      auto key = r.string();
+      p.attributes[key] = r.string();
+    }
+  }
+  if (!r.at_end()) throw std::runtime_error("frame: trailing bytes after the attributes");
   return p;
 }
 
@@ -467,6 +477,8 @@ Checkpoint assemble(std::vector<FramePiece>& pieces, const RunInfo& run) {
   g.periodic = run.periodic;
   g.units = run.units;
   g.attributes = run.attributes;
+  for (const auto& p : pieces)
+    for (const auto& [k, v] : p.attributes) g.attributes[k] = v;
   c.step = step;
   c.time = pieces.front().time;
   c.dt = run.dt;

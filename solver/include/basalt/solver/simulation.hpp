@@ -62,6 +62,9 @@ struct RestartLayout {
   std::array<double, 3> box_min{0, 0, 0}, box_max{0, 0, 0};  ///< the decomposition's box
   double ghost_width = 0;
   double contact_cutoff = 0;
+  /// The cuts in force at the checkpoint (Decomposition::cuts; empty: the even grid). Taken when they
+  /// fit the restart's rank grid (as many ranks along each axis), else the grid starts even.
+  std::array<std::vector<double>, 3> cuts;
 };
 
 template <class Real>
@@ -148,6 +151,11 @@ class Simulation {
   void state_changed();
   /// Collective: rebuilds the lists now (migrating particles), then recomputes forces.
   void force_rebuild();
+  /// Collective: the busiest rank's owned particles over the mean (1 = perfectly balanced).
+  double imbalance() const;
+  /// Times the cuts moved (run.balance = "count"), and the imbalance before the last move.
+  std::int64_t rebalances() const { return rebalances_; }
+  double imbalance_before_last_rebalance() const { return imbalance_before_; }
   /// Rows this rank read and records it received at start-up (zeros when given a whole geometry).
   const LoadStats& load_stats() const { return load_stats_; }
   /// Bytes held by the solver's arrays on this rank (capacity, not RSS).
@@ -194,6 +202,9 @@ class Simulation {
   /// so far from the origin that float rounds a distance between two of the smallest to a strain above
   /// kResolutionWarn (the load check sees only the start; docs/stability.md, "Energy drift over 1e7 steps").
   void warn_far_positions();
+  /// Collective, in a rebuild after migration (simulation_balance.cpp): with run.balance = "count", moves
+  /// the cuts when the busiest rank exceeds the mean by run.balance_threshold, and migrates to them.
+  void balance_at_rebuild();
   /// x0 = the owned positions relative to skin_origin (of the decomposition box), as float: the skin
   /// criterion's reference, set at every rebuild (and restored after the critical-step estimate).
   void set_skin_reference();
@@ -277,6 +288,9 @@ class Simulation {
   OutputSink* output_ = nullptr;   ///< set during run(steps, OutputSink&)
   std::int64_t rebuild_step_ = 0;  ///< step of the last rebuild (checkpoints store it with p_.xr, yr, zr)
   bool far_warned_ = false;        ///< warn_far_positions() has warned (or the load check did at the start)
+  std::int64_t rebalances_ = 0;
+  double imbalance_before_ = 1;
+  bool balance_paused_ = false;  ///< a restart replaying a rebuild with the checkpoint's own cuts
 };
 
 extern template class Simulation<double>;

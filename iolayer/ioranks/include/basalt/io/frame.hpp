@@ -57,6 +57,8 @@ struct FramePiece {
 
   // Global, identical on every rank; only the piece of compute rank 0 needs to carry them.
   std::vector<WallState> walls;
+  /// The frame's own checkpoint attributes (FrameWriter::attributes): they override the run's.
+  std::map<std::string, std::string> attributes;
 
   std::size_t size() const { return id.size(); }
   void clear();  ///< empties the arrays, keeping their capacity

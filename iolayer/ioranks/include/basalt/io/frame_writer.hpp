@@ -10,6 +10,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <map>
 #include <span>
 #include <stdexcept>
 #include <string>
@@ -215,6 +216,7 @@ class FrameWriter {
   /// sent as float64. header.fields of them must follow the walls.
   template <class T>
   void field(std::string_view name, std::span<const T> v) {
+    if (attributes_) throw std::logic_error("frame writer: particle fields must come before the attributes");
     if (v.size() != layout_.length[0])
       throw std::logic_error("frame writer: a particle field of the wrong length");
     append(std::uint64_t(name.size()));
@@ -226,7 +228,8 @@ class FrameWriter {
   }
   /// Appends a wall (walls are global: one compute rank's frame carries them).
   void wall(const WallState& w) {
-    if (fields_ > 0) throw std::logic_error("frame writer: walls must come before the particle fields");
+    if (fields_ > 0 || attributes_)
+      throw std::logic_error("frame writer: walls must come before the particle fields");
     append(std::uint64_t(w.name.size()));
     append_raw(w.name.data(), w.name.size());
     for (const Vec3* v : {&w.position, &w.normal, &w.velocity, &w.force}) append(*v);
@@ -234,9 +237,23 @@ class FrameWriter {
     for (const double v : w.motion_state) append(v);
     ++walls_;
   }
+  /// Appends the frame's own root attributes for a checkpoint (after every particle field; at most
+  /// once): global values that change during a run, e.g. the decomposition's cuts, which override
+  /// the run's attributes (RunInfo) of the same name. One compute rank's frame carries them.
+  void attributes(const std::map<std::string, std::string>& a) {
+    if (attributes_) throw std::logic_error("frame writer: attributes written twice");
+    attributes_ = true;
+    append(std::uint64_t(a.size()));
+    for (const auto& [k, v] : a)
+      for (const std::string* t : {&k, &v}) {
+        append(std::uint64_t(t->size()));
+        append_raw(t->data(), t->size());
+      }
+  }
   /// Checks that every column was filled exactly once over; returns the frame's size in bytes.
   /// Throws std::logic_error otherwise (a bug in the code that fills the frame).
   std::size_t finish() {
+    if (!attributes_) attributes({});
     for (std::size_t k = 0; k < kColumns; ++k)
       if (filled_[k] != layout_.length[k])
         throw std::logic_error("frame writer: column " + std::to_string(k) + " filled with " +
@@ -317,6 +334,7 @@ class FrameWriter {
   std::array<std::size_t, kColumns> filled_{};
   std::uint64_t walls_ = 0;
   std::uint64_t fields_ = 0;
+  bool attributes_ = false;
 };
 
 /// Something that can write a frame: the solver's state (solver/output/simulation_frame.hpp) or

@@ -4,6 +4,8 @@
 // the solver's arrays (a memcpy per column when Real = double), with no intermediate copy and no
 // per-particle arithmetic (the I/O side derives masses from the inverse masses).
 #include <cstdint>
+#include <map>
+#include <string>
 #include <vector>
 
 #include "basalt/io/frame_writer.hpp"
@@ -28,6 +30,7 @@ class SimulationFrame final : public io::FrameSource {
   const Simulation<Real>& sim_;
   io::FrameHeader header_;
   std::vector<io::WallState> walls_;
+  std::map<std::string, std::string> attributes_;  ///< rank 0, checkpoints: the decomposition's cuts
   /// Checkpoints: history of the pair models that keep one ([k] of the k-th such model).
   std::vector<ContactRecords> history_;
   bool with_bonds_ = true;  ///< false for a frame that is only an in-situ picture

@@ -1,7 +1,9 @@
 #pragma once
 // 3-D Cartesian decomposition of space over the compute ranks. The cut planes along each axis split
-// the geometry's bounding box evenly; ranks on the outer faces of the grid own half-infinite regions,
-// so the domain follows particles that leave the initial box (open boundaries).
+// the geometry's bounding box evenly at first; load balancing (parallel/balance.hpp) may move them
+// (per axis, dims - 1 increasing cuts: a weighted grid with the same neighbours). Ranks on the outer
+// faces of the grid own half-infinite regions, so the domain follows particles that leave the
+// initial box (open boundaries).
 #include <mpi.h>
 
 #include <array>
@@ -30,6 +32,11 @@ class Decomposition {
   /// The box the cut planes split (restart rebuilds the same decomposition from it).
   const std::array<double, 3>& box_min() const { return box_min_; }
   const std::array<double, 3>& box_max() const { return box_max_; }
+  /// The dims[d] - 1 interior cut planes along axis d, increasing: region c spans [cut c-1, cut c).
+  const std::vector<double>& cuts(int d) const { return cuts_[d]; }
+  /// Moves the cut planes (every rank must pass the same ones): owners change, so particles must
+  /// migrate afterwards. Throws InputError when an axis has not dims[d] - 1 increasing finite cuts.
+  void set_cuts(const std::array<std::vector<double>, 3>& cuts);
   double lo(int d) const { return lo_[d]; }
   double hi(int d) const { return hi_[d]; }
   /// Grid coordinate along d of the rank owning coordinate v.
@@ -46,6 +53,8 @@ class Decomposition {
   double min_interior_width() const;
 
  private:
+  void set_bounds();  ///< lo_, hi_ of this rank's region from cuts_
+
   MPI_Comm cart_raw_ = MPI_COMM_NULL;
   Comm cart_;
   std::array<int, 3> dims_{1, 1, 1};
@@ -53,6 +62,7 @@ class Decomposition {
   std::array<std::array<int, 2>, 3> nb_{};
   std::array<double, 3> box_min_{}, box_max_{};
   std::array<double, 3> lo_{}, hi_{};
+  std::array<std::vector<double>, 3> cuts_;
   std::vector<int> rank_table_;  ///< rank of grid coordinates (x * dims[1] + y) * dims[2] + z
 };
 

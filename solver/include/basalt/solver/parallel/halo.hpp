@@ -23,9 +23,10 @@ class Halo {
   /// every contact-history record naming them: `history`, one set per pair model, null entries for
   /// models without history) to the neighbour in that direction. Requires no ghosts. Returns an error
   /// message (not thrown: the caller agrees on errors across ranks) when a particle arrives outside its
-  /// new owner's region.
+  /// new owner's region. far (collective: after the cuts moved, parallel/balance.hpp): particles go on
+  /// hop by hop along each axis until every one reaches its owner, however many regions away.
   std::optional<std::string> migrate(Particles<Real>& p, Bonds<Real>& bonds,
-                                     const std::vector<ContactRecords*>& history = {});
+                                     const std::vector<ContactRecords*>& history = {}, bool far = false);
 
   /// Appends as ghosts copies of the neighbours' particles within `width` of this rank's faces and
   /// remembers the lists for update_ghosts(). Requires no ghosts.

@@ -177,6 +177,11 @@ struct Scene {
   bool force_overlap = false;             ///< start even when particles overlap deeply (each other or a wall)
   double dt_safety = 0.2;                 ///< warn when dt > dt_safety * critical step
   std::int64_t energy_check_every = 100;  ///< 0: no energy-growth guard
+  /// run.balance: "none" (the even grid, never moved) or "count" (cuts moved at a rebuild so that each
+  /// slab of the rank grid holds an equal share of the particles: parallel/balance.hpp).
+  std::string balance = "none";
+  /// run.balance_threshold: re-balance at a rebuild when the busiest rank holds more than this x the mean.
+  double balance_threshold = 1.2;
   std::vector<InteractionSpec> bonds;     ///< bond groups, in scene order (a bond's group indexes these)
   std::vector<InteractionSpec> contacts;  ///< pair (contact) groups, in scene order
   std::vector<WallSpec> walls;

@@ -1,0 +1,49 @@
+#pragma once
+// Load balancing by a weighted grid (docs/solver.md, "Load balancing"): the rank grid keeps its 3-D
+// Cartesian neighbours, and along each axis the dims - 1 cut planes move to where the global particle
+// count's marginal along that axis splits evenly. The marginal is a histogram that every rank fills
+// with its owned particles and one reduction sums; the cuts below are then a function of that sum
+// alone, so every rank computes the same ones. Pure: no MPI (the simulation does the reduction).
+#include <algorithm>
+#include <array>
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace basalt::solver {
+
+/// Counts of coordinates along one axis in `bins` equal bins over [lo, hi] (values outside go to the
+/// end bins). Counts are doubles so that one MPI sum adds them exactly (below 2^53 particles).
+struct AxisHistogram {
+  double lo = 0, hi = 0;
+  std::vector<double> counts;
+
+  AxisHistogram(double lo_, double hi_, std::size_t bins) : lo(lo_), hi(hi_), counts(bins, 0.0) {}
+  void add(double v) {
+    const double w = hi - lo;
+    const double f = w > 0 ? (v - lo) / w * double(counts.size()) : 0.0;
+    const auto b = f <= 0 ? std::size_t(0) : std::min(counts.size() - 1, static_cast<std::size_t>(f));
+    counts[b] += 1;
+  }
+};
+
+/// The parts - 1 increasing cut positions that split the histogram's total into `parts` slabs of
+/// (nearly) equal count: cut k where the cumulative count reaches k N / parts, linear within its bin,
+/// so a slab's count is within one bin's count of N / parts. Interior slabs (1 .. parts - 2) are then
+/// widened to at least min_width each (later cuts pushed up: a rank's region must hold its ghost
+/// band); the outer slabs are half-infinite and need no width. An empty histogram gives even cuts.
+std::vector<double> balanced_cuts(const AxisHistogram& h, int parts, double min_width);
+
+/// The largest slab's count when `cuts` split the histogram (each bin counted in the slab of its centre):
+/// how the re-balance judges whether new cuts are worth the migration.
+double largest_slab(const AxisHistogram& h, const std::vector<double>& cuts);
+
+/// The cuts as checkpoint text (attribute decomposition_cuts, docs/formats.md): the three axes separated
+/// by ';', each axis's cuts by ',', in exact decimal (17 digits), e.g. "1.5,3.25;;" for a 3 x 1 x 1 grid.
+std::string cuts_text(const std::vector<double>& x, const std::vector<double>& y,
+                      const std::vector<double>& z);
+/// Reads cuts_text back; nullopt when the text is not three ';'-separated lists of numbers.
+std::optional<std::array<std::vector<double>, 3>> parse_cuts(const std::string& text);
+
+}  // namespace basalt::solver

@@ -1,0 +1,219 @@
+// Load balancing by a weighted grid (parallel/balance.hpp, docs/solver.md "Load balancing"):
+// - the cut choice: on a skewed distribution every slab holds N / parts particles to within one bin's
+//   count, interior slabs keep the minimum width, and the cuts' checkpoint text reads back exactly;
+// - a dense column with one grain far away (the even grid puts nearly everything on one side) at np 2
+//   and 4: the imbalance (max/mean particles per rank) drops below run.balance_threshold, and the run's
+//   kinetic-energy series and final positions agree with the unbalanced run's to 1e-9 relative
+//   (decomposition invariance extended to balanced runs).
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <mpi.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <string>
+
+#include "basalt/solver/core/errors.hpp"
+#include "basalt/solver/parallel/balance.hpp"
+#include "basalt/solver/simulation.hpp"
+#include "solver_helpers.hpp"
+#include "test_support.hpp"
+
+using namespace basalt::solver;
+
+TEST(BalancedCuts, SkewedDistributionSplitsEvenly) {
+  // Coordinates u^3 over [0, 10): most of them near 0 (a skewed marginal, like a collapsed column).
+  constexpr std::size_t kN = 200000;
+  std::vector<double> v(kN);
+  for (std::size_t i = 0; i < kN; ++i) v[i] = 10 * std::pow(basalt::test::hash_unit(i), 3.0);
+  for (const int parts : {2, 3, 4, 7}) {
+    AxisHistogram h(*std::min_element(v.begin(), v.end()), *std::max_element(v.begin(), v.end()), 4096);
+    for (const double x : v) h.add(x);
+    const double largest_bin = *std::max_element(h.counts.begin(), h.counts.end());
+    const auto cuts = balanced_cuts(h, parts, 0.0);
+    ASSERT_EQ(cuts.size(), static_cast<std::size_t>(parts - 1));
+    std::vector<double> slab(static_cast<std::size_t>(parts), 0.0);
+    for (const double x : v)
+      ++slab[static_cast<std::size_t>(std::upper_bound(cuts.begin(), cuts.end(), x) - cuts.begin())];
+    const double target = double(kN) / parts;
+    for (int s = 0; s < parts; ++s)
+      EXPECT_NEAR(slab[static_cast<std::size_t>(s)], target, largest_bin)
+          << parts << " parts, slab " << s << " (the even split's first slab holds "
+          << std::count_if(v.begin(), v.end(), [&](double x) { return x < 10.0 / parts; }) << ")";
+    for (std::size_t k = 1; k < cuts.size(); ++k) EXPECT_GT(cuts[k], cuts[k - 1]);
+  }
+}
+
+TEST(BalancedCuts, InteriorSlabsKeepTheMinimumWidth) {
+  AxisHistogram h(0.0, 10.0, 1000);
+  for (int i = 0; i < 1000; ++i) h.add(0.5 + 1e-3 * i);  // all within [0.5, 1.5)
+  const auto cuts = balanced_cuts(h, 5, 2.0);
+  ASSERT_EQ(cuts.size(), 4u);
+  for (std::size_t k = 1; k < cuts.size(); ++k) EXPECT_GE(cuts[k] - cuts[k - 1], 2.0) << k;
+  EXPECT_NEAR(cuts[0], 0.7, 0.011) << "the first cut still splits off a fifth";
+  const auto even = balanced_cuts(AxisHistogram(0.0, 10.0, 8), 4, 0.0);  // no particles: even cuts
+  EXPECT_EQ(even, (std::vector<double>{2.5, 5.0, 7.5}));
+}
+
+TEST(BalancedCuts, CheckpointTextRoundTripsExactly) {
+  const std::vector<double> x{0.1, 1.0 / 3.0, 2e10}, y{}, z{-7.25};
+  const auto t = cuts_text(x, y, z);
+  const auto back = parse_cuts(t);
+  ASSERT_TRUE(back) << t;
+  EXPECT_EQ((*back)[0], x);
+  EXPECT_EQ((*back)[1], y);
+  EXPECT_EQ((*back)[2], z);
+  EXPECT_EQ(cuts_text({}, {}, {}), ";;");
+  EXPECT_TRUE(parse_cuts(";;"));
+  EXPECT_FALSE(parse_cuts("1,2"));
+  EXPECT_FALSE(parse_cuts("1;x;"));
+  EXPECT_FALSE(parse_cuts("1;;;"));
+}
+
+TEST(BalanceScene, KeysAreReadAndBadValuesNamed) {
+  const std::string run = "[run]\ndt = 1e-3\nsteps = 1\nskin = 0.1\n";
+  const auto s = basalt::test::scene_from(run + "balance = \"count\"\nbalance_threshold = 1.5\n");
+  EXPECT_EQ(s.balance, "count");
+  EXPECT_EQ(s.balance_threshold, 1.5);
+  EXPECT_EQ(basalt::test::scene_from(run).balance, "none") << "off unless asked for";
+  for (const std::string bad : {"balance = \"rcb\"\n", "balance_threshold = 0.9\n"}) {
+    try {
+      (void)basalt::test::scene_from(run + bad);
+      ADD_FAILURE() << bad << " accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(bad.substr(0, bad.find(' '))), std::string::npos) << e.what();
+    }
+  }
+}
+
+namespace {
+
+const std::string kScene = R"(
+[particles]
+rotation = true
+[run]
+dt = 2e-3
+steps = 0
+skin = 0.1
+[[interactions]]
+type = "rot_friction"
+K = 1000.0
+Ks = 500.0
+mu = 0.5
+[[walls]]
+name = "floor"
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
+interaction = "friction"
+K = 1000.0
+Ks = 500.0
+mu = 0.5
+[[walls]]
+name = "back"
+point = [0.0, 0.0, 0.0]
+normal = [1.0, 0.0, 0.0]
+K = 1000.0
+[[body_forces]]
+type = "gravity"
+acceleration = [0.0, 0.0, -1.0]
+[[body_forces]]
+type = "linear_damping"
+viscosity = 0.05
+[[output.fields]]
+type = "kinetic_energy"
+)";
+
+/// A column of 12 x 2 x 10 grains (lattice, jittered radii 0.35-0.5) at x in [0, 12], and one grain resting
+/// on the floor at x = 40: the even grid cuts x at ~20, so one side holds every grain but one.
+basalt::io::Geometry blob_and_grain() {
+  basalt::io::Geometry g;
+  std::int64_t id = 1;
+  for (int k = 0; k < 10; ++k)
+    for (int j = 0; j < 2; ++j)
+      for (int i = 0; i < 12; ++i, ++id) {
+        const auto u = static_cast<std::uint64_t>(id);
+        g.add_particle(id,
+                       {0.5 + i + 0.04 * basalt::test::hash_unit(3 * u + 1),
+                        0.5 + j + 0.04 * basalt::test::hash_unit(3 * u + 2), 0.5 + k},
+                       0.425 + 0.075 * basalt::test::hash_unit(u));
+      }
+  g.add_particle(id, {40.0, 2.0, 0.45}, 0.45);
+  return g;
+}
+
+struct Outcome {
+  std::vector<double> ke;
+  std::vector<double> xyz;  ///< final positions by id (3 per particle, every rank the same)
+  double start = 0, end = 0, before = 0;
+  std::int64_t rebalances = 0;
+};
+
+Outcome run(const std::string& balance, MPI_Comm comm, std::array<int, 3> dims, int steps) {
+  auto scene = basalt::test::scene_from(kScene);
+  scene.balance = balance;
+  scene.balance_threshold = 1.2;
+  const auto g = blob_and_grain();
+  RunOptions opt;
+  opt.dims = dims;
+  opt.quiet = true;
+  Simulation<double> sim(scene, g, comm, opt);
+  Outcome o;
+  o.start = sim.imbalance();
+  o.before = sim.imbalance_before_last_rebalance();
+  basalt::test::MemorySink sink;
+  sink.begin(field_columns(scene));
+  sim.run(steps, &sink);
+  o.ke = sink.column(0);
+  o.end = sim.imbalance();
+  o.rebalances = sim.rebalances();
+  o.xyz.assign(3 * g.size(), 0.0);
+  const auto& p = sim.particles();
+  for (std::size_t i = 0; i < p.n_owned; ++i) {
+    const auto k = 3 * static_cast<std::size_t>(p.id[i] - 1);
+    o.xyz[k] = p.x[i];
+    o.xyz[k + 1] = p.y[i];
+    o.xyz[k + 2] = p.z[i];
+  }
+  MPI_Allreduce(MPI_IN_PLACE, o.xyz.data(), static_cast<int>(o.xyz.size()), MPI_DOUBLE, MPI_SUM, comm);
+  return o;
+}
+
+}  // namespace
+
+TEST(Balance, UnevenSceneIsBalancedAndDecompositionInvariant) {
+  const int n = basalt::test::size();
+  if (n == 1) GTEST_SKIP() << "balancing needs more than one rank";
+  constexpr int kSteps = 600;
+  std::vector<std::array<int, 3>> grids{{0, 0, 0}};
+  if (n == 4) grids.push_back({4, 1, 1});
+  for (const auto& dims : grids) {
+    const auto plain = run("none", basalt::test::world(), dims, kSteps);
+    const auto balanced = run("count", basalt::test::world(), dims, kSteps);
+    if (basalt::test::rank() != 0) continue;
+    const std::string grid = fmt::format("np {} dims {},{},{}", n, dims[0], dims[1], dims[2]);
+    EXPECT_GT(plain.start, 1.2) << grid << ": the even grid must be uneven here";
+    EXPECT_EQ(plain.rebalances, 0) << grid;
+    EXPECT_GE(balanced.rebalances, 1) << grid;
+    EXPECT_DOUBLE_EQ(balanced.before, plain.start)
+        << grid << ": the first re-balance starts from the even grid";
+    EXPECT_LT(balanced.start, 1.2) << grid;
+    EXPECT_LT(balanced.end, 1.2) << grid;
+    ASSERT_EQ(balanced.ke.size(), plain.ke.size());
+    double worst_ke = 0, worst_x = 0;
+    for (std::size_t s = 0; s < plain.ke.size(); ++s)
+      if (plain.ke[s] > 1e-6 * plain.ke.back())
+        worst_ke = std::max(worst_ke, std::abs(balanced.ke[s] - plain.ke[s]) / plain.ke[s]);
+    for (std::size_t k = 0; k < plain.xyz.size(); ++k)
+      worst_x =
+          std::max(worst_x, std::abs(balanced.xyz[k] - plain.xyz[k]) / std::max(1.0, std::abs(plain.xyz[k])));
+    EXPECT_GT(plain.ke.back(), 0.0);
+    EXPECT_LT(worst_ke, 1e-9) << grid;
+    EXPECT_LT(worst_x, 1e-9) << grid;
+    std::printf(
+        "%s: max/mean particles per rank %.3f unbalanced, %.3f -> %.3f balanced at start, %.3f at the end "
+        "(%lld re-balances); KE %.3g, positions %.3g relative\n",
+        grid.c_str(), plain.start, balanced.before, balanced.start, balanced.end,
+        static_cast<long long>(balanced.rebalances), worst_ke, worst_x);
+  }
+}
