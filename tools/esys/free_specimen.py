@@ -6,7 +6,7 @@
     /usr/bin/python3 tools/esys/free_specimen.py --geometry disc.h5 --output out/esys_free [--steps 3000]
 
 The geometry is a Basalt geometry file (basalt-pack's HDF5: particles/id, position, radius; bonds/pairs),
-read here with h5py and handed to ESyS as it is: RotSphere(id, position, radius, mass 4/3 pi r^3), one
+read here with h5py (bonds/pairs hold particle ids) and handed to ESyS as it is: RotSphere(id, position, radius, mass 4/3 pi r^3), one
 TaggedIdConnection per bond (lower id first, as Basalt stores it), tag 0. Physics as scenes/ucs.toml:
   * BrittleBeamPrms(youngsModulus=1e5, poissonsRatio=0.25, cohesion=--cohesion, tanAngle=1,
     meanR_scaling=True, truncated=1, beta1=1, beta2=1) on the bonds;
@@ -63,8 +63,11 @@ def write_particles(geometry, path):
     with open(path, "w") as out:
         for i in range(len(ids)):
             out.write(f"P {int(ids[i])} {pos[i][0]!r} {pos[i][1]!r} {pos[i][2]!r} {rad[i]!r}\n")
-        for a, b in pairs:
-            a, b = int(ids[a]), int(ids[b])  # pairs index the particle arrays
+        known = {int(i) for i in ids}
+        for a, b in pairs:  # particle ids (basalt-geometry schema), lower first
+            a, b = int(a), int(b)
+            if a not in known or b not in known:
+                raise KeyError(f"bonds/pairs: bond {a}-{b} names an unknown particle id")
             out.write(f"B {min(a, b)} {max(a, b)}\n")
     return len(ids), len(pairs)
 
