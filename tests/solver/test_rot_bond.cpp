@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <fstream>
@@ -350,6 +351,76 @@ type = "total_energy"
 
 namespace {
 
+/// A free cluster at rest: 3 x 3 x 3 spheres on a cubic lattice, radii 0.5 and 0.3 alternating (each bond
+/// joins a 0.5 and a 0.3, touching), bonded to their axis neighbours (54 bonds; ids scrambled so bonds are
+/// given in both orders). The scene of scenes/ucs.toml's bonds (BrittleBeam E = 1e5, r0 = r1 + r2) without
+/// damping or contacts. Returns the kinetic energy (with rotation) every 10 steps over 3,000 steps.
+std::vector<double> free_cluster_energy(const char* angles) {
+  Geometry g;
+  const double s = 0.8;
+  const V o{0.37, -1.13, 2.71};
+  const auto id = [](int i, int j, int k) { return std::int64_t(1 + (7 * (9 * i + 3 * j + k)) % 27); };
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      for (int k = 0; k < 3; ++k)
+        g.add_particle(id(i, j, k), {o.x + s * i, o.y + s * j, o.z + s * k}, (i + j + k) % 2 ? 0.3 : 0.5);
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      for (int k = 0; k < 3; ++k) {
+        if (i < 2) g.add_bond(id(i + 1, j, k), id(i, j, k));
+        if (j < 2) g.add_bond(id(i, j, k), id(i, j + 1, k));
+        if (k < 2) g.add_bond(id(i, j, k + 1), id(i, j, k));
+      }
+  g.sort_by_id();
+  const auto scene = basalt::test::scene_from(fmt::format(R"(
+[particles]
+rotation = true
+[run]
+dt = 1e-4
+steps = 0
+skin = 0.05
+energy_check_every = 0
+[[interactions]]
+type = "rot_bond"
+youngs_modulus = 1.0e5
+poissons_ratio = 0.25
+rest_length = "sum_of_radii"
+angles = "{}"
+[output]
+[[output.fields]]
+type = "kinetic_energy"
+every = 10
+)",
+                                                          angles));
+  Simulation<double> sim(scene, g, MPI_COMM_SELF);
+  EXPECT_EQ(sim.bonds().size(), 54u);
+  basalt::test::MemorySink sink;
+  sink.begin(field_columns(scene));
+  for (int k = 0; k < 3000; ++k) sim.step(&sink);
+  return sink.column(0);
+}
+
+}  // namespace
+
+TEST(RotBondRun, FreeClusterAtRestStaysAtRestWithAtan2Angles) {
+  // ESyS's angles (acos of a cosine) read a 1-ulp rounding of the cosine as 1.5e-8 rad: a bond at rest can be
+  // kicked in a rounding-set direction every step and a free specimen gains energy (ESyS-Particle's own
+  // 1,097-sphere disc does: tools/esys/free_specimen.py, docs/validation-rock.md "Energy"). With
+  // angles = "atan2" the same cluster stays at rest to rounding.
+  const auto esys = free_cluster_energy("esys");
+  const auto exact = free_cluster_energy("atan2");
+  const double esys_max = *std::max_element(esys.begin(), esys.end());
+  const double exact_max = *std::max_element(exact.begin(), exact.end());
+  std::printf("free cluster, largest kinetic energy over 3,000 steps: esys angles %.3g, atan2 %.3g\n",
+              esys_max, exact_max);
+  // Measured: atan2 below 2e-23 throughout (5e-8 with esys angles; ESyS-Particle on this cluster, whose
+  // bonds lie on the axes, stays at 1e-23: the esys-angle growth here is not yet explained, so only bounded).
+  EXPECT_LT(exact_max, 1e-20) << "atan2 angles: an unloaded free cluster must stay at rest";
+  EXPECT_LT(esys_max, 1e-6) << "esys angles: more growth than acos rounding explains";
+}
+
+namespace {
+
 /// Two fixed spheres (they move only with the velocities given), bond strengths from the scene; particle 2
 /// moves or turns at a constant rate. Returns the break record, or none.
 std::optional<BrokenBond> drive(const std::string& strengths, V v2, V w2, int steps) {
@@ -511,7 +582,8 @@ rest_length = "sum_of_radii"
     std::printf("%-8s %zu steps: max deviation from ESyS %.3g (relative to each quantity's largest value)\n",
                 c.name, ref.size() - 1, worst);
     // 1e-4: in the pure stretch and gap runs Basalt's spheres pick up a rounding-level spin (4e-7 rad/ms
-    // after 200 steps) where ESyS's stay exactly at 0; every driven quantity agrees to 1e-7
+    // after 200 steps) where ESyS's stay exactly at 0 (Basalt's q^-1 divides by |q|^2, ESyS's is the
+    // conjugate: with the conjugate these runs agree to 2e-9); every driven quantity agrees to 1e-7
     // (docs/reference-runs.md).
     EXPECT_LT(worst, 1e-4) << c.name << ": " << where;
     if (std::string(c.name) == "break") {

@@ -27,6 +27,13 @@
 //   broken when normal > truncated or shear > 1 - normal;
 // criterion = "sum" (LAMMPS bpm/rotational): max(Fn, 0)/Fn_max + Fs/Fs_max + Mb/Mb_max + Mt/Mt_max >= 1.
 // The failure mode recorded is the largest of the four terms (tension, shear, bending, torsion).
+//
+// Angles (angles = "esys", default): gamma = acos(cos gamma), theta = acos(t0 - t2), psi from acos, as ESyS.
+// Near zero acos loses half the digits: a rounding of cos by 1 ulp reads as an angle of sqrt(2 * 1.1e-16)
+// = 1.5e-8 rad, so a bond at rest carries loads of ks r0 1.5e-8 in a direction set by rounding; in a free
+// specimen these kicks pump energy in (docs/validation-rock.md, "Energy"). angles = "atan2" takes the same
+// angles from atan2(|sin|, cos) (gamma = atan2(|rb x D|, rb.D), theta = 2 atan2(sqrt t2, sqrt t0),
+// psi = 2 atan2(r.z, r.w)): equal to acos's up to rounding at every angle, exact near zero.
 #include <array>
 #include <cmath>
 #include <limits>
@@ -62,6 +69,9 @@ struct Quat {
     return {w * o.w - x * o.x - y * o.y - z * o.z, w * o.x + x * o.w + y * o.z - z * o.y,
             w * o.y - x * o.z + y * o.w + z * o.x, w * o.z + x * o.y - y * o.x + z * o.w};
   }
+  /// Divided by |q|^2. ESyS's Quaternion::inverse is the conjugate: the same for unit quaternions, but here
+  /// q^-1 q keeps a rounding-level vector part that acos reads as a 1.5e-8 rad bend on a bond at rest (ESyS:
+  /// exactly none). Kept for now: the conjugate moves chaotic fracture results (docs/validation-rock.md).
   Quat inverse() const {
     const Real n = w * w + x * x + y * y + z * z;
     return {w / n, -x / n, -y / n, -z / n};
@@ -120,6 +130,7 @@ struct RotBond {
       KeyDoc{"beta1", "esys: weight of bending in the normal term, >= 0 (default 1)"},
       KeyDoc{"beta2", "esys: weight of torsion in the shear term, >= 0 (default 1)"},
       KeyDoc{"rest_length", "\"initial_distance\" (default) or \"sum_of_radii\" (ESyS)"},
+      KeyDoc{"angles", "\"esys\" (default: acos, as ESyS) or \"atan2\" (exact for small angles)"},
       KeyDoc{"tags", "[a, b]: bonds between particles tagged a and b (default: all)"},
       KeyDoc{"bond_tag", "the geometry's bond tag this group takes (default: all)"}};
   static constexpr Fields reads = kPosition | kId | kRadius | kOrientation;
@@ -136,6 +147,7 @@ struct RotBond {
     Criterion criterion = Criterion::esys;
     double truncated = 1, beta1 = 1, beta2 = 1;
     RestLength rest_length = RestLength::initial_distance;
+    bool atan2_angles = false;
   };
   template <class Real>
   struct Coeffs {
@@ -144,6 +156,7 @@ struct RotBond {
     Real fn_max, fs_max, mb_max, mt_max;
     bool sum;
     Real truncated, beta1, beta2;
+    bool atan2_angles;
   };
   struct History {};  // rest length: the bond store; reference direction: the particles' initial positions
 
@@ -152,6 +165,7 @@ struct RotBond {
   struct BondCoeffs {
     Real kn, ks, kb, kt;
     Real ifn, ifs, imb, imt;  ///< 1 / strength (0: never)
+    bool atan2_angles = false;
   };
 
   static Params parse(TableReader& t) {
@@ -193,6 +207,7 @@ struct RotBond {
         t.choice_or("rest_length", {"initial_distance", "sum_of_radii"}, "initial_distance") == "sum_of_radii"
             ? RestLength::sum_of_radii
             : RestLength::initial_distance;
+    p.atan2_angles = t.choice_or("angles", {"esys", "atan2"}, "esys") == "atan2";
     return p;
   }
   template <class Real>
@@ -210,7 +225,8 @@ struct RotBond {
             p.criterion == Criterion::sum,
             Real(p.truncated),
             Real(p.beta1),
-            Real(p.beta2)};
+            Real(p.beta2),
+            p.atan2_angles};
   }
   /// The stiffest spring (critical step): kn, or with scaling kn at the largest bond (R = rmax, L = 2 rmax);
   /// the shear spring adds to it in the network.
@@ -231,11 +247,12 @@ struct RotBond {
   static BondCoeffs<Real> bond_coeffs(const Coeffs<Real>& c, Real L, Real r1, Real r2) {
     const auto inv = [](Real s) { return std::isfinite(s) ? Real(1) / s : Real(0); };
     if (!c.scaled)
-      return {c.kn, c.ks, c.kb, c.kt, inv(c.fn_max), inv(c.fs_max), inv(c.mb_max), inv(c.mt_max)};
+      return {c.kn,          c.ks,          c.kb,          c.kt,          inv(c.fn_max),
+              inv(c.fs_max), inv(c.mb_max), inv(c.mt_max), c.atan2_angles};
     const Real R = c.mean_radius ? Real(0.5) * L : std::min(r1, r2);
     const Real A = R * R, J = Real(0.5) * A * A, I = Real(0.5) * J;
-    return {c.kn * A / L,      c.ks * A / L,      c.kb * I / L,          c.kt * J / L,
-            inv(c.fn_max * A), inv(c.fs_max * A), inv(c.mb_max * I / R), inv(c.mt_max * J / R)};
+    return {c.kn * A / L,      c.ks * A / L,          c.kb * I / L,          c.kt * J / L,  inv(c.fn_max * A),
+            inv(c.fs_max * A), inv(c.mb_max * I / R), inv(c.mt_max * J / R), c.atan2_angles};
   }
 
   /// What the bond sees: particle 1 and 2 (the bond's ends a, b).
@@ -266,7 +283,9 @@ struct RotBond {
     const V fr = rb * (k.kn * (nb - r0) / nb);
     // Shear from the turn of the line of centres away from D, in 1's frame.
     const Real gc = rb.dot(g.d) / (nb * g.d.norm());
-    const Real gamma = (gc < Real(1) && gc > Real(-1)) ? std::acos(gc) : Real(0);
+    const Real gamma = k.atan2_angles                    ? std::atan2(rb.cross(g.d).norm(), rb.dot(g.d))
+                       : (gc < Real(1) && gc > Real(-1)) ? std::acos(gc)
+                                                         : Real(0);
     const V c0 = rb.cross(g.d), c1 = rb.cross(c0);
     const Real n0 = c0.norm(), n1 = c1.norm();
     const V fst = n1 != Real(0) ? c1 * (k.ks * r0 * gamma / n1) : V{};
@@ -284,13 +303,15 @@ struct RotBond {
     Real psi = 0;
     if (t0 != Real(0)) {
       const Real st = std::sqrt(t0);
-      psi = 2 * beam::signed_angle(r.z / st, r.w / st);
+      psi = k.atan2_angles ? 2 * std::atan2(r.z, r.w) : 2 * beam::signed_angle(r.z / st, r.w / st);
     }
     const V mtr = qm.to_world(V{0, 0, k.kt * psi});
     V mbr{}, fsr{}, msr{};
     if (t2 != Real(0)) {
       const Real t1 = t0 - t2;
-      const Real theta = (t1 >= Real(1) || t1 <= Real(-1)) ? Real(0) : std::acos(t1);
+      const Real theta = k.atan2_angles                      ? 2 * std::atan2(std::sqrt(t2), std::sqrt(t0))
+                         : (t1 >= Real(1) || t1 <= Real(-1)) ? Real(0)
+                                                             : std::acos(t1);
       Real cf, sf;
       if (t0 == Real(0)) {
         const Real q = std::sqrt(t2);
