@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 
 namespace basalt::solver {
 
@@ -29,7 +30,13 @@ std::vector<double> balanced_cuts(const AxisHistogram& h, int parts, double min_
   }
   // Strictly increasing, interior slabs at least min_width wide.
   const double gap = std::max(min_width, 1e-12 * std::max({1.0, std::abs(h.lo), std::abs(h.hi)}));
-  for (std::size_t k = 1; k < cuts.size(); ++k) cuts[k] = std::max(cuts[k], cuts[k - 1] + gap);
+  // cuts[k - 1] + gap can round so that the difference is an ulp short of gap (seen at -O1 without
+  // -march=native): step up until the width, as later code computes it, is at least gap.
+  for (std::size_t k = 1; k < cuts.size(); ++k) {
+    cuts[k] = std::max(cuts[k], cuts[k - 1] + gap);
+    while (cuts[k] - cuts[k - 1] < gap)
+      cuts[k] = std::nextafter(cuts[k], std::numeric_limits<double>::infinity());
+  }
   return cuts;
 }
 
