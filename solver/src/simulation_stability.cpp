@@ -10,6 +10,7 @@
 #include <numbers>
 
 #include "basalt/solver/core/errors.hpp"
+#include "basalt/solver/integrate/integrators.hpp"
 #include "basalt/solver/simulation.hpp"
 #include "basalt/solver/stability/critical_step.hpp"
 
@@ -106,10 +107,10 @@ void Simulation<Real>::estimate_critical_step(bool fresh) {
   st.dt_bound = stability::critical_step(bound2);
 
   // Power iterations on M^-1 K, each product K u from the force field, K u = (F(x) - F(x + delta u)) /
-  // delta: F(x) is computed again for each product and negated in the force arrays, where F(x + delta u)
-  // then adds onto it, so no forces are stored (two evaluations per product; central differences,
-  // at the same cost, would drop the O(delta) bias, ~1e-7 here, far below the tolerance, but move the
-  // printed estimates' last digits). The iteration vector is kept in float in the float positions of
+  // delta: F(x), computed once and kept (3 values per owned particle while the estimate runs), is
+  // negated into the force arrays, where F(x + delta u) then adds onto it: one evaluation per product
+  // (central differences, at twice the cost, would drop the O(delta) bias, ~1e-7 here, far below the
+  // tolerance, but move the printed estimates' last digits). The iteration vector is kept in float in the float positions of
   // the last rebuild (p_.x0, equal to float(x) right after it; restored at the end) or, after a
   // restart (x0 then belongs to the checkpoint's rebuild), in a float scratch vector. The positions
   // are not copied: each perturbation is a multiple of the ulp of its coordinate and stays within its
@@ -153,8 +154,14 @@ void Simulation<Real>::estimate_critical_step(bool fresh) {
         breakable ? p_.bonds_broken : std::vector<std::int32_t>{};
     const std::size_t broken_at_start = broken_.size();
     const bool bond_broke_at_start = bond_broke_;
-    compute_forces<false>();  // also F(x) for the first product
+    compute_forces<false>();
+    // F(x) once for all products (120 force evaluations became 61: half the start-up of a large run,
+    // docs/BENCHMARKS.md). Bonds beyond their break strain broke in that evaluation, and a model whose
+    // breaking bond still acts then (rot_bond) put its force in: F(x) again without them.
+    if (broken_.size() != broken_at_start) compute_forces<false>();
     const std::size_t broken_before = broken_.size();
+    std::vector<Real> f_at_x(3 * n);
+    for (int d = 0; d < 3; ++d) std::copy(frc[d], frc[d] + n, f_at_x.begin() + std::ptrdiff_t(d * n));
     std::vector<double> sums(2);
     double vmax = 0;
     for (int it = 0; it < stability::kMaxIterations; ++it) {
@@ -163,9 +170,9 @@ void Simulation<Real>::estimate_critical_step(bool fresh) {
         for (std::size_t i = 0; i < n; ++i) vmax = std::max(vmax, double(std::abs(sv[d][i])));
       vmax = comm().max(vmax);
       if (!(vmax > 0) || !std::isfinite(vmax)) break;
-      if (it > 0) compute_forces<false>();  // F(x) (the first one is above)
+      zero_forces(p_);  // ghosts' forces and the torques too
       for (int d = 0; d < 3; ++d)
-        for (std::size_t i = 0; i < n; ++i) frc[d][i] = -frc[d][i];
+        for (std::size_t i = 0; i < n; ++i) frc[d][i] = -f_at_x[d * n + i];
       forces_zeroed_ = true;  // the next evaluation adds F(x + d) onto -F(x)
       // x + d: delta v / vmax, rounded to a multiple of the coordinate's ulp where it is movable.
       for (std::size_t i = 0, k = 0; i < n; ++i)
