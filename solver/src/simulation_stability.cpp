@@ -110,9 +110,9 @@ void Simulation<Real>::estimate_critical_step(bool fresh) {
   // delta: F(x), computed once and kept (3 values per owned particle while the estimate runs), is
   // negated into the force arrays, where F(x + delta u) then adds onto it: one evaluation per product
   // (central differences, at twice the cost, would drop the O(delta) bias, ~1e-7 here, far below the
-  // tolerance, but move the printed estimates' last digits). The iteration vector is kept in float in the float positions of
-  // the last rebuild (p_.x0, equal to float(x) right after it; restored at the end) or, after a
-  // restart (x0 then belongs to the checkpoint's rebuild), in a float scratch vector. The positions
+  // tolerance, but move the printed estimates' last digits). The iteration vector is kept in float in the
+  // float positions of the last rebuild (p_.x0, equal to float(x) right after it; restored at the end) or,
+  // after a restart (x0 then belongs to the checkpoint's rebuild), in a float scratch vector. The positions
   // are not copied: each perturbation is a multiple of the ulp of its coordinate and stays within its
   // binade, so x -> x + d -> x is exact (the few coordinates near zero or a power of two, where that
   // fails, are kept in a side list). The products need the ghosts' perturbed positions: a ghost update per
