@@ -263,7 +263,7 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
         ckpt ? fmt::format(", continuing from step {} ({})", ckpt->step, ckpt_file.string()) : std::string());
     if (st.dt_critical > 0) {
       fmt::print(
-          "critical step: {:.4g} {} (2/omega_max, {} power iterations on the network: {:.4g}; one new "
+          "critical step: {:.4g} {} (2/omega_max, {} Lanczos iterations on the network: {:.4g}; one new "
           "contact "
           "of the lightest particle: {:.4g}); bound {:.4g} (omega^2 <= max_i 2 sum_j k_ij / m_i); former "
           "estimate 2 sqrt(m_min/k_max) = {:.4g} (m_min = {:.4g}, k_max = {:.4g})\n",
