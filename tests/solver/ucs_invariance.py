@@ -50,13 +50,14 @@ BASE = {
 }
 
 
-# Tolerances per law and quantity (relative), each about twice what was measured on this specimen
-# (docs/validation-rock.md, "Invariance laws"): strength law UCS 1.9 %, modulus 1.9 %; stiffness law UCS
-# 1.3 %, modulus 0.1 %, strain at the peak 2.6 %; rate law (0.02 -> 0.01 mm/ms) UCS 3.1 %, modulus 0.2 %,
-# strain at the peak 4.1 %, curve up to 90 % of the peak strain 0.5 % of the UCS.
+# Tolerances per law and quantity (relative), measured on this specimen (docs/validation-rock.md,
+# "Invariance laws"): strength law UCS 1.9 %, modulus 0.1 %; stiffness law UCS 0.06 %, modulus 0.2 %, strain
+# at the peak 0.3 %; rate law (0.02 -> 0.01 mm/ms) UCS 3.1 %, modulus 0.2 %, strain at the peak 4.1 %, curve
+# up to 90 % of the peak strain 0.5 % of the UCS. Each tolerance sits above its measurement and below what
+# the law's control gives (33 % on the UCS; 9.7 % on the modulus; 68 % on the modulus, 24 % on the curve).
 TOL = {
-    "strength": {"ucs": 0.05, "E": 0.05},
-    "stiffness": {"ucs": 0.05, "E": 0.02, "strain": 0.06},
+    "strength": {"ucs": 0.05, "E": 0.02},
+    "stiffness": {"ucs": 0.03, "E": 0.02, "strain": 0.03},
     "rate": {"ucs": 0.06, "E": 0.02, "strain": 0.08, "curve": 0.02},
 }
 
