@@ -88,7 +88,7 @@ inline void half_turn(Real w2, Real dt, Real& c, Real& s) {
 
 /// Rotation (with_rotation), the twin of kick_zero_drift: w += h T / I (I = 2/5 m r^2: a sphere needs
 /// no gyroscopic term), torques zeroed, then the orientation turned by the angle |w| dt about w (an
-/// exact rotation for the step's constant w, so the quaternion stays of unit length to rounding).
+/// exact rotation for the step's constant w) and brought back to unit length (ESyS's rescale).
 template <class Real>
 void rotate_kick_zero_drift(Particles<Real>& p, Real h, Real dt) {
   const std::size_t n = p.n_owned;
@@ -123,6 +123,16 @@ void rotate_kick_zero_drift(Particles<Real>& p, Real h, Real dt) {
     qxs[i] = c * qx + ax * qw + ay * qz - az * qy;
     qys[i] = c * qy + ay * qw + az * qx - ax * qz;
     qzs[i] = c * qz + az * qw + ax * qy - ay * qx;
+    // Back to unit length, as ESyS-Particle after every step (CRotParticle::rescale: q times 1/|q|). The
+    // turn keeps |q| to rounding per step, but the roundings add up (|q|^2 - 1 reached 6e-14 in 3,000
+    // steps), and rot_bond's ESyS angles read a norm defect e as a bend of sqrt(2 e): 1e-7 rad, a kick on
+    // every bond that pumped energy into a free specimen 5x faster than ESyS (docs/validation-rock.md).
+    const Real nw = qws[i], nx = qxs[i], ny = qys[i], nz = qzs[i];
+    const Real inv = Real(1) / std::sqrt(nw * nw + nx * nx + ny * ny + nz * nz);
+    qws[i] = nw * inv;
+    qxs[i] = nx * inv;
+    qys[i] = ny * inv;
+    qzs[i] = nz * inv;
   }
 }
 

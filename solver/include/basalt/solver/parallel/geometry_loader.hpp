@@ -40,8 +40,9 @@ struct LoadStats {
 
 class GeometryLoader {
  public:
-  /// Collective: reads this rank's slice of the particle rows and reduces the extent. A bad file is an
-  /// InputError (naming the file and dataset) on every rank alike.
+  /// Collective: reads this rank's slice of the particle rows and of the bond rows (slice().bonds: what
+  /// the load checks summarise, bond tags included) and reduces the extent. A bad file is an InputError
+  /// (naming the file and dataset) on every rank alike.
   GeometryLoader(const io::GeometryFile& file, const Comm& comm);
   const io::Geometry& slice() const { return slice_; }
   const GeometryExtent& extent() const { return extent_; }
