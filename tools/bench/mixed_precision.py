@@ -41,10 +41,11 @@ def run(build, work, geo, tag, precision, env, steps, fraction=None):
         raise SystemExit(f"{tag}: {r.stderr.strip()[-300:]}")
     cpu = float(re.search(r"cpu time of the loop: ([0-9.]+) s", r.stdout).group(1))
     bpp = int(re.search(r"= (\d+) B/particle", r.stdout).group(1))
+    solver = float(re.search(r"solver arrays: [0-9.]+ MB \(([0-9.]+) bytes per particle\)", r.stdout).group(1))
     rows = (out / "fields.csv").read_text().split("\n")
     col = rows[0].split(",").index("kinetic_energy")
     ke = [float(line.split(",")[col]) for line in rows[1:] if line]
-    return cpu, bpp, ke
+    return cpu, f"{bpp} / {solver:.0f}", ke
 
 
 def l2(ke, ref):
@@ -71,7 +72,7 @@ def main():
         subprocess.run(["/usr/bin/python3", str(ROOT / "tools" / "bench" / "wave_tile_geo.py"), str(cube), "2",
                         str(tiled)], check=True)
     cases = [(c, {"15": cube, "30": tiled}[c]) for c in a.cases.split(",")]
-    print("| case | setting | loop CPU (s), median (range) | speed-up vs double (median) | B/particle | "
+    print("| case | setting | loop CPU (s), median (range) | speed-up vs double (median) | B/particle: fields / solver | "
           "KE L2 rel. vs double |")
     print("| --- | --- | ---: | ---: | ---: | ---: |")
     for case, geo in cases:
