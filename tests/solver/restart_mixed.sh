@@ -23,6 +23,13 @@ if ! h5dump -a /precision "$dir/b/$ckpt" 2>/dev/null | grep -q '"mixed"'; then
   echo "FAIL: the checkpoint's precision attribute is not \"mixed\""
   exit 1
 fi
+# Positions and the wall are absolute in the checkpoint (origin + float offset), not in the run's frame.
+x=$(h5dump -m '%.17g' -d /particles/position -s '0,0' -c '1,1' "$dir/b/$ckpt" | sed -n 's/.*(0,0): *\([-0-9.e+]*\).*/\1/p')
+w=$(h5dump -m '%.17g' -d /walls/base/position "$dir/b/$ckpt" | sed -n 's/.*(0): *\([-0-9.e+]*\).*/\1/p')
+if ! awk -v x="$x" -v w="$w" -v d="$d" 'BEGIN { exit !(x > d - 1 && x < d + 16 && w == d) }'; then
+  echo "FAIL: the checkpoint's first position ($x) or wall x ($w) is not absolute (offset $d)"
+  exit 1
+fi
 if $launch "$run" "$dir/wave.toml" --geometry "$dir/cube.geo" --precision float --steps 10 --output "$dir/c" --restart "$dir/b" --quiet >"$dir/refused.txt" 2>&1; then
   echo "FAIL: a restart of a mixed checkpoint in float was not refused"
   exit 1
