@@ -11,8 +11,10 @@
 #include <string>
 #include <vector>
 
+#include "basalt/io/frame.hpp"
 #include "basalt/solver/core/errors.hpp"
 #include "basalt/solver/integrate/integrators.hpp"
+#include "basalt/solver/output/simulation_frame.hpp"
 #include "basalt/solver/simulation.hpp"
 #include "solver_helpers.hpp"
 #include "test_support.hpp"
@@ -156,4 +158,50 @@ TEST(MixedPrecision, FarGeometryIsNotRefused) {
   EXPECT_NO_THROW(Simulation<float>(wave_scene(1e9), shifted(cube1(), 1e9), basalt::test::world(), opt));
   EXPECT_THROW(Simulation<float>(wave_scene(1e9, "float"), shifted(cube1(), 1e9), basalt::test::world(), opt),
                InputError);
+}
+
+// A checkpoint frame (as the I/O ranks read it) holds absolute coordinates: positions and positions at the
+// rebuild = origin + float offset, the wall's point; and the exact float offsets and the drift's
+// remainders as particle fields, which a restart reads back.
+TEST(MixedPrecision, FramesAreAbsoluteAndCarryTheExactOffsets) {
+  constexpr double d = 1e6;
+  RunOptions opt;
+  opt.quiet = true;
+  Scene scene = wave_scene(d);
+  scene.checkpoint_every = 100;  // positions at the rebuild are kept for checkpoints only
+  Simulation<float> sim(scene, shifted(cube1(), d), basalt::test::world(), opt);
+  sim.run(30);
+  std::vector<std::byte> bytes;
+  basalt::io::serialize(SimulationFrame<float>(sim, basalt::io::kFrameCheckpoint), bytes);
+  const auto q = basalt::io::deserialize(bytes);
+  const auto& p = sim.particles();
+  const auto& o = sim.origin();
+  ASSERT_EQ(q.size(), p.n_owned);
+  ASSERT_EQ(q.position_at_rebuild.size(), p.n_owned);
+  const auto field = [&](const std::string& name) -> const std::vector<double>* {
+    for (const auto& [n, v] : q.fields)
+      if (n == name) return &v;
+    return nullptr;
+  };
+  const std::vector<double>* exact[6];
+  for (std::size_t k = 0; k < 6; ++k) {
+    exact[k] = field(kFramePositionFields[k]);
+    ASSERT_NE(exact[k], nullptr) << kFramePositionFields[k];
+  }
+  ASSERT_NE(field("position_remainder_x"), nullptr);
+  std::size_t wrong = 0;
+  for (std::size_t i = 0; i < p.n_owned; ++i) {
+    const float x[3] = {p.x[i], p.y[i], p.z[i]}, xr[3] = {p.xr[i], p.yr[i], p.zr[i]};
+    for (std::size_t k = 0; k < 3; ++k)
+      wrong += q.position[i][k] != o[k] + double(x[k]) ||
+               q.position_at_rebuild[i][k] != o[k] + double(xr[k]) || (*exact[k])[i] != double(x[k]) ||
+               (*exact[k + 3])[i] != double(xr[k]);
+  }
+  EXPECT_EQ(wrong, 0u);
+  if (basalt::test::rank() == 0) {
+    ASSERT_EQ(q.walls.size(), 1u);
+    EXPECT_EQ(q.walls[0].position[0], d);
+    EXPECT_NEAR(q.walls[0].position[2], d, 0.01);
+    EXPECT_GT(q.walls[0].position[2], d) << "the pulse has moved the wall up";
+  }
 }
