@@ -397,8 +397,9 @@ int run_world(int argc, char** argv) {
                  "(double, 0.25), reference (double, 0.05); overrides run.dt, run.dt_fraction, run.precision")
       ->check(CLI::IsMember({"fast", "balanced", "reference"}));
   app.add_option("--precision", cli.precision,
-                 "floating-point type of the solver: double or float; overrides run.precision")
-      ->check(CLI::IsMember({"double", "float"}));
+                 "floating-point type of the solver: double, float or mixed (float offsets from the "
+                 "geometry's centre, compensated drift); overrides run.precision")
+      ->check(CLI::IsMember({"double", "float", "mixed"}));
   app.add_option(
          "--balance", cli.balance,
          "load balancing of the rank grid: none (even cuts) or count (cuts moved at rebuilds by particle "
@@ -537,7 +538,7 @@ int run_world(int argc, char** argv) {
     const auto report = server.run();
     return report.error && !cfg.continue_on_error ? 1 : 0;
   }
-  if (scene.precision == "float")
+  if (scene.precision == "float" || scene.precision == "mixed")
     return run_compute<float>(cli, scene, layout, cfg, vtk, ckpt ? &*ckpt : nullptr, ckpt_file);
   return run_compute<double>(cli, scene, layout, cfg, vtk, ckpt ? &*ckpt : nullptr, ckpt_file);
 }

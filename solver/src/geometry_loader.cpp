@@ -129,6 +129,15 @@ int GeometryLoader::slice_of(std::int64_t id) const {
   return found;
 }
 
+void GeometryLoader::to_frame(const std::array<double, 3>& o) {
+  for (auto& x : slice_.position)
+    for (std::size_t d = 0; d < 3; ++d) x[d] -= o[d];
+  for (std::size_t d = 0; d < 3; ++d) {
+    extent_.lo[d] -= o[d];
+    extent_.hi[d] -= o[d];
+  }
+}
+
 io::Geometry GeometryLoader::local_part(const Decomposition& dec) {
   const auto p = static_cast<std::size_t>(comm_.size());
   const bool has_mass = file_.header().has_mass;

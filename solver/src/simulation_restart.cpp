@@ -21,6 +21,10 @@ Simulation<Real>::Simulation(const Scene& scene, const io::Checkpoint& c, const 
                              MPI_Comm comm, const RunOptions& options)
     : scene_(scene), options_(options), forces_(scene) {
   configure_particles();
+  if (mixed_) {  // the frame of the run that wrote the checkpoint (frame_origin.hpp)
+    origin_ = layout.origin;
+    enter_frame();
+  }
   if (c.size() == 0) throw InputError("the checkpoint has no particles");
   if (scene.bonds.size() > 254) throw InputError("interactions: at most 254 bond groups");
   if (scene.dt_fraction > 0) scene_.dt = c.dt;  // the run's dt (a fraction of the critical step at its start)
@@ -31,8 +35,9 @@ Simulation<Real>::Simulation(const Scene& scene, const io::Checkpoint& c, const 
   kick1_ = Real(se ? scene_.dt : scene_.dt / 2);
   kick2_ = Real(se ? 0.0 : scene_.dt / 2);
   rebuild_limit2_ = 0.25 * scene.skin * scene.skin;
-  const auto summary = summarize_geometry(scene, c.geometry, "the checkpoint");
-  run_load_checks(scene, summary, "the checkpoint", comm, kEpsilon, kPrecision);
+  auto summary = summarize_geometry(scene_, c.geometry, "the checkpoint");
+  if (mixed_) summary.xmax = frame_xmax(CheckpointFrame(c, origin_), c.size());
+  run_load_checks(scene_, summary, "the checkpoint", comm, kEpsilon, precision_name());
   check_stability(summary);
   distribute_checkpoint(c, layout, comm);
   restore_servos(c, !c.position_at_rebuild.empty());
@@ -82,11 +87,12 @@ void Simulation<Real>::distribute_checkpoint(const io::Checkpoint& c, const Rest
         dec_->min_interior_width(), ghost_width_, dec_->dims()[0], dec_->dims()[1], dec_->dims()[2]));
   // Particles go where the last rebuild's migration put them: by their positions at that rebuild
   // (replay_rebuild restores the current ones), or by the current ones for an old checkpoint.
-  const auto& at = c.position_at_rebuild.empty() ? g.position : c.position_at_rebuild;
+  const bool at_rebuild = !c.position_at_rebuild.empty();
+  const CheckpointFrame frame(c, origin_);  // positions in the run's frame (mixed precision)
   std::vector<char> owned(g.size(), 0);
   std::vector<std::size_t> mine;  // geometry index of each owned particle, in local order
   for (std::size_t i = 0; i < g.size(); ++i) {
-    const auto& x = at[i];
+    const auto x = frame.position(i, at_rebuild);
     if (!dec_->owns(x[0], x[1], x[2])) continue;
     owned[i] = 1;
     mine.push_back(i);
@@ -106,7 +112,7 @@ void Simulation<Real>::distribute_checkpoint(const io::Checkpoint& c, const Rest
     // Where it broke: the checkpoint's row for it among its broken bonds (NaN when it has none).
     const io::Vec3 where = c.bond_broken[k] == 0 || c.bond_break_position.empty()
                                ? io::Vec3{unknown, unknown, unknown}
-                               : c.bond_break_position[nb];
+                               : frame.point(c.bond_break_position[nb]);
     nb += c.bond_broken[k] != 0 ? 1 : 0;
     const auto ia = static_cast<std::size_t>(g.index_of(b.a)), ib = static_cast<std::size_t>(g.index_of(b.b));
     const int state = c.bond_broken[k] & 3;
@@ -219,8 +225,9 @@ void Simulation<Real>::replay_rebuild(const io::Checkpoint& c) {
   step_ = now;
   restore_servos(c, false);  // from where the rebuild saw them to where the checkpoint has them
   // Back to the checkpoint's positions; the ghosts follow as after any step without a rebuild.
+  const CheckpointFrame frame(c, origin_);  // positions in the run's frame (mixed precision)
   for (std::size_t i = 0; i < p_.n_owned; ++i) {
-    const auto& x = g.position[static_cast<std::size_t>(g.index_of(p_.id[i]))];
+    const auto x = frame.position(static_cast<std::size_t>(g.index_of(p_.id[i])), false);
     p_.x[i] = Real(x[0]);
     p_.y[i] = Real(x[1]);
     p_.z[i] = Real(x[2]);
@@ -245,9 +252,10 @@ void Simulation<Real>::restore_servos(const io::Checkpoint& c, bool at_rebuild) 
     if (!st || (at_rebuild && st->motion_state.size() != 3))
       throw InputError(fmt::format("the checkpoint has no servo state for wall \"{}\" (/walls/{}{})",
                                    walls.spec(w).name, walls.spec(w).name, st ? "/motion_state" : ""));
-    const auto& x = at_rebuild
-                        ? std::array<double, 3>{st->motion_state[0], st->motion_state[1], st->motion_state[2]}
-                        : st->position;
+    const auto x = CheckpointFrame(c, origin_)
+                       .point(at_rebuild ? std::array<double, 3>{st->motion_state[0], st->motion_state[1],
+                                                                 st->motion_state[2]}
+                                         : st->position);
     walls.restore_servo(w, x, st->velocity);
   }
 }
