@@ -2,6 +2,7 @@
 #include "basalt/solver/output/simulation_frame.hpp"
 
 #include <algorithm>
+#include <array>
 #include <span>
 #include <vector>
 
@@ -45,8 +46,11 @@ SimulationFrame<Real>::SimulationFrame(const Simulation<Real>& sim, std::uint32_
         h.contacts += history_.back().size();
         h.contact_width = std::max(h.contact_width, static_cast<std::uint32_t>(history_.back().width));
       }
-  // The scene's optional particle fields that frames carry (Particles' array list).
+  // The scene's optional particle fields that frames carry (Particles' array list); checkpoints of
+  // velocity Verlet with velocity-dependent forces add the forces (simulation_kick_forces.cpp).
   p.for_each_array([&](const ArrayInfo& a, const auto&) { h.fields += !a.output.empty() && p.enabled(a); });
+  if ((kinds & io::kFrameCheckpoint) && sim.checkpoints_forces()) kick_forces_ = p.with_rotation ? 6 : 3;
+  h.fields += kick_forces_;
   // Walls: global; the force is summed over the ranks (collective), rank 0 carries them.
   // Mesh walls follow the planar ones (so a checkpoint's wall count covers their history ids, -1 -
   // (planar walls + k)): position = where the rotation axis passes, normal = the axis, velocity = the
@@ -166,6 +170,8 @@ void SimulationFrame<Real>::write(io::FrameWriter& w) const {
   p.for_each_array([&](const ArrayInfo& a, const auto& v) {
     if (!a.output.empty() && p.enabled(a)) w.field(a.output, std::span(v.data(), n));
   });
+  const std::array<const std::vector<Real>*, 6> forces{&p.fx, &p.fy, &p.fz, &p.tx, &p.ty, &p.tz};
+  for (std::size_t k = 0; k < kick_forces_; ++k) w.field(kick_force_fields[k], owned(*forces[k]));
   w.attributes(attributes_);
 }
 

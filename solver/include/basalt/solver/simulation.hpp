@@ -9,6 +9,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -233,6 +234,14 @@ class Simulation {
   /// Restart: the optional particle fields the checkpoint stores (by name), for the owned particles
   /// (`mine`: their geometry indices in local order); bond damage counters adjusted for the replay.
   void restore_particle_fields(const io::Checkpoint& c, const std::vector<std::size_t>& mine, bool replay);
+  /// Whether checkpoints store the last step's forces and torques (kick_force_fields): velocity Verlet
+  /// with a model reading velocities. The next step's first half-kick takes them, and they were
+  /// computed from the half-step velocities, which a checkpoint does not hold: a restart recomputing
+  /// them from the full-step velocities would not continue bit for bit (simulation_kick_forces.cpp).
+  bool checkpoints_forces() const;
+  /// Restart, after the start's force computation: the forces and torques the checkpoint stores, by id;
+  /// a warning (rank 0) when it has none (then the continuation agrees to rounding only).
+  void restore_kick_forces(const io::Checkpoint& c);
   /// Restart: the lists of the uninterrupted run's last rebuild (see the restart constructor).
   void replay_rebuild(const io::Checkpoint& c);
   /// Restart: servo walls' point and velocity from the checkpoint (at_rebuild: their point at the last
@@ -292,6 +301,11 @@ class Simulation {
   double imbalance_before_ = 1;
   bool balance_paused_ = false;  ///< a restart replaying a rebuild with the checkpoint's own cuts
 };
+
+/// The checkpoint's particle fields of Simulation::checkpoints_forces(): force, then (with rotation)
+/// torque, /particles/<name> float64 (N).
+inline constexpr std::array<std::string_view, 6> kick_force_fields{"force_x",  "force_y",  "force_z",
+                                                                   "torque_x", "torque_y", "torque_z"};
 
 extern template class Simulation<double>;
 extern template class Simulation<float>;
