@@ -46,10 +46,10 @@ SimulationFrame<Real>::SimulationFrame(const Simulation<Real>& sim, std::uint32_
         h.contacts += history_.back().size();
         h.contact_width = std::max(h.contact_width, static_cast<std::uint32_t>(history_.back().width));
       }
-  // The scene's optional particle fields that frames carry (Particles' array list); checkpoints of
-  // velocity Verlet with velocity-dependent forces add the forces (simulation_kick_forces.cpp).
+  // The scene's optional particle fields that frames carry (Particles' array list); checkpoints add the
+  // forces and torques, for a restart's first kick (simulation_kick_forces.cpp).
   p.for_each_array([&](const ArrayInfo& a, const auto&) { h.fields += !a.output.empty() && p.enabled(a); });
-  if ((kinds & io::kFrameCheckpoint) && sim.checkpoints_forces()) kick_forces_ = p.with_rotation ? 6 : 3;
+  if (kinds & io::kFrameCheckpoint) kick_forces_ = p.with_rotation ? 6 : 3;
   h.fields += kick_forces_;
   // Walls: global; the force is summed over the ranks (collective), rank 0 carries them.
   // Mesh walls follow the planar ones (so a checkpoint's wall count covers their history ids, -1 -

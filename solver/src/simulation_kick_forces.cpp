@@ -1,10 +1,15 @@
-// The last step's forces and torques through a checkpoint, for velocity Verlet's first half-kick.
-// A step kicks by F_n dt/2, drifts, computes F_{n+1} and kicks by F_{n+1} dt/2; a model reading
-// velocities (damping, dashpots) computes F_{n+1} from the half-step velocities v_{n+1/2}. A checkpoint
-// holds v_{n+1}, so the force a restart computes at its start differs from F_{n+1} in the last bits
-// (symplectic Euler has no second kick: there the velocities are those the forces saw, and a restart
-// recomputes them exactly). Checkpoints of such scenes therefore store the forces and torques, and a
-// restart takes them for its first kick: the continuation is bit for bit (issue #11).
+// The last step's forces and torques through a checkpoint: a restart's first kick takes them instead of
+// forces it recomputes. A recomputation need not give the uninterrupted run's bits:
+// - velocity Verlet kicks by F_n dt/2, drifts, computes F_{n+1} and kicks by F_{n+1} dt/2; a model
+//   reading velocities (damping, dashpots) computes F_{n+1} from the half-step velocities v_{n+1/2},
+//   while a checkpoint holds v_{n+1};
+// - a step computes forces through other instantiations of the force loops than a restart's start does
+//   (Advance: contact history moves on), and with -march=native the compiler contracts a * b + c into
+//   fused multiply-adds differently in each: forces from the same positions, velocities and history
+//   differed in the last bit (scenes/granular-esys.toml, symplectic Euler: 35 of 2,884 particles at
+//   step 500; with -ffp-contract=off, none).
+// So every checkpoint stores them (/particles/force_x ... torque_z) and the restart, after its start's
+// force computation (which the energy ledger still uses), puts them back: bit for bit (issue #11).
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -16,13 +21,7 @@
 namespace basalt::solver {
 
 template <class Real>
-bool Simulation<Real>::checkpoints_forces() const {
-  return kick2_ != Real(0) && forces_.reads_velocity();
-}
-
-template <class Real>
 void Simulation<Real>::restore_kick_forces(const io::Checkpoint& c) {
-  if (!checkpoints_forces()) return;
   const std::size_t n = p_.with_rotation ? 6 : 3;
   std::array<const std::vector<double>*, 6> from{};
   for (std::size_t k = 0; k < n; ++k) {
@@ -32,10 +31,10 @@ void Simulation<Real>::restore_kick_forces(const io::Checkpoint& c) {
       if (comm().rank() == 0)
         fmt::print(
             stderr,
-            "basalt-run: warning: the checkpoint has no /particles/{} (written by an older basalt-run or "
-            "with another integrator): velocity Verlet's first half-kick takes forces recomputed from "
-            "the checkpoint's velocities, not the half-step velocities the uninterrupted run computed "
-            "them from, so the continuation agrees with it to rounding only\n",
+            "basalt-run: warning: the checkpoint has no /particles/{} (written by an older basalt-run): "
+            "the first step kicks with forces recomputed at the restart, which can differ from the "
+            "uninterrupted run's in the last bits (velocity Verlet computed those from half-step "
+            "velocities), so the continuation agrees with it to rounding only\n",
             kick_force_fields[k]);
       return;
     }
@@ -49,8 +48,6 @@ void Simulation<Real>::restore_kick_forces(const io::Checkpoint& c) {
   }
 }
 
-template bool Simulation<double>::checkpoints_forces() const;
-template bool Simulation<float>::checkpoints_forces() const;
 template void Simulation<double>::restore_kick_forces(const io::Checkpoint&);
 template void Simulation<float>::restore_kick_forces(const io::Checkpoint&);
 

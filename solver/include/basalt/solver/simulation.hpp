@@ -234,13 +234,9 @@ class Simulation {
   /// Restart: the optional particle fields the checkpoint stores (by name), for the owned particles
   /// (`mine`: their geometry indices in local order); bond damage counters adjusted for the replay.
   void restore_particle_fields(const io::Checkpoint& c, const std::vector<std::size_t>& mine, bool replay);
-  /// Whether checkpoints store the last step's forces and torques (kick_force_fields): velocity Verlet
-  /// with a model reading velocities. The next step's first half-kick takes them, and they were
-  /// computed from the half-step velocities, which a checkpoint does not hold: a restart recomputing
-  /// them from the full-step velocities would not continue bit for bit (simulation_kick_forces.cpp).
-  bool checkpoints_forces() const;
-  /// Restart, after the start's force computation: the forces and torques the checkpoint stores, by id;
-  /// a warning (rank 0) when it has none (then the continuation agrees to rounding only).
+  /// Restart, after the start's force computation: the last step's forces and torques, which every
+  /// checkpoint stores (kick_force_fields), by id, for the first kick; a warning (rank 0) when it has
+  /// none (an older checkpoint: then the continuation agrees to rounding only). simulation_kick_forces.cpp.
   void restore_kick_forces(const io::Checkpoint& c);
   /// Restart: the lists of the uninterrupted run's last rebuild (see the restart constructor).
   void replay_rebuild(const io::Checkpoint& c);
@@ -302,8 +298,8 @@ class Simulation {
   bool balance_paused_ = false;  ///< a restart replaying a rebuild with the checkpoint's own cuts
 };
 
-/// The checkpoint's particle fields of Simulation::checkpoints_forces(): force, then (with rotation)
-/// torque, /particles/<name> float64 (N).
+/// The last step's force and (with rotation) torque in checkpoints, /particles/<name> float64 (N): what a
+/// restart's first kick takes (Simulation::restore_kick_forces).
 inline constexpr std::array<std::string_view, 6> kick_force_fields{"force_x",  "force_y",  "force_z",
                                                                    "torque_x", "torque_y", "torque_z"};
 

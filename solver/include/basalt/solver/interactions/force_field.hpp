@@ -37,12 +37,6 @@ class ForceField {
       if (c->reads() & kVelocity) return true;
     return false;
   }
-  /// Whether some model's force reads velocities or angular velocities (damping, dashpots, friction).
-  bool reads_velocity() const {
-    for (const auto& c : computes_)
-      if (c->reads() & (kVelocity | kAngularVelocity)) return true;
-    return false;
-  }
   /// Largest spring constant over the models for radii up to rmax.
   double max_stiffness(double rmax) const;
   /// Rest length of a new bond of group g (the bond model's rule); r without bond models.

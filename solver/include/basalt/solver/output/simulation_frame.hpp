@@ -34,7 +34,7 @@ class SimulationFrame final : public io::FrameSource {
   /// Checkpoints: history of the pair models that keep one ([k] of the k-th such model).
   std::vector<ContactRecords> history_;
   bool with_bonds_ = true;  ///< false for a frame that is only an in-situ picture
-  /// Checkpoints with Simulation::checkpoints_forces(): force (3) and torque (3 more) fields.
+  /// Checkpoints: force (3) and, with rotation, torque (3 more) fields (kick_force_fields).
   std::size_t kick_forces_ = 0;
 };
 
