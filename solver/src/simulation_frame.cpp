@@ -2,6 +2,7 @@
 #include "basalt/solver/output/simulation_frame.hpp"
 
 #include <algorithm>
+#include <array>
 #include <span>
 #include <vector>
 
@@ -45,7 +46,8 @@ SimulationFrame<Real>::SimulationFrame(const Simulation<Real>& sim, std::uint32_
         h.contacts += history_.back().size();
         h.contact_width = std::max(h.contact_width, static_cast<std::uint32_t>(history_.back().width));
       }
-  // The scene's optional particle fields that frames carry (Particles' array list).
+  // The scene's optional particle fields that frames carry (Particles' array list); checkpoints add the
+  // forces and torques, for a restart's first kick (simulation_kick_forces.cpp).
   p.for_each_array([&](const ArrayInfo& a, const auto&) { h.fields += !a.output.empty() && p.enabled(a); });
   // Mixed precision: the float positions in the run's frame, exactly (frame_origin.hpp).
   if (sim.mixed_) h.fields += h.with_rebuild ? 6 : 3;
@@ -54,6 +56,8 @@ SimulationFrame<Real>::SimulationFrame(const Simulation<Real>& sim, std::uint32_
     for (std::size_t d = 0; d < 3; ++d) x[d] += o[d];
     return x;
   };
+  if (kinds & io::kFrameCheckpoint) kick_forces_ = p.with_rotation ? 6 : 3;
+  h.fields += kick_forces_;
   // Walls: global; the force is summed over the ranks (collective), rank 0 carries them.
   // Mesh walls follow the planar ones (so a checkpoint's wall count covers their history ids, -1 -
   // (planar walls + k)): position = where the rotation axis passes, normal = the axis, velocity = the
@@ -203,6 +207,8 @@ void SimulationFrame<Real>::write(io::FrameWriter& w) const {
     for (std::size_t k = 0; k < (header_.with_rebuild ? 6u : 3u); ++k)
       w.field(kFramePositionFields[k], std::span(exact[k], n));
   }
+  const std::array<const std::vector<Real>*, 6> forces{&p.fx, &p.fy, &p.fz, &p.tx, &p.ty, &p.tz};
+  for (std::size_t k = 0; k < kick_forces_; ++k) w.field(kick_force_fields[k], owned(*forces[k]));
   w.attributes(attributes_);
 }
 

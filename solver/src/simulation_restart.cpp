@@ -57,6 +57,7 @@ Simulation<Real>::Simulation(const Scene& scene, const io::Checkpoint& c, const 
   check_start(false);
   estimate_critical_step(false);  // simulation_stability.cpp
   start_ledger(compute_forces<true>());
+  restore_kick_forces(c);  // simulation_kick_forces.cpp
 }
 
 template <class Real>

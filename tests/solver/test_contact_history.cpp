@@ -24,7 +24,9 @@ namespace {
 
 using Age = std::tuple<std::int64_t, std::int64_t, double>;  // lower id, higher id, steps in contact
 
-/// Collective: every contact's age across ranks, sorted, on every rank.
+/// Collective: every contact's age across ranks, sorted, on every rank. A pair between two ranks is
+/// listed on both, and each saves its own record of it: the two must agree (then they count once; two
+/// different ages for one pair stay two entries, which the tests catch).
 std::vector<Age> contact_ages(const Simulation<double>& sim, MPI_Comm comm) {
   std::vector<double> mine;  // (a, b, age) triples as doubles (ids are small)
   for (const auto& c : sim.force_computes()) {
@@ -47,6 +49,7 @@ std::vector<Age> contact_ages(const Simulation<double>& sim, MPI_Comm comm) {
   for (std::size_t k = 0; k + 2 < all.size(); k += 3)
     ages.emplace_back(std::int64_t(all[k]), std::int64_t(all[k + 1]), all[k + 2]);
   std::sort(ages.begin(), ages.end());
+  ages.erase(std::unique(ages.begin(), ages.end()), ages.end());
   return ages;
 }
 
@@ -245,4 +248,31 @@ K = 100.0
     EXPECT_NEAR(pa.x[i], pb.x[j], 1e-12) << "id " << pa.id[i];
     EXPECT_NEAR(pa.vx[i], pb.vx[j], 1e-12) << "id " << pa.id[i];
   }
+}
+
+TEST(ContactRecords, FindPrefersTheRecordInTheListedOrientation) {
+  if (basalt::test::rank() != 0) return;
+  // A pair between two ranks is saved by each in its own orientation (owned id first), with its own
+  // history: each must get its own back (a restart from a checkpoint holding both is then bit for bit).
+  ContactRecords r;
+  r.width = 1;
+  const double a = 1.0, b = -1.0000000000000002, c = 5.0;
+  r.push(7, 3, &c);  // another pair
+  r.push(1, 2, &a);
+  r.push(2, 1, &b);
+  std::vector<std::uint32_t> order;
+  r.index(order);
+  ASSERT_GE(r.find(order, 1, 2), 0);
+  EXPECT_EQ(r.at(static_cast<std::size_t>(r.find(order, 1, 2)))[0], a);
+  EXPECT_EQ(r.at(static_cast<std::size_t>(r.find(order, 2, 1)))[0], b);
+  EXPECT_EQ(r.at(static_cast<std::size_t>(r.find(order, 3, 7)))[0], c);  // one orientation: that one
+  EXPECT_EQ(r.find(order, 1, 3), -1);
+  // Saved the other way round first: the orientation still decides, not the order.
+  ContactRecords s;
+  s.width = 1;
+  s.push(2, 1, &b);
+  s.push(1, 2, &a);
+  s.index(order);
+  EXPECT_EQ(s.at(static_cast<std::size_t>(s.find(order, 1, 2)))[0], a);
+  EXPECT_EQ(s.at(static_cast<std::size_t>(s.find(order, 2, 1)))[0], b);
 }

@@ -455,7 +455,8 @@ Checkpoint assemble(std::vector<FramePiece>& pieces, const RunInfo& run) {
   const auto contact_key = [&](const std::pair<std::uint32_t, std::uint32_t>& e) {
     const auto& p = pieces[e.first];
     const auto& ids = p.contact_ids[e.second];
-    return std::tuple(p.contact_model[e.second], std::min(ids[0], ids[1]), std::max(ids[0], ids[1]));
+    // A pair between two ranks comes from each in its own orientation: the lower id first goes first.
+    return std::tuple(p.contact_model[e.second], std::min(ids[0], ids[1]), std::max(ids[0], ids[1]), ids[0]);
   };
   std::sort(contacts.begin(), contacts.end(),
             [&](const auto& x, const auto& y) { return contact_key(x) < contact_key(y); });

@@ -8,7 +8,8 @@
   strip_rebuild FILE          removes position_at_rebuild, rebuild_step and rebuild_pending (an older
                               basalt-run's checkpoint)
   contacts FILE N             the checkpoint holds at least N contacts with a history (/contacts), each pair
-                              once, with positive ages, and some contacts with an age below the step
+                              once per orientation (pairs between two ranks in both, agreeing), with
+                              positive ages, and some contacts with an age below the step
   pvd DIR                     every frame of DIR/frames.pvd, read with vtkXMLPPolyDataReader, has the
                               positions of DIR/ckpt_<step>.h5 (same ids), when that checkpoint exists
   compressed FILE             the checkpoint's position, velocity and bond datasets are chunked through the
@@ -80,10 +81,15 @@ def contacts(f, n):
             return False
         ids, hist = h["contacts/ids"][()], h["contacts/history"][()]
         step = int(h.attrs["step"])
-        pairs = {(min(a, b), max(a, b)) for a, b in ids}
-        print(f"{len(ids)} contacts with history ({len(pairs)} pairs), ages {hist.min():g} .. {hist.max():g}, "
-              f"step {step}")
-        return (len(ids) >= n and len(pairs) == len(ids) and hist.min() > 0 and hist.max() <= step
+        # Each (pair, orientation) once: a pair between two ranks comes from both, each with its own
+        # record in its own orientation (the age is the same either way).
+        rows = {(int(a), int(b)): float(v) for (a, b), v in zip(ids, hist[:, 0])}
+        pairs = {(min(a, b), max(a, b)) for a, b in rows}
+        twice = [(a, b) for a, b in rows if a < b and (b, a) in rows]
+        same = all(rows[(a, b)] == rows[(b, a)] for a, b in twice)
+        print(f"{len(ids)} contacts with history ({len(pairs)} pairs, {len(twice)} between two ranks, "
+              f"both orientations agreeing: {same}), ages {hist.min():g} .. {hist.max():g}, step {step}")
+        return (len(pairs) >= n and len(rows) == len(ids) and same and hist.min() > 0 and hist.max() <= step
                 and hist.min() < step)
 
 

@@ -9,6 +9,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -244,6 +245,10 @@ class Simulation {
   /// Restart: the optional particle fields the checkpoint stores (by name), for the owned particles
   /// (`mine`: their geometry indices in local order); bond damage counters adjusted for the replay.
   void restore_particle_fields(const io::Checkpoint& c, const std::vector<std::size_t>& mine, bool replay);
+  /// Restart, after the start's force computation: the last step's forces and torques, which every
+  /// checkpoint stores (kick_force_fields), by id, for the first kick; a warning (rank 0) when it has
+  /// none (an older checkpoint: then the continuation agrees to rounding only). simulation_kick_forces.cpp.
+  void restore_kick_forces(const io::Checkpoint& c);
   /// Restart: the lists of the uninterrupted run's last rebuild (see the restart constructor).
   void replay_rebuild(const io::Checkpoint& c);
   /// Restart: servo walls' point and velocity from the checkpoint (at_rebuild: their point at the last
@@ -305,6 +310,11 @@ class Simulation {
   bool mixed_ = false;           ///< run.precision = "mixed" (set by configure_particles())
   Origin origin_{};              ///< the frame's origin (mixed; zero otherwise)
 };
+
+/// The last step's force and (with rotation) torque in checkpoints, /particles/<name> float64 (N): what a
+/// restart's first kick takes (Simulation::restore_kick_forces).
+inline constexpr std::array<std::string_view, 6> kick_force_fields{"force_x",  "force_y",  "force_z",
+                                                                   "torque_x", "torque_y", "torque_z"};
 
 extern template class Simulation<double>;
 extern template class Simulation<float>;

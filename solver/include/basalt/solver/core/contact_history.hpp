@@ -39,12 +39,19 @@ struct ContactRecords {
       return ki != kj ? ki < kj : i < j;
     });
   }
-  /// The record of the pair {ia, ib} (either orientation) through an index(), or -1.
+  /// The record of the pair {ia, ib} through an index(), or -1: the first one saved in the orientation
+  /// ia -> ib if there is one, else the first in the other. A pair between two ranks is listed on both,
+  /// each as (owned, ghost), and each rank's history of it is its own: computed with the pair's roles
+  /// swapped, it is the other's flipped only to rounding. Both are kept (checkpoints, migration), and
+  /// each rank takes back its own, so a restart continues bit for bit (docs/solver.md).
   std::int64_t find(const std::vector<std::uint32_t>& order, std::int64_t ia, std::int64_t ib) const {
     const std::pair<std::int64_t, std::int64_t> want{std::min(ia, ib), std::max(ia, ib)};
-    const auto it = std::lower_bound(order.begin(), order.end(), want,
-                                     [&](std::uint32_t k, const auto& w) { return key(k) < w; });
-    return it != order.end() && key(*it) == want ? std::int64_t(*it) : -1;
+    auto it = std::lower_bound(order.begin(), order.end(), want,
+                               [&](std::uint32_t k, const auto& w) { return key(k) < w; });
+    if (it == order.end() || key(*it) != want) return -1;
+    for (auto at = it; at != order.end() && key(*at) == want; ++at)
+      if (a[*at] == ia) return std::int64_t(*at);
+    return std::int64_t(*it);
   }
 
  private:

@@ -95,16 +95,17 @@ class PairDriver final : public ForceCompute<Real> {
   void save_history(const Particles<Real>& p) override {
     if constexpr (kHistory) {
       if (own_ == nullptr) return;
-      collect(p, *own_, hist_own_, false, pending_);
-      collect(p, *ghost_, hist_ghost_, false, pending_);
+      collect(p, *own_, hist_own_, pending_);
+      collect(p, *ghost_, hist_ghost_, pending_);
     }
   }
   ContactRecords* pending() override { return kHistory ? &pending_ : nullptr; }
   void history_records(const Particles<Real>& p, ContactRecords& out) const override {
     if constexpr (kHistory) {
       if (own_ == nullptr) return;
-      collect(p, *own_, hist_own_, false, out);
-      collect(p, *ghost_, hist_ghost_, true, out);
+      // The pairs to a ghost too: the other rank saves its own history of each (contact_history.hpp).
+      collect(p, *own_, hist_own_, out);
+      collect(p, *ghost_, hist_ghost_, out);
     }
   }
   std::size_t history_bytes() const override { return basalt::solver::history_bytes<Model>(); }
@@ -333,15 +334,14 @@ class PairDriver final : public ForceCompute<Real> {
     return std::memcmp(&h, &zero, sizeof(History)) == 0;
   }
 
-  /// Records of the listed contacts whose history is not the default; once across ranks: the pairs
-  /// to a ghost only from the rank owning the lower id.
+  /// Records of the listed contacts whose history is not the default, in the listed orientation.
   static void collect(const Particles<Real>& p, const PairList& list, const std::vector<History>& hist,
-                      bool lower_id_only, ContactRecords& out) {
+                      ContactRecords& out) {
     out.width = history_width<Model>();
     for (std::size_t i = 0; i + 1 < list.offset.size(); ++i)
       for (auto k = list.offset[i]; k < list.offset[i + 1]; ++k) {
         const auto j = static_cast<std::size_t>(list.neigh[k]);
-        if (is_default(hist[k]) || (lower_id_only && p.id[j] < p.id[i])) continue;
+        if (is_default(hist[k])) continue;
         out.push(p.id[i], p.id[j], reinterpret_cast<const double*>(&hist[k]));
       }
   }

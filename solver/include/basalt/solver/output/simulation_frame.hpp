@@ -34,6 +34,8 @@ class SimulationFrame final : public io::FrameSource {
   /// Checkpoints: history of the pair models that keep one ([k] of the k-th such model).
   std::vector<ContactRecords> history_;
   bool with_bonds_ = true;  ///< false for a frame that is only an in-situ picture
+  /// Checkpoints: force (3) and, with rotation, torque (3 more) fields (kick_force_fields).
+  std::size_t kick_forces_ = 0;
 };
 
 extern template class SimulationFrame<double>;
