@@ -229,6 +229,9 @@ class Server {
     }
     if (kinds & kFrameCheckpoint) {
       take_queued_field_batches();
+      // The receive buffers last held a whole piece: free them before the checkpoint needs the memory.
+      std::vector<std::byte>().swap(buffer_);
+      std::vector<std::byte>().swap(gathered_);
       const bool ok = write_checkpoint(list);
       if (io_index_ == 0)
         for (int c = 0; c < L_.n_compute; ++c) acknowledge(c, step, ok);
