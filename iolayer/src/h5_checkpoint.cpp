@@ -32,6 +32,10 @@ Vec3& wall_vector(WallState& w, int k) {
 }
 const Vec3& wall_vector(const WallState& w, int k) { return wall_vector(const_cast<WallState&>(w), k); }
 
+/// Writes `c` (validated, in file order); see below.
+void write_checkpoint_file(const Checkpoint& c, const fs::path& file, Compression compression,
+                           const h5::Written& written);
+
 std::string root_attribute(const std::string& name) { return fmt::format("attribute '{}' of /", name); }
 
 /// Checks the completion mark: present and equal to 1.
@@ -52,6 +56,29 @@ Compression parse_compression(const std::string& name) {
   if (name == "small") return Compression::small;
   throw std::invalid_argument(
       fmt::format("compression \"{}\": expected \"none\", \"fast\" or \"small\"", name));
+}
+
+void write_checkpoint(const Checkpoint& c, const fs::path& file, Compression compression) {
+  c.validate(file);
+  // The file stores particles sorted by id and bonds smaller id first; sort a copy if needed.
+  Checkpoint storage;
+  const Checkpoint* s = &c;
+  if (!in_file_order(c.geometry)) {
+    const auto order = sorting_order(c.geometry.id);
+    storage = c;
+    storage.geometry.sort_by_id();  // the same stable order as `order`
+    for (std::size_t k = 0; k < order.size(); ++k) storage.velocity[k] = c.velocity[order[k]];
+    if (!c.inv_mass.empty())
+      for (std::size_t k = 0; k < order.size(); ++k) storage.inv_mass[k] = c.inv_mass[order[k]];
+    if (!c.position_at_rebuild.empty())
+      for (std::size_t k = 0; k < order.size(); ++k)
+        storage.position_at_rebuild[k] = c.position_at_rebuild[order[k]];
+    for (std::size_t f = 0; f < c.particle_fields.size(); ++f)
+      for (std::size_t k = 0; k < order.size(); ++k)
+        storage.particle_fields[f].second[k] = c.particle_fields[f].second[order[k]];
+    s = &storage;
+  }
+  write_checkpoint_file(*s, file, compression, {});
 }
 
 namespace {
@@ -119,29 +146,6 @@ void write_checkpoint_file(const Checkpoint& c, const fs::path& file, Compressio
 }
 
 }  // namespace
-
-void write_checkpoint(const Checkpoint& c, const fs::path& file, Compression compression) {
-  c.validate(file);
-  // The file stores particles sorted by id and bonds smaller id first; sort a copy if needed.
-  Checkpoint storage;
-  const Checkpoint* s = &c;
-  if (!in_file_order(c.geometry)) {
-    const auto order = sorting_order(c.geometry.id);
-    storage = c;
-    storage.geometry.sort_by_id();  // the same stable order as `order`
-    for (std::size_t k = 0; k < order.size(); ++k) storage.velocity[k] = c.velocity[order[k]];
-    if (!c.inv_mass.empty())
-      for (std::size_t k = 0; k < order.size(); ++k) storage.inv_mass[k] = c.inv_mass[order[k]];
-    if (!c.position_at_rebuild.empty())
-      for (std::size_t k = 0; k < order.size(); ++k)
-        storage.position_at_rebuild[k] = c.position_at_rebuild[order[k]];
-    for (std::size_t f = 0; f < c.particle_fields.size(); ++f)
-      for (std::size_t k = 0; k < order.size(); ++k)
-        storage.particle_fields[f].second[k] = c.particle_fields[f].second[order[k]];
-    s = &storage;
-  }
-  write_checkpoint_file(*s, file, compression, {});
-}
 
 void write_checkpoint(Checkpoint&& c, const fs::path& file, Compression compression) {
   if (!in_file_order(c.geometry)) return write_checkpoint(std::as_const(c), file, compression);
