@@ -4,6 +4,9 @@
 
 #include <algorithm>
 #include <charconv>
+#include <string_view>
+#include <type_traits>
+#include <utility>
 
 #include "basalt/io/checkpoint.hpp"
 #include "geometry_order.hpp"
@@ -28,6 +31,10 @@ Vec3& wall_vector(WallState& w, int k) {
   return *v[k];
 }
 const Vec3& wall_vector(const WallState& w, int k) { return wall_vector(const_cast<WallState&>(w), k); }
+
+/// Writes `c` (validated, in file order); see below.
+void write_checkpoint_file(const Checkpoint& c, const fs::path& file, Compression compression,
+                           const h5::Written& written);
 
 std::string root_attribute(const std::string& name) { return fmt::format("attribute '{}' of /", name); }
 
@@ -71,25 +78,48 @@ void write_checkpoint(const Checkpoint& c, const fs::path& file, Compression com
         storage.particle_fields[f].second[k] = c.particle_fields[f].second[order[k]];
     s = &storage;
   }
+  write_checkpoint_file(*s, file, compression, {});
+}
 
+namespace {
+
+/// Writes `s` (validated, in file order); `written(dataset)` is called after each particle, bond and
+/// contact dataset, so a caller that owns `s` may free that column (write_checkpoint(Checkpoint&&)).
+void write_checkpoint_file(const Checkpoint& c, const fs::path& file, Compression compression,
+                           const h5::Written& written) {
+  const Checkpoint* s = &c;
+  const auto done = [&](std::string_view dataset) {
+    if (written) written(dataset);
+  };
   h5::Writer w(file, file.string() + ".partial");
   w.compress(compression == Compression::fast ? 1 : compression == Compression::small ? 6 : 0);
   h5::write_schema(w, kSchema, kSchemaVersion);
-  h5::write_geometry_layout(w, s->geometry, kRunAttributes);
+  h5::write_geometry_layout(w, s->geometry, kRunAttributes, written);
   w.dataset("/particles/velocity", reinterpret_cast<const double*>(s->velocity.data()), s->size(), 3);
-  if (!s->inv_mass.empty()) w.dataset("/particles/inverse_mass", s->inv_mass);
+  done("/particles/velocity");
+  if (!s->inv_mass.empty()) {
+    w.dataset("/particles/inverse_mass", s->inv_mass);
+    done("/particles/inverse_mass");
+  }
   if (!s->position_at_rebuild.empty()) {
     w.dataset("/particles/position_at_rebuild",
               reinterpret_cast<const double*>(s->position_at_rebuild.data()), s->size(), 3);
+    done("/particles/position_at_rebuild");
     w.scalar_attribute<std::int64_t>("/", "rebuild_step", s->rebuild_step);
     w.scalar_attribute<std::uint8_t>("/", "rebuild_pending", s->rebuild_pending ? 1 : 0);
   }
-  for (const auto& [name, values] : s->particle_fields) w.dataset("/particles/" + name, values);
+  for (const auto& [name, values] : s->particle_fields) {
+    w.dataset("/particles/" + name, values);
+    done("/particles/" + name);
+  }
   w.dataset("/bonds/rest_length", s->bond_rest_length);
+  done("/bonds/rest_length");
   w.dataset("/bonds/broken", s->bond_broken);
+  done("/bonds/broken");
   if (!s->bond_break_position.empty())
     w.dataset("/bonds/break_position", reinterpret_cast<const double*>(s->bond_break_position.data()),
               s->bond_break_position.size(), 3);
+  done("/bonds/break_position");
   w.group("/walls");
   for (std::size_t i = 0; i < s->walls.size(); ++i) {
     const auto& wall = s->walls[i];
@@ -105,6 +135,7 @@ void write_checkpoint(const Checkpoint& c, const fs::path& file, Compression com
     w.dataset("/contacts/ids", s->contact_ids.data()->data(), s->contact_ids.size(), 2);
     w.dataset("/contacts/model", s->contact_model);
     w.dataset("/contacts/history", s->contact_history.data(), s->contact_ids.size(), s->contact_width);
+    done("/contacts/history");
   }
   w.scalar_attribute<std::int64_t>("/", "step", s->step);
   w.scalar_attribute<double>("/", "time", s->time);
@@ -112,6 +143,47 @@ void write_checkpoint(const Checkpoint& c, const fs::path& file, Compression com
   w.attribute("/", "scene_text", s->scene_text);
   w.scalar_attribute<std::uint8_t>("/", "complete", 1);  // last: its presence means everything above is there
   w.commit();
+}
+
+}  // namespace
+
+void write_checkpoint(Checkpoint&& c, const fs::path& file, Compression compression) {
+  if (!in_file_order(c.geometry)) return write_checkpoint(std::as_const(c), file, compression);
+  c.validate(file);
+  // Each column is freed once in the file: the peak is the file's image plus what is left of `c`.
+  const auto release = [](auto& v) { std::decay_t<decltype(v)>().swap(v); };
+  auto& g = c.geometry;
+  write_checkpoint_file(c, file, compression, [&](std::string_view ds) {
+    if (ds == "/particles/position")
+      release(g.position);
+    else if (ds == "/particles/radius")
+      release(g.radius);
+    else if (ds == "/particles/tag")
+      release(g.tag);
+    else if (ds == "/particles/mass")
+      release(g.mass);
+    else if (ds == "/bonds/tag")
+      release(g.bonds);
+    else if (ds == "/particles/velocity")
+      release(c.velocity);
+    else if (ds == "/particles/inverse_mass")
+      release(c.inv_mass);
+    else if (ds == "/particles/position_at_rebuild")
+      release(c.position_at_rebuild);
+    else if (ds == "/bonds/rest_length")
+      release(c.bond_rest_length);
+    else if (ds == "/bonds/broken")
+      release(c.bond_broken);
+    else if (ds == "/bonds/break_position")
+      release(c.bond_break_position);
+    else if (ds == "/contacts/history") {
+      release(c.contact_ids);
+      release(c.contact_model);
+      release(c.contact_history);
+    } else
+      for (auto& [name, values] : c.particle_fields)
+        if (ds == "/particles/" + name) release(values);
+  });
 }
 
 namespace {

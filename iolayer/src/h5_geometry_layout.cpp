@@ -61,7 +61,7 @@ void check_schema(const Reader& r, const std::string& schema, int version) {
   if (v < 1) r.fail(root_attribute("schema_version"), fmt::format("must be >= 1, found {}", v));
 }
 
-void write_geometry_layout(Writer& w, const Geometry& g, Names extra_reserved) {
+void write_geometry_layout(Writer& w, const Geometry& g, Names extra_reserved, const Written& written) {
   w.attribute("/", "length_unit", g.units.length);
   w.attribute("/", "time_unit", g.units.time);
   w.attribute("/", "force_unit", g.units.force);
@@ -77,25 +77,40 @@ void write_geometry_layout(Writer& w, const Geometry& g, Names extra_reserved) {
     w.attribute("/", name, value);
   }
 
+  const auto done = [&](std::string_view dataset) {
+    if (written) written(dataset);
+  };
   const std::size_t n = g.size();
   w.group("/particles");
   w.dataset("/particles/id", g.id);
   w.dataset("/particles/position", reinterpret_cast<const double*>(g.position.data()), n, 3);
+  done("/particles/position");
   w.dataset("/particles/radius", g.radius);
+  done("/particles/radius");
   w.dataset("/particles/tag", g.tag);
-  if (g.has_mass()) w.dataset("/particles/mass", g.mass);
-
-  const std::size_t m = g.bonds.size();
-  std::vector<std::int64_t> pairs(2 * m);
-  std::vector<std::int32_t> tags(m);
-  for (std::size_t k = 0; k < m; ++k) {
-    pairs[2 * k] = g.bonds[k].a;
-    pairs[2 * k + 1] = g.bonds[k].b;
-    tags[k] = g.bonds[k].tag;
+  done("/particles/tag");
+  if (g.has_mass()) {
+    w.dataset("/particles/mass", g.mass);
+    done("/particles/mass");
   }
+
+  // One bond column at a time (the pairs, then the tags), each freed once written.
+  const std::size_t m = g.bonds.size();
   w.group("/bonds");
-  w.dataset("/bonds/pairs", pairs.data(), m, 2);
-  w.dataset("/bonds/tag", tags);
+  {
+    std::vector<std::int64_t> pairs(2 * m);
+    for (std::size_t k = 0; k < m; ++k) {
+      pairs[2 * k] = g.bonds[k].a;
+      pairs[2 * k + 1] = g.bonds[k].b;
+    }
+    w.dataset("/bonds/pairs", pairs.data(), m, 2);
+  }
+  {
+    std::vector<std::int32_t> tags(m);
+    for (std::size_t k = 0; k < m; ++k) tags[k] = g.bonds[k].tag;
+    w.dataset("/bonds/tag", tags);
+  }
+  done("/bonds/tag");
 
   w.group("/statistics");
   for (const auto& [name, values] : g.statistics) {

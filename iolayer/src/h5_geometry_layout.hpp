@@ -2,6 +2,7 @@
 // The geometry part of Basalt's HDF5 schemas (docs/formats.md), shared by "basalt-geometry" and
 // "basalt-checkpoint": root attributes for units, box and provenance; /particles, /bonds and
 // /statistics. Each schema adds its own identification and, for checkpoints, the run state.
+#include <functional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -13,6 +14,8 @@ namespace basalt::io::h5 {
 
 /// Names of root attributes a schema reserves for itself.
 using Names = std::span<const std::string_view>;
+/// Told the path of each dataset once it is written (a caller that owns the data may free it then).
+using Written = std::function<void(std::string_view dataset)>;
 
 /// Writes the `schema`, `schema_version` and `writer` root attributes.
 void write_schema(Writer& w, const std::string& schema, int version);
@@ -23,7 +26,9 @@ void check_schema(const Reader& r, const std::string& schema, int version);
 /// Writes the geometry's root attributes (units, box, periodic, provenance) and the groups
 /// /particles, /bonds, /statistics. `g` must be validated, sorted by id, bonds stored a < b.
 /// `extra_reserved`: root attributes the calling schema writes itself (provenance may not use them).
-void write_geometry_layout(Writer& w, const Geometry& g, Names extra_reserved);
+/// `written`, when given, hears of /particles/position, radius, tag, mass and /bonds/tag (after
+/// which g.bonds is no longer read) as each is written; /particles/id is read to the end.
+void write_geometry_layout(Writer& w, const Geometry& g, Names extra_reserved, const Written& written = {});
 
 /// Reads and checks the root attributes write_geometry_layout wrote (units, box, periodic, provenance)
 /// into `g`, no particle or bond data.

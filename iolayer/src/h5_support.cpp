@@ -5,9 +5,11 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <cstring>
 #include <limits>
+#include <span>
 #include <vector>
 
 namespace basalt::io::h5 {
@@ -414,16 +416,32 @@ void Writer::commit() {
   if (H5Fflush(file_id_.get(), H5F_SCOPE_GLOBAL) < 0) fail("", "cannot finish the file in memory");
   const ssize_t size = H5Fget_file_image(file_id_.get(), nullptr, 0);
   if (size < 0) fail("", "cannot take the file image");
-  std::vector<char> image(static_cast<std::size_t>(size));
-  if (H5Fget_file_image(file_id_.get(), image.data(), image.size()) != size)
+  // Write the core driver's own buffer (its handle is the address of the buffer's pointer): a copy
+  // of the image would double the memory a large checkpoint needs. The file is closed afterwards.
+  void* handle = nullptr;
+  if (H5Fget_vfd_handle(file_id_.get(), H5P_DEFAULT, &handle) < 0 || handle == nullptr ||
+      *static_cast<unsigned char**>(handle) == nullptr)
     fail("", "cannot take the file image");
-  if (!file_id_.reset()) fail("", "cannot close the in-memory file");
+  const std::span<const char> image(reinterpret_cast<const char*>(*static_cast<unsigned char**>(handle)),
+                                    static_cast<std::size_t>(size));
+  // The superblock's first bytes go from a copy with its status flags cleared, as H5Fget_file_image
+  // clears them (the open file marks itself open for writing there): the same bytes as its image.
+  std::array<char, 64> head{};
+  const std::size_t head_size = std::min(head.size(), image.size());
+  std::copy_n(image.data(), head_size, head.data());
+  if (head_size > 8) {
+    const int version = static_cast<unsigned char>(head[8]);  // after the 8-byte signature
+    const std::size_t flags = version >= 2 ? 11 : 20, flags_size = version >= 2 ? 1 : 4;
+    if (flags + flags_size <= head_size) std::fill_n(head.data() + flags, flags_size, '\0');
+  }
   // Write, then make the bytes durable before the rename makes them visible under the final name.
   const int fd = ::open(temp_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
   if (fd < 0) fail("", fmt::format("cannot create '{}': {}", temp_.string(), std::strerror(errno)));
   std::size_t done = 0;
   while (done < image.size()) {
-    const ssize_t n = ::write(fd, image.data() + done, image.size() - done);
+    const bool in_head = done < head_size;
+    const ssize_t n = ::write(fd, (in_head ? head.data() : image.data()) + done,
+                              (in_head ? head_size : image.size()) - done);
     if (n < 0 && errno == EINTR) continue;
     if (n <= 0) {
       const int err = n < 0 ? errno : ENOSPC;
@@ -439,6 +457,7 @@ void Writer::commit() {
     fail("", fmt::format("cannot sync '{}' to disk: {}", temp_.string(), std::strerror(err)));
   }
   if (::close(fd) != 0) fail("", fmt::format("cannot close '{}': {}", temp_.string(), std::strerror(errno)));
+  if (!file_id_.reset()) fail("", "cannot close the in-memory file");
   std::error_code ec;
   fs::rename(temp_, file_, ec);
   if (ec) fail("", fmt::format("cannot rename '{}' into place: {}", temp_.string(), ec.message()));

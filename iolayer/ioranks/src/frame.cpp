@@ -342,7 +342,23 @@ RunInfo deserialize_run_info(std::span<const std::byte> bytes) {
   return info;
 }
 
-Checkpoint assemble(std::vector<FramePiece>& pieces, const RunInfo& run) {
+namespace {
+
+/// Frees a vector's memory (clear() keeps the capacity).
+template <class V>
+void release(V& v) {
+  V().swap(v);
+}
+
+/// A piece's row: which piece, which index in it.
+struct Row {
+  std::uint32_t piece;
+  std::uint32_t index;
+};
+
+/// Joins the pieces; `spend`: empties each piece's column once it is copied into the checkpoint, so
+/// the pieces and the checkpoint together hold about one copy of the data plus one column.
+Checkpoint assemble_pieces(std::vector<FramePiece>& pieces, const RunInfo& run, bool spend) {
   if (pieces.empty()) throw std::runtime_error("assemble: no pieces");
   const auto step = pieces.front().step;
   std::size_t n = 0, m = 0;
@@ -353,11 +369,14 @@ Checkpoint assemble(std::vector<FramePiece>& pieces, const RunInfo& run) {
     m += p.bonds.size();
   }
   // Gather (piece, index) and sort by id.
-  std::vector<std::pair<std::int64_t, std::pair<std::uint32_t, std::uint32_t>>> order;
+  std::vector<std::pair<std::int64_t, Row>> order;
   order.reserve(n);
   for (std::uint32_t k = 0; k < pieces.size(); ++k)
-    for (std::uint32_t i = 0; i < pieces[k].size(); ++i) order.push_back({pieces[k].id[i], {k, i}});
-  std::sort(order.begin(), order.end());
+    for (std::uint32_t i = 0; i < pieces[k].size(); ++i) order.push_back({pieces[k].id[i], Row{k, i}});
+  std::sort(order.begin(), order.end(), [](const auto& x, const auto& y) {
+    return x.first < y.first || (x.first == y.first && std::tie(x.second.piece, x.second.index) <
+                                                           std::tie(y.second.piece, y.second.index));
+  });
   for (std::size_t i = 1; i < order.size(); ++i)
     if (order[i].first == order[i - 1].first)
       throw std::runtime_error(
@@ -365,37 +384,33 @@ Checkpoint assemble(std::vector<FramePiece>& pieces, const RunInfo& run) {
 
   Checkpoint c;
   auto& g = c.geometry;
-  g.id.resize(n);
-  g.position.resize(n);
-  g.radius.resize(n);
-  g.tag.resize(n);
-  g.mass.resize(n);
-  c.velocity.resize(n);
   const bool inv = std::all_of(pieces.begin(), pieces.end(),
                                [](const FramePiece& p) { return p.inv_mass.size() == p.size(); }) &&
                    n > 0;
-  if (inv) c.inv_mass.resize(n);
   const bool at_rebuild =
       n > 0 && std::all_of(pieces.begin(), pieces.end(), [&](const FramePiece& p) {
         return p.position_at_rebuild.size() == p.size() && p.rebuild_step == pieces.front().rebuild_step;
       });
   if (at_rebuild) {
-    c.position_at_rebuild.resize(n);
     c.rebuild_step = pieces.front().rebuild_step;
     for (const auto& p : pieces) c.rebuild_pending = c.rebuild_pending || p.rebuild_pending != 0;
   }
-  for (std::size_t i = 0; i < n; ++i) {
-    const auto& p = pieces[order[i].second.first];
-    const auto j = order[i].second.second;
-    g.id[i] = p.id[j];
-    g.position[i] = p.position[j];
-    g.radius[i] = p.radius[j];
-    g.tag[i] = p.tag[j];
-    g.mass[i] = p.mass[j];
-    c.velocity[i] = p.velocity[j];
-    if (inv) c.inv_mass[i] = p.inv_mass[j];
-    if (at_rebuild) c.position_at_rebuild[i] = p.position_at_rebuild[j];
-  }
+  // One column at a time, through the order: the piece's column is freed once copied.
+  const auto gather = [&](auto column, auto& out) {
+    out.resize(n);
+    for (std::size_t i = 0; i < n; ++i)
+      out[i] = (pieces[order[i].second.piece].*column)[order[i].second.index];
+    if (spend)
+      for (auto& p : pieces) release(p.*column);
+  };
+  gather(&FramePiece::id, g.id);
+  gather(&FramePiece::position, g.position);
+  gather(&FramePiece::radius, g.radius);
+  gather(&FramePiece::tag, g.tag);
+  gather(&FramePiece::mass, g.mass);
+  gather(&FramePiece::velocity, c.velocity);
+  if (inv) gather(&FramePiece::inv_mass, c.inv_mass);
+  if (at_rebuild) gather(&FramePiece::position_at_rebuild, c.position_at_rebuild);
   // Optional particle fields: every piece names the same ones (the solver's list), in the same order.
   for (const auto& p : pieces)
     if (p.fields.size() != pieces.front().fields.size())
@@ -405,43 +420,72 @@ Checkpoint assemble(std::vector<FramePiece>& pieces, const RunInfo& run) {
     for (const auto& p : pieces)
       if (p.fields[f].first != name)
         throw std::runtime_error(fmt::format("assemble: particle field {} missing from a piece", name));
+  }
+  for (std::size_t f = 0; f < pieces.front().fields.size(); ++f) {
     std::vector<double> values(n);
     for (std::size_t i = 0; i < n; ++i)
-      values[i] = pieces[order[i].second.first].fields[f].second[order[i].second.second];
-    c.particle_fields.emplace_back(name, std::move(values));
+      values[i] = pieces[order[i].second.piece].fields[f].second[order[i].second.index];
+    c.particle_fields.emplace_back(pieces.front().fields[f].first, std::move(values));
+    if (spend)
+      for (auto& p : pieces) release(p.fields[f].second);
   }
+  release(order);
 
-  struct BondRow {
-    Bond b;
-    double rest;
-    std::uint8_t broken;
-    Vec3 at;  ///< where a broken bond broke (NaN: not known)
+  // Bonds sorted by (smaller id, larger id): sort references to them, then copy column by column.
+  const auto bond_key = [&](const Row& r) {
+    const auto& b = pieces[r.piece].bonds[r.index];
+    return std::pair(std::min(b.a, b.b), std::max(b.a, b.b));
   };
+  std::vector<Row> bonds;
+  bonds.reserve(m);
+  for (std::uint32_t k = 0; k < pieces.size(); ++k)
+    for (std::uint32_t i = 0; i < pieces[k].bonds.size(); ++i) bonds.push_back({k, i});
+  std::sort(bonds.begin(), bonds.end(),
+            [&](const Row& x, const Row& y) { return bond_key(x) < bond_key(y); });
+  g.bonds.resize(m);
+  for (std::size_t j = 0; j < m; ++j) {
+    Bond b = pieces[bonds[j].piece].bonds[bonds[j].index];
+    if (b.a > b.b) std::swap(b.a, b.b);
+    g.bonds[j] = b;
+  }
+  if (spend)
+    for (auto& p : pieces) release(p.bonds);
+  const auto gather_bonds = [&](auto column, auto& out) {
+    out.resize(m);
+    for (std::size_t j = 0; j < m; ++j) out[j] = (pieces[bonds[j].piece].*column)[bonds[j].index];
+  };
+  gather_bonds(&FramePiece::bond_rest_length, c.bond_rest_length);
+  if (spend)
+    for (auto& p : pieces) release(p.bond_rest_length);
+  gather_bonds(&FramePiece::bond_broken, c.bond_broken);
+  // Where broken bonds broke (NaN: not known), one row per broken bond, when any piece knows one.
   const bool with_breaks = std::any_of(pieces.begin(), pieces.end(),
                                        [](const FramePiece& p) { return !p.bond_break_position.empty(); });
-  constexpr double nan = std::numeric_limits<double>::quiet_NaN();
-  std::vector<BondRow> bonds;
-  bonds.reserve(m);
-  for (const auto& p : pieces)
-    for (std::size_t k = 0, nb = 0; k < p.bonds.size(); ++k) {
-      Bond b = p.bonds[k];
-      if (b.a > b.b) std::swap(b.a, b.b);
-      Vec3 at{nan, nan, nan};
-      if (p.bond_broken[k] != 0 && !p.bond_break_position.empty()) at = p.bond_break_position[nb++];
-      bonds.push_back({b, p.bond_rest_length[k], p.bond_broken[k], at});
+  if (with_breaks) {
+    // The row of each broken bond among its piece's break positions.
+    std::vector<std::vector<std::uint32_t>> nth(pieces.size());
+    for (std::size_t k = 0; k < pieces.size(); ++k) {
+      const auto& p = pieces[k];
+      if (p.bond_break_position.empty()) continue;
+      nth[k].resize(p.bond_broken.size());
+      for (std::uint32_t i = 0, nb = 0; i < p.bond_broken.size(); ++i)
+        if (p.bond_broken[i] != 0) nth[k][i] = nb++;
     }
-  std::sort(bonds.begin(), bonds.end(), [](const BondRow& x, const BondRow& y) {
-    return std::tie(x.b.a, x.b.b) < std::tie(y.b.a, y.b.b);
-  });
-  g.bonds.reserve(m);
-  c.bond_rest_length.reserve(m);
-  c.bond_broken.reserve(m);
-  for (const auto& row : bonds) {
-    g.bonds.push_back(row.b);
-    c.bond_rest_length.push_back(row.rest);
-    c.bond_broken.push_back(row.broken);
-    if (with_breaks && row.broken != 0) c.bond_break_position.push_back(row.at);
+    constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+    for (std::size_t j = 0; j < m; ++j) {
+      if (c.bond_broken[j] == 0) continue;
+      const auto& [k, i] = bonds[j];
+      c.bond_break_position.push_back(pieces[k].bond_break_position.empty()
+                                          ? Vec3{nan, nan, nan}
+                                          : pieces[k].bond_break_position[nth[k][i]]);
+    }
   }
+  release(bonds);
+  if (spend)
+    for (auto& p : pieces) {
+      release(p.bond_broken);
+      release(p.bond_break_position);
+    }
 
   // Contacts sorted by (model, pair), whatever rank listed them.
   std::vector<std::pair<std::uint32_t, std::uint32_t>> contacts;
@@ -484,7 +528,23 @@ Checkpoint assemble(std::vector<FramePiece>& pieces, const RunInfo& run) {
   c.time = pieces.front().time;
   c.dt = run.dt;
   c.scene_text = run.scene_text;
+  if (spend)
+    for (auto& p : pieces) {
+      release(p.contact_ids);
+      release(p.contact_model);
+      release(p.contact_history);
+    }
   return c;
+}
+
+}  // namespace
+
+Checkpoint assemble(std::vector<FramePiece>& pieces, const RunInfo& run) {
+  return assemble_pieces(pieces, run, false);
+}
+
+Checkpoint assemble(std::vector<FramePiece>&& pieces, const RunInfo& run) {
+  return assemble_pieces(pieces, run, true);
 }
 
 }  // namespace basalt::io

@@ -57,6 +57,7 @@ class SyncWriter final : public OutputClientImpl {
         std::vector<FramePiece> pieces;
         for (int r = 0; r < size; ++r)
           pieces.push_back(deserialize(std::span<const std::byte>(all).subspan(displs[r], counts[r])));
+        std::vector<std::byte>().swap(all);  // the pieces hold it all now
         if (header.kinds & kFrameVtk) {
           const double tv = MPI_Wtime();
           local.frames.bytes += vtk(pieces, header.step, header.time, 0, 1, cfg.dir);

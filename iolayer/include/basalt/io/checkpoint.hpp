@@ -97,6 +97,11 @@ Compression parse_compression(const std::string& name);
 /// under the final name.
 void write_checkpoint(const Checkpoint& c, const std::filesystem::path& file,
                       Compression compression = Compression::none);
+/// The same, spending `c`: each column is freed as soon as it is in the file, so writing needs little
+/// more memory than the file's image (the I/O rank's checkpoints). Only c.geometry.id, the walls and
+/// the run's clock and attributes are left; c.size() stays.
+void write_checkpoint(Checkpoint&& c, const std::filesystem::path& file,
+                      Compression compression = Compression::none);
 
 /// Reads and validates a checkpoint; refuses (FormatError) a file without the completion mark,
 /// of another schema, or of a newer schema version.

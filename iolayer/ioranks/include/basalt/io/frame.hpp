@@ -100,6 +100,11 @@ struct RunInfo {
 /// (a, b), walls from whichever piece carries them. Throws std::runtime_error if pieces
 /// disagree on the step or a particle id appears twice.
 Checkpoint assemble(std::vector<FramePiece>& pieces, const RunInfo& run);
+/// The same, spending the pieces: each piece's column is freed once copied into the checkpoint, so the
+/// pieces and the checkpoint never hold much more than one copy of the data between them (what the
+/// I/O rank needs for a checkpoint of millions of particles). The pieces are left empty but for their
+/// header fields, walls and attributes.
+Checkpoint assemble(std::vector<FramePiece>&& pieces, const RunInfo& run);
 
 /// RunInfo as a flat buffer (sent once from compute rank 0 to every I/O rank at start).
 void serialize(const RunInfo& info, std::vector<std::byte>& out);
