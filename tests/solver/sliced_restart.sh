@@ -81,6 +81,20 @@ scenario wave "$WAVE" "$CUBE" 100 1
 awk 'NR == 7 { print $1 + 1; next } /^EndParticles/ { print "60 7.5 0.5 0.5 10000000 1" } { print }' "$CUBE" \
   >"$W/uneven.geo"
 scenario balanced "$WAVE" "$W/uneven.geo" 100 0 --balance count
+# The balanced checkpoint on another rank count (np % 4 + 1): its cuts do not fit, the grid starts even and
+# the replayed rebuild re-balances, moving particles to ranks that did not read them (asked of the others).
+other=$((np % 4 + 1))
+for v in sliced whole; do
+  d=balanced.$v.np$other extra=()
+  mkdir -p "$W/$d"
+  cp "$W/balanced/ckpt_000100.h5" "$W/$d/"
+  [ $v = whole ] && extra=(--whole-checkpoint)
+  run "$d" "$other" "$WAVE" --geometry "$W/uneven.geo" --balance count --steps 100 --checkpoint-every 100 \
+    --fields-every 10 --restart "$W/$d/ckpt_000100.h5" "${extra[@]}"
+done
+same "balanced.sliced.np$other" "balanced.whole.np$other" fields.csv ckpt_000200.h5
+[ "$other" -gt 1 ] && { grep -q "^balance: step" "$W/balanced.sliced.np$other.log" || fail "no re-balance on $other ranks"; }
+echo "np $np: balanced checkpoint restarted on $other ranks: sliced = whole, byte for byte"
 scenario granular "$GRANULAR" "$COLUMN" 100 0
 scenario ucs "$UCS" "$UCS_GEOMETRY" 500 1
 # The ucs checkpoint has broken bonds with break positions: the restart routed them with their bonds.
