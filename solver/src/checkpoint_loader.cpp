@@ -31,12 +31,17 @@ struct EndRecord {
   std::int32_t owner;
 };
 
-/// One bond as it travels, with its state.
+/// One bond as it travels, with its state (a broken one's BreakRecord follows it in a second exchange).
 struct BondRecord {
   std::int64_t a, b, row;
-  double rest, length, bx, by, bz;
+  double rest;
   std::int32_t tag;
-  std::uint8_t flag, has_break;
+  std::uint8_t flag;
+};
+
+/// What a broken bond carries besides: the distance of its ends and where it broke (NaN: not known).
+struct BreakRecord {
+  double length, x, y, z;
 };
 
 /// One contact as it travels (its history alongside, contact_width values).
@@ -180,10 +185,16 @@ CheckpointPart CheckpointLoader::local_part(const Decomposition& dec) {
                         v[1], v[2], g.tag[i]});
       for (const auto& f : slice_.particle_fields) fields[o].push_back(f.second[i]);
     }
-    const auto owned = comm_.exchange(out);  // in file (id) order: slices come in rank order
-    std::vector<std::vector<ParticleRecord>>(p).swap(out);
-    const auto values = comm_.exchange(fields);
-    std::vector<std::vector<double>>(p).swap(fields);
+    // Of the slice's particles, only ids and positions are asked for from here on.
+    slice_.velocity = {};
+    slice_.inv_mass = {};
+    slice_.position_at_rebuild = {};
+    slice_.particle_fields = {};
+    slice_.geometry.radius = {};
+    slice_.geometry.mass = {};
+    slice_.geometry.tag = {};
+    const auto owned = comm_.exchange(std::move(out));  // in file (id) order: slices come in rank order
+    const auto values = comm_.exchange(std::move(fields));
     auto& c = part.c;
     c = h.run;  // walls, clock, attributes, box, units, contact width
     const std::size_t n = owned.size();
@@ -230,7 +241,7 @@ CheckpointPart CheckpointLoader::local_part(const Decomposition& dec) {
     if (s >= 0) ask[static_cast<std::size_t>(s)].push_back(end_ids[j]);
   }
   std::vector<std::size_t> asked_counts;
-  const auto asked = comm_.exchange(ask, &asked_counts);
+  auto asked = comm_.exchange(ask, &asked_counts);
   std::vector<std::vector<EndRecord>> answer(p);
   {
     std::size_t q = 0;
@@ -247,7 +258,8 @@ CheckpointPart CheckpointLoader::local_part(const Decomposition& dec) {
       }
   }
   {
-    const auto answers = comm_.exchange(answer);  // per slice, in the order asked (ascending ids)
+    std::vector<std::int64_t>().swap(asked);
+    const auto answers = comm_.exchange(std::move(answer));  // per slice, in the order asked (ascending ids)
     std::size_t q = 0;
     for (std::size_t r = 0; r < p; ++r)
       for (const auto id : ask[r]) {
@@ -284,65 +296,67 @@ CheckpointPart CheckpointLoader::local_part(const Decomposition& dec) {
   // 3. Bonds, with their state, to the owners of both ends.
   {
     std::vector<std::vector<BondRecord>> send(p);
+    std::vector<std::vector<BreakRecord>> breaks(p);
     constexpr double unknown = std::numeric_limits<double>::quiet_NaN();
     for (std::size_t k = 0, nb = 0; k < bonds.size(); ++k) {
       const auto& b = bonds[k];
       const auto& ea = end_of(b.a);
       const auto& eb = end_of(b.b);
       const std::uint8_t flag = slice_.bond_broken[k];
-      BondRecord rec{b.a,
-                     b.b,
-                     static_cast<std::int64_t>(bond_begin_ + k),
-                     slice_.bond_rest_length[k],
-                     0.0,
-                     unknown,
-                     unknown,
-                     unknown,
-                     b.tag,
-                     flag,
-                     0};
-      if (flag != 0) {
-        rec.length = distance({ea.x, ea.y, ea.z}, {eb.x, eb.y, eb.z});
-        if (h.has_break_position) {
-          const auto& w = slice_.bond_break_position[nb];
-          rec.bx = w[0];
-          rec.by = w[1];
-          rec.bz = w[2];
-          rec.has_break = 1;
-        }
-        ++nb;
+      const BondRecord rec{b.a,   b.b, static_cast<std::int64_t>(bond_begin_ + k), slice_.bond_rest_length[k],
+                           b.tag, flag};
+      const auto oa = static_cast<std::size_t>(ea.owner), ob = static_cast<std::size_t>(eb.owner);
+      send[oa].push_back(rec);
+      if (ob != oa) send[ob].push_back(rec);
+      if (flag == 0) continue;
+      BreakRecord br{distance({ea.x, ea.y, ea.z}, {eb.x, eb.y, eb.z}), unknown, unknown, unknown};
+      if (h.has_break_position) {
+        const auto& w = slice_.bond_break_position[nb];
+        br.x = w[0];
+        br.y = w[1];
+        br.z = w[2];
       }
-      send[static_cast<std::size_t>(ea.owner)].push_back(rec);
-      if (eb.owner != ea.owner) send[static_cast<std::size_t>(eb.owner)].push_back(rec);
+      ++nb;
+      breaks[oa].push_back(br);
+      if (ob != oa) breaks[ob].push_back(br);
     }
-    const auto mine = comm_.exchange(send);  // in file order
+    slice_.geometry.bonds = {};
+    slice_.bond_rest_length = {};
+    slice_.bond_broken = {};
+    slice_.bond_break_position = {};
+    const auto mine = comm_.exchange(std::move(send));           // in file order
+    const auto broken_rows = comm_.exchange(std::move(breaks));  // the same order, broken ones only
     // No pair bonded twice: both copies of a pair reach the owner of its first end.
-    std::vector<std::pair<std::pair<std::int64_t, std::int64_t>, std::int64_t>> keys;
-    keys.reserve(mine.size());
-    for (const auto& b : mine) keys.push_back({{b.a, b.b}, b.row});
-    std::sort(keys.begin(), keys.end());
-    for (std::size_t k = 1; k < keys.size() && !error; ++k)
-      if (keys[k].first == keys[k - 1].first)
-        error = fmt::format(
-            "--restart: {}: /bonds/pairs: bonds {} and {} (counted from 0 in file order) both join particles "
-            "{} "
-            "and {}: a pair bonded twice acts as two springs; remove one",
-            file_.path().string(), keys[k - 1].second, keys[k].second, keys[k].first.first,
-            keys[k].first.second);
+    {
+      std::vector<std::pair<std::pair<std::int64_t, std::int64_t>, std::int64_t>> keys;
+      keys.reserve(mine.size());
+      for (const auto& b : mine) keys.push_back({{b.a, b.b}, b.row});
+      std::sort(keys.begin(), keys.end());
+      for (std::size_t k = 1; k < keys.size() && !error; ++k)
+        if (keys[k].first == keys[k - 1].first)
+          error = fmt::format(
+              "--restart: {}: /bonds/pairs: bonds {} and {} (counted from 0 in file order) both join "
+              "particles {} "
+              "and {}: a pair bonded twice acts as two springs; remove one",
+              file_.path().string(), keys[k - 1].second, keys[k].second, keys[k].first.first,
+              keys[k].first.second);
+    }
     if (auto e = comm_.agree_error(error)) throw InputError(*e);
     auto& c = part.c;
     const std::size_t m = mine.size();
     c.geometry.bonds.resize(m);
     c.bond_rest_length.resize(m);
     c.bond_broken.resize(m);
-    part.bond_length.resize(m);
-    for (std::size_t k = 0; k < m; ++k) {
+    part.bond_length.assign(m, 0.0);
+    for (std::size_t k = 0, nb = 0; k < m; ++k) {
       const auto& b = mine[k];
       c.geometry.bonds[k] = {b.a, b.b, b.tag};
       c.bond_rest_length[k] = b.rest;
       c.bond_broken[k] = b.flag;
-      part.bond_length[k] = b.length;
-      if (b.has_break) c.bond_break_position.push_back({b.bx, b.by, b.bz});
+      if (b.flag == 0) continue;
+      const auto& br = broken_rows[nb++];
+      part.bond_length[k] = br.length;
+      if (h.has_break_position) c.bond_break_position.push_back({br.x, br.y, br.z});
     }
   }
 
@@ -363,8 +377,8 @@ CheckpointPart CheckpointLoader::local_part(const Decomposition& dec) {
         history[static_cast<std::size_t>(ob)].insert(history[static_cast<std::size_t>(ob)].end(), hv, hv + w);
       }
     }
-    const auto mine = comm_.exchange(send);
-    auto values = comm_.exchange(history);
+    const auto mine = comm_.exchange(std::move(send));
+    auto values = comm_.exchange(std::move(history));
     auto& c = part.c;
     c.contact_ids.resize(mine.size());
     c.contact_model.resize(mine.size());
