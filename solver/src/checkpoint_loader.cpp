@@ -272,15 +272,22 @@ CheckpointPart CheckpointLoader::local_part(const Decomposition& dec) {
     return ends[static_cast<std::size_t>(std::lower_bound(end_ids.begin(), end_ids.end(), id) -
                                          end_ids.begin())];
   };
+  // Each bond end's entry in `ends`, looked up once.
+  std::vector<std::uint32_t> bond_end(2 * bonds.size());
   for (std::size_t k = 0; k < bonds.size() && !error; ++k)
-    for (const auto id : {bonds[k].a, bonds[k].b})
-      if (end_of(id).owner < 0 && !error)
+    for (int e = 0; e < 2; ++e) {
+      const auto id = e == 0 ? bonds[k].a : bonds[k].b;
+      const auto j =
+          static_cast<std::size_t>(std::lower_bound(end_ids.begin(), end_ids.end(), id) - end_ids.begin());
+      bond_end[2 * k + static_cast<std::size_t>(e)] = static_cast<std::uint32_t>(j);
+      if (ends[j].owner < 0 && !error)
         error = fmt::format("--restart: {}",
                             io::FormatError(file_.path(), "/bonds/pairs",
                                             fmt::format("bond {} refers to particle id {}, which "
                                                         "does not exist",
                                                         bond_begin_ + k, id))
                                 .what());
+    }
   for (std::size_t k = 0; k < slice_.contact_ids.size() && !error; ++k) {
     const auto& ids = slice_.contact_ids[k];
     for (int e = 0; e < 2 && !error; ++e)
@@ -300,8 +307,8 @@ CheckpointPart CheckpointLoader::local_part(const Decomposition& dec) {
     constexpr double unknown = std::numeric_limits<double>::quiet_NaN();
     for (std::size_t k = 0, nb = 0; k < bonds.size(); ++k) {
       const auto& b = bonds[k];
-      const auto& ea = end_of(b.a);
-      const auto& eb = end_of(b.b);
+      const auto& ea = ends[bond_end[2 * k]];
+      const auto& eb = ends[bond_end[2 * k + 1]];
       const std::uint8_t flag = slice_.bond_broken[k];
       const BondRecord rec{b.a,   b.b, static_cast<std::int64_t>(bond_begin_ + k), slice_.bond_rest_length[k],
                            b.tag, flag};
