@@ -286,7 +286,7 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
                : std::string());
     if (st.dt_critical > 0) {
       fmt::print(
-          "critical step: {:.4g} {} (2/omega_max, {} power iterations on the network: {:.4g}; one new "
+          "critical step: {:.4g} {} (2/omega_max, {} Lanczos iterations on the network: {:.4g}; one new "
           "contact "
           "of the lightest particle: {:.4g}); bound {:.4g} (omega^2 <= max_i 2 sum_j k_ij / m_i); former "
           "estimate 2 sqrt(m_min/k_max) = {:.4g} (m_min = {:.4g}, k_max = {:.4g})\n",
@@ -420,8 +420,9 @@ int run_world(int argc, char** argv) {
                  "(double, 0.25), reference (double, 0.05); overrides run.dt, run.dt_fraction, run.precision")
       ->check(CLI::IsMember({"fast", "balanced", "reference"}));
   app.add_option("--precision", cli.precision,
-                 "floating-point type of the solver: double or float; overrides run.precision")
-      ->check(CLI::IsMember({"double", "float"}));
+                 "floating-point type of the solver: double, float or mixed (float offsets from the "
+                 "geometry's centre, compensated drift); overrides run.precision")
+      ->check(CLI::IsMember({"double", "float", "mixed"}));
   app.add_option(
          "--balance", cli.balance,
          "load balancing of the rank grid: none (even cuts) or count (cuts moved at rebuilds by particle "
@@ -579,7 +580,7 @@ int run_world(int argc, char** argv) {
   }
   const io::CheckpointHeader* h = header ? &*header : nullptr;
   const io::Checkpoint* whole = ckpt ? &*ckpt : nullptr;
-  if (scene.precision == "float")
+  if (scene.precision == "float" || scene.precision == "mixed")
     return run_compute<float>(cli, scene, layout, cfg, vtk, h, whole, &ckpt_rows, ckpt_file);
   return run_compute<double>(cli, scene, layout, cfg, vtk, h, whole, &ckpt_rows, ckpt_file);
 }

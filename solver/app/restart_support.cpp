@@ -89,7 +89,8 @@ std::map<std::string, std::string> restart_attributes(const solver::RestartLayou
           {"decomposition_box_max", vec_text(l.box_max)},
           {"ghost_width", fmt::format("{:.17g}", l.ghost_width)},
           {"contact_cutoff", fmt::format("{:.17g}", l.contact_cutoff)},
-          {"decomposition_cuts", solver::cuts_text(l.cuts[0], l.cuts[1], l.cuts[2])}};
+          {"decomposition_cuts", solver::cuts_text(l.cuts[0], l.cuts[1], l.cuts[2])},
+          {"frame_origin", vec_text(l.origin)}};
 }
 
 solver::RestartLayout restart_layout_of(const io::CheckpointHeader& c, const fs::path& file) {
@@ -109,6 +110,8 @@ solver::RestartLayout restart_layout_of(const io::CheckpointHeader& c, const fs:
                       file.string(), it->second));
     l.cuts = *cuts;
   }
+  // run.precision = "mixed": the origin of the run's frame (box and cuts are relative to it); zero before.
+  if (c.run.geometry.attributes.count("frame_origin")) l.origin = vec(c, file, "frame_origin");
   return l;
 }
 

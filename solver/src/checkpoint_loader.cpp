@@ -11,6 +11,7 @@
 
 #include "basalt/io/geometry_rows.hpp"
 #include "basalt/solver/core/errors.hpp"
+#include "basalt/solver/scene/frame_origin.hpp"
 
 namespace basalt::solver {
 
@@ -162,7 +163,7 @@ int CheckpointLoader::slice_of(std::int64_t id) const {
   return found;
 }
 
-CheckpointPart CheckpointLoader::local_part(const Decomposition& dec) {
+CheckpointPart CheckpointLoader::local_part(const Decomposition& dec, const std::array<double, 3>& origin) {
   const auto p = static_cast<std::size_t>(comm_.size());
   const auto& h = file_.header();
   const auto& g = slice_.geometry;
@@ -174,10 +175,12 @@ CheckpointPart CheckpointLoader::local_part(const Decomposition& dec) {
   {
     std::vector<std::vector<ParticleRecord>> out(p);
     std::vector<std::vector<double>> fields(p);
+    const CheckpointFrame frame(slice_, origin);  // where the whole-checkpoint restart puts each particle
     for (std::size_t i = 0; i < g.size(); ++i) {
       const auto& x = g.position[i];
       const auto& at = h.has_position_at_rebuild ? slice_.position_at_rebuild[i] : x;
-      owner[i] = dec.rank_of(at[0], at[1], at[2]);
+      const auto in_frame = frame.position(i, h.has_position_at_rebuild);
+      owner[i] = dec.rank_of(in_frame[0], in_frame[1], in_frame[2]);
       const auto& v = slice_.velocity[i];
       const double im = h.has_inverse_mass ? slice_.inv_mass[i] : 0.0;
       const auto o = static_cast<std::size_t>(owner[i]);

@@ -75,6 +75,12 @@ GeometryLoader::GeometryLoader(const io::GeometryFile& file, const Comm& comm) :
   const auto [begin, end] = io::slice_rows(file.header().particles, comm.rank(), comm.size());
   agreed(comm, [&, begin = begin, end = end] { file.read_particles(begin, end, slice_); });
   stats_.particle_rows = slice_.size();
+  // This rank's slice of the bond rows too, read once here and routed by local_part: the load checks
+  // summarise the slices, and a slice without its bonds has no bond tags (a scene's bond_tag was then
+  // reported as matching no bond of the file, though the run took every bond with it).
+  const auto [bb, be] = io::slice_rows(file.header().bonds, comm.rank(), comm.size());
+  agreed(comm, [&, bb = bb, be = be] { slice_.bonds = file.read_bonds(bb, be); });
+  stats_.bond_rows = slice_.bonds.size();
   const GeometryExtent mine = extent_of(slice_);
   for (int d = 0; d < 3; ++d) {
     extent_.lo[d] = comm.min(mine.lo[d]);
@@ -123,6 +129,15 @@ int GeometryLoader::slice_of(std::int64_t id) const {
   return found;
 }
 
+void GeometryLoader::to_frame(const std::array<double, 3>& o) {
+  for (auto& x : slice_.position)
+    for (std::size_t d = 0; d < 3; ++d) x[d] -= o[d];
+  for (std::size_t d = 0; d < 3; ++d) {
+    extent_.lo[d] -= o[d];
+    extent_.hi[d] -= o[d];
+  }
+}
+
 io::Geometry GeometryLoader::local_part(const Decomposition& dec) {
   const auto p = static_cast<std::size_t>(comm_.size());
   const bool has_mass = file_.header().has_mass;
@@ -141,10 +156,9 @@ io::Geometry GeometryLoader::local_part(const Decomposition& dec) {
   stats_.owned = owned.size();
 
   // 2. Bonds: this rank's slice of bond rows; the slices holding their ends tell the ends' owners.
-  const auto [bb, be] = io::slice_rows(file_.header().bonds, comm_.rank(), comm_.size());
-  std::vector<io::Bond> bonds;
-  agreed(comm_, [&, bb = bb, be = be] { bonds = file_.read_bonds(bb, be); });
-  stats_.bond_rows = bonds.size();
+  const std::size_t bb = io::slice_rows(file_.header().bonds, comm_.rank(), comm_.size()).first;
+  std::vector<io::Bond> bonds = std::move(slice_.bonds);  // read by the constructor
+  slice_.bonds.clear();
   // Each end id is asked once of the slice holding it; ids sorted, so the answers come back in that order.
   std::vector<std::int64_t> end_ids;
   end_ids.reserve(2 * bonds.size());

@@ -227,7 +227,11 @@ std::string check_precision(const GeometrySummary& s, double epsilon, const std:
       source, s.xmax, s.rmin, precision, res);
   const std::string remedy =
       precision == "float"
-          ? "run in double (--precision double) or move the geometry nearer the origin"
+          ? "run in double (--precision double) or mixed (--precision mixed: float offsets from the "
+            "geometry's centre), or move the geometry nearer the origin"
+      : precision == "mixed"
+          ? "run in double (--precision double): in mixed precision |x| is the distance from the geometry's "
+            "centre, so it is the geometry's extent that is too large for float"
           : "move the geometry nearer the origin (rounding grows with |x|, not with its size)";
   if (res > kResolutionRefuse)
     throw InputError(

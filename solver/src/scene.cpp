@@ -206,7 +206,7 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
           "missing run.dt or run.dt_fraction (one is required): the time step, absolute or as a "
           "fraction of the critical step");
     }
-    s.precision = t.choice_or("precision", {"double", "float"}, "double");
+    s.precision = t.choice_or("precision", {"double", "float", "mixed"}, "double");
     s.steps = t.integer("steps");
     if (s.steps < 0) t.fail("steps", fmt::format("must be >= 0, got {}", s.steps));
     s.skin = t.positive("skin");

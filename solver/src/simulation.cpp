@@ -48,8 +48,13 @@ Simulation<Real>::Simulation(const Scene& scene, io::Geometry g, MPI_Comm comm, 
   if (g.size() == 0)
     throw InputError(fmt::format("{}: the geometry has no particles", scene.geometry.string()));
   start(scene);
-  const auto summary = summarize_geometry(scene, g, scene.geometry.string());
-  run_load_checks(scene, summary, scene.geometry.string(), comm, kEpsilon, kPrecision);
+  if (mixed_) {  // everything in the frame at the geometry's centre from here on
+    origin_ = frame_origin(extent_of(g));
+    geometry_to_frame(g, origin_);
+    enter_frame();
+  }
+  const auto summary = summarize_geometry(scene_, g, scene.geometry.string());
+  run_load_checks(scene_, summary, scene.geometry.string(), comm, kEpsilon, precision_name());
   check_stability(summary);
   const GeometryExtent extent = extent_of(g);
   decompose(extent, comm);
@@ -69,10 +74,15 @@ Simulation<Real>::Simulation(const Scene& scene, const io::GeometryFile& file, M
   start(scene);
   const Comm all(comm);
   GeometryLoader loader(file, all);
+  if (mixed_) {  // everything in the frame at the geometry's centre from here on
+    origin_ = frame_origin(loader.extent());
+    loader.to_frame(origin_);
+    enter_frame();
+  }
   // The checks see the whole geometry through the slices' summaries (mins, maxima and tag sets are exact).
   const auto summary =
-      merge_summaries(summarize_geometry(scene, loader.slice(), scene.geometry.string()), comm);
-  run_load_checks(scene, summary, scene.geometry.string(), comm, kEpsilon, kPrecision);
+      merge_summaries(summarize_geometry(scene_, loader.slice(), scene.geometry.string()), comm);
+  run_load_checks(scene_, summary, scene.geometry.string(), comm, kEpsilon, precision_name());
   check_stability(summary);
   decompose(loader.extent(), comm);
   io::Geometry part = loader.local_part(*dec_);
@@ -85,8 +95,19 @@ Simulation<Real>::Simulation(const Scene& scene, const io::GeometryFile& file, M
 }
 
 template <class Real>
+void Simulation<Real>::enter_frame() {
+  scene_to_frame(scene_, origin_);
+  forces_.walls() = Walls(scene_.walls, scene_.mesh_walls);
+}
+
+template <class Real>
 void Simulation<Real>::configure_particles() {
   // The optional field groups this scene needs (Particles::enabled()): nothing else is allocated.
+  mixed_ = scene_.precision == "mixed";
+  // Compensated drift in mixed precision (BASALT_MIXED_COMPENSATION=0 leaves it out: the measurement of
+  // what it buys, tools/bench/mixed_precision.py).
+  const char* comp = std::getenv("BASALT_MIXED_COMPENSATION");
+  p_.with_compensation = mixed_ && !(comp && std::string(comp) == "0");
   p_.with_exact_rebuild = scene_.checkpoint_every > 0;
   p_.with_damage = forces_.bonds_can_break();
   p_.with_rotation = scene_.rotation;

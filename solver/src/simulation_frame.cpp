@@ -47,6 +47,13 @@ SimulationFrame<Real>::SimulationFrame(const Simulation<Real>& sim, std::uint32_
       }
   // The scene's optional particle fields that frames carry (Particles' array list).
   p.for_each_array([&](const ArrayInfo& a, const auto&) { h.fields += !a.output.empty() && p.enabled(a); });
+  // Mixed precision: the float positions in the run's frame, exactly (frame_origin.hpp).
+  if (sim.mixed_) h.fields += h.with_rebuild ? 6 : 3;
+  const auto& o = sim.origin_;
+  const auto absolute = [&o](std::array<double, 3> x) {
+    for (std::size_t d = 0; d < 3; ++d) x[d] += o[d];
+    return x;
+  };
   // Walls: global; the force is summed over the ranks (collective), rank 0 carries them.
   // Mesh walls follow the planar ones (so a checkpoint's wall count covers their history ids, -1 -
   // (planar walls + k)): position = where the rotation axis passes, normal = the axis, velocity = the
@@ -62,10 +69,14 @@ SimulationFrame<Real>::SimulationFrame(const Simulation<Real>& sim, std::uint32_
       for (std::size_t w = 0; w < wd.size(); ++w) {
         const auto& s = wd.spec(w);
         const auto& v = wd.velocity(w);  // a servo wall's: that of the next step
-        walls_.push_back(
-            {s.name, wd.point(w), s.normal, {v[0], v[1], v[2]}, {f[3 * w], f[3 * w + 1], f[3 * w + 2]}, {}});
+        walls_.push_back({s.name,
+                          absolute(wd.point(w)),
+                          s.normal,
+                          {v[0], v[1], v[2]},
+                          {f[3 * w], f[3 * w + 1], f[3 * w + 2]},
+                          {}});
         if (wd.servo(w)) {
-          const auto at = wd.point_at_rebuild(w);
+          const auto at = absolute(wd.point_at_rebuild(w));
           walls_.back().motion_state.assign(at.begin(), at.end());
         }
       }
@@ -73,8 +84,12 @@ SimulationFrame<Real>::SimulationFrame(const Simulation<Real>& sim, std::uint32_
         const auto& s = wd.mesh_spec(k);
         const auto v = s.motion.velocity_at(sim.time_);
         const std::size_t at = 3 * (wd.size() + k);
-        walls_.push_back(
-            {s.name, wd.mesh_axis_point(k), s.axis, {v[0], v[1], v[2]}, {f[at], f[at + 1], f[at + 2]}, {}});
+        walls_.push_back({s.name,
+                          absolute(wd.mesh_axis_point(k)),
+                          s.axis,
+                          {v[0], v[1], v[2]},
+                          {f[at], f[at + 1], f[at + 2]},
+                          {}});
       }
     }
   }
@@ -96,15 +111,31 @@ void SimulationFrame<Real>::write(io::FrameWriter& w) const {
   const auto owned = [n](const auto& v) { return std::span(v.data(), n); };
   w.column(Column::id, owned(p.id));
   w.column(Column::tag, owned(p.tag));
-  w.column(Column::x, owned(p.x));
-  w.column(Column::y, owned(p.y));
-  w.column(Column::z, owned(p.z));
+  const auto& o = sim_.origin_;
+  const bool mixed = sim_.mixed_;
+  if (mixed) {  // absolute coordinates: the frame's origin plus the float offsets
+    for (std::size_t i = 0; i < n; ++i) {
+      w.set(Column::x, i, o[0] + double(p.x[i]));
+      w.set(Column::y, i, o[1] + double(p.y[i]));
+      w.set(Column::z, i, o[2] + double(p.z[i]));
+    }
+  } else {
+    w.column(Column::x, owned(p.x));
+    w.column(Column::y, owned(p.y));
+    w.column(Column::z, owned(p.z));
+  }
   w.column(Column::vx, owned(p.vx));
   w.column(Column::vy, owned(p.vy));
   w.column(Column::vz, owned(p.vz));
   w.column(Column::radius, owned(p.radius));
   w.column(Column::mass, owned(p.inv_mass));
-  if (header_.with_rebuild) {
+  if (header_.with_rebuild && mixed) {
+    for (std::size_t i = 0; i < n; ++i) {
+      w.set(Column::x_rebuild, i, o[0] + double(p.xr[i]));
+      w.set(Column::y_rebuild, i, o[1] + double(p.yr[i]));
+      w.set(Column::z_rebuild, i, o[2] + double(p.zr[i]));
+    }
+  } else if (header_.with_rebuild) {
     w.column(Column::x_rebuild, std::span(p.xr.data(), n));
     w.column(Column::y_rebuild, std::span(p.yr.data(), n));
     w.column(Column::z_rebuild, std::span(p.zr.data(), n));
@@ -140,9 +171,9 @@ void SimulationFrame<Real>::write(io::FrameWriter& w) const {
     w.set(Column::bond_rest_length, at, broken.rest_length);
     w.set(Column::bond_group, at, broken.group);
     w.set(Column::bond_broken, at, std::uint8_t((broken.step == sim_.step_ ? 2 : 1) | (broken.mode << 2)));
-    w.set(Column::break_x, k, broken.x);
-    w.set(Column::break_y, k, broken.y);
-    w.set(Column::break_z, k, broken.z);
+    w.set(Column::break_x, k, o[0] + broken.x);
+    w.set(Column::break_y, k, o[1] + broken.y);
+    w.set(Column::break_z, k, o[2] + broken.z);
     ++at;
   }
   std::size_t c = 0;
@@ -166,6 +197,12 @@ void SimulationFrame<Real>::write(io::FrameWriter& w) const {
   p.for_each_array([&](const ArrayInfo& a, const auto& v) {
     if (!a.output.empty() && p.enabled(a)) w.field(a.output, std::span(v.data(), n));
   });
+  if (mixed) {
+    const std::array<const Real*, 6> exact{p.x.data(),  p.y.data(),  p.z.data(),
+                                           p.xr.data(), p.yr.data(), p.zr.data()};
+    for (std::size_t k = 0; k < (header_.with_rebuild ? 6u : 3u); ++k)
+      w.field(kFramePositionFields[k], std::span(exact[k], n));
+  }
   w.attributes(attributes_);
 }
 

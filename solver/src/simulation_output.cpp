@@ -89,6 +89,7 @@ bool Simulation<Real>::field_partials(const std::vector<double>& pe, std::vector
           while (walls.mesh_spec(m).name != f.wall) ++m;
           x = walls.mesh_axis_point(m);
         }
+        for (std::size_t k = 0; k < 3; ++k) x[k] += origin_[k];  // absolute (mixed: out of the frame)
         if (comm().rank() != 0) x = {0, 0, 0};
         local.insert(local.end(), x.begin(), x.end());
         break;
@@ -164,6 +165,7 @@ RestartLayout Simulation<Real>::restart_layout() const {
   r.ghost_width = ghost_width_;
   r.contact_cutoff = contact_cutoff_;
   for (int d = 0; d < 3; ++d) r.cuts[static_cast<std::size_t>(d)] = dec_->cuts(d);
+  r.origin = origin_;
   return r;
 }
 

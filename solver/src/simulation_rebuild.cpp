@@ -157,10 +157,10 @@ void Simulation<Real>::warn_far_positions() {
     fmt::print(
         stderr,
         "basalt-run: warning: step {}: particles have reached |x| = {:.4g} with a smallest radius of {:.4g}: "
-        "in float a distance between particles there is rounded to a strain of {:.2g} (epsilon |x| / 2 "
+        "in {} a distance between particles there is rounded to a strain of {:.2g} (epsilon |x| / 2 "
         "r_min), above {:g}: expect the energy to drift (docs/stability.md, \"Energy drift over 1e7 "
         "steps\"); run in double (--precision double)\n",
-        step_, xmax, stability_.rmin, resolution, kResolutionWarn);
+        step_, xmax, stability_.rmin, precision_name(), resolution, kResolutionWarn);
 }
 
 template <class Real>

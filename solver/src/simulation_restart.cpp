@@ -19,8 +19,12 @@
 namespace basalt::solver {
 
 template <class Real>
-void Simulation<Real>::begin_restart(std::size_t particles, double dt) {
+void Simulation<Real>::begin_restart(std::size_t particles, double dt, const RestartLayout& layout) {
   configure_particles();
+  if (mixed_) {  // the frame of the run that wrote the checkpoint (frame_origin.hpp)
+    origin_ = layout.origin;
+    enter_frame();
+  }
   if (particles == 0) throw InputError("the checkpoint has no particles");
   if (scene_.bonds.size() > 254) throw InputError("interactions: at most 254 bond groups");
   const double scene_dt = scene_.dt;
@@ -38,10 +42,11 @@ template <class Real>
 Simulation<Real>::Simulation(const Scene& scene, const io::Checkpoint& c, const RestartLayout& layout,
                              MPI_Comm comm, const RunOptions& options)
     : scene_(scene), options_(options), forces_(scene) {
-  begin_restart(c.size(), c.dt);
+  begin_restart(c.size(), c.dt, layout);
   const bool replay = !c.position_at_rebuild.empty();
-  const auto summary = summarize_geometry(scene, c.geometry, "the checkpoint");
-  run_load_checks(scene, summary, "the checkpoint", comm, kEpsilon, kPrecision);
+  auto summary = summarize_geometry(scene_, c.geometry, "the checkpoint");
+  if (mixed_) summary.xmax = frame_xmax(CheckpointFrame(c, origin_), c.size());
+  run_load_checks(scene_, summary, "the checkpoint", comm, kEpsilon, precision_name());
   check_stability(summary);
   check_checkpoint_rows(c, replay);
   restore_decomposition(layout, comm);
@@ -56,14 +61,15 @@ Simulation<Real>::Simulation(const Scene& scene, const io::CheckpointFile& file,
                              MPI_Comm comm, const RunOptions& options)
     : scene_(scene), options_(options), forces_(scene) {
   const auto& h = file.header();
-  begin_restart(h.particles, h.run.dt);
+  begin_restart(h.particles, h.run.dt, layout);
   const bool replay = h.has_position_at_rebuild;
   const Comm all(comm);
   CheckpointLoader loader(file, all);
   // The checks see the whole checkpoint through the slices' summaries (mins, maxima and tag sets are exact).
-  const auto summary =
-      merge_summaries(summarize_geometry(scene, loader.slice().geometry, "the checkpoint"), comm);
-  run_load_checks(scene, summary, "the checkpoint", comm, kEpsilon, kPrecision);
+  auto local = summarize_geometry(scene_, loader.slice().geometry, "the checkpoint");
+  if (mixed_) local.xmax = frame_xmax(CheckpointFrame(loader.slice(), origin_), loader.slice().size());
+  const auto summary = merge_summaries(local, comm);
+  run_load_checks(scene_, summary, "the checkpoint", comm, kEpsilon, precision_name());
   check_stability(summary);
   {  // the lowest rank's first bad row is the file's first
     std::optional<std::string> error;
@@ -79,7 +85,7 @@ Simulation<Real>::Simulation(const Scene& scene, const io::CheckpointFile& file,
   load_stats_.bond_rows = loader.slice().geometry.bonds.size();
   n_global_ = static_cast<std::int64_t>(h.particles);
   ids_.configure(loader.first_id(), loader.last_id(), h.particles);
-  CheckpointPart part = loader.local_part(*dec_);
+  CheckpointPart part = loader.local_part(*dec_, origin_);
   load_stats_.owned = part.c.size();
   load_stats_.bonds = part.c.geometry.bonds.size();
   distribute_checkpoint(part.c, &part.bond_length, replay);
@@ -167,11 +173,12 @@ void Simulation<Real>::distribute_checkpoint(const io::Checkpoint& c, const std:
   const auto& g = c.geometry;
   // Particles go where the last rebuild's migration put them: by their positions at that rebuild
   // (replay_rebuild restores the current ones), or by the current ones for an old checkpoint.
-  const auto& at = c.position_at_rebuild.empty() ? g.position : c.position_at_rebuild;
+  const bool at_rebuild = !c.position_at_rebuild.empty();
+  const CheckpointFrame frame(c, origin_);  // positions in the run's frame (mixed precision)
   std::vector<char> owned(g.size(), 0);
   std::vector<std::size_t> mine;  // geometry index of each owned particle, in local order
   for (std::size_t i = 0; i < g.size(); ++i) {
-    const auto& x = at[i];
+    const auto x = frame.position(i, at_rebuild);
     if (!dec_->owns(x[0], x[1], x[2])) continue;
     owned[i] = 1;
     mine.push_back(i);
@@ -195,7 +202,7 @@ void Simulation<Real>::distribute_checkpoint(const io::Checkpoint& c, const std:
     // Where it broke: the checkpoint's row for it among its broken bonds (NaN when it has none).
     const io::Vec3 where = c.bond_broken[k] == 0 || c.bond_break_position.empty()
                                ? io::Vec3{unknown, unknown, unknown}
-                               : c.bond_break_position[nb];
+                               : frame.point(c.bond_break_position[nb]);
     nb += c.bond_broken[k] != 0 ? 1 : 0;
     const int state = c.bond_broken[k] & 3;
     if (state == 1 || (state == 2 && !replay)) {
@@ -298,19 +305,22 @@ void Simulation<Real>::replay_rebuild(const io::Checkpoint& c) {
   // Back to the checkpoint's positions; the ghosts follow as after any step without a rebuild. A rank
   // holding a part of the checkpoint asks the others for particles a re-balance moved to it during the
   // rebuild (a restart on another rank grid).
+  const CheckpointFrame frame(c, origin_);  // positions in the run's frame (mixed precision)
   std::vector<std::int64_t> moved;
   for (std::size_t i = 0; i < p_.n_owned; ++i)
     if (g.index_of(p_.id[i]) < 0) moved.push_back(p_.id[i]);
   std::vector<io::Vec3> moved_at;
   if (comm().size() > 1 && comm().sum(static_cast<long long>(moved.size())) > 0) {
     std::sort(moved.begin(), moved.end());
-    moved_at = positions_of(comm(), moved, g.id, g.position);
+    std::vector<io::Vec3> held(g.size());
+    for (std::size_t i = 0; i < g.size(); ++i) held[i] = frame.position(i, false);
+    moved_at = positions_of(comm(), moved, g.id, held);
   }
   for (std::size_t i = 0; i < p_.n_owned; ++i) {
     const auto k = g.index_of(p_.id[i]);
-    const auto& x = k >= 0 ? g.position[static_cast<std::size_t>(k)]
-                           : moved_at[static_cast<std::size_t>(
-                                 std::lower_bound(moved.begin(), moved.end(), p_.id[i]) - moved.begin())];
+    const auto x = k >= 0 ? frame.position(static_cast<std::size_t>(k), false)
+                          : moved_at[static_cast<std::size_t>(
+                                std::lower_bound(moved.begin(), moved.end(), p_.id[i]) - moved.begin())];
     p_.x[i] = Real(x[0]);
     p_.y[i] = Real(x[1]);
     p_.z[i] = Real(x[2]);
@@ -335,9 +345,10 @@ void Simulation<Real>::restore_servos(const io::Checkpoint& c, bool at_rebuild) 
     if (!st || (at_rebuild && st->motion_state.size() != 3))
       throw InputError(fmt::format("the checkpoint has no servo state for wall \"{}\" (/walls/{}{})",
                                    walls.spec(w).name, walls.spec(w).name, st ? "/motion_state" : ""));
-    const auto& x = at_rebuild
-                        ? std::array<double, 3>{st->motion_state[0], st->motion_state[1], st->motion_state[2]}
-                        : st->position;
+    const auto x = CheckpointFrame(c, origin_)
+                       .point(at_rebuild ? std::array<double, 3>{st->motion_state[0], st->motion_state[1],
+                                                                 st->motion_state[2]}
+                                         : st->position);
     walls.restore_servo(w, x, st->velocity);
   }
 }
@@ -347,7 +358,7 @@ void Simulation<Real>::restore_servos(const io::Checkpoint& c, bool at_rebuild) 
                                      const RunOptions&);                                                  \
   template Simulation<R>::Simulation(const Scene&, const io::CheckpointFile&, const RestartLayout&,       \
                                      MPI_Comm, const RunOptions&);                                        \
-  template void Simulation<R>::begin_restart(std::size_t, double);                                        \
+  template void Simulation<R>::begin_restart(std::size_t, double, const RestartLayout&);                  \
   template void Simulation<R>::check_checkpoint_rows(const io::Checkpoint&, bool);                        \
   template void Simulation<R>::restore_decomposition(const RestartLayout&, MPI_Comm);                     \
   template void Simulation<R>::distribute_checkpoint(const io::Checkpoint&, const std::vector<double>*,   \

@@ -10,6 +10,7 @@
 #include <numbers>
 
 #include "basalt/solver/core/errors.hpp"
+#include "basalt/solver/integrate/integrators.hpp"
 #include "basalt/solver/simulation.hpp"
 #include "basalt/solver/stability/critical_step.hpp"
 
@@ -106,12 +107,12 @@ void Simulation<Real>::estimate_critical_step(bool fresh) {
   st.dt_bound = stability::critical_step(bound2);
 
   // Power iterations on M^-1 K, each product K u from the force field, K u = (F(x) - F(x + delta u)) /
-  // delta: F(x) is computed again for each product and negated in the force arrays, where F(x + delta u)
-  // then adds onto it, so no forces are stored (two evaluations per product; central differences,
-  // at the same cost, would drop the O(delta) bias, ~1e-7 here, far below the tolerance, but move the
-  // printed estimates' last digits). The iteration vector is kept in float in the float positions of
-  // the last rebuild (p_.x0, equal to float(x) right after it; restored at the end) or, after a
-  // restart (x0 then belongs to the checkpoint's rebuild), in a float scratch vector. The positions
+  // delta: F(x), computed once and kept (3 values per owned particle while the estimate runs), is
+  // negated into the force arrays, where F(x + delta u) then adds onto it: one evaluation per product
+  // (central differences, at twice the cost, would drop the O(delta) bias, ~1e-7 here, far below the
+  // tolerance, but move the printed estimates' last digits). The iteration vector is kept in float in the
+  // float positions of the last rebuild (p_.x0, equal to float(x) right after it; restored at the end) or,
+  // after a restart (x0 then belongs to the checkpoint's rebuild), in a float scratch vector. The positions
   // are not copied: each perturbation is a multiple of the ulp of its coordinate and stays within its
   // binade, so x -> x + d -> x is exact (the few coordinates near zero or a power of two, where that
   // fails, are kept in a side list). The products need the ghosts' perturbed positions: a ghost update per
@@ -153,24 +154,53 @@ void Simulation<Real>::estimate_critical_step(bool fresh) {
         breakable ? p_.bonds_broken : std::vector<std::int32_t>{};
     const std::size_t broken_at_start = broken_.size();
     const bool bond_broke_at_start = bond_broke_;
-    compute_forces<false>();  // also F(x) for the first product
+    compute_forces<false>();
+    // F(x) once for all products (120 force evaluations became 61: half the start-up of a large run,
+    // docs/BENCHMARKS.md). Bonds beyond their break strain broke in that evaluation, and a model whose
+    // breaking bond still acts then (rot_bond) put its force in: F(x) again without them.
+    if (broken_.size() != broken_at_start) compute_forces<false>();
     const std::size_t broken_before = broken_.size();
-    std::vector<double> sums(2);
-    double vmax = 0;
+    std::vector<Real> f_at_x(3 * n);
+    for (int d = 0; d < 3; ++d) std::copy(frc[d], frc[d] + n, f_at_x.begin() + std::ptrdiff_t(d * n));
+    // Lanczos on the symmetric A = M^-1/2 K M^-1/2 (the same eigenvalues as M^-1 K): q_j in sv (float),
+    // q_(j-1) in `previous`, the perturbation along u = M^-1/2 q_j. Its largest Ritz value rises towards
+    // omega_max^2 from below as the power iteration's Rayleigh quotient did, but it converges in far
+    // fewer products when the top of the spectrum is crowded (a large network: at 9.47 M particles 60
+    // power iterations had not converged). q_j is the vector the perturbation actually applied (rounded
+    // to the coordinates' ulps), rescaled: rounding enters as a relative 1e-6 error of the product.
+    std::vector<float> previous(3 * n, 0.0f);
+    std::vector<double> alpha, beta;
+    std::vector<double> sums(1);
+    const auto norm_of = [&](const auto& value) {  // sqrt of the sum over ranks of value(d, i)^2
+      sums[0] = 0;
+      for (int d = 0; d < 3; ++d)
+        for (std::size_t i = 0; i < n; ++i) sums[0] += value(d, i) * value(d, i);
+      comm().sum_all(sums);
+      return std::sqrt(sums[0]);
+    };
+    {  // q_1: the start vector, of unit length
+      const double q1 = norm_of([&](int d, std::size_t i) { return double(sv[d][i]); });
+      if (q1 > 0)
+        for (int d = 0; d < 3; ++d)
+          for (std::size_t i = 0; i < n; ++i) sv[d][i] = float(double(sv[d][i]) / q1);
+    }
+    std::vector<double> sqrt_im(n);
+    for (std::size_t i = 0; i < n; ++i) sqrt_im[i] = std::sqrt(double(p_.inv_mass[i]));
+    Real* const w[3] = {frc[0], frc[1], frc[2]};  // A q_j and then the next Lanczos vector, in place
     for (int it = 0; it < stability::kMaxIterations; ++it) {
-      vmax = 0;
+      double umax = 0;
       for (int d = 0; d < 3; ++d)
-        for (std::size_t i = 0; i < n; ++i) vmax = std::max(vmax, double(std::abs(sv[d][i])));
-      vmax = comm().max(vmax);
-      if (!(vmax > 0) || !std::isfinite(vmax)) break;
-      if (it > 0) compute_forces<false>();  // F(x) (the first one is above)
+        for (std::size_t i = 0; i < n; ++i) umax = std::max(umax, std::abs(sqrt_im[i] * double(sv[d][i])));
+      umax = comm().max(umax);
+      if (!(umax > 0) || !std::isfinite(umax)) break;
+      zero_forces(p_);  // ghosts' forces and the torques too
       for (int d = 0; d < 3; ++d)
-        for (std::size_t i = 0; i < n; ++i) frc[d][i] = -frc[d][i];
+        for (std::size_t i = 0; i < n; ++i) frc[d][i] = -f_at_x[d * n + i];
       forces_zeroed_ = true;  // the next evaluation adds F(x + d) onto -F(x)
-      // x + d: delta v / vmax, rounded to a multiple of the coordinate's ulp where it is movable.
+      // x + d: delta u / umax, rounded to a multiple of the coordinate's ulp where it is movable.
       for (std::size_t i = 0, k = 0; i < n; ++i)
         for (int d = 0; d < 3; ++d) {
-          const double want = delta * double(sv[d][i]) / vmax;
+          const double want = delta * sqrt_im[i] * double(sv[d][i]) / umax;
           if (k < side_at.size() && side_at[k] == 3 * i + std::size_t(d)) {
             pos[d][i] = Real(double(side_value[k++]) + want);
           } else {
@@ -180,35 +210,50 @@ void Simulation<Real>::estimate_critical_step(bool fresh) {
         }
       if (parallel) halo_->update_ghosts(p_);
       compute_forces<false>();
-      sums[0] = sums[1] = 0;
+      // w = A q_j - beta_(j-1) q_(j-1), with q_j the perturbation actually applied (then undone, exactly).
+      const double beta_before = beta.empty() ? 0.0 : beta.back();
+      sums[0] = 0;
       for (std::size_t i = 0, k = 0; i < n; ++i) {
-        const double im = double(p_.inv_mass[i]);
         for (int d = 0; d < 3; ++d) {
-          // The perturbation actually applied (then undone, exactly) and K times it.
           double dd;
           if (k < side_at.size() && side_at[k] == 3 * i + std::size_t(d)) {
             dd = double(pos[d][i]) - double(side_value[k]);
             pos[d][i] = side_value[k++];
           } else {
             const Real q = stability::ulp(pos[d][i]);  // the same at x + d as at x
-            const Real step = Real(std::nearbyint(delta * double(sv[d][i]) / vmax / double(q))) * q;
+            const Real step =
+                Real(std::nearbyint(delta * sqrt_im[i] * double(sv[d][i]) / umax / double(q))) * q;
             pos[d][i] -= step;
             dd = double(step);
           }
-          const double u = dd / delta, w = -double(frc[d][i]) / delta;
-          sums[0] += u * w;
-          sums[1] += u * u / im;
-          sv[d][i] = float(w * im);
+          const double u = dd * umax / delta;  // M^-1/2 q_j as applied
+          const double qj = sqrt_im[i] > 0 ? u / sqrt_im[i] : 0.0;
+          const double aq = -sqrt_im[i] * double(frc[d][i]) * umax / delta;  // M^-1/2 K u
+          const double wi = aq - beta_before * double(previous[d * n + i]);
+          sv[d][i] = float(qj);
+          w[d][i] = Real(wi);
+          sums[0] += qj * wi;
         }
       }
       if (parallel) halo_->update_ghosts(p_);
       comm().sum_all(sums);
       ++st.iterations;
-      if (!(sums[1] > 0)) break;
-      const double rq = sums[0] / sums[1];
-      const bool converged = it > 2 && std::abs(rq - lambda) <= stability::kTolerance * rq;
-      lambda = std::max(lambda, rq);
-      if (converged) break;
+      const double a = sums[0];
+      if (!std::isfinite(a)) break;
+      alpha.push_back(a);
+      for (int d = 0; d < 3; ++d)
+        for (std::size_t i = 0; i < n; ++i) w[d][i] = Real(double(w[d][i]) - a * double(sv[d][i]));
+      const double b = norm_of([&](int d, std::size_t i) { return double(w[d][i]); });
+      const double ritz = stability::largest_eigenvalue(alpha, beta);
+      const bool converged = it > 2 && std::abs(ritz - lambda) <= stability::kTolerance * ritz;
+      lambda = std::max(lambda, ritz);
+      if (converged || !(b > 1e-12 * std::max(std::abs(a), lambda))) break;  // or an invariant subspace
+      beta.push_back(b);
+      for (int d = 0; d < 3; ++d)
+        for (std::size_t i = 0; i < n; ++i) {
+          previous[d * n + i] = sv[d][i];
+          sv[d][i] = float(double(w[d][i]) / b);
+        }
     }
     // x0 back to the values rebuild() gives it (the same function sets both). The forces hold the last
     // product: the callers compute them again.

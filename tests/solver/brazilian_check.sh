@@ -9,7 +9,7 @@ set -e
 pack=$1 run=$2 src=$3 dir=$4
 rm -rf "$dir" && mkdir -p "$dir"
 "$pack" cylinder --radius 5 --height 3 --origin 0,0,0 --rmin 0.15 --rmax 0.6 --seed 3 -o "$dir/disc.h5" >/dev/null
-"$run" "$src/scenes/brazilian.toml" --geometry "$dir/disc.h5" --steps 4000 --checkpoint-every 3000 \
+"$run" "$src/scenes/brazilian.toml" --geometry "$dir/disc.h5" --steps 5000 --checkpoint-every 3000 \
   --output "$dir/out" --quiet 2>/dev/null
 /usr/bin/python3 "$src/tools/brazilian_strength.py" "$dir/out" --diameter 10 --thickness 3 --speed 0.05 | tee "$dir/strength.txt"
 /usr/bin/python3 - "$dir" <<'PY'
@@ -23,7 +23,7 @@ if not (0 < k < len(load) - 1 and load[-1] < 0.8 * load[k]):
     sys.exit(f"FAIL: no peak load within the run (peak {load[k]:g} at row {k} of {len(load)}, last {load[-1]:g})")
 strength = open(f"{d}/strength.txt").read()
 sigma = float(strength.split("sigma_t = 2 F / (pi D t) = ")[1].split()[0])
-if not abs(sigma - 2 * load[k] / (np.pi * 10 * 3)) <= 1e-6 * sigma:
+if not abs(sigma - 2 * load[k] / (np.pi * 10 * 3)) <= 1e-5 * sigma:  # printed to 6 significant digits
     sys.exit(f"FAIL: sigma_t {sigma} is not 2 F / (pi D t) of the peak load {load[k]}")
 with h5py.File(f"{d}/out/ckpt_003000.h5", "r") as h:
     ids = h["particles/id"][...]

@@ -257,13 +257,17 @@ TEST_P(RadiusRatio, ClosedSystemConservesEnergy) { conserves_energy<double>(GetP
 TEST_P(RadiusRatio, ClosedSystemConservesEnergyFloat) { conserves_energy<float>(GetParam()); }
 
 // At 0.95 x the estimate the bonded network runs 2,000 steps: bounded (below the harmonic bound f^2 / (1 -
-// f^2) = 9.3) and without drift. A smaller particle than the estimate saw would make it explode.
+// f^2) = 9.3) and without growth. A smaller particle than the estimate saw would make it explode: an
+// unstable mode grows by orders of magnitude in 2,000 steps. The drift (mean of the last 20 samples against
+// the first 20) of this bounded beat near the limit is not monotonic in dt: ratio 50 in double gave 0.023 at
+// the power iterations' estimate (omega^2 1.3e-3 below the converged one), 0.117 at Lanczos' (2e-4 below)
+// and 0.061 at the converged omega_max itself; hence 0.25, far below any growth.
 template <class Real>
 void stable_at_estimate(double ratio) {
   const auto rec = ratio_energy<Real>(ratio, 0.95, false);
   EXPECT_FALSE(rec.stopped);
   EXPECT_LT(rec.worst, 1.0);
-  EXPECT_LT(rec.drift, 0.05);
+  EXPECT_LT(rec.drift, 0.25);
 }
 TEST_P(RadiusRatio, StableAtTheEstimate) { stable_at_estimate<double>(GetParam()); }
 TEST_P(RadiusRatio, StableAtTheEstimateFloat) { stable_at_estimate<float>(GetParam()); }

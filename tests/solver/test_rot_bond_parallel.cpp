@@ -131,8 +131,9 @@ TEST(RotBondParallel, CrushedSpecimenMatchesSerialRunThroughBreaks) {
         counts_agree = counts_agree && s[modes + m][same] == col(modes + m, same);
       if (counts_agree) ++same;
     }
-    // The platen force to 1e-8 through the first 100 breaks (measured 1e-9 to 6e-9: this specimen is crushed
-    // in 0.06 ms and each break passes on the other grid's rounding; 1.4e-8 after 541 breaks).
+    // The platen force to 5e-8 through the first 100 breaks (measured 2.5e-9 to 1.9e-8 since orientations are
+    // renormalised every step and q^-1 is the conjugate, as in ESyS; 1e-9 to 6e-9 before: this specimen is
+    // crushed in 0.06 ms and each break passes on the other grid's rounding).
     std::size_t first100 = 0;
     while (first100 < same && col(count, 0) - col(count, first100) < 100) ++first100;
     double worst = 0;
@@ -141,7 +142,7 @@ TEST(RotBondParallel, CrushedSpecimenMatchesSerialRunThroughBreaks) {
     const double broken_while_same = same > 0 ? col(count, 0) - col(count, same - 1) : 0;
     EXPECT_GE(broken_while_same, 100) << "dims " << dims[0] << "," << dims[1] << "," << dims[2]
                                       << ": broken bonds differ from the serial run at row " << same;
-    EXPECT_LT(worst, 1e-8) << "dims " << dims[0] << "," << dims[1] << "," << dims[2];
+    EXPECT_LT(worst, 5e-8) << "dims " << dims[0] << "," << dims[1] << "," << dims[2];
     std::printf(
         "np %d dims %d,%d,%d: identical broken bonds for %zu of %zu rows (%g breaks), platen force max "
         "rel. difference %.3g there; serial total %g broken (t %g s %g b %g t %g)\n",

@@ -2,9 +2,12 @@
 // their owners, solver/src/geometry_loader.cpp) gives exactly the state of the whole-file start-up: the
 // same owned particles in the same order, the same bonds with the same rest lengths and groups, the same
 // damage counters, and the same run. And no rank reads more than its share of the file's rows.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include "basalt/io/geometry_rows.hpp"
+#include "basalt/solver/parallel/geometry_loader.hpp"
+#include "basalt/solver/scene/load_checks.hpp"
 #include "basalt/solver/simulation.hpp"
 #include "solver_helpers.hpp"
 #include "test_support.hpp"
@@ -134,4 +137,48 @@ type = "kinetic_energy"
 every = 1
 )");
   compare_starts(scene, h5);
+}
+
+TEST(SlicedStart, LoadChecksSeeTheBondTagsOfTheSlices) {
+  // cube1.geo as ESyS-Particle's GenGeo writes it: every bond tagged 0 (its default). A bond group with
+  // bond_tag = 0 takes all of them, so the load check must not report that no bond has that tag (it
+  // did: the slices it summarised held particles only); a tag no bond has is still reported.
+  const auto dir = basalt::test::scratch_dir("sliced-start-bond-tags");
+  const auto h5 = dir / "cube1.h5";
+  const auto whole = io::read_geometry(basalt::test::reference_dir() / "cube1.geo");
+  ASSERT_FALSE(whole.bonds.empty());
+  for (const auto& b : whole.bonds) ASSERT_EQ(b.tag, 0);
+  if (basalt::test::rank() == 0) io::write_geometry(whole, h5);
+  MPI_Barrier(MPI_COMM_WORLD);
+  const auto scene_with = [](int tag) {
+    return basalt::test::scene_from(fmt::format(R"(
+[run]
+dt = 1.0e-3
+steps = 1
+skin = 0.1
+[[interactions]]
+name = "bonds"
+type = "linear_bond"
+K = 1000.0
+bond_tag = {}
+)",
+                                                tag));
+  };
+  const auto scene = scene_with(0);
+  io::GeometryFile file(h5);
+  const Comm comm(MPI_COMM_WORLD);
+  GeometryLoader loader(file, comm);
+  const auto sliced = merge_summaries(summarize_geometry(scene, loader.slice(), "cube1.h5"), MPI_COMM_WORLD);
+  const auto full = summarize_geometry(scene, whole, "cube1.h5");
+  EXPECT_EQ(sliced.bond_tags, full.bond_tags);
+  EXPECT_EQ(sliced.bond_tags, std::vector<std::int64_t>{0});
+  EXPECT_EQ(sliced.tags, full.tags);
+  EXPECT_TRUE(check_scene_with_summary(scene, sliced, "cube1.h5").empty());
+  const auto absent = check_scene_with_summary(scene_with(3), sliced, "cube1.h5");
+  ASSERT_EQ(absent.size(), 1u);
+  EXPECT_NE(absent[0].find("bond_tag = 3: no bond of cube1.h5 has that tag"), std::string::npos) << absent[0];
+  // The run from the slices takes every bond with bond_tag = 0.
+  Simulation<double> sim(scene, file, MPI_COMM_WORLD);
+  EXPECT_EQ(sim.unassigned_bonds(), 0u);
+  EXPECT_EQ(sim.bond_count(), static_cast<std::int64_t>(whole.bonds.size()));
 }

@@ -9,9 +9,11 @@
 #include <cmath>
 #include <numbers>
 #include <string>
+#include <vector>
 
 #include "basalt/solver/core/errors.hpp"
 #include "basalt/solver/simulation.hpp"
+#include "basalt/solver/stability/critical_step.hpp"
 #include "solver_helpers.hpp"
 #include "test_support.hpp"
 
@@ -91,6 +93,22 @@ TYPED_TEST(CriticalStep, ChainHighestMode) {
 
 // Particles that start apart have no spring yet: the critical step is that of one contact between two
 // of the lightest particles, 2 / sqrt(2 k_max / m_min), and dt above it is refused.
+// The Lanczos Ritz value: the largest eigenvalue of a symmetric tridiagonal matrix. The chain Laplacian
+// (2 on the diagonal, -1 beside it) of order m has eigenvalues 2 - 2 cos(k pi / (m + 1)), k = 1..m.
+TEST(LargestEigenvalue, TridiagonalClosedForms) {
+  for (const std::size_t m : {1u, 2u, 7u, 60u}) {
+    const std::vector<double> alpha(m, 2.0), beta(m, -1.0);  // beta[m - 1] is not read
+    const double want = 2 + 2 * std::cos(std::numbers::pi / double(m + 1));
+    EXPECT_NEAR(stability::largest_eigenvalue(alpha, beta), want, 1e-12 * want) << "order " << m;
+  }
+  // Diagonal (beta = 0): the largest entry, wherever it is; and scale: x 1e8 scales the result.
+  EXPECT_DOUBLE_EQ(stability::largest_eigenvalue({3.0, 9.0, 1.0}, {0.0, 0.0}), 9.0);
+  EXPECT_NEAR(stability::largest_eigenvalue({2e8, 2e8, 2e8}, {-1e8, -1e8}), (2 + std::sqrt(2.0)) * 1e8, 1e-4);
+  // [[1, 2], [2, 1]]: eigenvalues 3 and -1.
+  EXPECT_NEAR(stability::largest_eigenvalue({1.0, 1.0}, {2.0}), 3.0, 1e-14);
+  EXPECT_EQ(stability::largest_eigenvalue({}, {}), 0.0);
+}
+
 TEST(CriticalStepApart, OneFutureContactBetweenLightestParticles) {
   const std::string body = R"([run]
 dt = 0.02

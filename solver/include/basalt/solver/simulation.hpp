@@ -27,6 +27,7 @@
 #include "basalt/solver/parallel/decomposition.hpp"
 #include "basalt/solver/parallel/geometry_loader.hpp"
 #include "basalt/solver/parallel/halo.hpp"
+#include "basalt/solver/scene/frame_origin.hpp"
 #include "basalt/solver/scene/load_checks.hpp"
 #include "basalt/solver/scene/scene.hpp"
 #include "basalt/solver/timers.hpp"
@@ -66,6 +67,9 @@ struct RestartLayout {
   /// The cuts in force at the checkpoint (Decomposition::cuts; empty: the even grid). Taken when they
   /// fit the restart's rank grid (as many ranks along each axis), else the grid starts even.
   std::array<std::vector<double>, 3> cuts;
+  /// run.precision = "mixed": the origin of the run's frame (scene/frame_origin.hpp); the box and the cuts
+  /// above are in that frame (relative to it). Zero in double and float.
+  std::array<double, 3> origin{0, 0, 0};
 };
 
 template <class Real>
@@ -166,6 +170,11 @@ class Simulation {
   const LoadStats& load_stats() const { return load_stats_; }
   /// Bytes held by the solver's arrays on this rank (capacity, not RSS).
   std::size_t memory_bytes() const;
+  /// run.precision = "mixed": the origin of the frame the run holds positions, walls and the decomposition
+  /// in (positions() + origin() are the absolute coordinates); zero otherwise.
+  const Origin& origin() const { return origin_; }
+  /// "double", "float" or "mixed" (float storage in a frame at the geometry's centre).
+  const char* precision_name() const { return mixed_ ? "mixed" : kPrecision; }
 
  private:
   /// The precision's name and machine epsilon (load checks, messages).
@@ -176,6 +185,8 @@ class Simulation {
   void report_frame_times(std::vector<double> seconds) const;
   /// The common start of both constructors, before the particles exist (kicks, limits).
   void start(const Scene& scene);
+  /// Mixed precision: moves the scene (scene_, the walls) into the frame of origin_ (frame_origin.hpp).
+  void enter_frame();
   /// The rank grid over the geometry's box.
   void decompose(const GeometryExtent& e, MPI_Comm comm);
   /// Takes this rank's particles and bonds from `g`: the whole geometry, or this rank's part of it
@@ -236,7 +247,7 @@ class Simulation {
   /// Collective: the runout saver's value (FieldSpec::percentile of the distances along its direction).
   double runout(const FieldSpec& f) const;
   /// Restart: what both restart constructors check first (particles, bond groups, dt) and set.
-  void begin_restart(std::size_t particles, double dt);
+  void begin_restart(std::size_t particles, double dt, const RestartLayout& layout);
   /// Restart: the checkpoint's bonds belong to the scene's bond groups, its contact histories to its
   /// contact models (InputError naming the first row that does not, in file order).
   void check_checkpoint_rows(const io::Checkpoint& rows, bool replay);
@@ -309,6 +320,8 @@ class Simulation {
   std::int64_t rebalances_ = 0;
   double imbalance_before_ = 1;
   bool balance_paused_ = false;  ///< a restart replaying a rebuild with the checkpoint's own cuts
+  bool mixed_ = false;           ///< run.precision = "mixed" (set by configure_particles())
+  Origin origin_{};              ///< the frame's origin (mixed; zero otherwise)
 };
 
 extern template class Simulation<double>;

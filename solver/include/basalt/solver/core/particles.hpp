@@ -22,7 +22,7 @@
 namespace basalt::solver {
 
 /// Groups of arrays a scene may leave out (Particles::enabled()).
-enum class FieldGroup { core, exact_rebuild, damage, rotation, bond_frame };
+enum class FieldGroup { core, exact_rebuild, damage, rotation, bond_frame, compensation };
 
 /// What an array of Particles is (for_each_array()).
 struct ArrayInfo {
@@ -84,6 +84,12 @@ struct Particles {
   /// follow (x_b0 - x_a0); ghosts have it, and with it ghosts carry orientations refreshed every step.
   std::vector<Real> xi, yi, zi;
   bool with_bond_frame = false;
+  /// Optional (with_compensation: run.precision = "mixed"): each position's rounding remainder of the
+  /// drift x += v dt (Kahan): the part of the increments that float rounding dropped from x, owed to it
+  /// (the position is x - c). Small increments (v dt below half an ulp of x) then still move the
+  /// particles on average instead of being lost (docs/stability.md, "Mixed precision").
+  std::vector<Real> cx, cy, cz;
+  bool with_compensation = false;
   /// Ghosts carry velocities (and angular velocities with rotation), refreshed every step with their
   /// positions: set when a model reads the velocities of both particles of a pair (friction, damping).
   bool ghost_velocity = false;
@@ -93,7 +99,8 @@ struct Particles {
     return a.group == FieldGroup::core || (a.group == FieldGroup::exact_rebuild && with_exact_rebuild) ||
            (a.group == FieldGroup::damage && with_damage) ||
            (a.group == FieldGroup::rotation && with_rotation) ||
-           (a.group == FieldGroup::bond_frame && with_bond_frame);
+           (a.group == FieldGroup::bond_frame && with_bond_frame) ||
+           (a.group == FieldGroup::compensation && with_compensation);
   }
 
   /// Calls f(ArrayInfo, vector&) for every array, in a fixed order.
@@ -266,6 +273,9 @@ struct Particles {
         init_x{"initial_position", go, true, G::bond_frame, "initial_position_x"},
         init_y{"initial_position", go, true, G::bond_frame, "initial_position_y"},
         init_z{"initial_position", go, true, G::bond_frame, "initial_position_z"};
+    constexpr ArrayInfo rem_x{"position_remainder", false, true, G::compensation, "position_remainder_x"},
+        rem_y{"position_remainder", false, true, G::compensation, "position_remainder_y"},
+        rem_z{"position_remainder", false, true, G::compensation, "position_remainder_z"};
     f(pos, p.x), f(pos, p.y), f(pos, p.z);
     f(rad, p.radius);
     f(ident, p.id);
@@ -280,6 +290,7 @@ struct Particles {
     f(trq, p.tx), f(trq, p.ty), f(trq, p.tz);
     f(ori, p.qw), f(ori_x, p.qx), f(ori_y, p.qy), f(ori_z, p.qz);
     f(init_x, p.xi), f(init_y, p.yi), f(init_z, p.zi);
+    f(rem_x, p.cx), f(rem_y, p.cy), f(rem_z, p.cz);
   }
 };
 

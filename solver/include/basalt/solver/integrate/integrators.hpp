@@ -24,10 +24,18 @@ void kick(Particles<Real>& p, Real h) {
   detail::kick_pass<false>(p, h);
 }
 
-/// kick(h), zero the forces (the next force computation accumulates from zero), drift(dt), in one
-/// pass over memory. Returns the largest squared displacement since the last rebuild, or infinity when
-/// a position went non-finite.
+namespace detail {
+/// x += u dt by Kahan's compensated sum: c carries what rounding dropped from x (x - c is the
+/// position), fed back into the next increment.
 template <class Real>
+inline void drift_compensated(Real& x, Real& c, Real u, Real dt) {
+  const Real y = dt * u - c;
+  const Real t = x + y;
+  c = (t - x) - y;
+  x = t;
+}
+
+template <bool Compensated, class Real>
 double kick_zero_drift(Particles<Real>& p, Real h, Real dt) {
   const std::size_t n = p.n_owned;
   Real* __restrict x = p.x.data();
@@ -44,6 +52,9 @@ double kick_zero_drift(Particles<Real>& p, Real h, Real dt) {
   const float* __restrict y0 = p.y0.data();
   const float* __restrict z0 = p.z0.data();
   const Real ox = Real(p.skin_origin[0]), oy = Real(p.skin_origin[1]), oz = Real(p.skin_origin[2]);
+  Real* __restrict cx = p.cx.data();  // empty without compensation (never read then)
+  Real* __restrict cy = p.cy.data();
+  Real* __restrict cz = p.cz.data();
   Real m = 0;
   Real sum = 0;
   for (std::size_t i = 0; i < n; ++i) {
@@ -55,9 +66,15 @@ double kick_zero_drift(Particles<Real>& p, Real h, Real dt) {
     fx[i] = 0;
     fy[i] = 0;
     fz[i] = 0;
-    x[i] += dt * ux;
-    y[i] += dt * uy;
-    z[i] += dt * uz;
+    if constexpr (Compensated) {
+      drift_compensated(x[i], cx[i], ux, dt);
+      drift_compensated(y[i], cy[i], uy, dt);
+      drift_compensated(z[i], cz[i], uz, dt);
+    } else {
+      x[i] += dt * ux;
+      y[i] += dt * uy;
+      z[i] += dt * uz;
+    }
     const Real dx = x[i] - ox - x0[i], dy = y[i] - oy - y0[i], dz = z[i] - oz - z0[i];
     const Real d2 = dx * dx + dy * dy + dz * dz;
     m = d2 > m ? d2 : m;
@@ -65,6 +82,16 @@ double kick_zero_drift(Particles<Real>& p, Real h, Real dt) {
   }
   if (!std::isfinite(sum)) return std::numeric_limits<double>::infinity();
   return double(m);
+}
+}  // namespace detail
+
+/// kick(h), zero the forces (the next force computation accumulates from zero), drift(dt), in one
+/// pass over memory; the drift compensated (Kahan) when p.with_compensation. Returns the largest squared
+/// displacement since the last rebuild, or infinity when a position went non-finite.
+template <class Real>
+double kick_zero_drift(Particles<Real>& p, Real h, Real dt) {
+  return p.with_compensation ? detail::kick_zero_drift<true>(p, h, dt)
+                             : detail::kick_zero_drift<false>(p, h, dt);
 }
 
 /// cos(a) and sin(a) / w for the half angle a = |w| dt / 2 of a step's turn, from w2 = |w|^2: for
@@ -88,7 +115,7 @@ inline void half_turn(Real w2, Real dt, Real& c, Real& s) {
 
 /// Rotation (with_rotation), the twin of kick_zero_drift: w += h T / I (I = 2/5 m r^2: a sphere needs
 /// no gyroscopic term), torques zeroed, then the orientation turned by the angle |w| dt about w (an
-/// exact rotation for the step's constant w, so the quaternion stays of unit length to rounding).
+/// exact rotation for the step's constant w) and brought back to unit length (ESyS's rescale).
 template <class Real>
 void rotate_kick_zero_drift(Particles<Real>& p, Real h, Real dt) {
   const std::size_t n = p.n_owned;
@@ -123,6 +150,16 @@ void rotate_kick_zero_drift(Particles<Real>& p, Real h, Real dt) {
     qxs[i] = c * qx + ax * qw + ay * qz - az * qy;
     qys[i] = c * qy + ay * qw + az * qx - ax * qz;
     qzs[i] = c * qz + az * qw + ax * qy - ay * qx;
+    // Back to unit length, as ESyS-Particle after every step (CRotParticle::rescale: q times 1/|q|). The
+    // turn keeps |q| to rounding per step, but the roundings add up (|q|^2 - 1 reached 6e-14 in 3,000
+    // steps), and rot_bond's ESyS angles read a norm defect e as a bend of sqrt(2 e): 1e-7 rad, a kick on
+    // every bond that pumped energy into a free specimen 5x faster than ESyS (docs/validation-rock.md).
+    const Real nw = qws[i], nx = qxs[i], ny = qys[i], nz = qzs[i];
+    const Real inv = Real(1) / std::sqrt(nw * nw + nx * nx + ny * ny + nz * nz);
+    qws[i] = nw * inv;
+    qxs[i] = nx * inv;
+    qys[i] = ny * inv;
+    qzs[i] = nz * inv;
   }
 }
 

@@ -69,13 +69,10 @@ struct Quat {
     return {w * o.w - x * o.x - y * o.y - z * o.z, w * o.x + x * o.w + y * o.z - z * o.y,
             w * o.y - x * o.z + y * o.w + z * o.x, w * o.z + x * o.y - y * o.x + z * o.w};
   }
-  /// Divided by |q|^2. ESyS's Quaternion::inverse is the conjugate: the same for unit quaternions, but here
-  /// q^-1 q keeps a rounding-level vector part that acos reads as a 1.5e-8 rad bend on a bond at rest (ESyS:
-  /// exactly none). Kept for now: the conjugate moves chaotic fracture results (docs/validation-rock.md).
-  Quat inverse() const {
-    const Real n = w * w + x * x + y * y + z * z;
-    return {w / n, -x / n, -y / n, -z / n};
-  }
+  /// The conjugate, as ESyS's Quaternion::inverse: the inverse of a unit quaternion (the integrator keeps
+  /// orientations of unit length, as ESyS does). Unlike a division by |q|^2 it leaves q^-1 q at rest with no
+  /// rounding-level vector part, which acos would read as a 1.5e-8 rad bend (docs/validation-rock.md).
+  Quat inverse() const { return {w, -x, -y, -z}; }
   /// R^T v for the rotation R this quaternion stands for (body -> world): v in the body frame. Written
   /// in the homogeneous form (w^2 + x^2 - y^2 - z^2 ...) as ESyS's Quaternion::to_matrix.
   Vec<Real> to_body(const Vec<Real>& v) const {

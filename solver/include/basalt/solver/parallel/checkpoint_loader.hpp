@@ -46,7 +46,9 @@ class CheckpointLoader {
   std::int64_t last_id() const { return last_; }
   /// Collective: this rank's part under `dec` (see CheckpointPart). Checks what slices cannot alone: bond
   /// and contact ends exist, no pair bonded twice. Releases the slices.
-  CheckpointPart local_part(const Decomposition& dec);
+  /// `origin`: the run's frame (run.precision = "mixed"; zero otherwise): positions are routed by where the
+  /// frame puts them (CheckpointFrame), as the whole-checkpoint restart assigns them.
+  CheckpointPart local_part(const Decomposition& dec, const std::array<double, 3>& origin);
 
  private:
   int slice_of(std::int64_t id) const;

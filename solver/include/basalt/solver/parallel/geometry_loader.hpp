@@ -40,11 +40,15 @@ struct LoadStats {
 
 class GeometryLoader {
  public:
-  /// Collective: reads this rank's slice of the particle rows and reduces the extent. A bad file is an
-  /// InputError (naming the file and dataset) on every rank alike.
+  /// Collective: reads this rank's slice of the particle rows and of the bond rows (slice().bonds: what
+  /// the load checks summarise, bond tags included) and reduces the extent. A bad file is an InputError
+  /// (naming the file and dataset) on every rank alike.
   GeometryLoader(const io::GeometryFile& file, const Comm& comm);
   const io::Geometry& slice() const { return slice_; }
   const GeometryExtent& extent() const { return extent_; }
+  /// Subtracts o from the slice's positions and the extent's box (run.precision = "mixed": the run's
+  /// frame, scene/frame_origin.hpp); before local_part().
+  void to_frame(const std::array<double, 3>& o);
   /// Collective: this rank's part under `dec`: the particles it owns, the far ends of bonds with an
   /// owned end, and those bonds; particles by ascending id, bonds in file order, mass only if the file has
   /// it. Checks what slices cannot alone: ids ascending across slices, bond ends exist, no pair bonded

@@ -167,9 +167,11 @@ struct Scene {
   /// [particles] fixed_tags: particles of these tags feel forces but never move or turn (ESyS
   /// setParticleNonDynamic): rough bases, anchors.
   std::vector<std::int64_t> fixed_tags;
-  double dt = 0;                     ///< run.dt; with run.dt_fraction 0 until the simulation sets it
-  double dt_fraction = 0;            ///< run.dt_fraction: dt = this x the critical step (0: run.dt is given)
-  std::string precision = "double";  ///< run.precision: "double" or "float" (basalt-run's Simulation<Real>)
+  double dt = 0;           ///< run.dt; with run.dt_fraction 0 until the simulation sets it
+  double dt_fraction = 0;  ///< run.dt_fraction: dt = this x the critical step (0: run.dt is given)
+  /// run.precision: "double" or "float" (basalt-run's Simulation<Real>), or "mixed" (Simulation<float> in a
+  /// frame at the geometry's centre with a compensated drift: scene/frame_origin.hpp)
+  std::string precision = "double";
   std::int64_t steps = 0;
   double skin = 0;
   Integrator integrator = Integrator::velocity_verlet;

@@ -10,11 +10,13 @@
 //  - power iterations on M^-1 K, each product K v from two force evaluations (positions perturbed
 //    along v), so the models' real stiffnesses and the current contacts enter. The Rayleigh
 //    quotient rises towards omega_max^2 from below: 2 / omega_power is at least the true step.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <limits>
 #include <type_traits>
+#include <vector>
 
 namespace basalt::solver::stability {
 
@@ -47,6 +49,41 @@ Real ulp(Real c) {
   Real p;
   std::memcpy(&p, &b, sizeof p);
   return p * std::numeric_limits<Real>::epsilon();
+}
+
+/// The largest eigenvalue of the symmetric tridiagonal matrix with diagonal `alpha` and off-diagonal
+/// `beta` (alpha.size() - 1 of them are read), by bisection on the Sturm count: the Lanczos
+/// iterations' Ritz value. 0 for an empty matrix.
+inline double largest_eigenvalue(const std::vector<double>& alpha, const std::vector<double>& beta) {
+  const std::size_t m = alpha.size();
+  if (m == 0) return 0;
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (std::size_t k = 0; k < m; ++k) {  // Gershgorin's interval
+    const double r = (k > 0 ? std::abs(beta[k - 1]) : 0.0) + (k + 1 < m ? std::abs(beta[k]) : 0.0);
+    lo = std::min(lo, alpha[k] - r);
+    hi = std::max(hi, alpha[k] + r);
+  }
+  // Eigenvalues above x: negative pivots of T - x I = L D L^T counted from below, so the count of
+  // pivots < 0 is the number of eigenvalues below x.
+  const auto below = [&](double x) {
+    std::size_t count = 0;
+    double piv = 1;
+    for (std::size_t k = 0; k < m; ++k) {
+      const double b2 = k > 0 ? beta[k - 1] * beta[k - 1] : 0.0;
+      piv = alpha[k] - x - (k > 0 ? b2 / piv : 0.0);
+      if (piv == 0) piv = -1e-300;  // x is an eigenvalue of the leading block: step past it
+      if (piv < 0) ++count;
+    }
+    return count;
+  };
+  for (int i = 0; i < 200 && hi - lo > 1e-15 * std::max(std::abs(lo), std::abs(hi)); ++i) {
+    const double mid = 0.5 * (lo + hi);
+    if (below(mid) == m)
+      hi = mid;  // every eigenvalue below mid
+    else
+      lo = mid;
+  }
+  return hi;
 }
 
 /// Power iterations stop when the Rayleigh quotient changed by less than this (relative) between
