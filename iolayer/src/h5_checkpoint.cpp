@@ -10,8 +10,7 @@
 
 #include "basalt/io/checkpoint.hpp"
 #include "geometry_order.hpp"
-#include "h5_geometry_layout.hpp"
-#include "h5_support.hpp"
+#include "h5_checkpoint_layout.hpp"
 
 namespace basalt::io {
 
@@ -19,11 +18,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr const char* kSchema = "basalt-checkpoint";
-constexpr int kSchemaVersion = 1;
-// Root attributes of this schema besides the geometry's; "complete" is written last.
-constexpr std::string_view kRunAttributes[] = {
-    "step", "time", "dt", "scene_text", "rebuild_step", "rebuild_pending", "complete"};
 constexpr const char* kWallVectors[] = {"position", "normal", "velocity", "force"};
 
 Vec3& wall_vector(WallState& w, int k) {
@@ -36,10 +30,11 @@ const Vec3& wall_vector(const WallState& w, int k) { return wall_vector(const_ca
 void write_checkpoint_file(const Checkpoint& c, const fs::path& file, Compression compression,
                            const h5::Written& written);
 
-std::string root_attribute(const std::string& name) { return fmt::format("attribute '{}' of /", name); }
+}  // namespace
 
-/// Checks the completion mark: present and equal to 1.
-void check_complete(const h5::Reader& r) {
+namespace h5 {
+
+void check_complete(const Reader& r) {
   if (!r.has_attribute("/", "complete"))
     r.fail(root_attribute("complete"),
            "missing: the checkpoint was not completely written (did the run stop while writing it?)");
@@ -48,7 +43,40 @@ void check_complete(const h5::Reader& r) {
     r.fail(root_attribute("complete"), fmt::format("is {}, expected 1: the checkpoint is incomplete", mark));
 }
 
-}  // namespace
+std::vector<WallState> read_walls(const Reader& r) {
+  const auto names = r.members("/walls");
+  std::vector<WallState> walls(names.size());
+  std::vector<bool> seen(names.size(), false);
+  for (const auto& name : names) {
+    const auto g = "/walls/" + name;
+    r.require_group(g);
+    const auto index = r.scalar_attribute<std::int64_t>(g, "index");
+    if (index < 0 || index >= static_cast<std::int64_t>(names.size()) ||
+        seen[static_cast<std::size_t>(index)])
+      r.fail(fmt::format("attribute 'index' of {}", g),
+             fmt::format("{} is not a free position among {} walls", index, names.size()));
+    seen[static_cast<std::size_t>(index)] = true;
+    WallState& wall = walls[static_cast<std::size_t>(index)];
+    wall.name = name;
+    for (int k = 0; k < 4; ++k) {
+      const auto ds = g + "/" + kWallVectors[k];
+      const auto rows = r.rows<double>(ds);
+      if (rows != 3) r.fail(ds, fmt::format("expected 3 values, found {}", rows));
+      r.read_into(ds, wall_vector(wall, k).data());
+    }
+    if (r.exists(g + "/motion_state")) wall.motion_state = r.read<double>(g + "/motion_state");
+  }
+  return walls;
+}
+
+std::size_t contact_width(const Reader& r) {
+  const auto width = r.scalar_attribute<std::int64_t>("/contacts", "width");
+  if (width < 1 || width > 64)
+    r.fail("attribute 'width' of /contacts", fmt::format("{} is not in [1, 64]", width));
+  return static_cast<std::size_t>(width);
+}
+
+}  // namespace h5
 
 Compression parse_compression(const std::string& name) {
   if (name == "none") return Compression::none;
@@ -93,8 +121,8 @@ void write_checkpoint_file(const Checkpoint& c, const fs::path& file, Compressio
   };
   h5::Writer w(file, file.string() + ".partial");
   w.compress(compression == Compression::fast ? 1 : compression == Compression::small ? 6 : 0);
-  h5::write_schema(w, kSchema, kSchemaVersion);
-  h5::write_geometry_layout(w, s->geometry, kRunAttributes, written);
+  h5::write_schema(w, h5::kCheckpointSchema, h5::kCheckpointVersion);
+  h5::write_geometry_layout(w, s->geometry, h5::kRunAttributes, written);
   w.dataset("/particles/velocity", reinterpret_cast<const double*>(s->velocity.data()), s->size(), 3);
   done("/particles/velocity");
   if (!s->inv_mass.empty()) {
@@ -190,11 +218,11 @@ namespace {
 
 Checkpoint read_checkpoint_unguarded(const fs::path& file) {
   h5::Reader r(file);
-  h5::check_schema(r, kSchema, kSchemaVersion);
-  check_complete(r);
+  h5::check_schema(r, h5::kCheckpointSchema, h5::kCheckpointVersion);
+  h5::check_complete(r);
 
   Checkpoint c;
-  c.geometry = h5::read_geometry_layout(r, kRunAttributes);
+  c.geometry = h5::read_geometry_layout(r, h5::kRunAttributes);
   const std::size_t n = c.size();
   const std::size_t m = c.geometry.bonds.size();
   if (!c.geometry.has_mass() && n > 0)
@@ -215,7 +243,7 @@ Checkpoint read_checkpoint_unguarded(const fs::path& file) {
     if (prows != n)
       r.fail("/particles/position_at_rebuild", fmt::format("{} rows for {} particles", prows, n));
     if (!r.has_attribute("/", "rebuild_step"))
-      r.fail(root_attribute("rebuild_step"), "missing (required with /particles/position_at_rebuild)");
+      r.fail(h5::root_attribute("rebuild_step"), "missing (required with /particles/position_at_rebuild)");
     c.position_at_rebuild.resize(n);
     if (n)
       r.read_into("/particles/position_at_rebuild", reinterpret_cast<double*>(c.position_at_rebuild.data()));
@@ -248,37 +276,13 @@ Checkpoint read_checkpoint_unguarded(const fs::path& file) {
     if (r.rows<std::int32_t>("/contacts/model") != nc)
       r.fail("/contacts/model", fmt::format("expected {} values", nc));
     c.contact_model = r.read<std::int32_t>("/contacts/model");
-    const auto width = r.scalar_attribute<std::int64_t>("/contacts", "width");
-    if (width < 1 || width > 64)
-      r.fail("attribute 'width' of /contacts", fmt::format("{} is not in [1, 64]", width));
-    const auto w = static_cast<std::size_t>(width);
+    const auto w = h5::contact_width(r);
     if (r.rows<double>("/contacts/history", w) != nc)
       r.fail("/contacts/history", fmt::format("expected {} rows", nc));
     c.contact_width = w;
     c.contact_history = r.read<double>("/contacts/history", w);
   }
-  const auto names = r.members("/walls");
-  c.walls.resize(names.size());
-  std::vector<bool> seen(names.size(), false);
-  for (const auto& name : names) {
-    const auto g = "/walls/" + name;
-    r.require_group(g);
-    const auto index = r.scalar_attribute<std::int64_t>(g, "index");
-    if (index < 0 || index >= static_cast<std::int64_t>(names.size()) ||
-        seen[static_cast<std::size_t>(index)])
-      r.fail(fmt::format("attribute 'index' of {}", g),
-             fmt::format("{} is not a free position among {} walls", index, names.size()));
-    seen[static_cast<std::size_t>(index)] = true;
-    WallState& wall = c.walls[static_cast<std::size_t>(index)];
-    wall.name = name;
-    for (int k = 0; k < 4; ++k) {
-      const auto ds = g + "/" + kWallVectors[k];
-      const auto rows = r.rows<double>(ds);
-      if (rows != 3) r.fail(ds, fmt::format("expected 3 values, found {}", rows));
-      r.read_into(ds, wall_vector(wall, k).data());
-    }
-    if (r.exists(g + "/motion_state")) wall.motion_state = r.read<double>(g + "/motion_state");
-  }
+  c.walls = h5::read_walls(r);
 
   c.step = r.scalar_attribute<std::int64_t>("/", "step");
   c.time = r.scalar_attribute<double>("/", "time");
@@ -300,8 +304,8 @@ bool is_complete_checkpoint(const fs::path& file) {
     // Opening checks the file is as long as its superblock says (a cut-off file fails here);
     // then the schema, the completion mark, and that every dataset is there with the right shape.
     h5::Reader r(file);
-    h5::check_schema(r, kSchema, kSchemaVersion);
-    check_complete(r);
+    h5::check_schema(r, h5::kCheckpointSchema, h5::kCheckpointVersion);
+    h5::check_complete(r);
     const auto n = r.rows<std::int64_t>("/particles/id");
     const auto m = r.rows<std::int64_t>("/bonds/pairs", 2);
     return r.rows<double>("/particles/position", 3) == n && r.rows<double>("/particles/velocity", 3) == n &&

@@ -226,4 +226,55 @@ Geometry read_geometry_layout(const Reader& r, Names extra_reserved) {
   return g;
 }
 
+void read_particle_rows(const Reader& r, std::size_t begin, std::size_t n, bool has_mass, Geometry& g) {
+  g.id.resize(n);
+  g.position.resize(n);
+  g.radius.resize(n);
+  g.tag.resize(n);
+  g.mass.resize(has_mass ? n : 0);
+  r.read_rows_into("/particles/id", begin, n, 0, g.id.data());
+  r.read_rows_into("/particles/position", begin, n, 3, reinterpret_cast<double*>(g.position.data()));
+  r.read_rows_into("/particles/radius", begin, n, 0, g.radius.data());
+  r.read_rows_into("/particles/tag", begin, n, 0, g.tag.data());
+  if (has_mass) r.read_rows_into("/particles/mass", begin, n, 0, g.mass.data());
+  for (std::size_t i = 1; i < n; ++i) {
+    if (g.id[i] == g.id[i - 1])
+      r.fail("/particles/id",
+             fmt::format("duplicate id {} (rows {} and {})", g.id[i], begin + i - 1, begin + i));
+    if (g.id[i] < g.id[i - 1])
+      r.fail("/particles/id", fmt::format("ids must be sorted ascending: id {} at row {} follows id {}",
+                                          g.id[i], begin + i, g.id[i - 1]));
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto& p = g.position[i];
+    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
+      r.fail("/particles/position",
+             fmt::format("particle id {} (row {}): position is not finite", g.id[i], begin + i));
+    if (!(g.radius[i] > 0) || !std::isfinite(g.radius[i]))
+      r.fail("/particles/radius",
+             fmt::format("particle id {} (row {}): radius must be finite and > 0, got {}", g.id[i], begin + i,
+                         g.radius[i]));
+    if (g.has_mass() && (!(g.mass[i] > 0) || !std::isfinite(g.mass[i])))
+      r.fail("/particles/mass", fmt::format("particle id {} (row {}): mass must be finite and > 0, got {}",
+                                            g.id[i], begin + i, g.mass[i]));
+  }
+}
+
+std::vector<Bond> read_bond_rows(const Reader& r, std::size_t begin, std::size_t m) {
+  std::vector<std::int64_t> pairs(2 * m);
+  std::vector<std::int32_t> tags(m);
+  r.read_rows_into("/bonds/pairs", begin, m, 2, pairs.data());
+  r.read_rows_into("/bonds/tag", begin, m, 0, tags.data());
+  std::vector<Bond> bonds(m);
+  for (std::size_t k = 0; k < m; ++k) {
+    const auto a = pairs[2 * k], b = pairs[2 * k + 1];
+    if (a == b) r.fail("/bonds/pairs", fmt::format("bond {} joins particle {} to itself", begin + k, a));
+    if (a > b)
+      r.fail("/bonds/pairs",
+             fmt::format("bond {} is ({}, {}): each pair must be stored smaller id first", begin + k, a, b));
+    bonds[k] = {a, b, tags[k]};
+  }
+  return bonds;
+}
+
 }  // namespace basalt::io::h5

@@ -38,4 +38,11 @@ void read_geometry_attributes(const Reader& r, Names extra_reserved, Geometry& g
 /// Root string attributes that are neither the geometry's nor in `extra_reserved` become provenance.
 Geometry read_geometry_layout(const Reader& r, Names extra_reserved);
 
+/// Particle rows [begin, begin + n) of /particles (id, position, radius, tag, and mass when `has_mass`) into
+/// `g`, replacing what it held; checked as read_geometry_layout checks them (messages give file rows): ids
+/// strictly ascending within these rows, positions finite, radius (and mass) finite and > 0.
+void read_particle_rows(const Reader& r, std::size_t begin, std::size_t n, bool has_mass, Geometry& g);
+/// Bond rows [begin, begin + m) of /bonds, each checked a != b and a < b.
+std::vector<Bond> read_bond_rows(const Reader& r, std::size_t begin, std::size_t m);
+
 }  // namespace basalt::io::h5

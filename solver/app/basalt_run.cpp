@@ -1,7 +1,8 @@
 // basalt-run: runs a scene (TOML) on P compute ranks with Q dedicated I/O ranks.
 //   mpirun -np P+Q basalt-run scenes/wave.toml [--io-ranks Q] [--geometry FILE] [--steps N] [--output DIR]
 //          [--dims x,y,z] [--checkpoint-every N] [--frames-every N] [--fields-every N]
-//          [--restart FILE|DIR] [--balance none|count] [--balance-threshold X] [--quiet] [--force-dt]
+//          [--restart FILE|DIR [--whole-checkpoint]] [--balance none|count] [--balance-threshold X] [--quiet]
+//          [--force-dt]
 //          [--render-every N [--render SPEC]]
 // The only code that touches MPI_COMM_WORLD: it creates the output folder (world rank 0, a failure
 // stops every rank before anything starts) and splits the world into compute and I/O ranks. Compute
@@ -22,6 +23,7 @@
 #include <optional>
 
 #include "basalt/io/checkpoint.hpp"
+#include "basalt/io/checkpoint_rows.hpp"
 #include "basalt/io/geometry.hpp"
 #include "basalt/io/geometry_rows.hpp"
 #include "basalt/io/io_ranks.hpp"
@@ -47,7 +49,8 @@ namespace {
 struct Cli {
   std::string scene_file, geometry, output, dims_text, restart, precision, preset;
   std::int64_t steps = -1;
-  bool quiet = false, force_dt = false, force_overlap = false, whole_geometry = false;
+  bool quiet = false, force_dt = false, force_overlap = false, whole_geometry = false,
+       whole_checkpoint = false;
   int io_ranks = 0;
   std::int64_t checkpoint_every = -1, frames_every = -1, fields_every = -1, render_every = -1;
   std::optional<std::string> render;
@@ -167,7 +170,9 @@ void print_report(const io::OutputReport& r, int n_io) {
 
 template <class Real>
 int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::OutputConfig cfg,
-                const io::VtkFrameWriter& vtk, const io::Checkpoint* ckpt, const fs::path& ckpt_file) {
+                const io::VtkFrameWriter& vtk, const io::CheckpointHeader* header,
+                const io::Checkpoint* whole, std::optional<io::CheckpointFile>* rows_file,
+                const fs::path& ckpt_file) {
   const Comm comm(layout.compute);
   const bool root = comm.rank() == 0;
   RunOptions options;
@@ -181,13 +186,30 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
   io::RunInfo info;
   std::optional<std::string> setup_error;
   try {
-    if (ckpt) {
-      sim = std::make_unique<Simulation<Real>>(scene, *ckpt, basalt::run::restart_layout_of(*ckpt, ckpt_file),
-                                               layout.compute, options);
-      info.box_min = ckpt->geometry.box_min;
-      info.box_max = ckpt->geometry.box_max;
-      info.periodic = ckpt->geometry.periodic;
-      info.units = ckpt->geometry.units;
+    if (header) {
+      const auto restart_layout = basalt::run::restart_layout_of(*header, ckpt_file);
+      if (whole) {  // --whole-checkpoint: the former restart, kept as the check of the one below
+        sim = std::make_unique<Simulation<Real>>(scene, *whole, restart_layout, layout.compute, options);
+      } else {
+        // Each compute rank reads a slice of the checkpoint's rows and the ranks route them to their owners
+        // (docs/solver.md, "Restart"); the file is closed once they have.
+        sim = std::make_unique<Simulation<Real>>(scene, **rows_file, restart_layout, layout.compute, options);
+        rows_file->reset();
+      }
+      const auto& g = header->run.geometry;
+      info.box_min = g.box_min;
+      info.box_max = g.box_max;
+      info.periodic = g.periodic;
+      info.units = g.units;
+      if (std::getenv("BASALT_DEBUG_LOAD")) {
+        const auto& ls = sim->load_stats();
+        fmt::print(
+            "restart: compute rank {} read {} particle rows and {} bond rows of {} and {}; holds {} owned "
+            "particles, {} bonds\n",
+            comm.rank(), ls.particle_rows, ls.bond_rows, header->particles, header->bonds, ls.owned,
+            ls.bonds);
+        std::fflush(stdout);
+      }
     } else {
       // Each compute rank reads a slice of the file's rows and the ranks route them to their owners; a
       // .geo is first converted to HDF5 once, by compute rank 0 (docs/formats.md, "Start-up").
@@ -244,7 +266,7 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
   }
 
   std::int64_t steps = scene.steps;
-  if (ckpt) steps = cli.steps >= 0 ? cli.steps : std::max<std::int64_t>(0, scene.steps - ckpt->step);
+  if (header) steps = cli.steps >= 0 ? cli.steps : std::max<std::int64_t>(0, scene.steps - header->run.step);
   const auto& st = sim->stability();
   const double imbalance_start = sim->imbalance();
   const auto balance_setting = [&] {
@@ -260,7 +282,8 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
         basalt::kVersion, sim->total_particles(), sim->bond_count(), comm.size(),
         sim->decomposition().dims()[0], sim->decomposition().dims()[1], sim->decomposition().dims()[2],
         layout.n_io, steps, scene.dt, scene.units.time, scene.precision,
-        ckpt ? fmt::format(", continuing from step {} ({})", ckpt->step, ckpt_file.string()) : std::string());
+        header ? fmt::format(", continuing from step {} ({})", header->run.step, ckpt_file.string())
+               : std::string());
     if (st.dt_critical > 0) {
       fmt::print(
           "critical step: {:.4g} {} (2/omega_max, {} Lanczos iterations on the network: {:.4g}; one new "
@@ -414,6 +437,10 @@ int run_world(int argc, char** argv) {
   app.add_flag("--whole-geometry", cli.whole_geometry,
                "every compute rank reads the whole geometry file (the former start-up; a check of the "
                "sliced reading, which gives the same run)");
+  app.add_flag(
+      "--whole-checkpoint", cli.whole_checkpoint,
+      "with --restart: every compute rank reads the whole checkpoint (the former restart; a check of the "
+      "sliced reading, which gives the same run)");
   app.add_flag("--force-dt", cli.force_dt, "run even when dt exceeds the critical time step");
   app.add_flag("--force-overlap", cli.force_overlap,
                "start even when particles overlap by more than half a radius (each other or a wall)");
@@ -468,20 +495,31 @@ int run_world(int argc, char** argv) {
   if (!cli.balance.empty()) scene.balance = cli.balance;
   if (cli.balance_threshold > 0) scene.balance_threshold = cli.balance_threshold;
 
-  // A restart reads its checkpoint on every rank (so that a bad one stops all ranks alike, early).
+  // A restart reads its checkpoint's header on every rank (so that a bad one stops all ranks alike, early);
+  // the compute ranks read its rows in slices (or, with --whole-checkpoint, every rank reads it whole here).
   std::optional<io::Checkpoint> ckpt;
+  std::optional<io::CheckpointFile> ckpt_rows;
+  std::optional<io::CheckpointHeader> header;
   fs::path ckpt_file;
   if (!cli.restart.empty()) {
     ckpt_file = basalt::run::resolve_restart(cli.restart, world_root);
     try {
-      ckpt = io::read_checkpoint(ckpt_file);
+      if (cli.whole_checkpoint) {
+        ckpt = io::read_checkpoint(ckpt_file);
+        header = io::header_of(*ckpt);
+      } else {
+        ckpt_rows.emplace(ckpt_file);
+        header = ckpt_rows->header();
+      }
     } catch (const std::exception& e) {
       throw InputError(fmt::format("--restart: {}", e.what()));
     }
-    basalt::run::check_same_scene(*ckpt, ckpt_file, scene);
-    basalt::run::check_same_precision(*ckpt, ckpt_file, scene.precision);
-    if (scene.dt_fraction > 0) scene.dt = ckpt->dt;  // the run's step, chosen at its start
-    (void)basalt::run::restart_layout_of(*ckpt, ckpt_file);
+    basalt::run::check_same_scene(*header, ckpt_file, scene);
+    basalt::run::check_same_precision(*header, ckpt_file, scene.precision);
+    if (scene.dt_fraction > 0) scene.dt = header->run.dt;  // the run's step, chosen at its start
+    (void)basalt::run::restart_layout_of(*header, ckpt_file);
+  } else if (cli.whole_checkpoint) {
+    throw InputError("--whole-checkpoint: no --restart to read whole");
   } else if (!fs::exists(scene.geometry)) {
     throw InputError(
         fmt::format("{}: geometry file {} does not exist{}", cli.scene_file, scene.geometry.string(),
@@ -489,18 +527,18 @@ int run_world(int argc, char** argv) {
   }
 
   prepare_output_folder(scene.output_dir);
-  if (ckpt && world_root && !scene.fields.empty()) {
+  if (header && world_root && !scene.fields.empty()) {
     const fs::path csv = scene.output_dir / "fields.csv";
-    const auto last = basalt::run::truncate_fields(csv, ckpt->step);
+    const auto last = basalt::run::truncate_fields(csv, header->run.step);
     std::int64_t every = std::numeric_limits<std::int64_t>::max();
     for (const auto& f : scene.fields) every = std::min(every, f.every);
     // A checkpoint written before the rows up to its step reached the file (basalt-runs before the rows
     // were handed over first, or a crash of the machine): say so rather than leave a silent gap.
-    if (last && *last + every <= ckpt->step)
+    if (last && *last + every <= header->run.step)
       fmt::print(stderr,
                  "basalt-run: warning: {} ends at step {}, before the checkpoint's step {}: the rows between "
                  "were lost when the run stopped; the restarted run appends from step {}\n",
-                 csv.string(), *last, ckpt->step, ckpt->step + 1);
+                 csv.string(), *last, header->run.step, header->run.step + 1);
   }
 
   io::OutputConfig cfg;
@@ -512,11 +550,11 @@ int run_world(int argc, char** argv) {
   cfg.max_frames_in_flight = static_cast<int>(scene.frames_in_flight);
   cfg.continue_on_error = scene.output_continue_on_error;
   cfg.throttle_mb_per_s = cli.throttle_mbps;
-  cfg.append_fields = ckpt.has_value();
+  cfg.append_fields = header.has_value();
   cfg.render_every = scene.render_every;
   const auto vtk = io::make_vtk_frame_writer(
       io::Units{scene.units.length, scene.units.time, scene.units.force, io::Units{}.mass},
-      ckpt ? ckpt->time : -1.0);
+      header ? header->run.time : -1.0);
 
   io::RankLayout layout;
   try {
@@ -529,6 +567,8 @@ int run_world(int argc, char** argv) {
     ~Free() { io::free_layout(l); }
   } free_layout{layout};
   if (layout.is_io) {
+    ckpt_rows.reset();
+    ckpt.reset();
     // I/O ranks print nothing but errors (compute rank 0 prints the report). I/O rank 0 draws the
     // pictures: only it loads the render module (VTK rendering, OpenGL, X), and only when asked.
     io::Pictures pictures;
@@ -538,9 +578,11 @@ int run_world(int argc, char** argv) {
     const auto report = server.run();
     return report.error && !cfg.continue_on_error ? 1 : 0;
   }
+  const io::CheckpointHeader* h = header ? &*header : nullptr;
+  const io::Checkpoint* whole = ckpt ? &*ckpt : nullptr;
   if (scene.precision == "float" || scene.precision == "mixed")
-    return run_compute<float>(cli, scene, layout, cfg, vtk, ckpt ? &*ckpt : nullptr, ckpt_file);
-  return run_compute<double>(cli, scene, layout, cfg, vtk, ckpt ? &*ckpt : nullptr, ckpt_file);
+    return run_compute<float>(cli, scene, layout, cfg, vtk, h, whole, &ckpt_rows, ckpt_file);
+  return run_compute<double>(cli, scene, layout, cfg, vtk, h, whole, &ckpt_rows, ckpt_file);
 }
 
 }  // namespace

@@ -49,9 +49,9 @@ std::string vec_text(const std::array<double, 3>& v) {
   return fmt::format("{:.17g},{:.17g},{:.17g}", v[0], v[1], v[2]);
 }
 
-const std::string& attribute(const io::Checkpoint& c, const fs::path& file, const std::string& key) {
-  const auto it = c.geometry.attributes.find(key);
-  if (it == c.geometry.attributes.end())
+const std::string& attribute(const io::CheckpointHeader& c, const fs::path& file, const std::string& key) {
+  const auto it = c.run.geometry.attributes.find(key);
+  if (it == c.run.geometry.attributes.end())
     throw InputError(
         fmt::format("{}: attribute '{}' is missing: a restart needs the decomposition the run used "
                     "(checkpoints written by basalt-run carry it)",
@@ -59,7 +59,7 @@ const std::string& attribute(const io::Checkpoint& c, const fs::path& file, cons
   return it->second;
 }
 
-double number(const io::Checkpoint& c, const fs::path& file, const std::string& key) {
+double number(const io::CheckpointHeader& c, const fs::path& file, const std::string& key) {
   const auto& t = attribute(c, file, key);
   char* end = nullptr;
   const double v = std::strtod(t.c_str(), &end);
@@ -68,7 +68,7 @@ double number(const io::Checkpoint& c, const fs::path& file, const std::string& 
   return v;
 }
 
-std::array<double, 3> vec(const io::Checkpoint& c, const fs::path& file, const std::string& key) {
+std::array<double, 3> vec(const io::CheckpointHeader& c, const fs::path& file, const std::string& key) {
   const auto& t = attribute(c, file, key);
   std::array<double, 3> v{};
   const char* s = t.c_str();
@@ -93,14 +93,15 @@ std::map<std::string, std::string> restart_attributes(const solver::RestartLayou
           {"frame_origin", vec_text(l.origin)}};
 }
 
-solver::RestartLayout restart_layout_of(const io::Checkpoint& c, const fs::path& file) {
+solver::RestartLayout restart_layout_of(const io::CheckpointHeader& c, const fs::path& file) {
   solver::RestartLayout l;
   l.box_min = vec(c, file, "decomposition_box_min");
   l.box_max = vec(c, file, "decomposition_box_max");
   l.ghost_width = number(c, file, "ghost_width");
   l.contact_cutoff = number(c, file, "contact_cutoff");
   // The cuts in force at the checkpoint (run.balance); an older checkpoint has the even grid's.
-  if (const auto it = c.geometry.attributes.find("decomposition_cuts"); it != c.geometry.attributes.end()) {
+  if (const auto it = c.run.geometry.attributes.find("decomposition_cuts");
+      it != c.run.geometry.attributes.end()) {
     const auto cuts = solver::parse_cuts(it->second);
     if (!cuts)
       throw InputError(
@@ -110,22 +111,22 @@ solver::RestartLayout restart_layout_of(const io::Checkpoint& c, const fs::path&
     l.cuts = *cuts;
   }
   // run.precision = "mixed": the origin of the run's frame (box and cuts are relative to it); zero before.
-  if (c.geometry.attributes.count("frame_origin")) l.origin = vec(c, file, "frame_origin");
+  if (c.run.geometry.attributes.count("frame_origin")) l.origin = vec(c, file, "frame_origin");
   return l;
 }
 
-void check_same_scene(const io::Checkpoint& c, const fs::path& file, const solver::Scene& scene) {
-  if (c.scene_text != scene.text)
+void check_same_scene(const io::CheckpointHeader& c, const fs::path& file, const solver::Scene& scene) {
+  if (c.run.scene_text != scene.text)
     throw InputError(
         fmt::format("{}: this checkpoint was written by another scene ({} particles; its stored scene text "
                     "differs from {}): "
                     "restart it with the scene file that wrote it",
-                    file.string(), c.size(), scene.file.string()));
+                    file.string(), c.particles, scene.file.string()));
 }
 
-void check_same_precision(const io::Checkpoint& c, const fs::path& file, const std::string& precision) {
-  const auto it = c.geometry.attributes.find("precision");
-  const std::string written = it == c.geometry.attributes.end() ? "double" : it->second;
+void check_same_precision(const io::CheckpointHeader& c, const fs::path& file, const std::string& precision) {
+  const auto it = c.run.geometry.attributes.find("precision");
+  const std::string written = it == c.run.geometry.attributes.end() ? "double" : it->second;
   if (written != precision)
     throw InputError(fmt::format(
         "{}: this checkpoint was written by a run in {} precision; restarting it in {} is refused (the "

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "basalt/io/checkpoint.hpp"
+#include "basalt/io/checkpoint_rows.hpp"
 #include "basalt/solver/scene/scene.hpp"
 #include "basalt/solver/simulation.hpp"
 
@@ -22,14 +23,15 @@ std::filesystem::path resolve_restart(const std::filesystem::path& file_or_dir, 
 /// Checkpoint attributes that let a restart rebuild the same decomposition (exact decimal text).
 std::map<std::string, std::string> restart_attributes(const solver::RestartLayout& layout);
 /// Reads them back; throws InputError naming the file and the missing attribute.
-solver::RestartLayout restart_layout_of(const io::Checkpoint& c, const std::filesystem::path& file);
+solver::RestartLayout restart_layout_of(const io::CheckpointHeader& c, const std::filesystem::path& file);
 
 /// Refuses (InputError naming both files) a checkpoint written by another scene.
-void check_same_scene(const io::Checkpoint& c, const std::filesystem::path& file, const solver::Scene& scene);
+void check_same_scene(const io::CheckpointHeader& c, const std::filesystem::path& file,
+                      const solver::Scene& scene);
 
 /// Refuses (InputError naming the file and both precisions) a restart in another precision than the
 /// checkpoint's run (attribute "precision"; checkpoints without it were written in double).
-void check_same_precision(const io::Checkpoint& c, const std::filesystem::path& file,
+void check_same_precision(const io::CheckpointHeader& c, const std::filesystem::path& file,
                           const std::string& precision);
 
 /// Keeps the header and the rows with step <= `step` of an existing fields.csv (rewritten atomically),

@@ -77,6 +77,28 @@ struct Checkpoint {
   std::size_t size() const { return geometry.size(); }
   /// Geometry invariants plus: one velocity per particle, one state per bond, finite values.
   void validate(const std::filesystem::path& source) const;
+
+  // validate()'s checks in parts, for a checkpoint read in row ranges (CheckpointFile,
+  // checkpoint_rows.hpp): each checks the rows this object holds, with the same messages; `first` is
+  // the file row of the first one (messages count bonds, break positions and contacts from the file's
+  // first row). What needs rows of other ranges (ids unique and sorted, bond and contact ends exist, no
+  // pair bonded twice, one break position per broken bond) is the caller's to check.
+  /// Velocities, inverse masses, positions at the last rebuild (and with `fields` the particle fields):
+  /// one per particle, finite.
+  void validate_particle_rows(const std::filesystem::path& source, bool fields = true) const;
+  void validate_field_rows(const std::filesystem::path& source) const;
+  /// Rest lengths and flags: one per bond, finite and >= 0, flags valid.
+  void validate_bond_rows(const std::filesystem::path& source, std::size_t first) const;
+  /// Break positions finite, or NaN in all three.
+  void validate_break_rows(const std::filesystem::path& source, std::size_t first) const;
+  /// Model indices >= 0, wall indices within the walls, histories finite; with `ids` (sorted), the
+  /// particle ids exist.
+  void validate_contact_rows(const std::filesystem::path& source, std::size_t first,
+                             const std::vector<std::int64_t>* ids) const;
+  /// Walls, step, time, dt.
+  void validate_run(const std::filesystem::path& source) const;
+  /// The message for `rows` break positions against `broken` broken bonds.
+  static std::string break_rows_text(std::size_t rows, std::size_t broken);
 };
 
 /// Whether /particles/<name> is one of the schema's fixed datasets (not a particle field).

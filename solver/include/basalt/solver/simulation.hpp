@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "basalt/io/checkpoint.hpp"
+#include "basalt/io/checkpoint_rows.hpp"
 #include "basalt/io/geometry.hpp"
 #include "basalt/solver/core/bonds.hpp"
 #include "basalt/solver/core/id_map.hpp"
@@ -94,6 +95,11 @@ class Simulation {
   /// the same ranks the continued run is bit-for-bit the uninterrupted one (a checkpoint without
   /// them: a plain rebuild, exact to rounding only). Throws InputError when the checkpoint does not fit.
   Simulation(const Scene& scene, const io::Checkpoint& checkpoint, const RestartLayout& layout, MPI_Comm comm,
+             const RunOptions& options = {});
+  /// The same restart from a checkpoint file that no rank reads whole (basalt-run --restart): each rank
+  /// reads a slice of its rows and the ranks route them to their owners (parallel/checkpoint_loader.hpp).
+  /// Gives exactly the state of the constructor above given the whole checkpoint.
+  Simulation(const Scene& scene, const io::CheckpointFile& file, const RestartLayout& layout, MPI_Comm comm,
              const RunOptions& options = {});
 
   /// Runs `steps` steps with output through `out` (simulation_output.cpp): field partials every
@@ -241,7 +247,19 @@ class Simulation {
   void output_fields(const std::vector<double>& pe);
   /// Collective: the runout saver's value (FieldSpec::percentile of the distances along its direction).
   double runout(const FieldSpec& f) const;
-  void distribute_checkpoint(const io::Checkpoint& c, const RestartLayout& layout, MPI_Comm comm);
+  /// Restart: what both restart constructors check first (particles, bond groups, dt) and set.
+  void begin_restart(std::size_t particles, double dt, const RestartLayout& layout);
+  /// Restart: the checkpoint's bonds belong to the scene's bond groups, its contact histories to its
+  /// contact models (InputError naming the first row that does not, in file order).
+  void check_checkpoint_rows(const io::Checkpoint& rows, bool replay);
+  /// Restart: the decomposition, halo, ghost width and contact cut-off of `layout`.
+  void restore_decomposition(const RestartLayout& layout, MPI_Comm comm);
+  /// Restart: the owned particles of `c` (the whole checkpoint or this rank's part of it), the bonds and
+  /// contact histories with an owned end, the clock. `bond_length` (a part's): the distance of each bond's
+  /// ends, else computed from c's positions. `replay`: the checkpoint has positions at the last rebuild.
+  void distribute_checkpoint(const io::Checkpoint& c, const std::vector<double>* bond_length, bool replay);
+  /// Restart: servos, the replayed (or a new) rebuild, the start checks and the energy ledger.
+  void finish_restart(const io::Checkpoint& c, bool replay);
   /// Restart: the optional particle fields the checkpoint stores (by name), for the owned particles
   /// (`mine`: their geometry indices in local order); bond damage counters adjusted for the replay.
   void restore_particle_fields(const io::Checkpoint& c, const std::vector<std::size_t>& mine, bool replay);

@@ -55,6 +55,28 @@ class Comm {
     if (counts) *counts = std::move(recv_counts);
     return recv;
   }
+  /// The same, releasing each out[r] once copied into the send buffer: one copy of the data sent is held,
+  /// not two (restart and start-up route files' rows this way: peak memory).
+  template <class T>
+  std::vector<T> exchange(std::vector<std::vector<T>>&& out,
+                          std::vector<std::size_t>* counts = nullptr) const {
+    static_assert(std::is_trivially_copyable_v<T>, "exchange sends raw bytes");
+    std::vector<std::size_t> send_counts(out.size());
+    std::size_t total = 0;
+    for (std::size_t r = 0; r < out.size(); ++r) total += send_counts[r] = out[r].size();
+    std::vector<T> send;
+    send.reserve(total);
+    for (auto& v : out) {
+      send.insert(send.end(), v.begin(), v.end());
+      std::vector<T>().swap(v);
+    }
+    std::vector<std::size_t> recv_counts;
+    std::vector<T> recv;
+    exchange_raw(send.data(), send_counts, sizeof(T), recv_counts,
+                 [&](std::size_t n) { return static_cast<void*>((recv.resize(n), recv.data())); });
+    if (counts) *counts = std::move(recv_counts);
+    return recv;
+  }
 
  private:
   template <class F>
