@@ -15,7 +15,9 @@
 #include <algorithm>
 #include <array>
 #include <cstdio>
+#include <vector>
 
+#include "basalt/solver/parallel/checkpoint_loader.hpp"
 #include "basalt/solver/simulation.hpp"
 
 namespace basalt::solver {
@@ -42,9 +44,30 @@ void Simulation<Real>::restore_kick_forces(const io::Checkpoint& c) {
   }
   const std::array<std::vector<Real>*, 6> to{&p_.fx, &p_.fy, &p_.fz, &p_.tx, &p_.ty, &p_.tz};
   const auto& g = c.geometry;
+  // A sliced restart on another rank grid: the replayed rebuild's re-balance can move particles to a rank
+  // that did not read their rows; their values come from the ranks that did (as their positions do).
+  std::vector<std::int64_t> moved;
+  for (std::size_t i = 0; i < p_.n_owned; ++i)
+    if (g.index_of(p_.id[i]) < 0) moved.push_back(p_.id[i]);
+  std::array<std::vector<io::Vec3>, 2> moved_values;  // forces, torques
+  if (comm().size() > 1 && comm().sum(static_cast<long long>(moved.size())) > 0) {
+    std::sort(moved.begin(), moved.end());
+    for (std::size_t part = 0; part < n / 3; ++part) {
+      std::vector<io::Vec3> held(g.size());
+      for (std::size_t i = 0; i < g.size(); ++i)
+        held[i] = {(*from[3 * part])[i], (*from[3 * part + 1])[i], (*from[3 * part + 2])[i]};
+      moved_values[part] = positions_of(comm(), moved, g.id, held);
+    }
+  }
   for (std::size_t i = 0; i < p_.n_owned; ++i) {
-    const auto gi = static_cast<std::size_t>(g.index_of(p_.id[i]));
-    for (std::size_t k = 0; k < n; ++k) (*to[k])[i] = Real((*from[k])[gi]);
+    const auto gi = g.index_of(p_.id[i]);
+    if (gi >= 0) {
+      for (std::size_t k = 0; k < n; ++k) (*to[k])[i] = Real((*from[k])[static_cast<std::size_t>(gi)]);
+      continue;
+    }
+    const auto m =
+        static_cast<std::size_t>(std::lower_bound(moved.begin(), moved.end(), p_.id[i]) - moved.begin());
+    for (std::size_t k = 0; k < n; ++k) (*to[k])[i] = Real(moved_values[k / 3][m][k % 3]);
   }
 }
 
