@@ -50,20 +50,9 @@ CheckpointFile::CheckpointFile(const fs::path& file) : impl_(std::make_unique<Im
   h5::read_geometry_attributes(r, h5::kRunAttributes, h.run.geometry);
 
   // The shapes read_checkpoint checks, in its order and with its messages.
-  r.require_group("/particles");
-  const std::size_t n = r.rows<std::int64_t>("/particles/id");
-  auto check_rows = [&](const std::string& ds, std::size_t rows, const char* unit) {
-    if (rows != n) r.fail(ds, fmt::format("{} {} for {} particles", rows, unit, n));
-  };
-  check_rows("/particles/position", r.rows<double>("/particles/position", 3), "rows");
-  check_rows("/particles/radius", r.rows<double>("/particles/radius"), "values");
-  check_rows("/particles/tag", r.rows<std::int32_t>("/particles/tag"), "values");
-  if (r.exists("/particles/mass")) check_rows("/particles/mass", r.rows<double>("/particles/mass"), "values");
-  r.require_group("/bonds");
-  const std::size_t m = r.rows<std::int64_t>("/bonds/pairs", 2);
-  const auto tag_rows = r.rows<std::int32_t>("/bonds/tag");
-  if (tag_rows != m) r.fail("/bonds/tag", fmt::format("{} values for {} bonds", tag_rows, m));
-  if (!r.exists("/particles/mass") && n > 0)
+  const auto rows = h5::check_layout_rows(r);
+  const std::size_t n = rows.particles, m = rows.bonds;
+  if (!rows.has_mass && n > 0)
     r.fail("/particles/mass", "missing dataset (a checkpoint stores every particle's mass)");
   const auto vrows = r.rows<double>("/particles/velocity", 3);
   if (vrows != n) r.fail("/particles/velocity", fmt::format("{} rows for {} particles", vrows, n));

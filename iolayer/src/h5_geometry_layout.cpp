@@ -149,28 +149,38 @@ void read_geometry_attributes(const Reader& r, Names extra_reserved, Geometry& g
   }
 }
 
+LayoutRows check_layout_rows(const Reader& r) {
+  LayoutRows rows;
+  r.require_group("/particles");
+  const std::size_t n = rows.particles = r.rows<std::int64_t>("/particles/id");
+  auto check_rows = [&](const std::string& ds, std::size_t found, const char* unit) {
+    if (found != n) r.fail(ds, fmt::format("{} {} for {} particles", found, unit, n));
+  };
+  check_rows("/particles/position", r.rows<double>("/particles/position", 3), "rows");
+  check_rows("/particles/radius", r.rows<double>("/particles/radius"), "values");
+  check_rows("/particles/tag", r.rows<std::int32_t>("/particles/tag"), "values");
+  rows.has_mass = r.exists("/particles/mass");
+  if (rows.has_mass) check_rows("/particles/mass", r.rows<double>("/particles/mass"), "values");
+  r.require_group("/bonds");
+  const std::size_t m = rows.bonds = r.rows<std::int64_t>("/bonds/pairs", 2);
+  const auto tag_rows = r.rows<std::int32_t>("/bonds/tag");
+  if (tag_rows != m) r.fail("/bonds/tag", fmt::format("{} values for {} bonds", tag_rows, m));
+  return rows;
+}
+
 Geometry read_geometry_layout(const Reader& r, Names extra_reserved) {
   Geometry g;
   read_geometry_attributes(r, extra_reserved, g);
 
   // Particles: every per-particle dataset has one row per id.
-  r.require_group("/particles");
+  const auto rows = check_layout_rows(r);
+  const std::size_t n = rows.particles;
   g.id = r.read<std::int64_t>("/particles/id");
-  const std::size_t n = g.id.size();
-  auto check_rows = [&](const std::string& ds, std::size_t rows, const char* unit) {
-    if (rows != n) r.fail(ds, fmt::format("{} {} for {} particles", rows, unit, n));
-  };
-  check_rows("/particles/position", r.rows<double>("/particles/position", 3), "rows");
   g.position.resize(n);
   if (n) r.read_into("/particles/position", reinterpret_cast<double*>(g.position.data()));
-  check_rows("/particles/radius", r.rows<double>("/particles/radius"), "values");
   g.radius = r.read<double>("/particles/radius");
-  check_rows("/particles/tag", r.rows<std::int32_t>("/particles/tag"), "values");
   g.tag = r.read<std::int32_t>("/particles/tag");
-  if (r.exists("/particles/mass")) {
-    check_rows("/particles/mass", r.rows<double>("/particles/mass"), "values");
-    g.mass = r.read<double>("/particles/mass");
-  }
+  if (rows.has_mass) g.mass = r.read<double>("/particles/mass");
 
   for (std::size_t i = 1; i < n; ++i) {
     if (g.id[i] == g.id[i - 1])
@@ -194,11 +204,8 @@ Geometry read_geometry_layout(const Reader& r, Names extra_reserved) {
   }
 
   // Bonds: pairs of existing ids, smaller id first.
-  r.require_group("/bonds");
   const auto pairs = r.read<std::int64_t>("/bonds/pairs", 2);
-  const std::size_t m = pairs.size() / 2;
-  const auto tag_rows = r.rows<std::int32_t>("/bonds/tag");
-  if (tag_rows != m) r.fail("/bonds/tag", fmt::format("{} values for {} bonds", tag_rows, m));
+  const std::size_t m = rows.bonds;
   const auto tags = r.read<std::int32_t>("/bonds/tag");
   IdSet ids(n ? g.id.front() : 0, n ? g.id.back() : 0, n);
   for (auto pid : g.id) ids.insert(pid);

@@ -34,6 +34,14 @@ void write_geometry_layout(Writer& w, const Geometry& g, Names extra_reserved, c
 /// into `g`, no particle or bond data.
 void read_geometry_attributes(const Reader& r, Names extra_reserved, Geometry& g);
 
+/// The row counts of /particles and /bonds, checked before any row is read: each per-particle dataset
+/// (position, radius, tag, mass when present) has one row per id, /bonds/tag one value per pair.
+struct LayoutRows {
+  std::size_t particles = 0, bonds = 0;
+  bool has_mass = false;
+};
+LayoutRows check_layout_rows(const Reader& r);
+
 /// Reads and checks what write_geometry_layout wrote; every error names the dataset or attribute.
 /// Root string attributes that are neither the geometry's nor in `extra_reserved` become provenance.
 Geometry read_geometry_layout(const Reader& r, Names extra_reserved);

@@ -23,22 +23,10 @@ GeometryFile::GeometryFile(const std::filesystem::path& file) : impl_(std::make_
   header_.periodic = g.periodic;
   header_.units = g.units;
   header_.attributes = std::move(g.attributes);
-  r.require_group("/particles");
-  const std::size_t n = r.rows<std::int64_t>("/particles/id");
-  auto check_rows = [&](const std::string& ds, std::size_t rows, const char* unit) {
-    if (rows != n) r.fail(ds, fmt::format("{} {} for {} particles", rows, unit, n));
-  };
-  check_rows("/particles/position", r.rows<double>("/particles/position", 3), "rows");
-  check_rows("/particles/radius", r.rows<double>("/particles/radius"), "values");
-  check_rows("/particles/tag", r.rows<std::int32_t>("/particles/tag"), "values");
-  header_.has_mass = r.exists("/particles/mass");
-  if (header_.has_mass) check_rows("/particles/mass", r.rows<double>("/particles/mass"), "values");
-  header_.particles = n;
-  r.require_group("/bonds");
-  const std::size_t m = r.rows<std::int64_t>("/bonds/pairs", 2);
-  const auto tag_rows = r.rows<std::int32_t>("/bonds/tag");
-  if (tag_rows != m) r.fail("/bonds/tag", fmt::format("{} values for {} bonds", tag_rows, m));
-  header_.bonds = m;
+  const auto rows = h5::check_layout_rows(r);
+  header_.has_mass = rows.has_mass;
+  header_.particles = rows.particles;
+  header_.bonds = rows.bonds;
 }
 
 GeometryFile::~GeometryFile() = default;

@@ -51,8 +51,6 @@ struct ContactRecord {
   std::int32_t model;
 };
 
-constexpr std::int64_t kNoId = std::numeric_limits<std::int64_t>::max();
-
 /// Runs f on this rank; an exception on any rank becomes the same InputError on every rank.
 template <class F>
 void agreed(const Comm& comm, F&& f) {
@@ -63,12 +61,6 @@ void agreed(const Comm& comm, F&& f) {
     error = fmt::format("--restart: {}", e.what());
   }
   if (auto e = comm.agree_error(error)) throw InputError(*e);
-}
-
-std::vector<std::int64_t> gather(const Comm& comm, std::int64_t v) {
-  std::vector<std::int64_t> all(static_cast<std::size_t>(comm.size()));
-  MPI_Allgather(&v, 1, MPI_INT64_T, all.data(), 1, MPI_INT64_T, comm.raw());
-  return all;
 }
 
 double distance(const io::Vec3& a, const io::Vec3& b) {
@@ -101,7 +93,7 @@ CheckpointLoader::CheckpointLoader(const io::CheckpointFile& file, const Comm& c
   // of the slices before it.
   const auto broken = static_cast<std::int64_t>(std::count_if(
       slice_.bond_broken.begin(), slice_.bond_broken.end(), [](std::uint8_t f) { return f != 0; }));
-  const auto counts = gather(comm, broken);
+  const auto counts = comm.all_gather(broken);
   std::int64_t before = 0, total = 0;
   for (int q = 0; q < p; ++q) {
     if (q < r) before += counts[static_cast<std::size_t>(q)];
@@ -117,50 +109,21 @@ CheckpointLoader::CheckpointLoader(const io::CheckpointFile& file, const Comm& c
   });
 
   // Slices are ranges of ids (the file is sorted by id): each rank's range tells where an id is.
-  const bool empty = slice_.size() == 0;
-  first_id_ = gather(comm, empty ? kNoId : slice_.geometry.id.front());
-  last_id_ = gather(comm, empty ? std::numeric_limits<std::int64_t>::min() : slice_.geometry.id.back());
-  std::optional<std::string> order;
-  std::int64_t previous = std::numeric_limits<std::int64_t>::min();
-  std::size_t previous_row = 0;
-  bool any = false;
-  for (int q = 0; q < p; ++q) {
-    const auto k = static_cast<std::size_t>(q);
-    if (first_id_[k] > last_id_[k]) continue;  // empty slice
-    const auto [rb, re] = io::slice_rows(h.particles, q, p);
-    if (any && first_id_[k] <= previous && !order)
-      order = fmt::format(
-          "--restart: {}",
-          io::FormatError(file.path(), "/particles/id",
-                          first_id_[k] == previous
-                              ? fmt::format("duplicate id {} (rows {} and {})", previous, previous_row, rb)
-                              : fmt::format("ids must be sorted ascending: id {} at row {} follows id {}",
-                                            first_id_[k], rb, previous))
-              .what());
-    previous = last_id_[k];
-    previous_row = re - 1;
-    if (!any) first_ = first_id_[k];
-    last_ = last_id_[k];
-    any = true;
+  slices_ = IdSlices(comm, slice_.geometry.id);
+  first_ = slices_.first();
+  last_ = slices_.last();
+  if (const auto d = slices_.disorder()) {  // every rank found it in the same gathered ranges
+    const auto row = io::slice_rows(h.particles, d->rank, p).first;
+    const auto previous_row = io::slice_rows(h.particles, d->previous_rank, p).second - 1;
+    throw InputError(fmt::format(
+        "--restart: {}",
+        io::FormatError(file.path(), "/particles/id",
+                        d->id == d->previous
+                            ? fmt::format("duplicate id {} (rows {} and {})", d->previous, previous_row, row)
+                            : fmt::format("ids must be sorted ascending: id {} at row {} follows id {}",
+                                          d->id, row, d->previous))
+            .what()));
   }
-  if (order) throw InputError(*order);  // every rank found it in the same gathered ranges
-}
-
-int CheckpointLoader::slice_of(std::int64_t id) const {
-  // The last rank whose first id is <= id (empty slices have first = max and are never chosen).
-  int lo = 0, hi = comm_.size() - 1, found = -1;
-  while (lo <= hi) {
-    const int mid = (lo + hi) / 2;
-    const auto f = first_id_[static_cast<std::size_t>(mid)];
-    if (f <= id && f != kNoId) {
-      found = mid;
-      lo = mid + 1;
-    } else {
-      hi = mid - 1;
-    }
-  }
-  if (found < 0 || id > last_id_[static_cast<std::size_t>(found)]) return -1;
-  return found;
 }
 
 CheckpointPart CheckpointLoader::local_part(const Decomposition& dec, const std::array<double, 3>& origin) {
@@ -240,7 +203,7 @@ CheckpointPart CheckpointLoader::local_part(const Decomposition& dec, const std:
   std::vector<std::vector<std::int64_t>> ask(p);
   std::vector<EndRecord> ends(end_ids.size(), EndRecord{0, 0, 0, -1});
   for (std::size_t j = 0; j < end_ids.size(); ++j) {
-    const int s = slice_of(end_ids[j]);
+    const int s = slices_.slice_of(end_ids[j]);
     if (s >= 0) ask[static_cast<std::size_t>(s)].push_back(end_ids[j]);
   }
   std::vector<std::size_t> asked_counts;

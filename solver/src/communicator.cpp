@@ -67,6 +67,12 @@ std::vector<double> Comm::all_gather(const std::vector<double>& v) const {
   return all;
 }
 
+std::vector<std::int64_t> Comm::all_gather(std::int64_t v) const {
+  std::vector<std::int64_t> all(static_cast<std::size_t>(size_));
+  MPI_Allgather(&v, 1, MPI_INT64_T, all.data(), 1, MPI_INT64_T, comm_);
+  return all;
+}
+
 std::string Comm::broadcast(const std::string& s, int root) const {
   if (size_ == 1) return s;
   int n = static_cast<int>(s.size());

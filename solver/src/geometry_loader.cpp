@@ -39,12 +39,6 @@ void agreed(const Comm& comm, F&& f) {
   if (auto e = comm.agree_error(error)) throw InputError(*e);
 }
 
-std::vector<std::int64_t> gather(const Comm& comm, std::int64_t v) {
-  std::vector<std::int64_t> all(static_cast<std::size_t>(comm.size()));
-  MPI_Allgather(&v, 1, MPI_INT64_T, all.data(), 1, MPI_INT64_T, comm.raw());
-  return all;
-}
-
 ParticleRecord record_of(const io::Geometry& g, std::size_t i) {
   const auto& p = g.position[i];
   return {g.id[i], p[0], p[1], p[2], g.radius[i], g.has_mass() ? g.mass[i] : 0.0, g.tag[i]};
@@ -89,44 +83,14 @@ GeometryLoader::GeometryLoader(const io::GeometryFile& file, const Comm& comm) :
   extent_.rmax = comm.max(mine.rmax);
   extent_.n = static_cast<std::int64_t>(file.header().particles);
   // Slices are ranges of ids (the file is sorted by id): each rank's range tells where an id is.
-  const bool empty = slice_.size() == 0;
-  first_id_ = gather(comm, empty ? std::numeric_limits<std::int64_t>::max() : mine.first_id);
-  last_id_ = gather(comm, empty ? std::numeric_limits<std::int64_t>::min() : mine.last_id);
-  std::optional<std::string> order;
-  std::int64_t previous = std::numeric_limits<std::int64_t>::min();
-  bool any = false;
-  for (std::size_t r = 0; r < first_id_.size(); ++r) {
-    if (first_id_[r] > last_id_[r]) continue;  // empty slice
-    if (any && first_id_[r] <= previous && !order)
-      order = fmt::format(
-          "{}: /particles/id: ids must be sorted ascending and unique: id {} at row {} follows "
-          "id {}",
-          file.path().string(), first_id_[r],
-          io::slice_rows(file.header().particles, static_cast<int>(r), comm.size()).first, previous);
-    previous = last_id_[r];
-    if (!any) extent_.first_id = first_id_[r];
-    extent_.last_id = last_id_[r];
-    any = true;
-  }
-  if (order) throw InputError(*order);  // every rank found it in the same gathered ranges
-}
-
-int GeometryLoader::slice_of(std::int64_t id) const {
-  // The last rank whose first id is <= id (empty slices have first = max and are never chosen).
-  int lo = 0, hi = comm_.size() - 1, found = -1;
-  while (lo <= hi) {
-    const int mid = (lo + hi) / 2;
-    if (first_id_[static_cast<std::size_t>(mid)] <= id &&
-        first_id_[static_cast<std::size_t>(mid)] != std::numeric_limits<std::int64_t>::max()) {
-      found = mid;
-      lo = mid + 1;
-    } else {
-      hi = mid - 1;
-    }
-  }
-  // Empty slices between non-empty ones hold first = max, which breaks the monotony only above every id.
-  if (found < 0 || id > last_id_[static_cast<std::size_t>(found)]) return -1;
-  return found;
+  slices_ = IdSlices(comm, slice_.id);
+  extent_.first_id = slices_.first();
+  extent_.last_id = slices_.last();
+  if (const auto d = slices_.disorder())  // every rank found it in the same gathered ranges
+    throw InputError(fmt::format(
+        "{}: /particles/id: ids must be sorted ascending and unique: id {} at row {} follows id {}",
+        file.path().string(), d->id, io::slice_rows(file.header().particles, d->rank, comm.size()).first,
+        d->previous));
 }
 
 void GeometryLoader::to_frame(const std::array<double, 3>& o) {
@@ -165,7 +129,7 @@ io::Geometry GeometryLoader::local_part(const Decomposition& dec) {
   std::optional<std::string> error;
   for (std::size_t k = 0; k < bonds.size(); ++k)
     for (const auto id : {bonds[k].a, bonds[k].b}) {
-      if (slice_of(id) < 0) {
+      if (slices_.slice_of(id) < 0) {
         if (!error)
           error = fmt::format("{}: /bonds/pairs: bond {} refers to particle id {}, which does not exist",
                               file, bb + k, id);
@@ -178,7 +142,7 @@ io::Geometry GeometryLoader::local_part(const Decomposition& dec) {
   end_ids.erase(std::unique(end_ids.begin(), end_ids.end()), end_ids.end());
   end_ids.shrink_to_fit();
   std::vector<std::vector<std::int64_t>> ask(p);
-  for (const auto id : end_ids) ask[static_cast<std::size_t>(slice_of(id))].push_back(id);
+  for (const auto id : end_ids) ask[static_cast<std::size_t>(slices_.slice_of(id))].push_back(id);
   std::vector<std::size_t> asked_counts;
   std::vector<std::int64_t> asked = comm_.exchange(ask, &asked_counts);
   std::vector<std::vector<std::int64_t>>(p).swap(ask);
@@ -248,7 +212,7 @@ io::Geometry GeometryLoader::local_part(const Decomposition& dec) {
   std::sort(far.begin(), far.end());
   far.erase(std::unique(far.begin(), far.end()), far.end());
   std::vector<std::vector<std::int64_t>> want(p);
-  for (const auto id : far) want[static_cast<std::size_t>(slice_of(id))].push_back(id);
+  for (const auto id : far) want[static_cast<std::size_t>(slices_.slice_of(id))].push_back(id);
   std::vector<std::int64_t>().swap(far);
   std::vector<std::size_t> wanted_counts;
   const auto wanted = comm_.exchange(want, &wanted_counts);

@@ -240,6 +240,11 @@ TEST(CheckpointMemory, SpendingThePiecesWritesTheReferenceBytes) {
 // image (the core driver builds the file in memory). Before issue #14 it added a full copy of the
 // checkpoint, a 64-byte row per bond and a second copy of the file image: about 3 times the file.
 TEST(CheckpointMemory, WritingFromPiecesAddsLittleMoreThanTheFile) {
+#if defined(__SANITIZE_ADDRESS__)
+  // The sanitizer CI stage: freed blocks wait in AddressSanitizer's quarantine and every block carries
+  // red zones, so the peak resident size is not the writer's. The identity test above still runs.
+  GTEST_SKIP() << "peak resident size under AddressSanitizer is not the program's";
+#endif
   const auto dir = fresh_dir("peak");
   const auto run = run_info();
   {  // once beforehand: the writer's code and HDF5's are paged in before the peak is reset

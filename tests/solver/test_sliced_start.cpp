@@ -5,8 +5,12 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <limits>
+#include <vector>
+
 #include "basalt/io/geometry_rows.hpp"
 #include "basalt/solver/parallel/geometry_loader.hpp"
+#include "basalt/solver/parallel/id_slices.hpp"
 #include "basalt/solver/scene/load_checks.hpp"
 #include "basalt/solver/simulation.hpp"
 #include "solver_helpers.hpp"
@@ -181,4 +185,62 @@ bond_tag = {}
   Simulation<double> sim(scene, file, MPI_COMM_WORLD);
   EXPECT_EQ(sim.unassigned_bonds(), 0u);
   EXPECT_EQ(sim.bond_count(), static_cast<std::int64_t>(whole.bonds.size()));
+}
+
+// Which rank's slice holds an id, and where the ids stop ascending across slices (IdSlices, shared by the
+// sliced start-up and the sliced restart). Rank r holds ids 10r + 1 .. 10r + 5 (rank 1 none when there are
+// more than two ranks: an empty slice between others).
+TEST(IdSlices, RoutesIdsByTheSlicesRanges) {
+  const Comm comm(MPI_COMM_WORLD);
+  const int r = comm.rank(), p = comm.size();
+  const auto empty = [&](int q) { return q == 1 && p > 2; };
+  const std::vector<std::int64_t> mine =
+      empty(r) ? std::vector<std::int64_t>{} : std::vector<std::int64_t>{10 * r + 1, 10 * r + 5};
+  const IdSlices s(comm, mine);
+  for (int q = 0; q < p; ++q) {
+    EXPECT_EQ(s.slice_of(10 * q + 1), empty(q) ? -1 : q) << q;
+    EXPECT_EQ(s.slice_of(10 * q + 3), empty(q) ? -1 : q) << q;  // inside the range: the slice holds it
+    EXPECT_EQ(s.slice_of(10 * q + 7), -1) << q;                 // between two slices' ranges
+  }
+  EXPECT_EQ(s.slice_of(0), -1);
+  EXPECT_EQ(s.slice_of(10 * p + 1), -1);
+  EXPECT_EQ(s.slice_of(std::numeric_limits<std::int64_t>::max()), -1);
+  EXPECT_EQ(s.first(), 1);
+  EXPECT_EQ(s.last(), 10 * (p - 1) + 5);
+  EXPECT_FALSE(s.disorder());
+}
+
+TEST(IdSlices, FindsTheFirstSliceOutOfOrder) {
+  const Comm comm(MPI_COMM_WORLD);
+  const int r = comm.rank(), p = comm.size();
+  // Descending slices: the second non-empty slice comes too early.
+  const IdSlices down(comm, {100 - 10 * r, 105 - 10 * r});
+  // Overlapping by one id: slice r starts with the last id of slice r - 1.
+  const IdSlices dup(comm, {4 * r, 4 * r + 1, 4 * r + 4});
+  // Rank 1 empty (p > 2): the check skips it and compares rank 2 with rank 0.
+  const bool skip = r == 1 && p > 2;
+  const IdSlices gap(comm, skip ? std::vector<std::int64_t>{} : std::vector<std::int64_t>{50 - 10 * r});
+  if (p == 1) {
+    EXPECT_FALSE(down.disorder());
+    EXPECT_FALSE(dup.disorder());
+    EXPECT_FALSE(gap.disorder());
+    return;
+  }
+  const auto d = down.disorder();
+  ASSERT_TRUE(d);
+  EXPECT_EQ(d->rank, 1);
+  EXPECT_EQ(d->id, 90);
+  EXPECT_EQ(d->previous_rank, 0);
+  EXPECT_EQ(d->previous, 105);
+  const auto e = dup.disorder();
+  ASSERT_TRUE(e);
+  EXPECT_EQ(e->rank, 1);
+  EXPECT_EQ(e->id, 4);
+  EXPECT_EQ(e->previous, 4);  // the same id in two slices: a duplicate
+  const auto g = gap.disorder();
+  ASSERT_TRUE(g);
+  EXPECT_EQ(g->rank, p > 2 ? 2 : 1);
+  EXPECT_EQ(g->previous_rank, 0);
+  EXPECT_EQ(g->id, p > 2 ? 30 : 40);
+  EXPECT_EQ(g->previous, 50);
 }

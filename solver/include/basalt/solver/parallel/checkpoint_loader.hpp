@@ -19,6 +19,7 @@
 #include "basalt/io/checkpoint_rows.hpp"
 #include "basalt/solver/parallel/communicator.hpp"
 #include "basalt/solver/parallel/decomposition.hpp"
+#include "basalt/solver/parallel/id_slices.hpp"
 
 namespace basalt::solver {
 
@@ -51,7 +52,6 @@ class CheckpointLoader {
   CheckpointPart local_part(const Decomposition& dec, const std::array<double, 3>& origin);
 
  private:
-  int slice_of(std::int64_t id) const;
   [[noreturn]] void fail(const std::string& where, const std::string& what) const;
 
   const io::CheckpointFile& file_;
@@ -59,7 +59,7 @@ class CheckpointLoader {
   io::Checkpoint slice_;
   std::size_t bond_begin_ = 0, contact_begin_ = 0;
   std::int64_t first_ = 0, last_ = 0;
-  std::vector<std::int64_t> first_id_, last_id_;  ///< per rank, of its slice (empty: first = max)
+  IdSlices slices_;  ///< which rank's slice holds an id
 };
 
 /// Collective: the positions, from the ranks whose `held` (ids ascending, positions) has them, of the

@@ -17,6 +17,7 @@
 #include "basalt/io/geometry_rows.hpp"
 #include "basalt/solver/parallel/communicator.hpp"
 #include "basalt/solver/parallel/decomposition.hpp"
+#include "basalt/solver/parallel/id_slices.hpp"
 
 namespace basalt::solver {
 
@@ -57,15 +58,12 @@ class GeometryLoader {
   const LoadStats& stats() const { return stats_; }
 
  private:
-  /// The rank whose slice holds id, or -1 when no slice's id range covers it.
-  int slice_of(std::int64_t id) const;
-
   const io::GeometryFile& file_;
   const Comm& comm_;
   io::Geometry slice_;
   GeometryExtent extent_;
   LoadStats stats_;
-  std::vector<std::int64_t> first_id_, last_id_;  ///< per rank, of its slice (empty slices: last < first)
+  IdSlices slices_;  ///< which rank's slice holds an id
 };
 
 }  // namespace basalt::solver
