@@ -403,8 +403,11 @@ void same_dimensionless_run(double tol_ke, double tol_dt) {
 }  // namespace
 
 TEST(Scaling, StiffnessAndDensityWithDtScaledGiveTheSameRun) { same_dimensionless_run<double>(1e-9, 1e-9); }
+// The critical step in float comes from Lanczos iterations on float products: each scaled run's estimate
+// carries a few tens of roundings (1.4e-6 = 12 float ulps without fused multiply-adds, in the sanitizer
+// build's -march off; under 1e-6 with them), hence 32 epsilon.
 TEST(Scaling, StiffnessAndDensityWithDtScaledGiveTheSameRunFloat) {
-  same_dimensionless_run<float>(1e-3, 1e-6);
+  same_dimensionless_run<float>(1e-3, 32 * double(std::numeric_limits<float>::epsilon()));
 }
 
 // ---------------------------------------------------------------------------------------------------
