@@ -870,6 +870,10 @@ TEST(BasaltView, DrawsBrokenBondsWhereTheyBrokeInTheirOwnColour) {
   img = read_png(dir / "out.png");
   EXPECT_GT(crack_pixels(img, 0.36, 0.48), 300);
   EXPECT_EQ(img.count(kLow, 30) + img.count(kHigh, 30), 0);
+  // ... and the line names no colour range it did not use.
+  EXPECT_NE(r.out.find("0 drawn, particles not drawn (--only-cracks); "), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("coloured by"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("range "), std::string::npos) << r.out;
 
   r = render("ckpt_000100.h5", "--crack-radius -1");
   EXPECT_NE(r.code, 0);

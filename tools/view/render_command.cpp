@@ -210,16 +210,19 @@ void render(const RenderOptions& o) {
   const double draw_s = seconds_since(t1);
   if (o.quiet) return;
   const Prepared& f = frames.front();
+  // With --only-cracks no particle is drawn, so no colour map is used: the line says so instead of a range.
+  const bool coloured =
+      std::any_of(frames.begin(), frames.end(), [](const Prepared& p) { return !p.only_cracks; });
+  const std::string colour = coloured ? fmt::format("coloured by {}, {}", f.field, scale_text(scale))
+                                      : std::string("particles not drawn (--only-cracks)");
   if (panels == 1)
-    fmt::print(
-        "wrote {} ({}x{}, {} particles, {} in view, {} drawn, coloured by {}, {}{}; read {:.2f} s, draw "
-        "{:.2f} s)\n",
-        o.output.string(), size.width, size.height, f.total, f.in_view, drawn, f.field, scale_text(scale),
-        crack_text(frames), read_s, draw_s);
-  else
-    fmt::print("wrote {} ({}x{}, {} panels, {} drawn, coloured by {}, {}{}; read {:.2f} s, draw {:.2f} s)\n",
-               o.output.string(), size.width, size.height, panels, drawn, f.field, scale_text(scale),
+    fmt::print("wrote {} ({}x{}, {} particles, {} in view, {} drawn, {}{}; read {:.2f} s, draw {:.2f} s)\n",
+               o.output.string(), size.width, size.height, f.total, f.in_view, drawn, colour,
                crack_text(frames), read_s, draw_s);
+  else
+    fmt::print("wrote {} ({}x{}, {} panels, {} drawn, {}{}; read {:.2f} s, draw {:.2f} s)\n",
+               o.output.string(), size.width, size.height, panels, drawn, colour, crack_text(frames), read_s,
+               draw_s);
 }
 
 void movie(const MovieOptions& m) {
