@@ -51,18 +51,6 @@ struct ContactRecord {
   std::int32_t model;
 };
 
-/// Runs f on this rank; an exception on any rank becomes the same InputError on every rank.
-template <class F>
-void agreed(const Comm& comm, F&& f) {
-  std::optional<std::string> error;
-  try {
-    f();
-  } catch (const std::exception& e) {
-    error = fmt::format("--restart: {}", e.what());
-  }
-  if (auto e = comm.agree_error(error)) throw InputError(*e);
-}
-
 double distance(const io::Vec3& a, const io::Vec3& b) {
   return std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
                    (a[2] - b[2]) * (a[2] - b[2]));
@@ -84,11 +72,14 @@ CheckpointLoader::CheckpointLoader(const io::CheckpointFile& file, const Comm& c
   bond_begin_ = bb;
   contact_begin_ = cb;
   slice_.contact_width = h.run.contact_width;
-  agreed(comm, [&, pb = pb, pe = pe, bb = bb, be = be, cb = cb, ce = ce] {
-    file.read_particles(pb, pe, slice_);
-    file.read_bonds(bb, be, slice_);
-    if (h.contacts > 0) file.read_contacts(cb, ce, slice_);
-  });
+  agreed<InputError>(
+      comm,
+      [&, pb = pb, pe = pe, bb = bb, be = be, cb = cb, ce = ce] {
+        file.read_particles(pb, pe, slice_);
+        file.read_bonds(bb, be, slice_);
+        if (h.contacts > 0) file.read_contacts(cb, ce, slice_);
+      },
+      "--restart: ");
   // Break positions: one row per broken bond, in bond order; this slice's start after the broken bonds
   // of the slices before it.
   const auto broken = static_cast<std::int64_t>(std::count_if(
@@ -99,14 +90,17 @@ CheckpointLoader::CheckpointLoader(const io::CheckpointFile& file, const Comm& c
     if (q < r) before += counts[static_cast<std::size_t>(q)];
     total += counts[static_cast<std::size_t>(q)];
   }
-  agreed(comm, [&] {
-    if (!h.has_break_position) return;
-    if (static_cast<std::size_t>(total) != h.break_positions)
-      fail("/bonds/break_position",
-           io::Checkpoint::break_rows_text(h.break_positions, static_cast<std::size_t>(total)));
-    file.read_break_positions(static_cast<std::size_t>(before), static_cast<std::size_t>(before + broken),
-                              slice_);
-  });
+  agreed<InputError>(
+      comm,
+      [&] {
+        if (!h.has_break_position) return;
+        if (static_cast<std::size_t>(total) != h.break_positions)
+          fail("/bonds/break_position",
+               io::Checkpoint::break_rows_text(h.break_positions, static_cast<std::size_t>(total)));
+        file.read_break_positions(static_cast<std::size_t>(before), static_cast<std::size_t>(before + broken),
+                                  slice_);
+      },
+      "--restart: ");
 
   // Slices are ranges of ids (the file is sorted by id): each rank's range tells where an id is.
   slices_ = IdSlices(comm, slice_.geometry.id);

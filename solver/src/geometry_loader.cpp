@@ -27,18 +27,6 @@ struct BondRecord {
   std::int32_t tag;
 };
 
-/// Runs f on this rank; an exception on any rank becomes the same InputError on every rank.
-template <class F>
-void agreed(const Comm& comm, F&& f) {
-  std::optional<std::string> error;
-  try {
-    f();
-  } catch (const std::exception& e) {
-    error = e.what();
-  }
-  if (auto e = comm.agree_error(error)) throw InputError(*e);
-}
-
 ParticleRecord record_of(const io::Geometry& g, std::size_t i) {
   const auto& p = g.position[i];
   return {g.id[i], p[0], p[1], p[2], g.radius[i], g.has_mass() ? g.mass[i] : 0.0, g.tag[i]};
@@ -67,13 +55,13 @@ GeometryExtent extent_of(const io::Geometry& g) {
 
 GeometryLoader::GeometryLoader(const io::GeometryFile& file, const Comm& comm) : file_(file), comm_(comm) {
   const auto [begin, end] = io::slice_rows(file.header().particles, comm.rank(), comm.size());
-  agreed(comm, [&, begin = begin, end = end] { file.read_particles(begin, end, slice_); });
+  agreed<InputError>(comm, [&, begin = begin, end = end] { file.read_particles(begin, end, slice_); });
   stats_.particle_rows = slice_.size();
   // This rank's slice of the bond rows too, read once here and routed by local_part: the load checks
   // summarise the slices, and a slice without its bonds has no bond tags (a scene's bond_tag was then
   // reported as matching no bond of the file, though the run took every bond with it).
   const auto [bb, be] = io::slice_rows(file.header().bonds, comm.rank(), comm.size());
-  agreed(comm, [&, bb = bb, be = be] { slice_.bonds = file.read_bonds(bb, be); });
+  agreed<InputError>(comm, [&, bb = bb, be = be] { slice_.bonds = file.read_bonds(bb, be); });
   stats_.bond_rows = slice_.bonds.size();
   const GeometryExtent mine = extent_of(slice_);
   for (int d = 0; d < 3; ++d) {

@@ -6,8 +6,10 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <exception>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <type_traits>
 #include <vector>
 
@@ -121,5 +123,18 @@ class AsyncSum {
   MPI_Request request_ = MPI_REQUEST_NULL;
   bool active_ = false;
 };
+
+/// Collective: runs f on this rank; if it throws on any rank, every rank throws the same E with the lowest
+/// such rank's message, `prefix` before it (the sliced start-up and restart read their slices this way).
+template <class E, class F>
+void agreed(const Comm& comm, F&& f, std::string_view prefix = {}) {
+  std::optional<std::string> error;
+  try {
+    f();
+  } catch (const std::exception& e) {
+    error = std::string(prefix) + e.what();
+  }
+  if (auto e = comm.agree_error(error)) throw E(*e);
+}
 
 }  // namespace basalt::solver
