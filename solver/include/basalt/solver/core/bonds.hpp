@@ -4,6 +4,7 @@
 // and the bonds are ordered so that those with both ends owned come first ([0, n_both_owned)); in
 // the others ia is the owned end and ib a ghost.
 #include <algorithm>
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -18,6 +19,9 @@ struct Bonds {
   bool grouped = false;              ///< more than one bond group: group[] is kept
   std::vector<std::int32_t> ia, ib;  ///< local indices (valid between rebuilds)
   std::size_t n_both_owned = 0;
+  /// Changes whenever bond k may stand for another bond (push, permute, erase), never back to an earlier
+  /// value (a process-wide counter): what a driver caches per bond is valid while it is unchanged.
+  std::uint64_t stamp = 0;
 
   std::size_t size() const { return a.size(); }
 
@@ -35,11 +39,13 @@ struct Bonds {
     b.push_back(gb);
     r0.push_back(rest);
     if (grouped) group.push_back(g);
+    stamp = next_stamp();
   }
 
   /// Reorders: new bond k is old bond order[k]; drops the rest when order is shorter. A full
   /// permutation is applied in place (cycle by cycle, no copy of the arrays); `order` is consumed.
   void permute(std::vector<std::uint32_t>& order) {
+    stamp = next_stamp();
     if (order.size() == a.size() && order.size() < (1u << 31)) {
       permute_in_place(order);
       return;
@@ -102,6 +108,11 @@ struct Bonds {
   }
 
  private:
+  static std::uint64_t next_stamp() {
+    static std::atomic<std::uint64_t> counter{0};
+    return counter.fetch_add(1, std::memory_order_relaxed) + 1;
+  }
+
   void permute_in_place(std::vector<std::uint32_t>& order) {
     constexpr std::uint32_t kDone = 1u << 31;
     const bool has_local = !ia.empty(), has_group = !group.empty();

@@ -34,11 +34,13 @@
 // specimen these kicks pump energy in (docs/validation-rock.md, "Energy"). angles = "atan2" takes the same
 // angles from atan2(|sin|, cos) (gamma = atan2(|rb x D|, rb.D), theta = 2 atan2(sqrt t2, sqrt t0),
 // psi = 2 atan2(r.z, r.w)): equal to acos's up to rounding at every angle, exact near zero.
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
 #include <numbers>
 #include <string_view>
+#include <type_traits>
 
 #include "basalt/solver/models/model.hpp"
 #include "basalt/solver/scene/table_reader.hpp"
@@ -90,11 +92,63 @@ struct Quat {
   }
 };
 
+/// The rotation matrix of a unit quaternion (body -> world), built once for the several vectors a bond
+/// turns: the entries are Quat::to_world's (ESyS's Quaternion::to_matrix, homogeneous form).
+template <class Real>
+struct Rot {
+  Real m[3][3];
+  explicit Rot(const Quat<Real>& q) {
+    const Real ww = q.w * q.w, xx = q.x * q.x, yy = q.y * q.y, zz = q.z * q.z;
+    m[0][0] = ww + xx - yy - zz, m[0][1] = 2 * (q.x * q.y - q.w * q.z), m[0][2] = 2 * (q.x * q.z + q.w * q.y);
+    m[1][0] = 2 * (q.x * q.y + q.w * q.z), m[1][1] = ww - xx + yy - zz, m[1][2] = 2 * (q.y * q.z - q.w * q.x);
+    m[2][0] = 2 * (q.x * q.z - q.w * q.y), m[2][1] = 2 * (q.y * q.z + q.w * q.x), m[2][2] = ww - xx - yy + zz;
+  }
+  /// R v.
+  Vec<Real> to_world(const Vec<Real>& v) const {
+    return {m[0][0] * v.x + m[0][1] * v.y + m[0][2] * v.z, m[1][0] * v.x + m[1][1] * v.y + m[1][2] * v.z,
+            m[2][0] * v.x + m[2][1] * v.y + m[2][2] * v.z};
+  }
+  /// R (a, b, 0): a vector of the xy-plane.
+  Vec<Real> xy_to_world(Real a, Real b) const {
+    return {m[0][0] * a + m[0][1] * b, m[1][0] * a + m[1][1] * b, m[2][0] * a + m[2][1] * b};
+  }
+  /// R^T v.
+  Vec<Real> to_body(const Vec<Real>& v) const {
+    return {m[0][0] * v.x + m[1][0] * v.y + m[2][0] * v.z, m[0][1] * v.x + m[1][1] * v.y + m[2][1] * v.z,
+            m[0][2] * v.x + m[1][2] * v.y + m[2][2] * v.z};
+  }
+};
+
+/// acos c for c in (0.995, 1] (angles below 0.1 rad, where a bond's angles live; larger c, from rounding,
+/// read as 1): acos c = 2 asin(s),
+/// s = sqrt((1 - c)/2) <= 0.05, by asin's series to s^13 (the next term is below 1e-20 relative): 1 - c is
+/// exact for c >= 1/2, so the result is within 1-2 ulp of glibc's acos at a fraction of its cost (test
+/// RotBondLaw.FastAcosMatchesAcosToRounding).
+/// acos_near_one: the series on (0.995, 1], std::acos elsewhere and in single precision.
+template <class Real>
+[[gnu::always_inline]] inline Real acos_series(Real c) {
+  const Real s = std::sqrt(std::max(Real(0.5) * (Real(1) - c), Real(0))), t = s * s;
+  // asin s = s + s t (1/6 + t (3/40 + t (5/112 + t (35/1152 + t (63/2816 + t 231/13312)))))
+  const Real p =
+      Real(1.0 / 6) +
+      t * (Real(3.0 / 40) + t * (Real(5.0 / 112) + t * (Real(35.0 / 1152) +
+                                                        t * (Real(63.0 / 2816) + t * Real(231.0 / 13312)))));
+  return 2 * (s + s * t * p);
+}
+
+template <class Real>
+Real acos_near_one(Real c) {
+  if constexpr (std::is_same_v<Real, double>) {
+    if (c > 0.995) return acos_series(c);
+  }
+  return std::acos(c);
+}
+
 /// The signed angle whose cosine is c and whose sine has the sign of s (0 for s = 0 or |c| >= 1).
 template <class Real>
 Real signed_angle(Real s, Real c) {
   if (s == Real(0) || c >= Real(1) || c <= Real(-1)) return 0;
-  return s > 0 ? std::acos(c) : -std::acos(c);
+  return s > 0 ? acos_near_one(c) : -acos_near_one(c);
 }
 
 }  // namespace beam
@@ -268,71 +322,173 @@ struct RotBond {
     Real fs, mb, mt;
   };
 
+  /// What a bond's evaluation takes from its initial state alone (cached per bond by the driver).
+  template <class Real>
+  struct Fixed {
+    Real inv_d;   ///< 1 / |d|
+    Real e1, e2;  ///< r1/(r1+r2), r2/(r1+r2): the shares of the shear couple
+  };
+  template <class Real>
+  static Fixed<Real> fixed(const Geometry<Real>& g) {
+    return {Real(1) / g.d.norm(), g.r1 / (g.r1 + g.r2), g.r2 / (g.r1 + g.r2)};
+  }
+
   template <class Real>
   static Result<Real> evaluate(const BondCoeffs<Real>& k, const Geometry<Real>& g) {
+    return evaluate(k, g, fixed(g));
+  }
+
+  template <class Real>
+  static Result<Real> evaluate(const BondCoeffs<Real>& k, const Geometry<Real>& g, const Fixed<Real>& f) {
     using V = beam::Vec<Real>;
     using Q = beam::Quat<Real>;
     const Real h = Real(0.5) * std::sqrt(Real(2));
     const V rbp = g.x2 - g.x1;
     const Real lp = rbp.norm();
-    const V rb = g.q1.to_body(rbp);
-    const Real nb = rb.norm(), r0 = g.r0;
-    const V fr = rb * (k.kn * (nb - r0) / nb);
-    // Shear from the turn of the line of centres away from D, in 1's frame.
-    const Real gc = rb.dot(g.d) / (nb * g.d.norm());
-    const Real gamma = k.atan2_angles                    ? std::atan2(rb.cross(g.d).norm(), rb.dot(g.d))
-                       : (gc < Real(1) && gc > Real(-1)) ? std::acos(gc)
+    const beam::Rot<Real> R1(g.q1);
+    const V rb = R1.to_body(rbp);
+    const Real nb = rb.norm(), inb = Real(1) / nb, r0 = g.r0;
+    const V fr = rb * (k.kn * (nb - r0) * inb);
+    // Shear from the turn of the line of centres away from D, in 1's frame: |Fst| = ks r0 gamma along
+    // rb x (rb x D) (of norm |rb| |rb x D|), its couple -|Fst| along rb x D.
+    const V c0 = rb.cross(g.d);
+    const Real n0 = c0.norm(), dot = rb.dot(g.d);
+    const Real gc = dot * (inb * f.inv_d);
+    const Real gamma = k.atan2_angles                    ? std::atan2(n0, dot)
+                       : (gc < Real(1) && gc > Real(-1)) ? beam::acos_near_one(gc)
                                                          : Real(0);
-    const V c0 = rb.cross(g.d), c1 = rb.cross(c0);
-    const Real n0 = c0.norm(), n1 = c1.norm();
-    const V fst = n1 != Real(0) ? c1 * (k.ks * r0 * gamma / n1) : V{};
-    const V mst = n0 != Real(0) ? c0 * (-fst.norm() / n0) : V{};
+    V fst{}, mst{};
+    if (n0 != Real(0)) {
+      const Real a = k.ks * r0 * gamma / n0;
+      fst = rb.cross(c0) * (a * inb);
+      mst = c0 * -a;
+    }
     // qm turns z onto rb; r is the relative rotation seen in that frame.
-    Q qm{h * std::sqrt((nb + rb.z) / nb), 0, 0, 0};
-    const Real s = h * std::sqrt((nb - rb.z) / nb), rxy2 = rb.x * rb.x + rb.y * rb.y;
+    Q qm{h * std::sqrt((nb + rb.z) * inb), 0, 0, 0};
+    const Real s = h * std::sqrt((nb - rb.z) * inb), rxy2 = rb.x * rb.x + rb.y * rb.y;
     qm.x = -s, qm.y = s;
     if (rxy2 != Real(0)) {
-      const Real rxy = std::sqrt(rxy2);
-      qm.x = -s * rb.y / rxy, qm.y = s * rb.x / rxy;
+      const Real irxy = s / std::sqrt(rxy2);
+      qm.x = -rb.y * irxy, qm.y = rb.x * irxy;
     }
+    const beam::Rot<Real> Rm(qm);
     const Q r = qm.inverse() * (g.q1.inverse() * g.q2) * qm;
     const Real t0 = r.w * r.w + r.z * r.z, t2 = r.x * r.x + r.y * r.y;
     Real psi = 0;
     if (t0 != Real(0)) {
-      const Real st = std::sqrt(t0);
-      psi = k.atan2_angles ? 2 * std::atan2(r.z, r.w) : 2 * beam::signed_angle(r.z / st, r.w / st);
+      const Real ist = Real(1) / std::sqrt(t0);
+      psi = k.atan2_angles ? 2 * std::atan2(r.z, r.w) : 2 * beam::signed_angle(r.z * ist, r.w * ist);
     }
-    const V mtr = qm.to_world(V{0, 0, k.kt * psi});
+    const Real mt = k.kt * psi;
+    const V mtr{Rm.m[0][2] * mt, Rm.m[1][2] * mt, Rm.m[2][2] * mt};
     V mbr{}, fsr{}, msr{};
+    Real mb = 0;
     if (t2 != Real(0)) {
       const Real t1 = t0 - t2;
       const Real theta = k.atan2_angles                      ? 2 * std::atan2(std::sqrt(t2), std::sqrt(t0))
                          : (t1 >= Real(1) || t1 <= Real(-1)) ? Real(0)
-                                                             : std::acos(t1);
+                                                             : beam::acos_near_one(t1);
       Real cf, sf;
       if (t0 == Real(0)) {
-        const Real q = std::sqrt(t2);
-        cf = r.y / q, sf = -r.x / q;
+        const Real iq = Real(1) / std::sqrt(t2);
+        cf = r.y * iq, sf = -r.x * iq;
       } else {
-        const Real q = std::sqrt(t0 * t2);
-        cf = (r.x * r.z + r.w * r.y) / q, sf = (r.y * r.z - r.w * r.x) / q;
+        const Real iq = Real(1) / std::sqrt(t0 * t2);
+        cf = (r.x * r.z + r.w * r.y) * iq, sf = (r.y * r.z - r.w * r.x) * iq;
       }
       const Real b = Real(0.5) * k.kb * theta, sh = Real(0.5) * k.ks * theta * r0;
-      mbr = qm.to_world(V{-b * sf, b * cf, 0});
-      fsr = qm.to_world(V{-sh * cf, -sh * sf, 0});
-      msr = qm.to_world(V{sh * sf, -sh * cf, 0});
+      mb = std::abs(b);  // |Rm (-b sf, b cf, 0)|
+      mbr = Rm.xy_to_world(-b * sf, b * cf);
+      fsr = Rm.xy_to_world(-sh * cf, -sh * sf);
+      msr = Rm.xy_to_world(sh * sf, -sh * cf);
     }
-    const Real e1 = g.r1 / (g.r1 + g.r2), e2 = g.r2 / (g.r1 + g.r2);
     const V ms = msr + mst, fs = fst + fsr;
     Result<Real> out;
-    out.f1 = g.q1.to_world(fr + fs);
-    out.m1 = g.q1.to_world(mbr + mtr + ms * (e1 * lp));
-    out.m2 = g.q1.to_world(ms * (e2 * lp) - mbr - mtr);
+    out.f1 = R1.to_world(fr + fs);
+    out.m1 = R1.to_world(mbr + mtr + ms * (f.e1 * lp));
+    out.m2 = R1.to_world(ms * (f.e2 * lp) - mbr - mtr);
     out.fn = (lp < r0 ? Real(-1) : Real(1)) * fr.norm();
     out.fs = fs.norm();
-    out.mb = mbr.norm();
-    out.mt = mtr.norm();
+    out.mb = mb;
+    out.mt = std::abs(mt);
     return out;
+  }
+
+  /// W bonds side by side (structure of arrays), for evaluate_lanes.
+  template <class Real, int W>
+  struct Lanes {
+    alignas(64) Real x1[3][W], x2[3][W], q1[4][W], q2[4][W], d[3][W];
+    alignas(64) Real r0[W], inv_d[W], e1[W], e2[W], kn[W], ks[W], kb[W], kt[W];
+    alignas(64) Real f1[3][W], m1[3][W], m2[3][W], fn[W], fs[W], mb[W], mt[W];
+    alignas(64) Real general[W];  ///< 1: the lane is a case evaluate_lanes leaves to evaluate (see there)
+  };
+
+  /// evaluate() for W bonds at once, written without branches so that the compiler can run the lanes in
+  /// vector registers (it needs -fno-math-errno, set for the whole project, to vectorise sqrt): the same
+  /// formulas in the same order, with each of evaluate()'s special cases computed anyway and the lane marked
+  /// `general` instead. Those are the bonds at exactly zero shear, bend or lateral offset (at the start of a
+  /// run, the bonds no load has reached yet), angles beyond acos's series (cosines <= 0.995, above 0.1 rad)
+  /// and atan2 angles: the caller evaluates them with evaluate(). A bond's result depends on its own inputs
+  /// only, never on its lane or its neighbours in the batch.
+  template <class Real, int W>
+  static void evaluate_lanes(Lanes<Real, W>& b) {
+    using V = beam::Vec<Real>;
+    using Q = beam::Quat<Real>;
+    const Real h = Real(0.5) * std::sqrt(Real(2)), one = 1, zero = 0;
+    const auto acos_series = [](Real c) { return beam::acos_series(c); };
+#pragma GCC ivdep
+    for (int l = 0; l < W; ++l) {
+      const V x1{b.x1[0][l], b.x1[1][l], b.x1[2][l]}, x2{b.x2[0][l], b.x2[1][l], b.x2[2][l]};
+      const Q q1{b.q1[0][l], b.q1[1][l], b.q1[2][l], b.q1[3][l]},
+          q2{b.q2[0][l], b.q2[1][l], b.q2[2][l], b.q2[3][l]};
+      const V d{b.d[0][l], b.d[1][l], b.d[2][l]};
+      const Real r0 = b.r0[l], ks = b.ks[l];
+      const V rbp = x2 - x1;
+      const Real lp = rbp.norm();
+      const beam::Rot<Real> R1(q1);
+      const V rb = R1.to_body(rbp);
+      const Real nb = rb.norm(), inb = one / nb;
+      const V fr = rb * (b.kn[l] * (nb - r0) * inb);
+      const V c0 = rb.cross(d);
+      const Real n0 = c0.norm(), dot = rb.dot(d);
+      const Real gc = dot * (inb * b.inv_d[l]);
+      const Real gamma = acos_series(gc);
+      const Real a = ks * r0 * gamma / (n0 != zero ? n0 : one);
+      const V fst = rb.cross(c0) * (a * inb), mst = c0 * -a;
+      const Real s = h * std::sqrt((nb - rb.z) * inb), rxy2 = rb.x * rb.x + rb.y * rb.y;
+      const Real irxy = s / std::sqrt(rxy2 != zero ? rxy2 : one);
+      const Q qm{h * std::sqrt((nb + rb.z) * inb), -rb.y * irxy, rb.x * irxy, 0};
+      const beam::Rot<Real> Rm(qm);
+      const Q r = qm.inverse() * (q1.inverse() * q2) * qm;
+      const Real t0 = r.w * r.w + r.z * r.z, t2 = r.x * r.x + r.y * r.y;
+      const Real ist = one / std::sqrt(t0 != zero ? t0 : one);
+      const Real cpsi = r.w * ist, spsi = r.z * ist;
+      const Real apsi = acos_series(cpsi);
+      const Real psi = 2 * (spsi > zero ? apsi : spsi < zero ? -apsi : zero);
+      const Real mt = b.kt[l] * psi;
+      const V mtr{Rm.m[0][2] * mt, Rm.m[1][2] * mt, Rm.m[2][2] * mt};
+      const Real t1 = t0 - t2;
+      const Real theta = acos_series(t1);
+      const Real iq = one / std::sqrt(t0 * t2 != zero ? t0 * t2 : one);
+      const Real cf = (r.x * r.z + r.w * r.y) * iq, sf = (r.y * r.z - r.w * r.x) * iq;
+      const Real bb = Real(0.5) * b.kb[l] * theta, sh = Real(0.5) * ks * theta * r0;
+      const V mbr = Rm.xy_to_world(-bb * sf, bb * cf), fsr = Rm.xy_to_world(-sh * cf, -sh * sf),
+              msr = Rm.xy_to_world(sh * sf, -sh * cf);
+      const V ms = msr + mst, fs = fst + fsr;
+      const V f1 = R1.to_world(fr + fs), m1 = R1.to_world(mbr + mtr + ms * (b.e1[l] * lp)),
+              m2 = R1.to_world(ms * (b.e2[l] * lp) - mbr - mtr);
+      b.f1[0][l] = f1.x, b.f1[1][l] = f1.y, b.f1[2][l] = f1.z;
+      b.m1[0][l] = m1.x, b.m1[1][l] = m1.y, b.m1[2][l] = m1.z;
+      b.m2[0][l] = m2.x, b.m2[1][l] = m2.y, b.m2[2][l] = m2.z;
+      b.fn[l] = (lp < r0 ? -one : one) * fr.norm();
+      b.fs[l] = fs.norm();
+      b.mb[l] = std::abs(bb);
+      b.mt[l] = std::abs(mt);
+      const Real lim = Real(0.995);
+      // (& not &&: no branches in the loop)
+      b.general[l] = Real(!((n0 != zero) & (rxy2 != zero) & (t0 != zero) & (t2 != zero) & (gc > lim) &
+                            (t1 > lim) & ((cpsi > lim) | (spsi == zero))));
+    }
   }
 
   /// ESyS's potential energy of the bond for these loads.
