@@ -13,7 +13,8 @@ from the particles after step n), so ESyS's force is interpolated linearly to st
 Checks (exit 1 when one fails):
   - F within --force-tol (1 %) of ESyS's at every saved step where ESyS's F is at least --floor (5 %) of
     its peak, up to the step where ESyS's F first reaches half its peak;
-  - the peak force within 5 %, and the broken bonds (initial count - bond_count) at the peak within 10 %.
+  - the peak force within 5 %, and the broken bonds (initial count - bond_count) at the reference's peak
+    step within 10 % (the count at each run's own peak is printed, not checked: see compare()).
 The peak checks need an ESyS series that passes its peak (F falls below 90 % of its maximum afterwards);
 on a series that stops before, they are reported as not available and the exit status is 2 when nothing
 failed. The same numbers for ESyS against its run with one particle moved by 1e-12 (--perturbed), or for
@@ -112,13 +113,24 @@ def compare(ref, other, shift, floor, tol, label):
         print(f"{label}: FAIL the compared run ends at step {max(other)} before its peak")
         return False, True
     dp = abs(fo - fp) / fp
-    broken_ref, broken_other = initial - bp, other[min(other)][1] - bo
+    broken_ref, initial_other = initial - bp, other[min(other)][1]
+    # Broken bonds at the reference's peak step (the compared run's row of that step; Basalt's rows are
+    # shifted by one step). Not at each run's own peak: the force stays within 1 % of its peak for ~500
+    # steps while ~300 bonds break, so where in that plateau the largest value falls decides the count
+    # (ESyS against itself with a 1e-12 nudge: 880 against 780 at the own peaks, 12.8 %).
+    e = at(other, kp - shift)
+    if e is None:
+        print(f"{label}: FAIL the compared run has no row at the reference's peak step {kp}")
+        return False, True
+    broken_other = initial_other - e[1]
     db = abs(broken_other - broken_ref) / max(broken_ref, 1.0)
+    own = abs((initial_other - bo) - broken_ref) / max(broken_ref, 1.0)
     ok_p, ok_b = dp < 0.05, db < 0.10
     print(f"{label}: peak force {fo:.6g} at step {ko} against {fp:.6g} at step {kp}: {dp:.2%} -> "
           f"{'ok' if ok_p else 'FAIL'} (5 %)")
-    print(f"{label}: broken bonds at the peak {broken_other:.0f} against {broken_ref:.0f}: {db:.2%} -> "
-          f"{'ok' if ok_b else 'FAIL'} (10 %)")
+    print(f"{label}: broken bonds at the reference's peak (step {kp}) {broken_other:.0f} against "
+          f"{broken_ref:.0f}: {db:.2%} -> {'ok' if ok_b else 'FAIL'} (10 %); at each run's own peak "
+          f"{initial_other - bo:.0f} against {broken_ref:.0f} ({own:.2%}, not checked)")
     return ok and ok_p and ok_b, True
 
 
