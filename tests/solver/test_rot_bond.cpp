@@ -14,6 +14,7 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "basalt/solver/models/rot_bond.hpp"
 #include "basalt/solver/simulation.hpp"
@@ -180,6 +181,36 @@ TEST(RotBondLaw, LanesMatchTheScalarEvaluation) {
     }
   }
   for (int l = 3; l < W; ++l) EXPECT_EQ(L.general[l], 0.0) << l;
+}
+
+// The bond driver keeps each bond's constants until Bonds::stamp changes: every push, permutation and
+// erase must give a stamp never seen before, and a copy (the critical-step probe restores one) keeps its own.
+TEST(BondList, StampChangesWheneverABondMayStandForAnother) {
+  Bonds<double> b;
+  std::vector<std::uint64_t> seen{b.stamp};
+  const auto fresh = [&](const char* what) {
+    EXPECT_EQ(std::count(seen.begin(), seen.end(), b.stamp), 0) << what;
+    seen.push_back(b.stamp);
+  };
+  b.push(1, 2, 1.0, 0);
+  fresh("push");
+  b.push(2, 3, 1.5, 0);
+  b.push(3, 4, 2.0, 0);
+  fresh("push");
+  const Bonds<double> copy = b;
+  EXPECT_EQ(copy.stamp, b.stamp);
+  std::vector<std::uint32_t> order{2, 0, 1};
+  b.permute(order);
+  fresh("permute");
+  EXPECT_EQ(b.a[0], 3);
+  b.erase({1});
+  fresh("erase");
+  EXPECT_EQ(b.size(), 2u);
+  b = copy;  // the old content comes back with its old stamp: valid for whatever was cached for it
+  EXPECT_EQ(b.stamp, seen[2]);
+  std::vector<std::uint32_t> same{0, 1, 2};
+  b.permute(same);
+  fresh("permute after restoring a copy");
 }
 
 TEST(RotBondLaw, NormalSpring) {

@@ -75,25 +75,12 @@ struct Quat {
   /// orientations of unit length, as ESyS does). Unlike a division by |q|^2 it leaves q^-1 q at rest with no
   /// rounding-level vector part, which acos would read as a 1.5e-8 rad bend (docs/validation-rock.md).
   Quat inverse() const { return {w, -x, -y, -z}; }
-  /// R^T v for the rotation R this quaternion stands for (body -> world): v in the body frame. Written
-  /// in the homogeneous form (w^2 + x^2 - y^2 - z^2 ...) as ESyS's Quaternion::to_matrix.
-  Vec<Real> to_body(const Vec<Real>& v) const {
-    const Real ww = w * w, xx = x * x, yy = y * y, zz = z * z;
-    return {(ww + xx - yy - zz) * v.x + 2 * (x * y + w * z) * v.y + 2 * (x * z - w * y) * v.z,
-            2 * (x * y - w * z) * v.x + (ww - xx + yy - zz) * v.y + 2 * (y * z + w * x) * v.z,
-            2 * (x * z + w * y) * v.x + 2 * (y * z - w * x) * v.y + (ww - xx - yy + zz) * v.z};
-  }
-  /// R v (the transpose of to_body's matrix).
-  Vec<Real> to_world(const Vec<Real>& v) const {
-    const Real ww = w * w, xx = x * x, yy = y * y, zz = z * z;
-    return {(ww + xx - yy - zz) * v.x + 2 * (x * y - w * z) * v.y + 2 * (x * z + w * y) * v.z,
-            2 * (x * y + w * z) * v.x + (ww - xx + yy - zz) * v.y + 2 * (y * z - w * x) * v.z,
-            2 * (x * z - w * y) * v.x + 2 * (y * z + w * x) * v.y + (ww - xx - yy + zz) * v.z};
-  }
+  /// R v for the rotation R this quaternion stands for (body -> world): Rot's matrix (below).
+  Vec<Real> to_world(const Vec<Real>& v) const;
 };
 
 /// The rotation matrix of a unit quaternion (body -> world), built once for the several vectors a bond
-/// turns: the entries are Quat::to_world's (ESyS's Quaternion::to_matrix, homogeneous form).
+/// turns, in the homogeneous form (w^2 + x^2 - y^2 - z^2 ...) of ESyS's Quaternion::to_matrix.
 template <class Real>
 struct Rot {
   Real m[3][3];
@@ -118,6 +105,11 @@ struct Rot {
             m[0][2] * v.x + m[1][2] * v.y + m[2][2] * v.z};
   }
 };
+
+template <class Real>
+Vec<Real> Quat<Real>::to_world(const Vec<Real>& v) const {
+  return Rot<Real>(*this).to_world(v);
+}
 
 /// acos c for c in (0.995, 1] (angles below 0.1 rad, where a bond's angles live; larger c, from rounding,
 /// read as 1): acos c = 2 asin(s),
@@ -435,7 +427,6 @@ struct RotBond {
     using V = beam::Vec<Real>;
     using Q = beam::Quat<Real>;
     const Real h = Real(0.5) * std::sqrt(Real(2)), one = 1, zero = 0;
-    const auto acos_series = [](Real c) { return beam::acos_series(c); };
 #pragma GCC ivdep
     for (int l = 0; l < W; ++l) {
       const V x1{b.x1[0][l], b.x1[1][l], b.x1[2][l]}, x2{b.x2[0][l], b.x2[1][l], b.x2[2][l]};
@@ -452,7 +443,7 @@ struct RotBond {
       const V c0 = rb.cross(d);
       const Real n0 = c0.norm(), dot = rb.dot(d);
       const Real gc = dot * (inb * b.inv_d[l]);
-      const Real gamma = acos_series(gc);
+      const Real gamma = beam::acos_series(gc);
       const Real a = ks * r0 * gamma / (n0 != zero ? n0 : one);
       const V fst = rb.cross(c0) * (a * inb), mst = c0 * -a;
       const Real s = h * std::sqrt((nb - rb.z) * inb), rxy2 = rb.x * rb.x + rb.y * rb.y;
@@ -463,12 +454,12 @@ struct RotBond {
       const Real t0 = r.w * r.w + r.z * r.z, t2 = r.x * r.x + r.y * r.y;
       const Real ist = one / std::sqrt(t0 != zero ? t0 : one);
       const Real cpsi = r.w * ist, spsi = r.z * ist;
-      const Real apsi = acos_series(cpsi);
+      const Real apsi = beam::acos_series(cpsi);
       const Real psi = 2 * (spsi > zero ? apsi : spsi < zero ? -apsi : zero);
       const Real mt = b.kt[l] * psi;
       const V mtr{Rm.m[0][2] * mt, Rm.m[1][2] * mt, Rm.m[2][2] * mt};
       const Real t1 = t0 - t2;
-      const Real theta = acos_series(t1);
+      const Real theta = beam::acos_series(t1);
       const Real iq = one / std::sqrt(t0 * t2 != zero ? t0 * t2 : one);
       const Real cf = (r.x * r.z + r.w * r.y) * iq, sf = (r.y * r.z - r.w * r.x) * iq;
       const Real bb = Real(0.5) * b.kb[l] * theta, sh = Real(0.5) * ks * theta * r0;
