@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <string>
 
@@ -367,6 +368,102 @@ TEST(HertzMindlin, EffectiveModuliOfOneAndOfTwoMaterials) {
   const double G1 = 380.0e9 / 2.46, G2 = 70.0e9 / 2.5;
   EXPECT_NEAR(two.G_star, 1 / (1.77 / G1 + 1.75 / G2), 1e-6 * two.G_star);
   EXPECT_NEAR(two.E_star, 1 / ((1 - 0.0529) / 380.0e9 + (1 - 0.0625) / 70.0e9), 1e-6 * two.E_star);
+}
+
+// The pair loop evaluates 8 contacts at once (HertzMindlin::contact_lanes). On random contacts (sticking,
+// sliding, with and without shear history, rotating, history tilted out of the tangent plane) the lanes
+// must give contact()'s force, arm, history, dissipation and sliding flag to rounding, with and without
+// advancing the history; and a contact's result must not depend on its lane.
+TEST(HertzMindlin, LanesMatchTheScalarContact) {
+  constexpr int W = 8;
+  using Lanes = ContactLanes<double, W, HertzMindlin::History>;
+  const auto c = HertzMindlin::coeffs<double>(HertzMindlin::Params{{1.0e7, 0.25}, 0.5, 0.5});
+  const auto u = [](std::uint64_t k) { return 0.5 * basalt::test::hash_unit(k); };  // [-0.5, 0.5)
+  struct Case {
+    ContactKinematics<double> k;
+    HertzMindlin::History h;
+  };
+  const auto random_case = [&](std::uint64_t s) {
+    Case q{};
+    auto& k = q.k;
+    k.ri = 1e-3 * (1 + u(s)), k.rj = 1e-3 * (1 + u(s + 1));
+    const double nx = u(s + 2), ny = u(s + 3), nz = u(s + 4), nn = std::sqrt(nx * nx + ny * ny + nz * nz);
+    k.r = (k.ri + k.rj) * (1 - 1e-3 * (0.01 + u(s + 5) + 0.5));  // overlaps 1e-5 .. 1e-3 of the radii sum
+    k.dx = k.r * nx / nn, k.dy = k.r * ny / nn, k.dz = k.r * nz / nn;
+    k.imi = 1 / (1e-5 * (1 + u(s + 6))), k.imj = 1 / (1e-5 * (1 + u(s + 7)));
+    const double v = s % 2 == 0 ? 0.1 : 1e-4;  // half of them slow: sticking
+    k.vx = v * u(s + 8), k.vy = v * u(s + 9), k.vz = v * u(s + 10);
+    k.wix = 500 * v * u(s + 11), k.wiy = 500 * v * u(s + 12), k.wiz = 500 * v * u(s + 13);
+    k.wjx = 500 * v * u(s + 14), k.wjy = 500 * v * u(s + 15), k.wjz = 500 * v * u(s + 16);
+    k.dt = 1e-5;
+    if (s % 3 != 0)  // a third without history (a new contact)
+      q.h = {v * 2e-5 * u(s + 17) * double(s % 5), v * 2e-5 * u(s + 18), v * 2e-5 * u(s + 19)};
+    return q;
+  };
+  const auto load = [&](Lanes& L, int l, const Case& q) {
+    const auto& k = q.k;
+    L.dx[l] = k.dx, L.dy[l] = k.dy, L.dz[l] = k.dz, L.r2[l] = k.dx * k.dx + k.dy * k.dy + k.dz * k.dz;
+    L.ri[l] = k.ri, L.rj[l] = k.rj, L.imi[l] = k.imi, L.imj[l] = k.imj;
+    L.vx[l] = k.vx, L.vy[l] = k.vy, L.vz[l] = k.vz;
+    L.wix[l] = k.wix, L.wiy[l] = k.wiy, L.wiz[l] = k.wiz, L.wjx[l] = k.wjx, L.wjy[l] = k.wjy,
+    L.wjz[l] = k.wjz;
+    L.h[l] = q.h;
+    L.dt = k.dt;
+  };
+  const auto near = [](double got, double want, double scale) {
+    return std::abs(got - want) <= 1e-12 * scale;
+  };
+  int sliding = 0, sticking = 0;
+  for (const bool advance : {true, false}) {
+    for (std::uint64_t batch = 0; batch < 60; ++batch) {
+      Lanes L{};
+      std::array<Case, W> cases;
+      for (int l = 0; l < W; ++l) load(L, l, cases[l] = random_case(1000 * batch + 29 * l));
+      if (advance)
+        HertzMindlin::contact_lanes<true>(c, L);
+      else
+        HertzMindlin::contact_lanes<false>(c, L);
+      for (int l = 0; l < W; ++l) {
+        auto q = cases[l];
+        q.k.r = std::sqrt(L.r2[l]);  // as the driver gives it
+        ContactForce<double> f;
+        if (advance)
+          HertzMindlin::contact<true>(c, q.h, q.k, f);
+        else
+          HertzMindlin::contact<false>(c, q.h, q.k, f);
+        const double F = std::sqrt(f.fx * f.fx + f.fy * f.fy + f.fz * f.fz);
+        const double H = std::sqrt(q.h.x * q.h.x + q.h.y * q.h.y + q.h.z * q.h.z) + 1e-300;
+        SCOPED_TRACE(::testing::Message() << "advance " << advance << " batch " << batch << " lane " << l);
+        EXPECT_TRUE(near(L.fx[l], f.fx, F) && near(L.fy[l], f.fy, F) && near(L.fz[l], f.fz, F))
+            << L.fx[l] << " " << f.fx << " " << L.fy[l] << " " << f.fy << " " << L.fz[l] << " " << f.fz;
+        EXPECT_TRUE(near(L.arm_i[l], f.arm_i, q.k.r));
+        EXPECT_EQ(L.sliding[l] != 0, f.sliding);
+        if (advance) {
+          EXPECT_TRUE(near(L.h[l].x, q.h.x, H) && near(L.h[l].y, q.h.y, H) && near(L.h[l].z, q.h.z, H));
+          EXPECT_NEAR(L.dissipated[l], f.dissipated, 1e-11 * std::abs(f.dissipated) + 1e-300);
+        } else {
+          EXPECT_EQ(L.h[l].x, cases[l].h.x);  // left alone
+        }
+        (f.sliding ? sliding : sticking) += 1;
+      }
+    }
+  }
+  EXPECT_GT(sliding, 200);  // both regimes covered
+  EXPECT_GT(sticking, 200);
+  std::printf("lanes against contact(): %d sliding, %d sticking contacts\n", sliding, sticking);
+  // One contact in every lane, the others different: bitwise the same result in each.
+  const Case one = random_case(4242);
+  std::array<double, 7> want{};
+  for (int at = 0; at < W; ++at) {
+    Lanes L{};
+    for (int l = 0; l < W; ++l) load(L, l, l == at ? one : random_case(7000 + 31 * l + at));
+    HertzMindlin::contact_lanes<true>(c, L);
+    const std::array<double, 7> got{L.fx[at],  L.fy[at],  L.fz[at],        L.h[at].x,
+                                    L.h[at].y, L.h[at].z, L.dissipated[at]};
+    if (at == 0) want = got;
+    for (std::size_t k = 0; k < got.size(); ++k)
+      EXPECT_EQ(got[k], want[k]) << "lane " << at << " value " << k;
+  }
 }
 
 TEST(HertzMindlin, RestitutionAndContactDurationFollowTheClosedForms) {

@@ -9,7 +9,9 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <initializer_list>
 #include <string_view>
+#include <type_traits>
 #include <vector>
 
 #include "basalt/solver/interactions/force_compute.hpp"
@@ -203,6 +205,11 @@ class PairDriver final : public ForceCompute<Real> {
   template <bool Energy, bool Newton, bool Advance>
   double loop_kinematic(Particles<Real>& p, const PairList& list, History* hist) {
     const bool one = coeffs_.size() == 1;
+    if constexpr (kLanes) {
+      if (one)
+        return p.with_rotation ? batches<Energy, Newton, Advance, true>(p, list, hist)
+                               : batches<Energy, Newton, Advance, false>(p, list, hist);
+    }
     if (p.with_rotation)
       return one ? rows<Energy, Newton, Advance, true, true>(p, list, hist)
                  : rows<Energy, Newton, Advance, true, false>(p, list, hist);
@@ -316,6 +323,141 @@ class PairDriver final : public ForceCompute<Real> {
     return energy;
   }
 
+  /// rows() for a model with contact_lanes and one group: the pairs in contact are gathered kLaneWidth at
+  /// a time in list order, evaluated side by side, and their forces and torques added in list order, those
+  /// of particle i in registers until its row ends (as rows() does). Every contact goes through the lanes
+  /// (a short last batch repeats its last pair), so a pair's force does not depend on the rank or on
+  /// where in a batch it falls.
+  template <bool Energy, bool Newton, bool Advance, bool Rot>
+  double batches(Particles<Real>& p, const PairList& list, [[maybe_unused]] History* hist) {
+    double energy = 0, dissipated = 0;
+    std::size_t sliding = 0;
+    const std::size_t n = p.n_owned;
+    const std::uint32_t* __restrict off = list.offset.data();
+    const std::int32_t* __restrict nb = list.neigh.data();
+    const std::int64_t* __restrict id = p.id.data();
+    const Real* __restrict x = p.x.data();
+    const Real* __restrict y = p.y.data();
+    const Real* __restrict z = p.z.data();
+    const Real* __restrict rad = p.radius.data();
+    const Real* __restrict im = p.inv_mass.data();
+    const Real* __restrict vx = p.vx.data();
+    const Real* __restrict vy = p.vy.data();
+    const Real* __restrict vz = p.vz.data();
+    Real* __restrict fx = p.fx.data();
+    Real* __restrict fy = p.fy.data();
+    Real* __restrict fz = p.fz.data();
+    [[maybe_unused]] const Real* __restrict wx = Rot ? p.wx.data() : nullptr;
+    [[maybe_unused]] const Real* __restrict wy = Rot ? p.wy.data() : nullptr;
+    [[maybe_unused]] const Real* __restrict wz = Rot ? p.wz.data() : nullptr;
+    [[maybe_unused]] Real* __restrict tx = Rot ? p.tx.data() : nullptr;
+    [[maybe_unused]] Real* __restrict ty = Rot ? p.ty.data() : nullptr;
+    [[maybe_unused]] Real* __restrict tz = Rot ? p.tz.data() : nullptr;
+    const Coeffs c = coeffs_[0];
+    auto& L = lanes_;
+    L.dt = dt_;
+    std::size_t lane_i[kLaneWidth], lane_j[kLaneWidth], lane_e[kLaneWidth];
+    // Row accumulators of particle `row` (the last row a scattered pair came from).
+    std::size_t row = n;
+    Real fxi = 0, fyi = 0, fzi = 0, txi = 0, tyi = 0, tzi = 0;
+    const auto flush_row = [&] {
+      if (row == n) return;
+      fx[row] += fxi, fy[row] += fyi, fz[row] += fzi;
+      if constexpr (Rot) tx[row] += txi, ty[row] += tyi, tz[row] += tzi;
+      fxi = fyi = fzi = txi = tyi = tzi = 0;
+    };
+    // The batch's size comes in as an argument, and the pairs that part are tallied apart, so that the
+    // gathering loop keeps both in registers (a captured counter would go through memory every pair).
+    const auto run = [&](const int filled) {
+      for (int l = filled; l < kLaneWidth; ++l) copy_lane(L, filled - 1, l);
+      Model::template contact_lanes<Advance>(c, L);
+      for (int l = 0; l < filled; ++l) {
+        const std::size_t i = lane_i[l], j = lane_j[l];
+        if (i != row) {
+          flush_row();
+          row = i;
+        }
+        const Real gx = L.fx[l], gy = L.fy[l], gz = L.fz[l];
+        fxi += gx, fyi += gy, fzi += gz;
+        if constexpr (Newton) fx[j] -= gx, fy[j] -= gy, fz[j] -= gz;
+        if constexpr (Rot) {
+          const Real r = L.r[l], inv_r = Real(1) / r, dx = L.dx[l], dy = L.dy[l], dz = L.dz[l];
+          const Real si = -L.arm_i[l] * inv_r, sj = (r - L.arm_i[l]) * inv_r;
+          const Real cx = dy * gz - dz * gy, cy = dz * gx - dx * gz, cz = dx * gy - dy * gx;
+          txi += si * cx, tyi += si * cy, tzi += si * cz;
+          if constexpr (Newton) tx[j] -= sj * cx, ty[j] -= sj * cy, tz[j] -= sj * cz;
+        }
+        if constexpr (kHistory && Advance) hist[lane_e[l]] = L.h[l];
+        if (Newton || id[i] < id[j]) {
+          if constexpr (Advance) {
+            dissipated += L.dissipated[l];
+            sliding += L.sliding[l] != Real(0);
+          }
+          if constexpr (Energy) {
+            ContactKinematics<Real> k{};
+            k.dx = L.dx[l], k.dy = L.dy[l], k.dz = L.dz[l], k.r = L.r[l], k.ri = L.ri[l], k.rj = L.rj[l];
+            energy += double(Model::energy(c, L.h[l], k));
+          }
+        }
+      }
+    };
+    int filled = 0;
+    double parted = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (off[i] == off[i + 1]) continue;  // most rows of the ghost list
+      const Real xi = x[i], yi = y[i], zi = z[i], ri = rad[i], imi = im[i], vxi = vx[i], vyi = vy[i],
+                 vzi = vz[i];
+      [[maybe_unused]] Real wxi = 0, wyi = 0, wzi = 0;
+      if constexpr (Rot) wxi = wx[i], wyi = wy[i], wzi = wz[i];
+      for (auto e = off[i]; e < off[i + 1]; ++e) {
+        const auto j = static_cast<std::size_t>(nb[e]);
+        const Real dx = xi - x[j], dy = yi - y[j], dz = zi - z[j];
+        const Real r2 = dx * dx + dy * dy + dz * dz;
+        const Real rj = rad[j], rsum = ri + rj;
+        // Written to the next lane whether the pair touches or not, kept only if it does: no branch to
+        // mispredict. A listed pair apart loses its history (a touching one gets it back from the lane).
+        const bool touch = r2 < rsum * rsum;
+        const int l = filled;
+        lane_i[l] = i, lane_j[l] = j, lane_e[l] = e;
+        L.dx[l] = dx, L.dy[l] = dy, L.dz[l] = dz, L.r2[l] = r2, L.ri[l] = ri, L.rj[l] = rj;
+        L.imi[l] = imi, L.imj[l] = im[j];
+        L.vx[l] = vxi - vx[j], L.vy[l] = vyi - vy[j], L.vz[l] = vzi - vz[j];
+        if constexpr (Rot) {
+          L.wix[l] = wxi, L.wiy[l] = wyi, L.wiz[l] = wzi;
+          L.wjx[l] = wx[j], L.wjy[l] = wy[j], L.wjz[l] = wz[j];
+        }
+        if constexpr (kHistory) {
+          L.h[l] = hist[e];
+          if constexpr (Advance) {
+            // What the history still held is lost with it (a shear spring's energy): dissipated.
+            const double lost = Model::parting_energy(c, L.h[l]);
+            parted += !touch && (Newton || id[i] < id[j]) ? lost : 0.0;
+            Model::apart(hist[e]);
+          }
+        }
+        filled += touch;
+        if (filled == kLaneWidth) {
+          run(filled);
+          filled = 0;
+        }
+      }
+    }
+    if (filled > 0) run(filled);
+    flush_row();
+    dissipated += parted;
+    dissipated_ += dissipated;
+    sliding_ += sliding;
+    return energy;
+  }
+
+  template <class Lanes>
+  static void copy_lane(Lanes& L, int from, int to) {
+    for (Real* a : {L.dx, L.dy, L.dz, L.r2, L.ri, L.rj, L.imi, L.imj, L.vx, L.vy, L.vz, L.wix, L.wiy, L.wiz,
+                    L.wjx, L.wjy, L.wjz})
+      a[to] = a[from];
+    L.h[to] = L.h[from];
+  }
+
   /// The pairs of `in` that pair compute `index` takes.
   static void filter(const PairLists<Real>& l, const PairList& in, std::size_t index, PairList& out) {
     const std::size_t n = in.offset.empty() ? 0 : in.offset.size() - 1;
@@ -362,6 +504,12 @@ class PairDriver final : public ForceCompute<Real> {
       }
   }
 
+  static constexpr int kLaneWidth = 8;  ///< contacts evaluated side by side (Model::contact_lanes)
+  static constexpr bool kLanes = requires(const Coeffs& c, ContactLanes<Real, kLaneWidth, History>& b) {
+    Model::template contact_lanes<true>(c, b);
+  };
+  struct NoLanes {};
+  [[no_unique_address]] std::conditional_t<kLanes, ContactLanes<Real, kLaneWidth, History>, NoLanes> lanes_{};
   std::vector<typename Model::Params> params_;
   std::vector<Coeffs> coeffs_;
   std::vector<TagFilter> tags_;

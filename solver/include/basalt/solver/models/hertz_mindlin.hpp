@@ -211,6 +211,79 @@ struct HertzMindlin {
     const Real R = k.ri * k.rj * inv_sum, m = Real(1) / (k.imi + k.imj);
     hertz::law<Advance>(c, h, R, m, k.ri + k.rj - k.r, nx, ny, nz, ux, uy, uz, k.dt, f);
   }
+  /// contact() for W pairs at once (model.hpp, ContactLanes): the same formulas in the same order, each
+  /// branch of hertz::law computed in every lane and the right value selected, so that GCC vectorises the
+  /// loop (divisions and square roots of the unselected side may be inf or NaN; they are dropped).
+  template <bool Advance, class Real, int W>
+  static void contact_lanes(const Coeffs<Real>& c, ContactLanes<Real, W, History>& b) {
+    const Real dt = b.dt, zero = 0, one = 1;
+#pragma GCC ivdep
+    for (int l = 0; l < W; ++l) {
+      const Real dx = b.dx[l], dy = b.dy[l], dz = b.dz[l], ri = b.ri[l], rj = b.rj[l];
+      const Real r = std::sqrt(b.r2[l]);
+      const Real inv_r = one / r;
+      const Real nx = dx * inv_r, ny = dy * inv_r, nz = dz * inv_r;
+      const Real inv_sum = one / (ri + rj);
+      const Real ai = r * ri * inv_sum, aj = r - ai;
+      const Real ox = -(ai * b.wix[l] + aj * b.wjx[l]), oy = -(ai * b.wiy[l] + aj * b.wjy[l]),
+                 oz = -(ai * b.wiz[l] + aj * b.wjz[l]);
+      const Real ux = b.vx[l] + oy * nz - oz * ny, uy = b.vy[l] + oz * nx - ox * nz,
+                 uz = b.vz[l] + ox * ny - oy * nx;
+      const Real R = ri * rj * inv_sum, m = one / (b.imi[l] + b.imj[l]), d = ri + rj - r;
+      // hertz::law
+      const Real root = std::sqrt(R * d);
+      const Real St = 8 * c.G_star * root;
+      const Real q = std::sqrt(root * m);
+      const Real gn = c.damp_n * q, gt = c.damp_t * q;
+      const Real un = ux * nx + uy * ny + uz * nz;
+      const Real tx = ux - un * nx, ty = uy - un * ny, tz = uz - un * nz;
+      const Real fn = Real(4.0 / 3.0) * c.E_star * root * d - gn * un;
+      Real sx = Real(b.h[l].x), sy = Real(b.h[l].y), sz = Real(b.h[l].z);
+      if constexpr (Advance) {
+        const Real before = sx * sx + sy * sy + sz * sz;
+        const Real sn = sx * nx + sy * ny + sz * nz;
+        const Real px = sx - sn * nx, py = sy - sn * ny, pz = sz - sn * nz;
+        const Real after = px * px + py * py + pz * pz;
+        const Real s = after > 0 ? std::sqrt(before / after) : one;
+        const bool turn = before > 0;
+        sx = turn ? px * s : sx;
+        sy = turn ? py * s : sy;
+        sz = turn ? pz * s : sz;
+        sx += tx * dt;
+        sy += ty * dt;
+        sz += tz * dt;
+      }
+      Real ftx = -St * sx - gt * tx, fty = -St * sy - gt * ty, ftz = -St * sz - gt * tz;
+      const Real ft2 = ftx * ftx + fty * fty + ftz * ftz, limit = c.mu * (fn > 0 ? fn : zero);
+      double dissipated = 0;
+      if constexpr (Advance)
+        dissipated = double(gn * un * un + gt * (tx * tx + ty * ty + tz * tz)) * double(dt);
+      const bool slide = ft2 > limit * limit;
+      const Real scale = limit / std::sqrt(ft2);
+      const double stored = 0.5 * double(St) * double(sx * sx + sy * sy + sz * sz);
+      ftx = slide ? ftx * scale : ftx;
+      fty = slide ? fty * scale : fty;
+      ftz = slide ? ftz * scale : ftz;
+      const bool refit = slide && St > 0;
+      sx = refit ? -(ftx + gt * tx) / St : sx;
+      sy = refit ? -(fty + gt * ty) / St : sy;
+      sz = refit ? -(ftz + gt * tz) / St : sz;
+      if constexpr (Advance) {
+        const double kept = 0.5 * double(St) * double(sx * sx + sy * sy + sz * sz);
+        dissipated += slide ? stored - kept : 0.0;
+        b.h[l].x = double(sx);
+        b.h[l].y = double(sy);
+        b.h[l].z = double(sz);
+        b.dissipated[l] = dissipated;
+      }
+      b.sliding[l] = slide ? one : zero;
+      b.fx[l] = fn * nx + ftx;
+      b.fy[l] = fn * ny + fty;
+      b.fz[l] = fn * nz + ftz;
+      b.arm_i[l] = ai;
+      b.r[l] = r;
+    }
+  }
   template <class Real>
   static Real energy(const Coeffs<Real>& c, const History& h, const ContactKinematics<Real>& k) {
     return hertz::energy(c, h, k.ri * k.rj / (k.ri + k.rj), k.ri + k.rj - k.r);
