@@ -372,7 +372,7 @@ TEST(HertzMindlin, EffectiveModuliOfOneAndOfTwoMaterials) {
 
 // The pair loop evaluates 8 contacts at once (HertzMindlin::contact_lanes). On random contacts (sticking,
 // sliding, with and without shear history, rotating, history tilted out of the tangent plane) the lanes
-// must give contact()'s force, arm, history, dissipation and sliding flag to rounding, with and without
+// must give contact()'s force, torques, history, dissipation and sliding flag to rounding, with and without
 // advancing the history; and a contact's result must not depend on its lane.
 TEST(HertzMindlin, LanesMatchTheScalarContact) {
   constexpr int W = 8;
@@ -436,7 +436,14 @@ TEST(HertzMindlin, LanesMatchTheScalarContact) {
         SCOPED_TRACE(::testing::Message() << "advance " << advance << " batch " << batch << " lane " << l);
         EXPECT_TRUE(near(L.fx[l], f.fx, F) && near(L.fy[l], f.fy, F) && near(L.fz[l], f.fz, F))
             << L.fx[l] << " " << f.fx << " " << L.fy[l] << " " << f.fy << " " << L.fz[l] << " " << f.fz;
-        EXPECT_TRUE(near(L.arm_i[l], f.arm_i, q.k.r));
+        // Torques as the scalar loop makes them from the arm: (c - x_i) x F, (c - x_j) x (-F).
+        const double si = -f.arm_i / q.k.r, sj = (q.k.r - f.arm_i) / q.k.r;
+        const double cx = q.k.dy * f.fz - q.k.dz * f.fy, cy = q.k.dz * f.fx - q.k.dx * f.fz,
+                     cz = q.k.dx * f.fy - q.k.dy * f.fx;
+        const double T = F * q.k.r;
+        EXPECT_TRUE(near(L.tix[l], si * cx, T) && near(L.tiy[l], si * cy, T) && near(L.tiz[l], si * cz, T));
+        EXPECT_TRUE(near(L.tjx[l], -sj * cx, T) && near(L.tjy[l], -sj * cy, T) &&
+                    near(L.tjz[l], -sj * cz, T));
         EXPECT_EQ(L.sliding[l] != 0, f.sliding);
         if (advance) {
           EXPECT_TRUE(near(L.h[l].x, q.h.x, H) && near(L.h[l].y, q.h.y, H) && near(L.h[l].z, q.h.z, H));

@@ -381,11 +381,8 @@ class PairDriver final : public ForceCompute<Real> {
         fxi += gx, fyi += gy, fzi += gz;
         if constexpr (Newton) fx[j] -= gx, fy[j] -= gy, fz[j] -= gz;
         if constexpr (Rot) {
-          const Real r = L.r[l], inv_r = Real(1) / r, dx = L.dx[l], dy = L.dy[l], dz = L.dz[l];
-          const Real si = -L.arm_i[l] * inv_r, sj = (r - L.arm_i[l]) * inv_r;
-          const Real cx = dy * gz - dz * gy, cy = dz * gx - dx * gz, cz = dx * gy - dy * gx;
-          txi += si * cx, tyi += si * cy, tzi += si * cz;
-          if constexpr (Newton) tx[j] -= sj * cx, ty[j] -= sj * cy, tz[j] -= sj * cz;
+          txi += L.tix[l], tyi += L.tiy[l], tzi += L.tiz[l];
+          if constexpr (Newton) tx[j] += L.tjx[l], ty[j] += L.tjy[l], tz[j] += L.tjz[l];
         }
         if constexpr (kHistory && Advance) hist[lane_e[l]] = L.h[l];
         if (Newton || id[i] < id[j]) {

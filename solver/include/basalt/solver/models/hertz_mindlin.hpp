@@ -122,9 +122,10 @@ template <bool Advance, class Real>
     const double before = 0.5 * double(St) * double(sx * sx + sy * sy + sz * sz);
     ftx *= scale, fty *= scale, ftz *= scale;
     if (St > 0) {
-      sx = -(ftx + gt * tx) / St;
-      sy = -(fty + gt * ty) / St;
-      sz = -(ftz + gt * tz) / St;
+      const Real inv_St = Real(1) / St;
+      sx = -(ftx + gt * tx) * inv_St;
+      sy = -(fty + gt * ty) * inv_St;
+      sz = -(ftz + gt * tz) * inv_St;
     }
     if (Advance) f.dissipated += before - 0.5 * double(St) * double(sx * sx + sy * sy + sz * sz);
   }
@@ -265,9 +266,10 @@ struct HertzMindlin {
       fty = slide ? fty * scale : fty;
       ftz = slide ? ftz * scale : ftz;
       const bool refit = slide && St > 0;
-      sx = refit ? -(ftx + gt * tx) / St : sx;
-      sy = refit ? -(fty + gt * ty) / St : sy;
-      sz = refit ? -(ftz + gt * tz) / St : sz;
+      const Real inv_St = one / St;
+      sx = refit ? -(ftx + gt * tx) * inv_St : sx;
+      sy = refit ? -(fty + gt * ty) * inv_St : sy;
+      sz = refit ? -(ftz + gt * tz) * inv_St : sz;
       if constexpr (Advance) {
         const double kept = 0.5 * double(St) * double(sx * sx + sy * sy + sz * sz);
         dissipated += slide ? stored - kept : 0.0;
@@ -277,11 +279,16 @@ struct HertzMindlin {
         b.dissipated[l] = dissipated;
       }
       b.sliding[l] = slide ? one : zero;
-      b.fx[l] = fn * nx + ftx;
-      b.fy[l] = fn * ny + fty;
-      b.fz[l] = fn * nz + ftz;
-      b.arm_i[l] = ai;
+      const Real fx = fn * nx + ftx, fy = fn * ny + fty, fz = fn * nz + ftz;
+      b.fx[l] = fx;
+      b.fy[l] = fy;
+      b.fz[l] = fz;
       b.r[l] = r;
+      // Torques (c - x_i) x F on i and (c - x_j) x (-F) on j: arms -ai n and aj n, n = d / r.
+      const Real si = -ai * inv_r, sj = aj * inv_r;
+      const Real cx = dy * fz - dz * fy, cy = dz * fx - dx * fz, cz = dx * fy - dy * fx;
+      b.tix[l] = si * cx, b.tiy[l] = si * cy, b.tiz[l] = si * cz;
+      b.tjx[l] = -(sj * cx), b.tjy[l] = -(sj * cy), b.tjz[l] = -(sj * cz);
     }
   }
   template <class Real>

@@ -90,15 +90,18 @@ struct ContactForce {
 /// ContactLanes<Real, W, History>&)`: contact() for W pairs at once, written without branches so that the
 /// compiler runs the lanes in vector registers. The driver fills the inputs (r2 = |x_i - x_j|^2, the rest
 /// as in ContactKinematics; angular velocities zero when particles do not rotate) and h, and reads back the
-/// outputs and, on real steps, h. A pair's result depends on its own inputs only, never on its lane.
+/// outputs (the torques only when particles rotate) and, on real steps, h. A pair's result depends on its own
+/// inputs only, never on its lane.
 template <class Real, int W, class History>
 struct ContactLanes {
   alignas(64) Real dx[W], dy[W], dz[W], r2[W], ri[W], rj[W], imi[W], imj[W], vx[W], vy[W], vz[W];
   alignas(64) Real wix[W], wiy[W], wiz[W], wjx[W], wjy[W], wjz[W];
   History h[W];
-  alignas(64) Real fx[W], fy[W], fz[W], arm_i[W], r[W];  ///< out: force on i, arm (ContactForce), |x_i - x_j|
-  alignas(64) double dissipated[W];                      ///< out, on real steps
-  alignas(64) Real sliding[W];                           ///< out: 1 when the contact slides
+  alignas(64) Real fx[W], fy[W], fz[W], r[W];  ///< out: force on i (j gets the opposite), |x_i - x_j|
+  alignas(64) Real tix[W], tiy[W], tiz[W];     ///< out: torque on i (force and couple about its centre)
+  alignas(64) Real tjx[W], tjy[W], tjz[W];     ///< out: torque on j
+  alignas(64) double dissipated[W];            ///< out, on real steps
+  alignas(64) Real sliding[W];                 ///< out: 1 when the contact slides
   Real dt = 0;
 };
 
