@@ -125,6 +125,62 @@ TEST(Integrators, HalfTurnSeriesMatchesSinCosToRounding) {
   EXPECT_EQ(s, dt / 2);
 }
 
+// The pass runs branch-free in vector registers (a scalar tail for the last particles) and leaves the turns
+// too large for the series to a second pass: each particle must get the same bits as when it is turned
+// alone, whether it rests, turns a little or turns too far for the series, wherever it sits in the arrays
+// (a rank's share and order of particles must not change them); and that is the turn by half_turn(),
+// q <- dq q made unit, to rounding.
+TEST(Integrators, RotationPassTurnsEachParticleAsAlone) {
+  const double dt = 1e-3, h = 0.3e-3;
+  Particles<double> p;
+  p.with_rotation = true;
+  for (std::size_t i = 0; i < 67; ++i) {
+    p.push_owned(std::int64_t(i), 0, 0, double(i), 0.5 + 0.01 * double(i % 5), 0, 1.0 + 0.1 * double(i % 3));
+    const auto u = [&](std::uint64_t k) { return basalt::test::hash_unit(17 * i + k) - 0.5; };
+    // Every fifth at rest (with a torque of zero), every seventh spun past the series' range (a > 0.1).
+    const double spin = i % 5 == 0 ? 0.0 : i % 7 == 0 ? 900.0 : 40.0;
+    p.wx[i] = spin * u(0), p.wy[i] = spin * u(1), p.wz[i] = spin * u(2);
+    p.tx[i] = i % 5 == 0 ? 0.0 : u(3), p.ty[i] = i % 5 == 0 ? 0.0 : u(4), p.tz[i] = i % 5 == 0 ? 0.0 : u(5);
+    // Not quite unit orientations: a particle at rest must keep even these bits.
+    p.qw[i] = 0.6 + 1e-9 * u(6), p.qx[i] = 0.48, p.qy[i] = -0.64 * u(7), p.qz[i] = 0.1;
+  }
+  const Particles<double> before = p;
+  rotate_kick_zero_drift(p, h, dt);
+  std::size_t large = 0;
+  for (std::size_t i = 0; i < p.n_owned; ++i) {
+    Particles<double> one;
+    one.with_rotation = true;
+    one.push_owned(before.id[i], 0, 0, 0, before.radius[i], 0, before.inv_mass[i]);
+    one.wx[0] = before.wx[i], one.wy[0] = before.wy[i], one.wz[0] = before.wz[i];
+    one.tx[0] = before.tx[i], one.ty[0] = before.ty[i], one.tz[0] = before.tz[i];
+    one.qw[0] = before.qw[i], one.qx[0] = before.qx[i], one.qy[0] = before.qy[i], one.qz[0] = before.qz[i];
+    rotate_kick_zero_drift(one, h, dt);
+    EXPECT_EQ(p.wx[i], one.wx[0]) << i;
+    EXPECT_EQ(p.wy[i], one.wy[0]) << i;
+    EXPECT_EQ(p.wz[i], one.wz[0]) << i;
+    EXPECT_EQ(p.tx[i], 0.0) << i;
+    EXPECT_EQ(p.qw[i], one.qw[0]) << i;
+    EXPECT_EQ(p.qx[i], one.qx[0]) << i;
+    EXPECT_EQ(p.qy[i], one.qy[0]) << i;
+    EXPECT_EQ(p.qz[i], one.qz[0]) << i;
+    // The turn itself, to rounding; at rest, the same bits.
+    const double wx = p.wx[i], wy = p.wy[i], wz = p.wz[i], w2 = wx * wx + wy * wy + wz * wz;
+    double qw = before.qw[i], qx = before.qx[i], qy = before.qy[i], qz = before.qz[i];
+    if (w2 > 0) {
+      large += w2 * (dt / 2) * (dt / 2) >= 1e-2;
+      double c = 0, sn = 0;
+      basalt::solver::half_turn(w2, dt, c, sn);
+      basalt::solver::detail::turn(c, sn, wx, wy, wz, qw, qx, qy, qz);
+    }
+    const double tol = w2 > 0 ? 1e-15 : 0.0;
+    EXPECT_NEAR(p.qw[i], qw, tol) << i;
+    EXPECT_NEAR(p.qx[i], qx, tol) << i;
+    EXPECT_NEAR(p.qy[i], qy, tol) << i;
+    EXPECT_NEAR(p.qz[i], qz, tol) << i;
+  }
+  EXPECT_GT(large, 5u) << "the test needs turns past the series";
+}
+
 TEST(Integrators, OrientationsStayOfUnitLengthOverManySteps) {
   // Each turn keeps |q| to rounding, but over many steps the roundings add up unless q is brought back to
   // unit length every step (ESyS-Particle's CRotParticle::rescale). rot_bond's ESyS angles read a norm

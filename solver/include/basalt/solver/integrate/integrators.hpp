@@ -5,8 +5,11 @@
 // The first kick and the drift run fused in kick_zero_drift(), which returns the largest squared
 // displacement since the last rebuild (inf if any position went non-finite): it decides the next
 // neighbour-list rebuild.
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <limits>
+#include <type_traits>
 
 #include "basalt/solver/core/particles.hpp"
 
@@ -55,8 +58,14 @@ double kick_zero_drift(Particles<Real>& p, Real h, Real dt) {
   Real* __restrict cx = p.cx.data();  // empty without compensation (never read then)
   Real* __restrict cy = p.cy.data();
   Real* __restrict cz = p.cz.data();
-  Real m = 0;
-  Real sum = 0;
+  // The largest d2 is taken on its bits as a signed integer, which order as the values do for d2 >= 0:
+  // GCC keeps a floating-point max (NaN rules) or sum (order) out of vector registers, not an integer one.
+  // Non-finite displacements are counted apart.
+  using Bits = std::conditional_t<sizeof(Real) == 8, std::int64_t, std::int32_t>;
+  Bits m = 0;
+  std::size_t bad = 0;
+  // ivdep: GCC does not take __restrict on locals as proof that the arrays are distinct (they are).
+#pragma GCC ivdep
   for (std::size_t i = 0; i < n; ++i) {
     const Real s = h * im[i];
     const Real ux = vx[i] + s * fx[i], uy = vy[i] + s * fy[i], uz = vz[i] + s * fz[i];
@@ -77,11 +86,12 @@ double kick_zero_drift(Particles<Real>& p, Real h, Real dt) {
     }
     const Real dx = x[i] - ox - x0[i], dy = y[i] - oy - y0[i], dz = z[i] - oz - z0[i];
     const Real d2 = dx * dx + dy * dy + dz * dz;
-    m = d2 > m ? d2 : m;
-    sum += d2;
+    const Bits bits = std::bit_cast<Bits>(d2);
+    m = bits > m ? bits : m;
+    bad += !(d2 <= std::numeric_limits<Real>::max());
   }
-  if (!std::isfinite(sum)) return std::numeric_limits<double>::infinity();
-  return double(m);
+  if (bad > 0) return std::numeric_limits<double>::infinity();
+  return double(std::bit_cast<Real>(m));
 }
 }  // namespace detail
 
@@ -94,28 +104,59 @@ double kick_zero_drift(Particles<Real>& p, Real h, Real dt) {
                              : detail::kick_zero_drift<false>(p, h, dt);
 }
 
+/// The half angle a^2 = (|w| dt / 2)^2 below which half_turn() takes the Taylor series.
+template <class Real>
+inline constexpr Real kTaylorTurn = Real(1e-2);
+
+/// cos(a) and sin(a) / w by their Taylor series through a^8, from a2 = a^2 and h = dt / 2: for
+/// a2 < kTaylorTurn the first omitted term is below 3e-17 relative (under an ulp).
+template <class Real>
+inline void half_turn_series(Real a2, Real h, Real& c, Real& s) {
+  c = Real(1) +
+      a2 * (Real(-1.0 / 2) + a2 * (Real(1.0 / 24) + a2 * (Real(-1.0 / 720) + a2 * Real(1.0 / 40320))));
+  s = h * (Real(1) + a2 * (Real(-1.0 / 6) +
+                           a2 * (Real(1.0 / 120) + a2 * (Real(-1.0 / 5040) + a2 * Real(1.0 / 362880)))));
+}
+
 /// cos(a) and sin(a) / w for the half angle a = |w| dt / 2 of a step's turn, from w2 = |w|^2: for
-/// a^2 < 1e-2 (every step of a stable run turns by far less) by their Taylor series through a^8,
-/// whose first omitted term is below 3e-17 relative (under an ulp: the same to rounding as
+/// a^2 < 1e-2 (every step of a stable run turns by far less) by half_turn_series (the same to rounding as
 /// std::sin and std::cos, with no square root, division or call); above, by std::sin and std::cos.
 template <class Real>
 inline void half_turn(Real w2, Real dt, Real& c, Real& s) {
   const Real h = Real(0.5) * dt, a2 = w2 * h * h;
-  if (a2 < Real(1e-2)) {
-    c = Real(1) +
-        a2 * (Real(-1.0 / 2) + a2 * (Real(1.0 / 24) + a2 * (Real(-1.0 / 720) + a2 * Real(1.0 / 40320))));
-    s = h * (Real(1) + a2 * (Real(-1.0 / 6) +
-                             a2 * (Real(1.0 / 120) + a2 * (Real(-1.0 / 5040) + a2 * Real(1.0 / 362880)))));
-    return;
-  }
+  if (a2 < kTaylorTurn<Real>) return half_turn_series(a2, h, c, s);
   const Real w = std::sqrt(w2), a = h * w;
   c = std::cos(a);
   s = std::sin(a) / w;
 }
 
+namespace detail {
+/// q <- dq q for dq = (c, s w), then q back to unit length, as ESyS-Particle after every step
+/// (CRotParticle::rescale: q times 1/|q|). The turn keeps |q| to rounding per step, but the roundings add
+/// up (|q|^2 - 1 reached 6e-14 in 3,000 steps), and rot_bond's ESyS angles read a norm defect e as a bend
+/// of sqrt(2 e): 1e-7 rad, a kick on every bond that pumped energy into a free specimen 5x faster than
+/// ESyS (docs/validation-rock.md).
+template <class Real>
+inline void turn(Real c, Real sn, Real wx, Real wy, Real wz, Real& qw, Real& qx, Real& qy, Real& qz) {
+  const Real ax = sn * wx, ay = sn * wy, az = sn * wz;
+  const Real nw = c * qw - ax * qx - ay * qy - az * qz;
+  const Real nx = c * qx + ax * qw + ay * qz - az * qy;
+  const Real ny = c * qy + ay * qw + az * qx - ax * qz;
+  const Real nz = c * qz + az * qw + ax * qy - ay * qx;
+  const Real inv = Real(1) / std::sqrt(nw * nw + nx * nx + ny * ny + nz * nz);
+  qw = nw * inv;
+  qx = nx * inv;
+  qy = ny * inv;
+  qz = nz * inv;
+}
+}  // namespace detail
+
 /// Rotation (with_rotation), the twin of kick_zero_drift: w += h T / I (I = 2/5 m r^2: a sphere needs
 /// no gyroscopic term), torques zeroed, then the orientation turned by the angle |w| dt about w (an
-/// exact rotation for the step's constant w) and brought back to unit length (ESyS's rescale).
+/// exact rotation for the step's constant w) and brought back to unit length. A particle at rest (w = 0)
+/// keeps its orientation bit for bit. The pass has no branch, so that it runs in vector registers: a turn
+/// too large for the series (a2 >= kTaylorTurn, never in a stable run) leaves its orientation alone there
+/// and is made by sin and cos in a second pass, which only runs when there is one.
 template <class Real>
 void rotate_kick_zero_drift(Particles<Real>& p, Real h, Real dt) {
   const std::size_t n = p.n_owned;
@@ -131,6 +172,10 @@ void rotate_kick_zero_drift(Particles<Real>& p, Real h, Real dt) {
   Real* __restrict qxs = p.qx.data();
   Real* __restrict qys = p.qy.data();
   Real* __restrict qzs = p.qz.data();
+  const Real hh = Real(0.5) * dt;
+  std::size_t large = 0;  // turns left to the second pass (NaN included)
+  // ivdep: GCC does not take __restrict on locals as proof that the arrays are distinct (they are).
+#pragma GCC ivdep
   for (std::size_t i = 0; i < n; ++i) {
     const Real s = h * (Real(2.5) * im[i] / (rad[i] * rad[i]));  // inverse_inertia(i)
     const Real wx = wxs[i] + s * tx[i], wy = wys[i] + s * ty[i], wz = wzs[i] + s * tz[i];
@@ -140,37 +185,49 @@ void rotate_kick_zero_drift(Particles<Real>& p, Real h, Real dt) {
     tx[i] = 0;
     ty[i] = 0;
     tz[i] = 0;
+    const Real w2 = wx * wx + wy * wy + wz * wz, a2 = w2 * hh * hh;  // as half_turn(): the same bits
+    large += !(a2 < kTaylorTurn<Real>);
+    Real c, sn, qw = qws[i], qx = qxs[i], qy = qys[i], qz = qzs[i];
+    half_turn_series(a2, hh, c, sn);
+    detail::turn(c, sn, wx, wy, wz, qw, qx, qy, qz);
+    // At rest (w = 0) the orientation keeps its bits; a turn too large for the series waits for the pass
+    // below.
+    const bool keep = w2 == Real(0) || !(a2 < kTaylorTurn<Real>);
+    qws[i] = keep ? qws[i] : qw;
+    qxs[i] = keep ? qxs[i] : qx;
+    qys[i] = keep ? qys[i] : qy;
+    qzs[i] = keep ? qzs[i] : qz;
+  }
+  if (large == 0) return;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Real wx = wxs[i], wy = wys[i], wz = wzs[i];
     const Real w2 = wx * wx + wy * wy + wz * wz;
-    if (w2 == Real(0)) continue;
+    if (w2 * hh * hh < kTaylorTurn<Real>) continue;
     Real c, sn;
     half_turn(w2, dt, c, sn);
-    const Real ax = sn * wx, ay = sn * wy, az = sn * wz;  // dq = (c, a): q <- dq q
-    const Real qw = qws[i], qx = qxs[i], qy = qys[i], qz = qzs[i];
-    qws[i] = c * qw - ax * qx - ay * qy - az * qz;
-    qxs[i] = c * qx + ax * qw + ay * qz - az * qy;
-    qys[i] = c * qy + ay * qw + az * qx - ax * qz;
-    qzs[i] = c * qz + az * qw + ax * qy - ay * qx;
-    // Back to unit length, as ESyS-Particle after every step (CRotParticle::rescale: q times 1/|q|). The
-    // turn keeps |q| to rounding per step, but the roundings add up (|q|^2 - 1 reached 6e-14 in 3,000
-    // steps), and rot_bond's ESyS angles read a norm defect e as a bend of sqrt(2 e): 1e-7 rad, a kick on
-    // every bond that pumped energy into a free specimen 5x faster than ESyS (docs/validation-rock.md).
-    const Real nw = qws[i], nx = qxs[i], ny = qys[i], nz = qzs[i];
-    const Real inv = Real(1) / std::sqrt(nw * nw + nx * nx + ny * ny + nz * nz);
-    qws[i] = nw * inv;
-    qxs[i] = nx * inv;
-    qys[i] = ny * inv;
-    qzs[i] = nz * inv;
+    detail::turn(c, sn, wx, wy, wz, qws[i], qxs[i], qys[i], qzs[i]);
   }
 }
 
 /// The rotational half-kick w += h T / I.
 template <class Real>
 void rotate_kick(Particles<Real>& p, Real h) {
-  for (std::size_t i = 0; i < p.n_owned; ++i) {
-    const Real s = h * p.inverse_inertia(i);
-    p.wx[i] += s * p.tx[i];
-    p.wy[i] += s * p.ty[i];
-    p.wz[i] += s * p.tz[i];
+  const std::size_t n = p.n_owned;
+  const Real* __restrict im = p.inv_mass.data();
+  const Real* __restrict rad = p.radius.data();
+  Real* __restrict wx = p.wx.data();
+  Real* __restrict wy = p.wy.data();
+  Real* __restrict wz = p.wz.data();
+  const Real* __restrict tx = p.tx.data();
+  const Real* __restrict ty = p.ty.data();
+  const Real* __restrict tz = p.tz.data();
+  // ivdep: GCC does not take __restrict on locals as proof that the arrays are distinct (they are).
+#pragma GCC ivdep
+  for (std::size_t i = 0; i < n; ++i) {
+    const Real s = h * (Real(2.5) * im[i] / (rad[i] * rad[i]));  // inverse_inertia(i)
+    wx[i] += s * tx[i];
+    wy[i] += s * ty[i];
+    wz[i] += s * tz[i];
   }
 }
 
