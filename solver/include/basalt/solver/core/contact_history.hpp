@@ -60,4 +60,52 @@ struct ContactRecords {
   }
 };
 
+/// ContactRecords::find() through a hash table on the unordered pair: the same record, found in
+/// constant time (index() sorts the records, then each look-up is a binary search: at every rebuild of a
+/// granular scene that was 4 % of the run).
+class ContactLookup {
+ public:
+  explicit ContactLookup(const ContactRecords& r) {
+    std::size_t cap = 16;
+    while (cap < 2 * r.size()) cap <<= 1;
+    slots_.assign(cap, Slot{});
+    mask_ = cap - 1;
+    for (std::size_t k = 0; k < r.size(); ++k) {
+      const std::int64_t lo = std::min(r.a[k], r.b[k]), hi = std::max(r.a[k], r.b[k]);
+      Slot& s = slots_[probe(lo, hi)];
+      s.lo = lo, s.hi = hi;
+      std::int32_t& first = r.a[k] == lo ? s.fwd : s.bwd;  // saved as lo -> hi, or as hi -> lo
+      if (first < 0) first = static_cast<std::int32_t>(k);
+    }
+  }
+  /// The record of the pair {ia, ib}, or -1: the first one saved in the orientation ia -> ib if there
+  /// is one, else the first in the other (as ContactRecords::find).
+  std::int64_t find(std::int64_t ia, std::int64_t ib) const {
+    const std::int64_t lo = std::min(ia, ib), hi = std::max(ia, ib);
+    const Slot& s = slots_[probe(lo, hi)];
+    const std::int32_t mine = ia == lo ? s.fwd : s.bwd, other = ia == lo ? s.bwd : s.fwd;
+    return mine >= 0 ? mine : other;
+  }
+
+ private:
+  struct Slot {
+    std::int64_t lo = 0, hi = 0;
+    std::int32_t fwd = -1, bwd = -1;  ///< first record in each orientation; both -1: an empty slot
+    bool empty() const { return fwd < 0 && bwd < 0; }
+  };
+  /// The slot of the pair, or the empty slot where it would go (linear probing; never full).
+  std::size_t probe(std::int64_t lo, std::int64_t hi) const {
+    std::uint64_t h = std::uint64_t(lo) * 0x9E3779B97F4A7C15ull + std::uint64_t(hi);
+    h ^= h >> 29;
+    h *= 0xBF58476D1CE4E5B9ull;
+    h ^= h >> 32;
+    for (std::size_t at = h & mask_;; at = (at + 1) & mask_) {
+      const Slot& s = slots_[at];
+      if (s.empty() || (s.lo == lo && s.hi == hi)) return at;
+    }
+  }
+  std::vector<Slot> slots_;
+  std::size_t mask_ = 0;
+};
+
 }  // namespace basalt::solver

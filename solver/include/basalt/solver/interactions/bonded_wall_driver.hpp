@@ -48,8 +48,7 @@ class BondedWallDriver final : public ForceCompute<Real> {
 
   void rebuild_walls(const Particles<Real>& p, const Walls& walls) override {
     walls_ = &walls;
-    std::vector<std::uint32_t> order;
-    pending_.index(order);
+    const ContactLookup records(pending_);
     for (std::size_t k = 0; k < index_.size(); ++k) {
       const std::size_t w = index_[k];
       const auto& spec = walls.spec(w);
@@ -59,7 +58,7 @@ class BondedWallDriver final : public ForceCompute<Real> {
       h.assign(cand.size(), History{});
       for (std::size_t c = 0; c < cand.size(); ++c) {
         const auto i = static_cast<std::size_t>(cand[c]);
-        const auto r = pending_.empty() ? -1 : pending_.find(order, p.id[i], wall_id(k));
+        const auto r = pending_.empty() ? -1 : records.find(p.id[i], wall_id(k));
         if (r >= 0) {
           std::memcpy(static_cast<void*>(&h[c]), pending_.at(static_cast<std::size_t>(r)), sizeof(History));
         } else if (spec.bonds(p.tag[i])) {  // first met: the rest offset is where it is now

@@ -88,8 +88,9 @@ class PairDriver final : public ForceCompute<Real> {
       ghost_ = &ghost_sub_;
     }
     if constexpr (kHistory) {
-      restore(l.p, *own_, hist_own_);
-      restore(l.p, *ghost_, hist_ghost_);
+      const ContactLookup records(pending_);
+      restore(l.p, *own_, records, hist_own_);
+      restore(l.p, *ghost_, records, hist_ghost_);
       pending_.clear();
     }
   }
@@ -486,15 +487,14 @@ class PairDriver final : public ForceCompute<Real> {
   }
 
   /// History for each listed pair from the pending records (default when none).
-  void restore(const Particles<Real>& p, const PairList& list, std::vector<History>& hist) const {
+  void restore(const Particles<Real>& p, const PairList& list, const ContactLookup& records,
+               std::vector<History>& hist) const {
     hist.assign(list.pairs(), History{});
     if (pending_.empty()) return;
-    std::vector<std::uint32_t> order;
-    pending_.index(order);
     for (std::size_t i = 0; i + 1 < list.offset.size(); ++i)
       for (auto k = list.offset[i]; k < list.offset[i + 1]; ++k) {
         const auto j = static_cast<std::size_t>(list.neigh[k]);
-        const auto r = pending_.find(order, p.id[i], p.id[j]);
+        const auto r = records.find(p.id[i], p.id[j]);
         if (r < 0) continue;
         std::memcpy(static_cast<void*>(&hist[k]), pending_.at(static_cast<std::size_t>(r)), sizeof(History));
         if (pending_.a[static_cast<std::size_t>(r)] != p.id[i]) hist[k] = Model::flip(hist[k]);
