@@ -370,12 +370,12 @@ TEST(HertzMindlin, EffectiveModuliOfOneAndOfTwoMaterials) {
   EXPECT_NEAR(two.E_star, 1 / ((1 - 0.0529) / 380.0e9 + (1 - 0.0625) / 70.0e9), 1e-6 * two.E_star);
 }
 
-// The pair loop evaluates 8 contacts at once (HertzMindlin::contact_lanes). On random contacts (sticking,
-// sliding, with and without shear history, rotating, history tilted out of the tangent plane) the lanes
-// must give contact()'s force, torques, history, dissipation and sliding flag to rounding, with and without
-// advancing the history; and a contact's result must not depend on its lane.
+// The pair loop evaluates kContactLaneWidth contacts at once (HertzMindlin::contact_lanes). On random
+// contacts (sticking, sliding, with and without shear history, rotating, history tilted out of the tangent
+// plane) the lanes must give contact()'s force, torques, history, dissipation and sliding flag to rounding,
+// with and without advancing the history; and a contact's result must not depend on its lane.
 TEST(HertzMindlin, LanesMatchTheScalarContact) {
-  constexpr int W = 8;
+  constexpr int W = kContactLaneWidth;
   using Lanes = ContactLanes<double, W, HertzMindlin::History>;
   const auto c = HertzMindlin::coeffs<double>(HertzMindlin::Params{{1.0e7, 0.25}, 0.5, 0.5});
   const auto u = [](std::uint64_t k) { return 0.5 * basalt::test::hash_unit(k); };  // [-0.5, 0.5)

@@ -399,47 +399,58 @@ class PairDriver final : public ForceCompute<Real> {
         }
       }
     };
+    // The rest of a batch's inputs, once its pairs are known: particle data of both ends and the history
+    // (loaded here, from pairs that touch only). Every listed pair up to `last` has then been seen: the
+    // history of those that do not touch is cleared (the pairs that do get theirs back at the scatter).
+    std::size_t cleared = off[0];  // histories before this one are cleared
+    const auto complete = [&](const int filled, const std::size_t last) {
+      for (int l = 0; l < filled; ++l) {
+        const std::size_t i = lane_i[l], j = lane_j[l];
+        L.ri[l] = rad[i];
+        L.imi[l] = im[i], L.imj[l] = im[j];
+        L.vx[l] = vx[i] - vx[j], L.vy[l] = vy[i] - vy[j], L.vz[l] = vz[i] - vz[j];
+        if constexpr (Rot) {
+          L.wix[l] = wx[i], L.wiy[l] = wy[i], L.wiz[l] = wz[i];
+          L.wjx[l] = wx[j], L.wjy[l] = wy[j], L.wjz[l] = wz[j];
+        }
+        if constexpr (kHistory) L.h[l] = hist[lane_e[l]];
+      }
+      if constexpr (kHistory && Advance) {
+        for (std::size_t e = cleared; e < last; ++e) Model::apart(hist[e]);
+        cleared = last;
+      }
+    };
+    // The pairs in contact are found with positions and radii alone, written to the next lane whether
+    // they touch or not and kept only if they do: no branch to mispredict, and little work for a listed
+    // pair apart (a third of them in a settled pile). What a listed pair apart still held is lost with its
+    // history (a shear spring's energy): dissipated.
     int filled = 0;
     double parted = 0;
     for (std::size_t i = 0; i < n; ++i) {
       if (off[i] == off[i + 1]) continue;  // most rows of the ghost list
-      const Real xi = x[i], yi = y[i], zi = z[i], ri = rad[i], imi = im[i], vxi = vx[i], vyi = vy[i],
-                 vzi = vz[i];
-      [[maybe_unused]] Real wxi = 0, wyi = 0, wzi = 0;
-      if constexpr (Rot) wxi = wx[i], wyi = wy[i], wzi = wz[i];
+      const Real xi = x[i], yi = y[i], zi = z[i], ri = rad[i];
       for (auto e = off[i]; e < off[i + 1]; ++e) {
         const auto j = static_cast<std::size_t>(nb[e]);
         const Real dx = xi - x[j], dy = yi - y[j], dz = zi - z[j];
         const Real r2 = dx * dx + dy * dy + dz * dz;
         const Real rj = rad[j], rsum = ri + rj;
-        // Written to the next lane whether the pair touches or not, kept only if it does: no branch to
-        // mispredict. A listed pair apart loses its history (a touching one gets it back from the lane).
         const bool touch = r2 < rsum * rsum;
         const int l = filled;
         lane_i[l] = i, lane_j[l] = j, lane_e[l] = e;
-        L.dx[l] = dx, L.dy[l] = dy, L.dz[l] = dz, L.r2[l] = r2, L.ri[l] = ri, L.rj[l] = rj;
-        L.imi[l] = imi, L.imj[l] = im[j];
-        L.vx[l] = vxi - vx[j], L.vy[l] = vyi - vy[j], L.vz[l] = vzi - vz[j];
-        if constexpr (Rot) {
-          L.wix[l] = wxi, L.wiy[l] = wyi, L.wiz[l] = wzi;
-          L.wjx[l] = wx[j], L.wjy[l] = wy[j], L.wjz[l] = wz[j];
-        }
-        if constexpr (kHistory) {
-          L.h[l] = hist[e];
-          if constexpr (Advance) {
-            // What the history still held is lost with it (a shear spring's energy): dissipated.
-            const double lost = Model::parting_energy(c, L.h[l]);
-            parted += !touch && (Newton || id[i] < id[j]) ? lost : 0.0;
-            Model::apart(hist[e]);
-          }
+        L.dx[l] = dx, L.dy[l] = dy, L.dz[l] = dz, L.r2[l] = r2, L.rj[l] = rj;
+        if constexpr (kHistory && Advance) {
+          const double lost = Model::parting_energy(c, hist[e]);
+          parted += !touch && (Newton || id[i] < id[j]) ? lost : 0.0;
         }
         filled += touch;
         if (filled == kLaneWidth) {
+          complete(filled, std::size_t(e) + 1);
           run(filled);
           filled = 0;
         }
       }
     }
+    complete(filled, off[n]);
     if (filled > 0) run(filled);
     flush_row();
     dissipated += parted;
@@ -501,7 +512,7 @@ class PairDriver final : public ForceCompute<Real> {
       }
   }
 
-  static constexpr int kLaneWidth = 8;  ///< contacts evaluated side by side (Model::contact_lanes)
+  static constexpr int kLaneWidth = kContactLaneWidth;
   static constexpr bool kLanes = requires(const Coeffs& c, ContactLanes<Real, kLaneWidth, History>& b) {
     Model::template contact_lanes<true>(c, b);
   };

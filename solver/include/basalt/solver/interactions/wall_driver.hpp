@@ -67,15 +67,14 @@ class WallDriver final : public ForceCompute<Real> {
   void rebuild_walls(const Particles<Real>& p, const Walls& walls) override {
     walls_ = &walls;
     if constexpr (kHistory) {
-      std::vector<std::uint32_t> order;
-      pending_.index(order);
+      const ContactLookup records(pending_);
       for (std::size_t k = 0; k < index_.size(); ++k) {
         const auto& cand = walls.candidates(index_[k]);
         auto& h = hist_[k];
         h.assign(cand.size(), History{});
         if (pending_.empty()) continue;
         for (std::size_t c = 0; c < cand.size(); ++c) {
-          const auto r = pending_.find(order, p.id[static_cast<std::size_t>(cand[c])], wall_id(k));
+          const auto r = records.find(p.id[static_cast<std::size_t>(cand[c])], wall_id(k));
           if (r >= 0)
             std::memcpy(static_cast<void*>(&h[c]), pending_.at(static_cast<std::size_t>(r)), sizeof(History));
         }

@@ -85,6 +85,10 @@ struct ContactForce {
   bool sliding = false;         ///< the contact slides (Coulomb limit reached) this step
 };
 
+/// Contacts a pair driver evaluates side by side (Model::contact_lanes): 16 measured a little faster than 8
+/// (and 4 or 64 slower) on the granular bench, docs/BENCHMARKS.md.
+inline constexpr int kContactLaneWidth = 16;
+
 /// W pairs in contact side by side (structure of arrays), for a velocity-dependent pair model that also
 /// offers `template <bool Advance, class Real, int W> static void contact_lanes(const Coeffs<Real>&,
 /// ContactLanes<Real, W, History>&)`: contact() for W pairs at once, written without branches so that the
