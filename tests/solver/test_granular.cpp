@@ -473,6 +473,75 @@ TEST(HertzMindlin, LanesMatchTheScalarContact) {
   }
 }
 
+// The pair loop finds the pairs in contact first and clears the history of every listed pair apart as a
+// range (those in contact get theirs back after their force): a pair that parts while still listed (no
+// rebuild) must lose its shear history, and a pair that stays in contact beside it must keep its own.
+TEST(HertzMindlin, APairThatPartsLosesItsHistoryWhileItsNeighbourKeepsIt) {
+  const auto scene = basalt::test::scene_from(R"(
+[particles]
+rotation = true
+[run]
+dt = 2e-5
+steps = 0
+skin = 0.1
+[[interactions]]
+type = "hertz_mindlin"
+E = 1.0e5
+nu = 0.25
+mu = 0.5
+e = 0.5
+)");
+  basalt::io::Geometry g;
+  g.add_particle(1, {-0.5005, 0, 0}, 0.5);  // 1 and 2 meet fast and part
+  g.add_particle(2, {0.5005, 0, 0}, 0.5);
+  g.add_particle(3, {-0.4999995, 0, 5}, 0.5);  // 3 and 4 touch from the start and meet slowly: they stay
+  g.add_particle(4, {0.4999995, 0, 5}, 0.5);
+  RunOptions opt;
+  opt.quiet = true;
+  Simulation<double> sim(scene, g, MPI_COMM_SELF, opt);
+  auto& p = sim.particles();
+  for (std::size_t i = 0; i < p.n_owned; ++i) {
+    const double side = p.id[i] % 2 == 1 ? 1.0 : -1.0, v = p.id[i] <= 2 ? 0.1 : 1e-4;
+    p.vx[i] = side * v / 2, p.vy[i] = side * v / 4;  // a sliding part too: a shear history
+  }
+  sim.state_changed();
+  const auto records = [&] {
+    std::vector<std::pair<std::int64_t, std::int64_t>> pairs;
+    for (const auto& c : sim.force_computes()) {
+      if (c->history_bytes() == 0) continue;
+      ContactRecords r;
+      c->history_records(sim.particles(), r);
+      for (std::size_t k = 0; k < r.size(); ++k)
+        pairs.emplace_back(std::min(r.a[k], r.b[k]), std::max(r.a[k], r.b[k]));
+    }
+    std::sort(pairs.begin(), pairs.end());
+    return pairs;
+  };
+  const auto gap = [&](std::int64_t a, std::int64_t b) {
+    std::size_t i = 0, j = 0;
+    while (p.id[i] != a) ++i;
+    while (p.id[j] != b) ++j;
+    const double dx = p.x[i] - p.x[j], dy = p.y[i] - p.y[j], dz = p.z[i] - p.z[j];
+    return std::sqrt(dx * dx + dy * dy + dz * dz) - 1.0;
+  };
+  sim.step();
+  const auto rebuilds = sim.rebuilds();
+  bool met = false;
+  int s = 0;
+  for (; s < 100000 && !(met && gap(1, 2) > 0); ++s) {
+    sim.step();
+    if (gap(1, 2) < 0 && !met) {
+      met = true;
+      EXPECT_EQ(records(), (std::vector<std::pair<std::int64_t, std::int64_t>>{{1, 2}, {3, 4}}));
+    }
+  }
+  ASSERT_TRUE(met && gap(1, 2) > 0) << "1 and 2 did not meet and part in " << s << " steps";
+  ASSERT_LT(gap(3, 4), 0) << "3 and 4 must still touch";
+  ASSERT_EQ(sim.rebuilds(), rebuilds) << "the pairs must have stayed listed (no rebuild)";
+  sim.step();  // the first step computed apart
+  EXPECT_EQ(records(), (std::vector<std::pair<std::int64_t, std::int64_t>>{{3, 4}}));
+}
+
 TEST(HertzMindlin, RestitutionAndContactDurationFollowTheClosedForms) {
   if (basalt::test::rank() != 0) return;
   // Undamped: duration 2.87 (m*^2 / (R* E*^2 v))^{1/5}; damped (Tsuji): the measured restitution equals

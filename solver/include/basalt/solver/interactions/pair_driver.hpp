@@ -334,6 +334,7 @@ class PairDriver final : public ForceCompute<Real> {
     double energy = 0, dissipated = 0;
     std::size_t sliding = 0;
     const std::size_t n = p.n_owned;
+    if (n == 0) return 0;  // (a rank without particles may have no list offsets at all)
     const std::uint32_t* __restrict off = list.offset.data();
     const std::int32_t* __restrict nb = list.neigh.data();
     const std::int64_t* __restrict id = p.id.data();
