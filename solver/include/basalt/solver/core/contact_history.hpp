@@ -30,7 +30,8 @@ struct ContactRecords {
   }
   const double* at(std::size_t k) const { return values.data() + k * width; }
 
-  /// Index for find(): records ordered by their unordered pair (lower id, higher id).
+  /// Records ordered by their unordered pair (lower id, higher id), in saved order within a pair: the
+  /// mesh walls' look-up of all records of a pair (ContactLookup finds the one record a pair keeps).
   void index(std::vector<std::uint32_t>& order) const {
     order.resize(size());
     for (std::uint32_t k = 0; k < order.size(); ++k) order[k] = k;
@@ -39,20 +40,6 @@ struct ContactRecords {
       return ki != kj ? ki < kj : i < j;
     });
   }
-  /// The record of the pair {ia, ib} through an index(), or -1: the first one saved in the orientation
-  /// ia -> ib if there is one, else the first in the other. A pair between two ranks is listed on both,
-  /// each as (owned, ghost), and each rank's history of it is its own: computed with the pair's roles
-  /// swapped, it is the other's flipped only to rounding. Both are kept (checkpoints, migration), and
-  /// each rank takes back its own, so a restart continues bit for bit (docs/solver.md).
-  std::int64_t find(const std::vector<std::uint32_t>& order, std::int64_t ia, std::int64_t ib) const {
-    const std::pair<std::int64_t, std::int64_t> want{std::min(ia, ib), std::max(ia, ib)};
-    auto it = std::lower_bound(order.begin(), order.end(), want,
-                               [&](std::uint32_t k, const auto& w) { return key(k) < w; });
-    if (it == order.end() || key(*it) != want) return -1;
-    for (auto at = it; at != order.end() && key(*at) == want; ++at)
-      if (a[*at] == ia) return std::int64_t(*at);
-    return std::int64_t(*it);
-  }
 
  private:
   std::pair<std::int64_t, std::int64_t> key(std::size_t k) const {
@@ -60,10 +47,13 @@ struct ContactRecords {
   }
 };
 
-/// ContactRecords::find() through a hash table on the unordered pair: the same record, found in
-/// constant time (index() sorts the records, then each look-up is a binary search: at every rebuild of a
-/// granular scene that was 4 % of the run). A slot holds two record numbers (8 B; 16 B per record at
-/// half load), the pair's ids are read from the records: it refers to `r`, which must outlive it.
+/// The record a pair takes back at a rebuild, through a hash table on the unordered pair (a sort and a
+/// binary search per pair were 4 % of a granular run). A pair between two ranks is listed on both, each as
+/// (owned, ghost), and each rank's history of it is its own: computed with the pair's roles swapped, it is
+/// the other's flipped only to rounding. Both are kept (checkpoints, migration), and each rank takes back
+/// its own, so a restart continues bit for bit (docs/solver.md). A slot holds two record numbers (8 B; 16 B
+/// per record at half load), the pair's ids are read from the records: it refers to `r`, which must outlive
+/// it.
 class ContactLookup {
  public:
   explicit ContactLookup(const ContactRecords& r) : r_(r) {
@@ -79,7 +69,7 @@ class ContactLookup {
     }
   }
   /// The record of the pair {ia, ib}, or -1: the first one saved in the orientation ia -> ib if there
-  /// is one, else the first in the other (as ContactRecords::find).
+  /// is one, else the first in the other.
   std::int64_t find(std::int64_t ia, std::int64_t ib) const {
     const std::int64_t lo = std::min(ia, ib), hi = std::max(ia, ib);
     const Slot& s = slots_[probe(lo, hi)];
