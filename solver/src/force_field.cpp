@@ -3,6 +3,8 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cstdlib>
+#include <string>
 
 #include "basalt/solver/core/errors.hpp"
 #include "basalt/solver/models/registry.hpp"
@@ -27,6 +29,9 @@ ForceField<Real>::ForceField(const Scene& scene)
     pair_group_compute_.push_back(static_cast<int>(k));
   }
   pairs_take_all_ = scene.contacts.size() == 1 && scene.contacts[0].tags.empty();
+  const char* rebuild_on_break = std::getenv("BASALT_REBUILD_ON_BREAK");
+  mark_bonds_ = pair_computes_.size() == 1 && bonds_can_break() &&
+                !(rebuild_on_break && std::string(rebuild_on_break) == "1");
   // Checkpoints store all contact histories in one table as wide as the widest history; narrower ones
   // are padded with zeros (SimulationFrame) and read back at their own width (restart).
 
@@ -111,11 +116,11 @@ void ForceField<Real>::rebuild_lists(const Particles<Real>& p,
     if (pairs_take_all_) {
       build_pair_lists(
           p, grid_, ghost_grid_, skin, exclusions_, [](std::size_t, std::size_t) { return true; }, own_,
-          ghost_);
+          ghost_, mark_bonds_);
     } else {
       build_pair_lists(
           p, grid_, ghost_grid_, skin, exclusions_,
-          [&](std::size_t i, std::size_t j) { return taker(i, j) >= 0; }, own_, ghost_);
+          [&](std::size_t i, std::size_t j) { return taker(i, j) >= 0; }, own_, ghost_, mark_bonds_);
     }
     const PairLists<Real> lists{p, own_, ghost_, pair_computes_.size(), taker};
     for (std::size_t k = 0; k < pair_computes_.size(); ++k) pair_computes_[k]->rebuild(lists, k);

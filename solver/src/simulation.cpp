@@ -253,7 +253,15 @@ const std::vector<double>& Simulation<Real>::compute_forces(bool ghosts_in_fligh
   }
   forces_.add(state, Part::ghost, Energy, advance, [] {});
   hold_fixed();
-  if (broken_.size() != before) bond_broke_ = true;  // the lists must learn the pair is now unbonded
+  if (!bonds_.parted.empty()) {
+    // The lists must learn that the pairs are unbonded: at once where they list bonded pairs, else by
+    // a rebuild before the next force computation.
+    if (forces_.lists_mark_bonds())
+      forces_.unbond(bonds_.parted);
+    else
+      bond_broke_ = true;
+    bonds_.parted.clear();
+  }
   for (std::size_t k = before; k < broken_.size(); ++k) broken_[k].step = step_;
   return forces_.potentials();
 }

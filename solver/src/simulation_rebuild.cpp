@@ -194,7 +194,7 @@ void Simulation<Real>::check_start(bool fresh) {
   for (const PairList* list : {&forces_.own_pairs(), &forces_.ghost_pairs()})
     for (std::size_t i = 0; i + 1 < list->offset.size(); ++i)
       for (auto k = list->offset[i]; k < list->offset[i + 1]; ++k)
-        pair(i, static_cast<std::size_t>(list->neigh[k]), false);
+        if (!list->is_bonded(k)) pair(i, static_cast<std::size_t>(list->neigh[k]), false);
   for (std::size_t k = 0; k < bonds_.size(); ++k)
     pair(static_cast<std::size_t>(bonds_.ia[k]), static_cast<std::size_t>(bonds_.ib[k]), true);
   const auto& walls = forces_.walls();

@@ -80,7 +80,7 @@ void Simulation<Real>::estimate_critical_step(bool fresh) {
     for (std::size_t i = 0; i + 1 < list->offset.size() && i < n; ++i)
       for (auto q = list->offset[i]; q < list->offset[i + 1]; ++q) {
         const auto j = static_cast<std::size_t>(list->neigh[q]);
-        if (!touching(i, j)) continue;
+        if (list->is_bonded(q) || !touching(i, j)) continue;  // (a bond's stiffness is counted above)
         const double k = 2 * k_of(1, std::max(double(p_.radius[i]), double(p_.radius[j])));
         add_k(i, k);
         if (j < n) add_k(j, k);
@@ -154,6 +154,7 @@ void Simulation<Real>::estimate_critical_step(bool fresh) {
         breakable ? p_.bonds_broken : std::vector<std::int32_t>{};
     const std::size_t broken_at_start = broken_.size();
     const bool bond_broke_at_start = bond_broke_;
+    auto marks_at_start = breakable ? forces_.bond_marks() : decltype(forces_.bond_marks()){};
     compute_forces<false>();
     // F(x) once for all products (120 force evaluations became 61: half the start-up of a large run,
     // docs/BENCHMARKS.md). Bonds beyond their break strain broke in that evaluation, and a model whose
@@ -268,6 +269,7 @@ void Simulation<Real>::estimate_critical_step(bool fresh) {
       p_.bonds_broken = damage_at_start;
       broken_.erase(broken_.begin() + static_cast<std::ptrdiff_t>(broken_at_start), broken_.end());
       bond_broke_ = bond_broke_at_start;
+      forces_.set_bond_marks(std::move(marks_at_start));
     }
   }
   st.dt_power = stability::critical_step(lambda);

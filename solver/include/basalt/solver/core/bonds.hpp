@@ -4,6 +4,7 @@
 // and the bonds are ordered so that those with both ends owned come first ([0, n_both_owned)); in
 // the others ia is the owned end and ib a ghost.
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
@@ -19,6 +20,9 @@ struct Bonds {
   bool grouped = false;              ///< more than one bond group: group[] is kept
   std::vector<std::int32_t> ia, ib;  ///< local indices (valid between rebuilds)
   std::size_t n_both_owned = 0;
+  /// Local ends (ia, ib) of the bonds erase() removed since the caller last cleared it: their pairs
+  /// become contacts (ForceField::unbond).
+  std::vector<std::array<std::int32_t, 2>> parted;
   /// Changes whenever bond k may stand for another bond (push, permute, erase), never back to an earlier
   /// value (a process-wide counter): what a driver caches per bond is valid while it is unchanged.
   std::uint64_t stamp = 0;
@@ -71,6 +75,7 @@ struct Bonds {
     std::size_t g = 0, n2 = 0;
     for (std::size_t k = 0; k < size(); ++k) {
       if (g < gone.size() && gone[g] == k) {
+        if (k < ia.size()) parted.push_back({ia[k], ib[k]});
         ++g;
         continue;
       }

@@ -3,6 +3,7 @@
 // registry, models/registry.hpp), the walls they act through, the contact candidate lists they share,
 // and the energy ledger their potentials fill. Simulation drives it: rebuild_lists() at each
 // neighbour-list rebuild, add() twice per step (owned part, then ghost part).
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -51,6 +52,23 @@ class ForceField {
   const Walls& walls() const { return walls_; }
   const PairList& own_pairs() const { return own_; }
   const PairList& ghost_pairs() const { return ghost_; }
+  /// Whether the contact lists hold bonded pairs, marked (bonds can break and one pair model takes
+  /// every contact): a broken bond's pair then becomes a contact through unbond(), without a rebuild.
+  /// BASALT_REBUILD_ON_BREAK=1 turns it off (bonded pairs excluded, a break forces a rebuild: the
+  /// measurement of what it saves, and the test that both give the same forces).
+  bool lists_mark_bonds() const { return mark_bonds_; }
+  /// The bonds of these pairs (local ends, as Bonds::parted) broke: their listed pairs are contacts now.
+  void unbond(const std::vector<std::array<std::int32_t, 2>>& pairs) {
+    for (const auto& [i, j] : pairs)
+      for (PairList* list : {&own_, &ghost_})
+        list->unbond(static_cast<std::size_t>(i), static_cast<std::size_t>(j));
+  }
+  /// The bonded marks of both lists (to undo the breaks of a trial force computation).
+  std::array<std::vector<std::uint8_t>, 2> bond_marks() const { return {own_.bonded, ghost_.bonded}; }
+  void set_bond_marks(std::array<std::vector<std::uint8_t>, 2> marks) {
+    own_.bonded = std::move(marks[0]);
+    ghost_.bonded = std::move(marks[1]);
+  }
 
   // Energy ledger.
   const Ledger& ledger() const { return ledger_; }
@@ -87,7 +105,8 @@ class ForceField {
   /// The pending records of each pair compute (null: no history), for migration and restarts.
   std::vector<ContactRecords*> pending_history() const;
   /// After migration, ghosts and bonds: the contact lists (bonded pairs excluded through the bonds'
-  /// buckets, see Exclusions), each pair model's share with its history, the walls' candidates.
+  /// buckets, see Exclusions, or listed and marked: lists_mark_bonds()), each pair model's share with its
+  /// history, the walls' candidates.
   void rebuild_lists(const Particles<Real>& p, const std::vector<std::uint32_t>& bond_bucket_end,
                      const Bonds<Real>& bonds, double skin, double contact_cutoff);
 
@@ -104,6 +123,7 @@ class ForceField {
   std::vector<TagFilter> pair_group_tags_;  ///< each scene pair group's tags
   std::vector<int> pair_group_compute_;     ///< each scene pair group's compute in pair_computes_
   bool pairs_take_all_ = false;             ///< one pair group, every tag
+  bool mark_bonds_ = false;                 ///< lists_mark_bonds()
   Walls walls_;
   PairList own_, ghost_;
   CellGrid grid_, ghost_grid_;  ///< owned and ghost particles in the same cells (rebuilds only)

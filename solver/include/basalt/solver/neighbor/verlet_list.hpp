@@ -2,7 +2,9 @@
 // Verlet pair lists with a skin, built over a cell grid at each rebuild. Half lists: a pair of owned
 // particles appears once (i < j, Newton's third law applies); a pair of an owned particle and a ghost
 // appears in the ghost list of the owned one (the owning rank of the ghost lists it too; each rank
-// applies the force to its own particle only). Bonded pairs are excluded (they interact by their bond).
+// applies the force to its own particle only). Bonded pairs are excluded (they interact by their bond),
+// or, where bonds can break, listed and marked bonded: a pair whose bond breaks is then a contact at the
+// next step without a rebuild (PairList::unbond).
 #include <algorithm>
 #include <cstdint>
 #include <vector>
@@ -12,13 +14,34 @@
 
 namespace basalt::solver {
 
-/// Compressed rows over owned particles: neighbours of i are neigh[offset[i] .. offset[i+1]).
+/// Compressed rows over owned particles: neighbours of i are neigh[offset[i] .. offset[i+1]). With
+/// bonded pairs listed (`bonded` not empty), bonded[e] is 1 while entry e's pair is bonded: the pair
+/// models pass over it as over a pair apart.
 struct PairList {
   std::vector<std::uint32_t> offset;
   std::vector<std::int32_t> neigh;
+  std::vector<std::uint8_t> bonded;  ///< empty: bonded pairs are not listed at all
   std::size_t pairs() const { return neigh.size(); }
+  bool is_bonded(std::size_t e) const { return !bonded.empty() && bonded[e] != 0; }
+  /// The bond of listed pair (i, j) broke (i owned; j owned or a ghost): from now on it is a contact.
+  /// Returns whether the pair was listed (a pair beyond its cutoff at the last rebuild cannot touch
+  /// before the next one).
+  bool unbond(std::size_t i, std::size_t j) {
+    if (bonded.empty()) return false;
+    const auto clear_in_row = [&](std::size_t row, std::size_t other) {
+      if (row + 1 >= offset.size()) return false;
+      for (auto e = offset[row]; e < offset[row + 1]; ++e)
+        if (static_cast<std::size_t>(neigh[e]) == other) {
+          bonded[e] = 0;
+          return true;
+        }
+      return false;
+    };
+    return clear_in_row(i, j) || clear_in_row(j, i);
+  }
   std::size_t memory_bytes() const {
-    return offset.capacity() * sizeof(std::uint32_t) + neigh.capacity() * sizeof(std::int32_t);
+    return offset.capacity() * sizeof(std::uint32_t) + neigh.capacity() * sizeof(std::int32_t) +
+           bonded.capacity();
   }
 };
 
@@ -53,20 +76,25 @@ struct Exclusions {
 };
 
 /// Lists every owned-owned and owned-ghost pair closer than ri + rj + skin that `accept(i, j)` takes
-/// and that is not bonded. `owned` holds the owned particles [0, n_owned), `ghosts` (the same cells)
-/// the ghosts. Cells may be narrower than the longest cutoff: particle i looks as far as it can
-/// interact, ri + skin + the largest radius, so a small sphere (most of a power-law packing) searches a
-/// small box. Each owned-owned pair is listed once, from the particle in the lower cell (cells ordered z,
-/// y, x: the upper half of the box) or, in one cell, from the lower index; a ghost from the whole box.
-/// Rows of cells along x are single ranges of the cell order, scanned without a per-cell step.
+/// and that is not bonded (with `mark_bonded`: bonded too, marked in PairList::bonded). `owned` holds the
+/// owned particles [0, n_owned), `ghosts` (the same cells) the ghosts. Cells may be narrower than the longest
+/// cutoff: particle i looks as far as it can interact, ri + skin + the largest radius, so a small sphere
+/// (most of a power-law packing) searches a small box. Each owned-owned pair is listed once, from the
+/// particle in the lower cell (cells ordered z, y, x: the upper half of the box) or, in one cell, from the
+/// lower index; a ghost from the whole box. Rows of cells along x are single ranges of the cell order,
+/// scanned without a per-cell step.
 template <class Real, class Accept>
 void build_pair_lists(const Particles<Real>& p, const CellGrid& owned, const CellGrid& ghosts, double skin,
-                      const Exclusions& ex, Accept&& accept, PairList& own, PairList& ghost) {
+                      const Exclusions& ex, Accept&& accept, PairList& own, PairList& ghost,
+                      bool mark_bonded = false) {
   const std::size_t n = p.n_owned;
   own.offset.assign(n + 1, 0);
   ghost.offset.assign(n + 1, 0);
   own.neigh.clear();
   ghost.neigh.clear();
+  own.bonded.clear();
+  ghost.bonded.clear();
+  const bool exclude = !ex.empty() && !mark_bonded;
   const Real s = Real(skin);
   const Real rmax = p.size() == 0 ? Real(0) : *std::max_element(p.radius.begin(), p.radius.end());
   const auto& dims = owned.dims();
@@ -83,7 +111,7 @@ void build_pair_lists(const Particles<Real>& p, const CellGrid& owned, const Cel
         const Real cut = ri + p.radius[j];
         if (dx * dx + dy * dy + dz * dz >= cut * cut) continue;
         if (!accept(i, j)) continue;
-        if (!ex.empty() && ex.has(i, static_cast<std::int32_t>(j))) continue;
+        if (exclude && ex.has(i, static_cast<std::int32_t>(j))) continue;
         list.neigh.push_back(static_cast<std::int32_t>(j));
       }
     };
@@ -116,9 +144,15 @@ void build_pair_lists(const Particles<Real>& p, const CellGrid& owned, const Cel
     std::sort(own.neigh.begin() + own.offset[i], own.neigh.end());
     own.offset[i + 1] = static_cast<std::uint32_t>(own.neigh.size());
     ghost.offset[i + 1] = static_cast<std::uint32_t>(ghost.neigh.size());
+    if (mark_bonded)
+      for (PairList* list : {&own, &ghost})
+        for (auto e = list->bonded.size(); e < list->neigh.size(); ++e)
+          list->bonded.push_back(!ex.empty() && ex.has(i, list->neigh[e]) ? 1 : 0);
   }
   own.neigh.shrink_to_fit();
   ghost.neigh.shrink_to_fit();
+  own.bonded.shrink_to_fit();
+  ghost.bonded.shrink_to_fit();
 }
 
 }  // namespace basalt::solver
