@@ -5,6 +5,7 @@
 // force (local damping) sees every other model's share.
 #include <algorithm>
 #include <string_view>
+#include <type_traits>
 #include <vector>
 
 #include "basalt/solver/interactions/force_compute.hpp"
@@ -46,8 +47,17 @@ class BodyDriver final : public ForceCompute<Real> {
   /// the rotational state (its inertia costs two divisions per particle).
   static constexpr bool kTurns = (Model::reads & kAngularVelocity) != 0 || (Model::writes & kTorque) != 0;
 
+  static constexpr int kLaneWidth = 8;
+  static constexpr bool kLanes = requires(const Coeffs& c, BodyLanes<Real, kLaneWidth>& b) {
+    Model::template apply_lanes<Real, kLaneWidth>(c, b);
+  };
+
   template <bool Energy, bool Advance>
   double loop(Particles<Real>& p) {
+    if constexpr (kLanes) {
+      static_assert(Model::energy_term.empty(), "apply_lanes is for models without a potential");
+      if (coeffs_.size() == 1 && tags_[0].empty()) return lanes<Advance>(p);
+    }
     double e = 0, d = 0;
     const bool rot = kTurns && p.with_rotation;
     BodyState<Real> b{};
@@ -84,6 +94,49 @@ class BodyDriver final : public ForceCompute<Real> {
     dissipated_ += d;
     return e;
   }
+
+  /// loop() for a model with apply_lanes and one group taking every particle: kLaneWidth consecutive
+  /// particles at a time (a short last batch repeats its last particle), the same arithmetic per
+  /// particle as apply(), the dissipation added in particle order.
+  template <bool Advance>
+  double lanes(Particles<Real>& p) {
+    const bool rot = kTurns && p.with_rotation;
+    const std::size_t n = p.n_owned;
+    const Coeffs& c = coeffs_[0];
+    auto& L = lanes_;
+    L.dt = dt_;
+    double d = 0;
+    for (std::size_t i0 = 0; i0 < n; i0 += kLaneWidth) {
+      const int filled = static_cast<int>(std::min<std::size_t>(kLaneWidth, n - i0));
+      for (int l = 0; l < kLaneWidth; ++l) {
+        const std::size_t i = i0 + static_cast<std::size_t>(std::min(l, filled - 1));
+        L.m[l] = p.mass(i);
+        L.im[l] = p.inv_mass[i];
+        L.vx[l] = p.vx[i], L.vy[l] = p.vy[i], L.vz[l] = p.vz[i];
+        L.fx[l] = p.fx[i], L.fy[l] = p.fy[i], L.fz[l] = p.fz[i];
+        if (rot) {
+          L.inertia[l] = Real(1) / p.inverse_inertia(i);
+          L.wx[l] = p.wx[i], L.wy[l] = p.wy[i], L.wz[l] = p.wz[i];
+          L.tx[l] = p.tx[i], L.ty[l] = p.ty[i], L.tz[l] = p.tz[i];
+        } else {
+          L.inertia[l] = 0;
+          L.wx[l] = L.wy[l] = L.wz[l] = L.tx[l] = L.ty[l] = L.tz[l] = 0;
+        }
+      }
+      Model::template apply_lanes<Real, kLaneWidth>(c, L);
+      for (int l = 0; l < filled; ++l) {
+        const std::size_t i = i0 + static_cast<std::size_t>(l);
+        p.fx[i] += L.gx[l], p.fy[i] += L.gy[l], p.fz[i] += L.gz[l];
+        if (rot) p.tx[i] += L.hx[l], p.ty[i] += L.hy[l], p.tz[i] += L.hz[l];
+        if constexpr (Advance) d += L.dissipated[l];
+      }
+    }
+    dissipated_ += d;
+    return 0;
+  }
+
+  struct NoLanes {};
+  [[no_unique_address]] std::conditional_t<kLanes, BodyLanes<Real, kLaneWidth>, NoLanes> lanes_{};
 
   std::vector<Coeffs> coeffs_;
   std::vector<TagFilter> tags_;

@@ -86,6 +86,70 @@ struct LinearDamping {
     return u;
   }
 
+  /// esys_velocity for W particles side by side (M and s per lane; v in, the damped velocity u out):
+  /// each lane iterates exactly as the scalar form and stops where it would, branch-free (a particle's
+  /// iteration count depends on its speed: the scalar loop mispredicted it). Inputs and outputs are
+  /// separate arrays: GCC 12 at -O2 lost a component of v in a form that overwrote it in place.
+  template <class Real, int W>
+  static void esys_velocity_lanes(Real nu, const Real* __restrict M, const Real* __restrict s, Real dt, int n,
+                                  const Real* __restrict vx, const Real* __restrict vy,
+                                  const Real* __restrict vz, const Real* __restrict Fx,
+                                  const Real* __restrict Fy, const Real* __restrict Fz, Real* __restrict ux,
+                                  Real* __restrict uy, Real* __restrict uz) {
+    alignas(64) Real count[W], on[W];
+    for (int l = 0; l < W; ++l) {
+      ux[l] = 0;
+      uy[l] = 0;
+      uz[l] = 0;
+      count[l] = 0;
+      on[l] = n > 0 ? 1 : 0;  // (the first test, error = 1 > 1e-6, always passes)
+    }
+    const Real limit = Real(n);
+    for (int it = 0; it < n; ++it) {
+      Real any = 0;
+      for (int l = 0; l < W; ++l) {
+        const Real x = vx[l] + s[l] * dt * (Fx[l] - ux[l] * nu * M[l]);
+        const Real y = vy[l] + s[l] * dt * (Fy[l] - uy[l] * nu * M[l]);
+        const Real z = vz[l] + s[l] * dt * (Fz[l] - uz[l] * nu * M[l]);
+        const double error =
+            double((x - ux[l]) * (x - ux[l]) + (y - uy[l]) * (y - uy[l]) + (z - uz[l]) * (z - uz[l]));
+        const bool step = on[l] != 0;
+        ux[l] = step ? x : ux[l];
+        uy[l] = step ? y : uy[l];
+        uz[l] = step ? z : uz[l];
+        count[l] += step ? 1 : 0;
+        on[l] = step && error * error > 1e-12 && count[l] < limit ? 1 : 0;
+        any += on[l];
+      }
+      if (any == 0) break;
+    }
+    for (int l = 0; l < W; ++l) {
+      const bool spent = count[l] >= limit;
+      ux[l] = spent ? 0 : ux[l];
+      uy[l] = spent ? 0 : uy[l];
+      uz[l] = spent ? 0 : uz[l];
+    }
+  }
+
+  template <class Real, int W>
+  static void apply_lanes(const Coeffs<Real>& c, BodyLanes<Real, W>& b) {
+    alignas(64) Real vx[W], vy[W], vz[W], ux[W], uy[W], uz[W];
+    for (int l = 0; l < W; ++l) vx[l] = b.vx[l] - c.vx, vy[l] = b.vy[l] - c.vy, vz[l] = b.vz[l] - c.vz;
+    if (c.iterations > 0)
+      esys_velocity_lanes<Real, W>(c.nu, b.m, b.im, b.dt, c.iterations, vx, vy, vz, b.fx, b.fy, b.fz, ux, uy,
+                                   uz);
+    else
+      for (int l = 0; l < W; ++l) ux[l] = vx[l], uy[l] = vy[l], uz[l] = vz[l];
+    for (int l = 0; l < W; ++l) {
+      const Real s = -c.nu * b.m[l];
+      b.gx[l] = s * ux[l];
+      b.gy[l] = s * uy[l];
+      b.gz[l] = s * uz[l];
+      b.hx[l] = b.hy[l] = b.hz[l] = 0;
+      b.dissipated[l] = -double(b.gx[l] * b.vx[l] + b.gy[l] * b.vy[l] + b.gz[l] * b.vz[l]) * double(b.dt);
+    }
+  }
+
   template <class Real>
   static void apply(const Coeffs<Real>& c, const BodyState<Real>& b, BodyForce<Real>& f) {
     std::array<Real, 3> u{b.vx - c.vx, b.vy - c.vy, b.vz - c.vz};
@@ -137,6 +201,25 @@ struct RotationalDamping {
     return {Real(p.nu), static_cast<int>(p.iterations)};
   }
   static double max_stiffness(const Params&, double) { return 0; }
+
+  template <class Real, int W>
+  static void apply_lanes(const Coeffs<Real>& c, BodyLanes<Real, W>& b) {
+    alignas(64) Real ux[W], uy[W], uz[W], s[W];
+    for (int l = 0; l < W; ++l) s[l] = Real(1) / b.inertia[l];
+    if (c.iterations > 0)
+      LinearDamping::esys_velocity_lanes<Real, W>(c.nu, b.inertia, s, b.dt, c.iterations, b.wx, b.wy, b.wz,
+                                                  b.tx, b.ty, b.tz, ux, uy, uz);
+    else
+      for (int l = 0; l < W; ++l) ux[l] = b.wx[l], uy[l] = b.wy[l], uz[l] = b.wz[l];
+    for (int l = 0; l < W; ++l) {
+      const Real k = -c.nu * b.inertia[l];
+      b.gx[l] = b.gy[l] = b.gz[l] = 0;
+      b.hx[l] = k * ux[l];
+      b.hy[l] = k * uy[l];
+      b.hz[l] = k * uz[l];
+      b.dissipated[l] = -double(b.hx[l] * b.wx[l] + b.hy[l] * b.wy[l] + b.hz[l] * b.wz[l]) * double(b.dt);
+    }
+  }
 
   template <class Real>
   static void apply(const Coeffs<Real>& c, const BodyState<Real>& b, BodyForce<Real>& f) {

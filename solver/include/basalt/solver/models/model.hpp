@@ -144,6 +144,19 @@ struct BodyForce {
   double dissipated = 0;  ///< energy it takes out this step (damping)
 };
 
+/// W particles side by side for a body-force model with `apply_lanes` (BodyDriver): BodyState's fields
+/// that damping reads in, BodyForce's out. A model that defines it has no potential energy.
+template <class Real, int W>
+struct BodyLanes {
+  alignas(64) Real m[W], im[W], inertia[W];
+  alignas(64) Real vx[W], vy[W], vz[W], fx[W], fy[W], fz[W];
+  alignas(64) Real wx[W], wy[W], wz[W], tx[W], ty[W], tz[W];
+  alignas(64) Real gx[W], gy[W], gz[W];  ///< out: force added
+  alignas(64) Real hx[W], hy[W], hz[W];  ///< out: torque added
+  alignas(64) double dissipated[W];      ///< out
+  Real dt = 0;
+};
+
 /// Bytes of per-contact history a model keeps (0 for an empty History: nothing is stored).
 template <class Model>
 constexpr std::size_t history_bytes() {
