@@ -312,8 +312,15 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
       b.model = t.choice_or("type", model_names(ModelKind::body), "");
       b.kind = ModelKind::body;
       b.name = group_name(t, fmt::format("{}{}", b.model, k), names);
-      b.params = find_model(b.model, ModelKind::body)->parse(t);
+      const ModelEntry* m = find_model(b.model, ModelKind::body);
+      b.params = m->parse(t);
       b.tags = t.integers_or("tags", {});
+      // (without rotation the angular velocities are absent: ESyS's iterated form would divide by a zero
+      // moment of inertia and put NaN in the ledger)
+      if ((m->reads & kAngularVelocity) && !s.rotation)
+        t.fail("type", fmt::format("\"{}\" acts on rotating particles, but the particles do not rotate: set "
+                                   "particles.rotation = true, or remove it",
+                                   b.model));
       t.finish();
       s.body_forces.push_back(std::move(b));
     }

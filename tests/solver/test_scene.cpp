@@ -176,3 +176,17 @@ TEST(WallMotion, HalfSineDisplacementIntegratesVelocity) {
   EXPECT_EQ(m.velocity_at(0.75)[2], 0.0);
   EXPECT_NEAR(m.velocity_at(0.25)[2], 0.1, 1e-12);
 }
+
+TEST(Scene, RotationalDampingOfParticlesThatDoNotRotateIsRefused) {
+  // The scene's particles do not rotate (no model needs it): rotational damping has no angular velocity
+  // to act on, and its iterated form would divide by a zero moment of inertia (NaN in the ledger).
+  const std::string damping =
+      "[[body_forces]]\ntype = \"rotational_damping\"\nviscosity = 0.1\niterations = 50\n";
+  auto msg = error_of(kGood + damping);
+  EXPECT_NE(msg.find("body_forces[0].type"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("particles.rotation = true"), std::string::npos) << msg;
+  // With rotation on, it is taken.
+  const auto s = basalt::test::scene_from(kGood + "[particles]\nrotation = true\n" + damping);
+  ASSERT_EQ(s.body_forces.size(), 1u);
+  EXPECT_TRUE(s.rotation);
+}
