@@ -59,7 +59,24 @@ class RotBondDriver final : public ForceCompute<Real> {
     } else {
       e = energy ? loop<true, false>(s, s.bonds.n_both_owned, s.bonds.size())
                  : loop<false, false>(s, s.bonds.n_both_owned, s.bonds.size());
-      if (!gone_.empty()) s.bonds.erase(gone_);
+      if (!gone_.empty()) {
+        // The kept constants of the bonds that stay are still theirs (functions of the initial geometry):
+        // dropped in step with the bonds instead of recomputed for all.
+        const bool current = stamp_ == s.bonds.stamp;
+        s.bonds.erase(gone_);
+        if (current) {
+          std::size_t kept = 0, g = 0;
+          for (std::size_t k = 0; k < fixed_.size(); ++k) {
+            if (g < gone_.size() && gone_[g] == k) {
+              ++g;
+              continue;
+            }
+            fixed_[kept++] = fixed_[k];
+          }
+          fixed_.resize(kept);
+          stamp_ = s.bonds.stamp;
+        }
+      }
       gone_.clear();
     }
     return e;
