@@ -118,10 +118,7 @@ class BodyDriver final : public ForceCompute<Real> {
           L.inertia[l] = Real(1) / p.inverse_inertia(i);
           L.wx[l] = p.wx[i], L.wy[l] = p.wy[i], L.wz[l] = p.wz[i];
           L.tx[l] = p.tx[i], L.ty[l] = p.ty[i], L.tz[l] = p.tz[i];
-        } else {
-          L.inertia[l] = 0;
-          L.wx[l] = L.wy[l] = L.wz[l] = L.tx[l] = L.ty[l] = L.tz[l] = 0;
-        }
+        }  // (else they stay zero: lanes_ starts zeroed, and only a turning model reads them)
       }
       Model::template apply_lanes<Real, kLaneWidth>(c, L);
       for (int l = 0; l < filled; ++l) {

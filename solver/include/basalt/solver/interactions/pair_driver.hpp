@@ -236,13 +236,20 @@ class PairDriver final : public ForceCompute<Real> {
   }
 
   template <bool Energy, bool Newton, bool Advance, bool Rot, bool One>
-  double rows(Particles<Real>& p, const PairList& list, [[maybe_unused]] History* hist) {
+  double rows(Particles<Real>& p, const PairList& list, History* hist) {
+    // (as loop(): a frictional scene without breakable bonds has no test of marks per pair)
+    return list.bonded.empty() ? rows_over<Energy, Newton, Advance, Rot, One, false>(p, list, hist)
+                               : rows_over<Energy, Newton, Advance, Rot, One, true>(p, list, hist);
+  }
+
+  template <bool Energy, bool Newton, bool Advance, bool Rot, bool One, bool Marked>
+  double rows_over(Particles<Real>& p, const PairList& list, [[maybe_unused]] History* hist) {
     double energy = 0, dissipated = 0;
     std::size_t sliding = 0;
     const std::size_t n = p.n_owned;
     const std::uint32_t* __restrict off = list.offset.data();
     const std::int32_t* __restrict nb = list.neigh.data();
-    const std::uint8_t* __restrict bonded = list.bonded.empty() ? nullptr : list.bonded.data();
+    [[maybe_unused]] const std::uint8_t* __restrict bonded = list.bonded.data();
     const Real* __restrict x = p.x.data();
     const Real* __restrict y = p.y.data();
     const Real* __restrict z = p.z.data();
@@ -283,7 +290,8 @@ class PairDriver final : public ForceCompute<Real> {
         History& h = kHistory ? hist[e] : none;
         // Apart, or held by a bond (one test for both: in an intact rock nearly every listed pair fails
         // it, a branch the processor predicts).
-        const bool held = bonded != nullptr && bonded[e] != 0;
+        bool held = false;
+        if constexpr (Marked) held = bonded[e] != 0;
         if (unsigned(!(r2 < rsum * rsum)) | unsigned(held)) {
           if constexpr (kHistory && Advance) {
             // What the history still held is lost with it (a shear spring's energy): dissipated.
