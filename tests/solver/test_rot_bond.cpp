@@ -96,31 +96,64 @@ TEST(RotBondLaw, FastAcosMatchesAcosToRounding) {
 // The bond loop evaluates 8 bonds at once (evaluate_lanes). On random small deformations its loads must be
 // evaluate()'s to rounding; a bond's result must not depend on its lane; the special cases (a bond at rest,
 // an angle beyond the acos series, 0.1 rad) must be flagged for evaluate() and the others not.
+/// W bonds for evaluate_lanes: bond l between particles 2l (its first end) and 2l + 1.
+template <int W>
+struct LaneBatch {
+  RotBond::Lanes<double, W> L{};
+  RotBond::Table<double> table;
+  std::array<std::vector<double>, 7> pa;  // x, y, z, qw, qx, qy, qz
+  LaneBatch() {
+    table.resize(W);
+    for (auto& a : pa) a.resize(2 * W);
+    L.x = pa[0].data(), L.y = pa[1].data(), L.z = pa[2].data();
+    L.qw = pa[3].data(), L.qx = pa[4].data(), L.qy = pa[5].data(), L.qz = pa[6].data();
+    L.table = &table, L.k0 = 0;
+  }
+  void fill(int l, const RotBond::Geometry<double>& g, const RotBond::Coeffs<double>& group,
+            const RotBond::BondCoeffs<double>& k) {
+    const std::size_t a = 2 * static_cast<std::size_t>(l), b = a + 1;
+    const double e1[7] = {g.x1.x, g.x1.y, g.x1.z, g.q1.w, g.q1.x, g.q1.y, g.q1.z};
+    const double e2[7] = {g.x2.x, g.x2.y, g.x2.z, g.q2.w, g.q2.x, g.q2.y, g.q2.z};
+    for (std::size_t c = 0; c < 7; ++c) pa[c][a] = e1[c], pa[c][b] = e2[c];
+    table.set(static_cast<std::size_t>(l), static_cast<std::uint32_t>(a), static_cast<std::uint32_t>(b),
+              group, k, RotBond::fixed(g), g.d, g.r0);
+  }
+  /// The loads lane l computed.
+  RotBond::Result<double> result(int l) const {
+    RotBond::Result<double> q;
+    q.f1 = {L.f1[0][l], L.f1[1][l], L.f1[2][l]};
+    q.m1 = {L.m1[0][l], L.m1[1][l], L.m1[2][l]};
+    q.m2 = {L.m2[0][l], L.m2[1][l], L.m2[2][l]};
+    q.fn = L.fn[l], q.fs = L.fs[l], q.mb = L.mb[l], q.mt = L.mt[l];
+    return q;
+  }
+};
+
+/// A bond of initial length kL in any orientation, deformed by `size` (relative turn and offset).
+RotBond::Geometry<double> deformed_bond(std::uint64_t seed, double size) {
+  const auto h = [](std::uint64_t k) { return basalt::test::hash_unit(k) - 0.5; };
+  auto g = at_rest(V{h(seed), h(seed + 1), h(seed + 2)}, kL, kR1, kR2);
+  g.x2 = g.x2 + V{h(seed + 3), h(seed + 4), h(seed + 5)} * size;
+  g.q1 = axis_angle({h(seed + 6), h(seed + 7), h(seed + 8)}, 0.3 + h(seed + 9));  // any orientation
+  g.q2 = g.q1 * axis_angle({h(seed + 10), h(seed + 11), h(seed + 12)}, size);     // a small relative turn
+  g.x2 = g.x1 + g.q1.to_world(g.x2 - g.x1);  // the bond turned with particle 1
+  return g;
+}
+
 TEST(RotBondLaw, LanesMatchTheScalarEvaluation) {
   constexpr int W = 8;
-  RotBond::Lanes<double, W> L{};
+  LaneBatch<W> B;
+  auto& L = B.L;
+  const auto group = RotBond::coeffs<double>(RotBond::Params{});
   std::array<RotBond::Geometry<double>, W> gs;
   std::array<RotBond::Fixed<double>, W> fs;
   const auto h = [](std::uint64_t k) { return basalt::test::hash_unit(k) - 0.5; };
   const auto fill = [&](int l, const RotBond::Geometry<double>& g) {
     gs[l] = g;
     fs[l] = RotBond::fixed(g);
-    const double q1[4] = {g.q1.w, g.q1.x, g.q1.y, g.q1.z}, q2[4] = {g.q2.w, g.q2.x, g.q2.y, g.q2.z};
-    const double x1[3] = {g.x1.x, g.x1.y, g.x1.z}, x2[3] = {g.x2.x, g.x2.y, g.x2.z},
-                 d[3] = {g.d.x, g.d.y, g.d.z};
-    for (int c = 0; c < 3; ++c) L.x1[c][l] = x1[c], L.x2[c][l] = x2[c], L.d[c][l] = d[c];
-    for (int c = 0; c < 4; ++c) L.q1[c][l] = q1[c], L.q2[c][l] = q2[c];
-    L.r0[l] = g.r0, L.inv_d[l] = fs[l].inv_d, L.e1[l] = fs[l].e1, L.e2[l] = fs[l].e2;
-    L.kn[l] = kK.kn, L.ks[l] = kK.ks, L.kb[l] = kK.kb, L.kt[l] = kK.kt;
+    B.fill(l, g, group, kK);
   };
-  const auto general_bond = [&](std::uint64_t seed, double size) {
-    auto g = at_rest(V{h(seed), h(seed + 1), h(seed + 2)}, kL, kR1, kR2);
-    g.x2 = g.x2 + V{h(seed + 3), h(seed + 4), h(seed + 5)} * size;
-    g.q1 = axis_angle({h(seed + 6), h(seed + 7), h(seed + 8)}, 0.3 + h(seed + 9));  // any orientation
-    g.q2 = g.q1 * axis_angle({h(seed + 10), h(seed + 11), h(seed + 12)}, size);     // a small relative turn
-    g.x2 = g.x1 + g.q1.to_world(g.x2 - g.x1);  // the bond turned with particle 1
-    return g;
-  };
+  const auto general_bond = [](std::uint64_t seed, double size) { return deformed_bond(seed, size); };
   int compared = 0;
   for (std::uint64_t batch = 0; batch < 50; ++batch) {
     for (int l = 0; l < W; ++l)
@@ -181,6 +214,47 @@ TEST(RotBondLaw, LanesMatchTheScalarEvaluation) {
     }
   }
   for (int l = 3; l < W; ++l) EXPECT_EQ(L.general[l], 0.0) << l;
+}
+
+// The lanes take failure()'s test too (the driver asks failure() only for the mode of a bond the lanes found
+// broken): on loads around the strengths, under either criterion, a lane must say broken exactly when
+// failure() does on the lane's loads, and both outcomes must occur.
+TEST(RotBondLaw, LanesTestFailureAsFailureDoes) {
+  constexpr int W = 8;
+  const auto u = [](std::uint64_t k) { return basalt::test::hash_unit(k); };
+  for (const bool sum : {false, true}) {
+    RotBond::Params pr;
+    pr.criterion = sum ? RotBond::Criterion::sum : RotBond::Criterion::esys;
+    pr.truncated = 0.8, pr.beta1 = 0.7, pr.beta2 = 1.3;
+    const auto group = RotBond::coeffs<double>(pr);
+    int broken = 0, held = 0;
+    for (std::uint64_t batch = 0; batch < 60; ++batch) {
+      LaneBatch<W> B;
+      std::array<RotBond::BondCoeffs<double>, W> ks;
+      for (int l = 0; l < W; ++l) {
+        const std::uint64_t seed = 1000 * batch + 31 * static_cast<std::uint64_t>(l) + (sum ? 7 : 0);
+        const auto g = deformed_bond(seed, 1e-4 * (1 + 2 * u(seed + 20)));
+        const auto q = RotBond::evaluate(kK, g);
+        // Each strength a random multiple (0.5 to 8) of this bond's own load: some terms dominate, some
+        // vanish.
+        ks[l] = kK;
+        ks[l].ifn = 1 / ((0.5 + 7.5 * u(seed + 21)) * std::max(std::abs(q.fn), 1e-30));
+        ks[l].ifs = 1 / ((0.5 + 7.5 * u(seed + 22)) * std::max(q.fs, 1e-30));
+        ks[l].imb = 1 / ((0.5 + 7.5 * u(seed + 23)) * std::max(q.mb, 1e-30));
+        ks[l].imt = 1 / ((0.5 + 7.5 * u(seed + 24)) * std::max(q.mt, 1e-30));
+        B.fill(l, g, group, ks[l]);
+      }
+      RotBond::evaluate_lanes(B.L);
+      for (int l = 0; l < W; ++l) {
+        ASSERT_EQ(B.L.general[l], 0.0) << "batch " << batch << " lane " << l;
+        const bool want = RotBond::failure(group, ks[l], B.result(l)) >= 0;
+        EXPECT_EQ(B.L.broken[l] != 0, want) << (sum ? "sum" : "esys") << " batch " << batch << " lane " << l;
+        (want ? broken : held)++;
+      }
+    }
+    EXPECT_GT(broken, 40) << (sum ? "sum" : "esys");
+    EXPECT_GT(held, 40) << (sum ? "sum" : "esys");
+  }
 }
 
 // The bond driver keeps each bond's constants until Bonds::stamp changes: every push, permutation and

@@ -42,7 +42,7 @@ class RotBondDriver final : public ForceCompute<Real> {
   }
   bool can_break() const override { return breakable_; }
   std::size_t memory_bytes() const override {
-    return fixed_.capacity() * sizeof(BondFixed) + gone_.capacity() * sizeof(std::size_t);
+    return table_.bytes() + gone_.capacity() * sizeof(std::size_t);
   }
   double rest_length(std::size_t g, double ri, double rj, double r) const override {
     return Model::rest_length(params_[g], ri, rj, r);
@@ -50,7 +50,7 @@ class RotBondDriver final : public ForceCompute<Real> {
 
   double compute(ForceState<Real>& s, Part part, bool energy, bool) override {
     if (s.bonds.size() == 0) return 0;
-    if (stamp_ != s.bonds.stamp || fixed_.size() != s.bonds.size()) refresh(s);
+    if (stamp_ != s.bonds.stamp || n_ != s.bonds.size()) refresh(s);
     double e = 0;
     if (part == Part::owned) {
       gone_.clear();
@@ -66,14 +66,14 @@ class RotBondDriver final : public ForceCompute<Real> {
         s.bonds.erase(gone_);
         if (current) {
           std::size_t kept = 0, g = 0;
-          for (std::size_t k = 0; k < fixed_.size(); ++k) {
+          for (std::size_t k = 0; k < n_; ++k) {
             if (g < gone_.size() && gone_[g] == k) {
               ++g;
               continue;
             }
-            fixed_[kept++] = fixed_[k];
+            table_.copy(kept++, k);
           }
-          fixed_.resize(kept);
+          pad(kept);
           stamp_ = s.bonds.stamp;
         }
       }
@@ -89,51 +89,38 @@ class RotBondDriver final : public ForceCompute<Real> {
   double loop(ForceState<Real>& s, std::size_t begin, std::size_t end) {
     auto& p = s.p;
     const auto& bonds = s.bonds;
+    const auto& t = table_;
     auto& L = lanes_;
+    L.x = p.x.data(), L.y = p.y.data(), L.z = p.z.data();
+    L.qw = p.qw.data(), L.qx = p.qx.data(), L.qy = p.qy.data(), L.qz = p.qz.data();
+    L.table = &table_;
     double energy = 0;
-    std::size_t n1s[kLanes], n2s[kLanes];
-    bool firsts[kLanes];
     for (std::size_t k0 = begin; k0 < end; k0 += kLanes) {
       const int n = static_cast<int>(std::min<std::size_t>(kLanes, end - k0));
-      for (int l = 0; l < kLanes; ++l) {  // a short last batch repeats its last bond
-        const std::size_t k = k0 + static_cast<std::size_t>(std::min(l, n - 1));
-        const auto i = static_cast<std::size_t>(bonds.ia[k]), j = static_cast<std::size_t>(bonds.ib[k]);
-        const bool first = p.id[i] == bonds.a[k];
-        const std::size_t n1 = first ? i : j, n2 = first ? j : i;
-        n1s[l] = n1, n2s[l] = n2, firsts[l] = first;
-        const BondFixed& f = fixed_[k];
-        L.x1[0][l] = p.x[n1], L.x1[1][l] = p.y[n1], L.x1[2][l] = p.z[n1];
-        L.x2[0][l] = p.x[n2], L.x2[1][l] = p.y[n2], L.x2[2][l] = p.z[n2];
-        L.q1[0][l] = p.qw[n1], L.q1[1][l] = p.qx[n1], L.q1[2][l] = p.qy[n1], L.q1[3][l] = p.qz[n1];
-        L.q2[0][l] = p.qw[n2], L.q2[1][l] = p.qx[n2], L.q2[2][l] = p.qy[n2], L.q2[3][l] = p.qz[n2];
-        L.d[0][l] = f.d.x, L.d[1][l] = f.d.y, L.d[2][l] = f.d.z;
-        L.r0[l] = bonds.r0[k], L.inv_d[l] = f.f.inv_d, L.e1[l] = f.f.e1, L.e2[l] = f.f.e2;
-        L.kn[l] = f.k.kn, L.ks[l] = f.k.ks, L.kb[l] = f.k.kb, L.kt[l] = f.k.kt;
-      }
+      L.k0 = k0;  // a short last batch reads the next bonds or the table's padding
       Model::evaluate_lanes(L);
       for (int l = 0; l < n; ++l) {
         const std::size_t k = k0 + static_cast<std::size_t>(l);
-        const std::size_t n1 = n1s[l], n2 = n2s[l];
-        const bool first = firsts[l];
-        const BondFixed& f = fixed_[k];
-        const auto& bk = f.k;
-        typename Model::template Geometry<Real> g;
-        g.x1 = {L.x1[0][l], L.x1[1][l], L.x1[2][l]};
-        g.x2 = {L.x2[0][l], L.x2[1][l], L.x2[2][l]};
-        g.r0 = L.r0[l];
+        const std::size_t n1 = t.n1[k], n2 = t.n2[k];
         typename Model::template Result<Real> q;
-        if (L.general[l] != Real(0) || bk.atan2_angles) [[unlikely]] {
-          g.q1 = {L.q1[0][l], L.q1[1][l], L.q1[2][l], L.q1[3][l]};
-          g.q2 = {L.q2[0][l], L.q2[1][l], L.q2[2][l], L.q2[3][l]};
-          g.d = f.d;
-          q = Model::evaluate(bk, g, f.f);
+        const bool general = L.general[l] != Real(0);
+        if (general) [[unlikely]] {
+          typename Model::template Geometry<Real> g;
+          g.x1 = {p.x[n1], p.y[n1], p.z[n1]};
+          g.x2 = {p.x[n2], p.y[n2], p.z[n2]};
+          g.q1 = {p.qw[n1], p.qx[n1], p.qy[n1], p.qz[n1]};
+          g.q2 = {p.qw[n2], p.qx[n2], p.qy[n2], p.qz[n2]};
+          g.d = t.d(k);
+          g.r0 = bonds.r0[k];
+          q = Model::evaluate(t.coeffs(k), g, t.fixed(k));
         } else {
           q.f1 = {L.f1[0][l], L.f1[1][l], L.f1[2][l]};
           q.m1 = {L.m1[0][l], L.m1[1][l], L.m1[2][l]};
           q.m2 = {L.m2[0][l], L.m2[1][l], L.m2[2][l]};
           q.fn = L.fn[l], q.fs = L.fs[l], q.mb = L.mb[l], q.mt = L.mt[l];
         }
-        const bool own1 = BothOwned || first, own2 = BothOwned || !first;
+        // ia, the owned end (Bonds), is n1 or n2.
+        const bool own1 = BothOwned || n1 < p.n_owned, own2 = BothOwned || !own1;
         if (own1) {
           p.fx[n1] += q.f1.x, p.fy[n1] += q.f1.y, p.fz[n1] += q.f1.z;
           p.tx[n1] += q.m1.x, p.ty[n1] += q.m1.y, p.tz[n1] += q.m1.z;
@@ -142,62 +129,72 @@ class RotBondDriver final : public ForceCompute<Real> {
           p.fx[n2] -= q.f1.x, p.fy[n2] -= q.f1.y, p.fz[n2] -= q.f1.z;
           p.tx[n2] += q.m2.x, p.ty[n2] += q.m2.y, p.tz[n2] += q.m2.z;
         }
-        const std::size_t i = first ? n1 : n2, j = first ? n2 : n1;
+        const std::size_t i = own1 ? n1 : n2, j = own1 ? n2 : n1;
         const bool tally = BothOwned || p.id[i] < p.id[j];
         if constexpr (Energy)
-          if (tally) energy += Model::energy(bk, q);
-        if (!breakable_) continue;
-        const int mode = Model::failure(coeffs_[bonds.group_of(k)], bk, q);
-        if (mode < 0) [[likely]]
+          if (tally) energy += Model::energy(t.coeffs(k), q);
+        if (!breakable_ || (!general && L.broken[l] == Real(0))) [[likely]]
           continue;
+        const auto& c = coeffs_[bonds.group_of(k)];
+        const int mode = general ? Model::failure(c, t.coeffs(k), q) : Model::failure_mode(c, t.coeffs(k), q);
+        if (mode < 0) continue;
         gone_.push_back(k);
         if (p.with_damage) {  // each rank counts the break for its own particles
           ++p.bonds_broken[i];
           if constexpr (BothOwned) ++p.bonds_broken[j];
         }
         if (tally) {
+          typename Model::template Geometry<Real> g;
+          g.x1 = {p.x[n1], p.y[n1], p.z[n1]};
+          g.x2 = {p.x[n2], p.y[n2], p.z[n2]};
+          const auto &x2 = g.x2, d = g.x1 - g.x2;
           const double w = double(p.radius[n2]) / double(p.radius[n1] + p.radius[n2]);
-          const auto d = g.x1 - g.x2;
-          s.broken.push_back({bonds.a[k], bonds.b[k], double(d.norm()), double(g.r0), -1, bonds.group_of(k),
-                              static_cast<std::uint8_t>(mode), double(g.x2.x) + w * double(d.x),
-                              double(g.x2.y) + w * double(d.y), double(g.x2.z) + w * double(d.z)});
+          s.broken.push_back({bonds.a[k], bonds.b[k], double(d.norm()), double(bonds.r0[k]), -1,
+                              bonds.group_of(k), static_cast<std::uint8_t>(mode),
+                              double(x2.x) + w * double(d.x), double(x2.y) + w * double(d.y),
+                              double(x2.z) + w * double(d.z)});
         }
       }
     }
     return energy;
   }
 
-  /// Each bond's constants, in the bond list's order.
-  struct BondFixed {
-    typename Model::template BondCoeffs<Real> k;
-    typename Model::template Fixed<Real> f;
-    decltype(Model::template Geometry<Real>::d) d;  ///< x2 - x1 at the start
-  };
-
+  /// The bond table for the bond list: n1 is the bond's first end (Bonds::a), as every rank evaluates it.
   void refresh(const ForceState<Real>& s) {
     const auto& p = s.p;
     const auto& bonds = s.bonds;
-    fixed_.resize(bonds.size());
-    for (std::size_t k = 0; k < bonds.size(); ++k) {
-      const auto i = static_cast<std::size_t>(bonds.ia[k]), j = static_cast<std::size_t>(bonds.ib[k]);
+    n_ = bonds.size();
+    table_.resize(n_ + kLanes);
+    for (std::size_t k = 0; k < n_; ++k) {
+      const auto i = static_cast<std::uint32_t>(bonds.ia[k]), j = static_cast<std::uint32_t>(bonds.ib[k]);
       const bool first = p.id[i] == bonds.a[k];
-      const std::size_t n1 = first ? i : j, n2 = first ? j : i;
+      const std::uint32_t n1 = first ? i : j, n2 = first ? j : i;
       typename Model::template Geometry<Real> g;
       g.d = {p.xi[n2] - p.xi[n1], p.yi[n2] - p.yi[n1], p.zi[n2] - p.zi[n1]};
       g.r1 = p.radius[n1];
       g.r2 = p.radius[n2];
-      fixed_[k] = {Model::bond_coeffs(coeffs_[bonds.group_of(k)], g.d.norm(), g.r1, g.r2), Model::fixed(g),
-                   g.d};
+      const auto& c = coeffs_[bonds.group_of(k)];
+      table_.set(k, n1, n2, c, Model::bond_coeffs(c, g.d.norm(), g.r1, g.r2), Model::fixed(g), g.d,
+                 bonds.r0[k]);
     }
+    pad(n_);
     stamp_ = bonds.stamp;
+  }
+
+  /// Keeps the first n bonds and fills the batch after them with copies of the last (read, not applied).
+  void pad(std::size_t n) {
+    n_ = n;
+    table_.resize(n + kLanes);
+    for (std::size_t k = n; k < n + kLanes; ++k) table_.copy(k, n > 0 ? n - 1 : k);
   }
 
   std::vector<typename Model::Params> params_;
   std::vector<Coeffs> coeffs_;
   bool breakable_ = false;
   std::vector<std::size_t> gone_;
-  std::vector<BondFixed> fixed_;
-  typename Model::template Lanes<Real, kLanes> lanes_;
+  typename Model::template Table<Real> table_;  ///< each bond's constants, padded by a batch
+  std::size_t n_ = 0;                           ///< bonds in table_
+  typename Model::template Lanes<Real, kLanes> lanes_{};
   std::uint64_t stamp_ = 0;
 };
 

@@ -37,10 +37,12 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <numbers>
 #include <string_view>
 #include <type_traits>
+#include <vector>
 
 #include "basalt/solver/models/model.hpp"
 #include "basalt/solver/scene/table_reader.hpp"
@@ -406,43 +408,116 @@ struct RotBond {
     return out;
   }
 
-  /// W bonds side by side (structure of arrays), for evaluate_lanes.
-  template <class Real, int W>
-  struct Lanes {
-    alignas(64) Real x1[3][W], x2[3][W], q1[4][W], q2[4][W], d[3][W];
-    alignas(64) Real r0[W], inv_d[W], e1[W], e2[W], kn[W], ks[W], kb[W], kt[W];
-    alignas(64) Real f1[3][W], m1[3][W], m2[3][W], fn[W], fs[W], mb[W], mt[W];
-    alignas(64) Real general[W];  ///< 1: the lane is a case evaluate_lanes leaves to evaluate (see there)
+  /// Every bond's constants in arrays indexed by bond, what evaluate_lanes reads: its ends' local indices
+  /// (n1 = its first end), its BondCoeffs, Fixed, initial offset d and rest length, and its group's
+  /// criterion. Kept by the driver while the bond list is unchanged; padded to a whole number of batches.
+  template <class Real>
+  struct Table {
+    enum Col {
+      dx,
+      dy,
+      dz,
+      r0,
+      inv_d,
+      e1,
+      e2,
+      kn,
+      ks,
+      kb,
+      kt,
+      ifn,
+      ifs,
+      imb,
+      imt,
+      truncated,
+      beta1,
+      beta2,
+      sum,
+      atan2,
+      kCols
+    };
+    std::vector<std::uint32_t> n1, n2;
+    std::array<std::vector<Real>, kCols> col;
+
+    std::size_t size() const { return n1.size(); }
+    void resize(std::size_t n) {
+      n1.resize(n), n2.resize(n);
+      for (auto& c : col) c.resize(n);
+    }
+    std::size_t bytes() const {
+      return (n1.capacity() + n2.capacity()) * sizeof(std::uint32_t) +
+             col.size() * col[0].capacity() * sizeof(Real);
+    }
+    /// Bond k: ends n1 (first) and n2, its constants and its group's.
+    void set(std::size_t k, std::uint32_t a, std::uint32_t b, const Coeffs<Real>& c,
+             const BondCoeffs<Real>& bk, const Fixed<Real>& f, const beam::Vec<Real>& d, Real rest) {
+      n1[k] = a, n2[k] = b;
+      const Real v[kCols] = {d.x,         d.y,     d.z,     rest,        f.inv_d,
+                             f.e1,        f.e2,    bk.kn,   bk.ks,       bk.kb,
+                             bk.kt,       bk.ifn,  bk.ifs,  bk.imb,      bk.imt,
+                             c.truncated, c.beta1, c.beta2, Real(c.sum), Real(bk.atan2_angles)};
+      for (int j = 0; j < kCols; ++j) col[j][k] = v[j];
+    }
+    void copy(std::size_t to, std::size_t from) {
+      n1[to] = n1[from], n2[to] = n2[from];
+      for (auto& c : col) c[to] = c[from];
+    }
+    BondCoeffs<Real> coeffs(std::size_t k) const {
+      return {col[kn][k],  col[ks][k],  col[kb][k],  col[kt][k],        col[ifn][k],
+              col[ifs][k], col[imb][k], col[imt][k], col[atan2][k] != 0};
+    }
+    Fixed<Real> fixed(std::size_t k) const { return {col[inv_d][k], col[e1][k], col[e2][k]}; }
+    beam::Vec<Real> d(std::size_t k) const { return {col[dx][k], col[dy][k], col[dz][k]}; }
   };
 
-  /// evaluate() for W bonds at once, written without branches so that the compiler can run the lanes in
-  /// vector registers (it needs -fno-math-errno, set for the whole project, to vectorise sqrt): the same
-  /// formulas in the same order, with each of evaluate()'s special cases computed anyway and the lane marked
-  /// `general` instead. Those are the bonds at exactly zero shear, bend or lateral offset (at the start of a
-  /// run, the bonds no load has reached yet), angles beyond acos's series (cosines <= 0.995, above 0.1 rad)
-  /// and atan2 angles: the caller evaluates them with evaluate(). A bond's result depends on its own inputs
-  /// only, never on its lane or its neighbours in the batch.
+  /// What evaluate_lanes reads (the particles' positions and orientations, the bond table and the batch's
+  /// first bond k0) and writes for W bonds side by side.
+  template <class Real, int W>
+  struct Lanes {
+    const Real *x, *y, *z, *qw, *qx, *qy, *qz;  ///< the particles' arrays (local index)
+    const Table<Real>* table;
+    std::size_t k0;
+    alignas(64) Real f1[3][W], m1[3][W], m2[3][W], fn[W], fs[W], mb[W], mt[W];
+    alignas(64) Real general[W];  ///< 1: the lane is a case evaluate_lanes leaves to evaluate (see there)
+    alignas(64) Real broken[W];   ///< 1: the bond fails under its group's criterion (lanes not general)
+  };
+
+  /// evaluate() and failure()'s test for the W bonds k0 ... k0 + W - 1 of the table at once, written without
+  /// branches so that the compiler can run the lanes in vector registers, the particles' values gathered by
+  /// index (it needs -fno-math-errno, set for the whole project, to vectorise sqrt): the same formulas in the
+  /// same order, with each of evaluate()'s special cases computed anyway and the lane marked `general`
+  /// instead. Those are the bonds at exactly zero shear, bend or lateral offset (at the start of a run, the
+  /// bonds no load has reached yet), angles beyond acos's series (cosines <= 0.995, above 0.1 rad) and atan2
+  /// angles: the caller evaluates them with evaluate() and failure(). A bond's result depends on its own
+  /// inputs only, never on its lane or its neighbours in the batch.
   template <class Real, int W>
   static void evaluate_lanes(Lanes<Real, W>& b) {
     using V = beam::Vec<Real>;
     using Q = beam::Quat<Real>;
+    using T = Table<Real>;
     const Real h = Real(0.5) * std::sqrt(Real(2)), one = 1, zero = 0;
+    const Real* __restrict px = b.x, * __restrict py = b.y, * __restrict pz = b.z;
+    const Real* __restrict pqw = b.qw, * __restrict pqx = b.qx, * __restrict pqy = b.qy, * __restrict pqz = b.qz;
+    const std::uint32_t* __restrict n1 = b.table->n1.data() + b.k0, * __restrict n2 =
+                                                                        b.table->n2.data() + b.k0;
+    const Real* __restrict c[T::kCols];
+    for (int j = 0; j < T::kCols; ++j) c[j] = b.table->col[static_cast<std::size_t>(j)].data() + b.k0;
 #pragma GCC ivdep
     for (int l = 0; l < W; ++l) {
-      const V x1{b.x1[0][l], b.x1[1][l], b.x1[2][l]}, x2{b.x2[0][l], b.x2[1][l], b.x2[2][l]};
-      const Q q1{b.q1[0][l], b.q1[1][l], b.q1[2][l], b.q1[3][l]},
-          q2{b.q2[0][l], b.q2[1][l], b.q2[2][l], b.q2[3][l]};
-      const V d{b.d[0][l], b.d[1][l], b.d[2][l]};
-      const Real r0 = b.r0[l], ks = b.ks[l];
+      const std::uint32_t i1 = n1[l], i2 = n2[l];
+      const V x1{px[i1], py[i1], pz[i1]}, x2{px[i2], py[i2], pz[i2]};
+      const Q q1{pqw[i1], pqx[i1], pqy[i1], pqz[i1]}, q2{pqw[i2], pqx[i2], pqy[i2], pqz[i2]};
+      const V d{c[T::dx][l], c[T::dy][l], c[T::dz][l]};
+      const Real r0 = c[T::r0][l], ks = c[T::ks][l];
       const V rbp = x2 - x1;
       const Real lp = rbp.norm();
       const beam::Rot<Real> R1(q1);
       const V rb = R1.to_body(rbp);
       const Real nb = rb.norm(), inb = one / nb;
-      const V fr = rb * (b.kn[l] * (nb - r0) * inb);
+      const V fr = rb * (c[T::kn][l] * (nb - r0) * inb);
       const V c0 = rb.cross(d);
       const Real n0 = c0.norm(), dot = rb.dot(d);
-      const Real gc = dot * (inb * b.inv_d[l]);
+      const Real gc = dot * (inb * c[T::inv_d][l]);
       const Real gamma = beam::acos_series(gc);
       const Real a = ks * r0 * gamma / (n0 != zero ? n0 : one);
       const V fst = rb.cross(c0) * (a * inb), mst = c0 * -a;
@@ -456,29 +531,35 @@ struct RotBond {
       const Real cpsi = r.w * ist, spsi = r.z * ist;
       const Real apsi = beam::acos_series(cpsi);
       const Real psi = 2 * (spsi > zero ? apsi : spsi < zero ? -apsi : zero);
-      const Real mt = b.kt[l] * psi;
+      const Real mt = c[T::kt][l] * psi;
       const V mtr{Rm.m[0][2] * mt, Rm.m[1][2] * mt, Rm.m[2][2] * mt};
       const Real t1 = t0 - t2;
       const Real theta = beam::acos_series(t1);
       const Real iq = one / std::sqrt(t0 * t2 != zero ? t0 * t2 : one);
       const Real cf = (r.x * r.z + r.w * r.y) * iq, sf = (r.y * r.z - r.w * r.x) * iq;
-      const Real bb = Real(0.5) * b.kb[l] * theta, sh = Real(0.5) * ks * theta * r0;
+      const Real bb = Real(0.5) * c[T::kb][l] * theta, sh = Real(0.5) * ks * theta * r0;
       const V mbr = Rm.xy_to_world(-bb * sf, bb * cf), fsr = Rm.xy_to_world(-sh * cf, -sh * sf),
               msr = Rm.xy_to_world(sh * sf, -sh * cf);
       const V ms = msr + mst, fs = fst + fsr;
-      const V f1 = R1.to_world(fr + fs), m1 = R1.to_world(mbr + mtr + ms * (b.e1[l] * lp)),
-              m2 = R1.to_world(ms * (b.e2[l] * lp) - mbr - mtr);
+      const V f1 = R1.to_world(fr + fs), m1 = R1.to_world(mbr + mtr + ms * (c[T::e1][l] * lp)),
+              m2 = R1.to_world(ms * (c[T::e2][l] * lp) - mbr - mtr);
       b.f1[0][l] = f1.x, b.f1[1][l] = f1.y, b.f1[2][l] = f1.z;
       b.m1[0][l] = m1.x, b.m1[1][l] = m1.y, b.m1[2][l] = m1.z;
       b.m2[0][l] = m2.x, b.m2[1][l] = m2.y, b.m2[2][l] = m2.z;
-      b.fn[l] = (lp < r0 ? -one : one) * fr.norm();
-      b.fs[l] = fs.norm();
-      b.mb[l] = std::abs(bb);
-      b.mt[l] = std::abs(mt);
+      const Real fn = (lp < r0 ? -one : one) * fr.norm(), fsn = fs.norm(), mb = std::abs(bb),
+                 amt = std::abs(mt);
+      b.fn[l] = fn, b.fs[l] = fsn, b.mb[l] = mb, b.mt[l] = amt;
+      // failure()'s test, both criteria, the group's taken.
+      const Real tn = fn * c[T::ifn][l], ts = fsn * c[T::ifs][l], tb = mb * c[T::imb][l],
+                 tt = amt * c[T::imt][l];
+      const Real normal = tn + c[T::beta1][l] * tb, shear = ts + c[T::beta2][l] * tt;
+      const Real esys = Real((normal > c[T::truncated][l]) | (shear > one - normal));
+      const Real sum = Real(((tn > zero ? tn : zero) + ts + tb + tt) >= one);
+      b.broken[l] = esys + c[T::sum][l] * (sum - esys);  // (a select here would be a branch)
       const Real lim = Real(0.995);
       // (& not &&: no branches in the loop)
       b.general[l] = Real(!((n0 != zero) & (rxy2 != zero) & (t0 != zero) & (t2 != zero) & (gc > lim) &
-                            (t1 > lim) & ((cpsi > lim) | (spsi == zero))));
+                            (t1 > lim) & ((cpsi > lim) | (spsi == zero)) & (c[T::atan2][l] == zero)));
     }
   }
 
@@ -493,16 +574,21 @@ struct RotBond {
   template <class Real>
   static int failure(const Coeffs<Real>& c, const BondCoeffs<Real>& k, const Result<Real>& q) {
     const Real tn = q.fn * k.ifn, ts = q.fs * k.ifs, tb = q.mb * k.imb, tt = q.mt * k.imt;
-    const Real wb = c.sum ? tb : c.beta1 * tb, wt = c.sum ? tt : c.beta2 * tt;
     bool broken;
     if (c.sum) {
       broken = std::max(tn, Real(0)) + ts + tb + tt >= Real(1);
     } else {
-      const Real normal = tn + wb, shear = ts + wt;
+      const Real normal = tn + c.beta1 * tb, shear = ts + c.beta2 * tt;
       broken = normal > c.truncated || shear > Real(1) - normal;
     }
-    if (!broken) return -1;
-    // The mode: the largest term of the criterion.
+    return broken ? failure_mode(c, k, q) : -1;
+  }
+
+  /// The failure mode of a bond that fails: the largest term of the criterion.
+  template <class Real>
+  static int failure_mode(const Coeffs<Real>& c, const BondCoeffs<Real>& k, const Result<Real>& q) {
+    const Real tn = q.fn * k.ifn, ts = q.fs * k.ifs, tb = q.mb * k.imb, tt = q.mt * k.imt;
+    const Real wb = c.sum ? tb : c.beta1 * tb, wt = c.sum ? tt : c.beta2 * tt;
     int mode = int(BondFailure::tension);
     Real top = tn;
     if (ts > top) top = ts, mode = int(BondFailure::shear);
