@@ -83,7 +83,7 @@ class RotBondDriver final : public ForceCompute<Real> {
   }
 
  private:
-  static constexpr int kLanes = 8;  ///< bonds evaluated side by side (Model::evaluate_lanes)
+  static constexpr int kLanes = 16;  ///< bonds evaluated side by side (Model::evaluate_lanes)
 
   template <bool Energy, bool BothOwned>
   double loop(ForceState<Real>& s, std::size_t begin, std::size_t end) {

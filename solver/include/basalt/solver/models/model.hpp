@@ -85,6 +85,15 @@ struct ContactForce {
   bool sliding = false;         ///< the contact slides (Coulomb limit reached) this step
 };
 
+/// On a lane loop heavy in arithmetic: lets GCC use 512-bit vectors there where the target has them (it
+/// prefers 256-bit ones elsewhere). The rotational bonds' lanes ran 0.76x the time with it and 16 lanes
+/// (docs/validation-rock.md, "How fast"); other targets and compilers ignore it.
+#if defined(__GNUC__) && !defined(__clang__) && (defined(__x86_64__) || defined(__i386__))
+#define BASALT_WIDE_LANES [[gnu::target("prefer-vector-width=512")]]
+#else
+#define BASALT_WIDE_LANES
+#endif
+
 /// Contacts a pair driver evaluates side by side (Model::contact_lanes): 16 measured a little faster than 8
 /// (and 4 or 64 slower) on the granular bench, docs/BENCHMARKS.md.
 inline constexpr int kContactLaneWidth = 16;

@@ -491,7 +491,7 @@ struct RotBond {
   /// angles: the caller evaluates them with evaluate() and failure(). A bond's result depends on its own
   /// inputs only, never on its lane or its neighbours in the batch.
   template <class Real, int W>
-  static void evaluate_lanes(Lanes<Real, W>& b) {
+  BASALT_WIDE_LANES static void evaluate_lanes(Lanes<Real, W>& b) {
     using V = beam::Vec<Real>;
     using Q = beam::Quat<Real>;
     using T = Table<Real>;
