@@ -18,6 +18,19 @@
 
 namespace basalt::solver {
 
+/// Whether a contact history holds anything (a bit set). Every model's apart() clears its history to all
+/// bits zero, and a clear history parts with no energy, so a pair apart whose history is clear needs
+/// neither. (Bits, not values: a -0 is cleared to +0 as before.)
+template <class History>
+inline bool holds(const History& h) {
+  static_assert(std::is_trivially_copyable_v<History> && sizeof(History) % sizeof(std::uint64_t) == 0);
+  std::uint64_t w[sizeof(History) / sizeof(std::uint64_t)];
+  std::memcpy(w, &h, sizeof(History));
+  std::uint64_t any = 0;
+  for (const auto v : w) any |= v;
+  return any != 0;
+}
+
 template <class Real, class Model>
 class PairDriver final : public ForceCompute<Real> {
  public:
@@ -294,9 +307,12 @@ class PairDriver final : public ForceCompute<Real> {
         if constexpr (Marked) held = bonded[e] != 0;
         if (unsigned(!(r2 < rsum * rsum)) | unsigned(held)) {
           if constexpr (kHistory && Advance) {
-            // What the history still held is lost with it (a shear spring's energy): dissipated.
-            if (Newton || id[i] < id[j]) dissipated += Model::parting_energy(coeffs_of(i, j), h);
-            Model::apart(h);
+            // What the history still held is lost with it (a shear spring's energy): dissipated. Most
+            // pairs here were apart or bonded the step before too: their history is clear already.
+            if (holds(h)) [[unlikely]] {
+              if (Newton || id[i] < id[j]) dissipated += Model::parting_energy(coeffs_of(i, j), h);
+              Model::apart(h);
+            }
           }
           continue;
         }
