@@ -65,15 +65,7 @@ class RotBondDriver final : public ForceCompute<Real> {
         const bool current = stamp_ == s.bonds.stamp;
         s.bonds.erase(gone_);
         if (current) {
-          std::size_t kept = 0, g = 0;
-          for (std::size_t k = 0; k < n_; ++k) {
-            if (g < gone_.size() && gone_[g] == k) {
-              ++g;
-              continue;
-            }
-            table_.copy(kept++, k);
-          }
-          pad(kept);
+          pad(table_.erase(gone_, n_));
           stamp_ = s.bonds.stamp;
         }
       }

@@ -458,6 +458,22 @@ struct RotBond {
                              c.truncated, c.beta1, c.beta2, Real(c.sum), Real(bk.atan2_angles)};
       for (int j = 0; j < kCols; ++j) col[j][k] = v[j];
     }
+    /// Removes the bonds at the ascending positions `gone` from the first n, keeping the others' order
+    /// (column by column, each run of kept bonds moved at once); returns the bonds left.
+    std::size_t erase(const std::vector<std::size_t>& gone, std::size_t n) {
+      if (gone.empty()) return n;
+      const auto squeeze = [&](auto& v) {
+        auto to = v.begin() + static_cast<std::ptrdiff_t>(gone[0]);
+        for (std::size_t g = 0; g < gone.size(); ++g) {
+          const std::size_t from = gone[g] + 1, end = g + 1 < gone.size() ? gone[g + 1] : n;
+          to = std::copy(v.begin() + static_cast<std::ptrdiff_t>(from),
+                         v.begin() + static_cast<std::ptrdiff_t>(end), to);
+        }
+      };
+      squeeze(n1), squeeze(n2);
+      for (auto& c : col) squeeze(c);
+      return n - gone.size();
+    }
     void copy(std::size_t to, std::size_t from) {
       n1[to] = n1[from], n2[to] = n2[from];
       for (auto& c : col) c[to] = c[from];
