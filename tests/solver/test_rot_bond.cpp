@@ -696,6 +696,70 @@ TEST(RotBondRun, EachModeBreaksAtItsStrength) {
   }
 }
 
+// Two bond groups with their own criteria: the driver's table keeps each bond's group values (one group
+// keeps them once). Pair 1-2 (bond tag 1, the first bond): the sum criterion; pair 3-4 (tag 2): esys with a
+// tension cut-off at a quarter of twice the strength, so it breaks first, under its own group's criterion
+// and not the first bond's (with which it would break after pair 1-2). The bonds carry a little shear,
+// bend and twist, so they go through the lanes.
+TEST(RotBondRun, EachGroupBreaksUnderItsOwnCriterion) {
+  const double rate = 1e-2, per_step = 1000 * rate * 1e-4;
+  const auto scene = basalt::test::scene_from(R"(
+[run]
+dt = 1e-4
+steps = 0
+skin = 0.05
+[[interactions]]
+type = "rot_bond"
+bond_tag = 1
+kn = 1000.0
+ks = 400.0
+kb = 30.0
+kt = 20.0
+rest_length = "sum_of_radii"
+max_normal_force = 2e-2
+criterion = "sum"
+[[interactions]]
+type = "rot_bond"
+bond_tag = 2
+kn = 1000.0
+ks = 400.0
+kb = 30.0
+kt = 20.0
+rest_length = "sum_of_radii"
+max_normal_force = 4e-2
+truncated = 0.25
+[particles]
+fixed_tags = [0, 1]
+)");
+  Geometry g;
+  g.add_particle(1, {0, 0, 0}, 0.5);
+  g.add_particle(2, {1, 0, 0}, 0.5, 1);
+  g.add_particle(3, {0, 10, 0}, 0.5);
+  g.add_particle(4, {1, 10, 0}, 0.5, 1);
+  g.add_bond(1, 2, 1);
+  g.add_bond(3, 4, 2);
+  g.sort_by_id();
+  Simulation<double> sim(scene, g, MPI_COMM_SELF);
+  auto& p = sim.particles();
+  for (const std::int64_t id :
+       {2, 4}) {  // pulled, with a little shear, bend and twist: no lane is a special case
+    const auto i = index_of(p, id);
+    p.vx[i] = rate, p.vy[i] = 1e-3 * rate;
+    p.wx[i] = 2e-3 * rate, p.wy[i] = 1e-3 * rate, p.wz[i] = 3e-3 * rate;
+  }
+  sim.state_changed();
+  for (int k = 0; k < 60 && sim.broken_bonds().size() < 2; ++k) sim.step();
+  ASSERT_EQ(sim.broken_bonds().size(), 2u);
+  const auto& first = sim.broken_bonds()[0];
+  const auto& second = sim.broken_bonds()[1];
+  EXPECT_EQ(first.a, 3);
+  EXPECT_EQ(second.a, 1);
+  EXPECT_NEAR(double(first.step), std::ceil(0.25 * 4e-2 / per_step), 1.0);  // 10
+  EXPECT_NEAR(double(second.step), std::ceil(2e-2 / per_step), 1.0);        // 20
+  EXPECT_EQ(first.mode, std::uint8_t(BondFailure::tension));
+  EXPECT_EQ(second.mode, std::uint8_t(BondFailure::tension));
+}
+
 // ---- Against ESyS-Particle 2.3.5 (tools/esys/probe_rotbond.py, docs/data/esys-rotbond) ----
 
 namespace {

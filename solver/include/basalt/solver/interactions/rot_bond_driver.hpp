@@ -156,6 +156,7 @@ class RotBondDriver final : public ForceCompute<Real> {
     const auto& p = s.p;
     const auto& bonds = s.bonds;
     n_ = bonds.size();
+    table_.one_group = coeffs_.size() == 1;
     table_.resize(n_ + kLanes);
     for (std::size_t k = 0; k < n_; ++k) {
       const auto i = static_cast<std::uint32_t>(bonds.ia[k]), j = static_cast<std::uint32_t>(bonds.ib[k]);
