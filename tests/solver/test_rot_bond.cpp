@@ -471,19 +471,20 @@ std::size_t index_of(const Particles<Real>& p, std::int64_t id) {
   return 0;
 }
 
-const char* kStiff = R"(
-[run]
-dt = 1e-4
-steps = 0
-skin = 0.05
-[[interactions]]
-type = "rot_bond"
-kn = 1000.0
+/// The springs of the runs below (an [[interactions]] rot_bond table's lines).
+const std::string kSprings = R"(kn = 1000.0
 ks = 400.0
 kb = 30.0
 kt = 20.0
 rest_length = "sum_of_radii"
 )";
+const std::string kRun = R"(
+[run]
+dt = 1e-4
+steps = 0
+skin = 0.05
+)";
+const std::string kStiff = kRun + "[[interactions]]\ntype = \"rot_bond\"\n" + kSprings;
 
 double mass_of(double r) { return 4.0 / 3.0 * kPi * r * r * r; }
 
@@ -536,7 +537,7 @@ TEST(RotBondRun, EnergyInEachMode) {
   // One mode at a time (stretch, twist, shear, bend), then all together: kinetic (with rotation) plus the
   // bond's energy (ESyS's expression) over 20,000 steps of a free pair.
   const double r1 = 0.5, r2 = 0.4, L = 0.9;
-  const auto scene = basalt::test::scene_from(std::string(kStiff) + R"(
+  const auto scene = basalt::test::scene_from(kStiff + R"(
 [output]
 [[output.fields]]
 type = "total_energy"
@@ -652,7 +653,7 @@ namespace {
 /// Two fixed spheres (they move only with the velocities given), bond strengths from the scene; particle 2
 /// moves or turns at a constant rate. Returns the break record, or none.
 std::optional<BrokenBond> drive(const std::string& strengths, V v2, V w2, int steps) {
-  const auto scene = basalt::test::scene_from(std::string(kStiff) + strengths + R"(
+  const auto scene = basalt::test::scene_from(kStiff + strengths + R"(
 [particles]
 fixed_tags = [0, 1]
 )");
@@ -703,34 +704,13 @@ TEST(RotBondRun, EachModeBreaksAtItsStrength) {
 // bend and twist, so they go through the lanes.
 TEST(RotBondRun, EachGroupBreaksUnderItsOwnCriterion) {
   const double rate = 1e-2, per_step = 1000 * rate * 1e-4;
-  const auto scene = basalt::test::scene_from(R"(
-[run]
-dt = 1e-4
-steps = 0
-skin = 0.05
-[[interactions]]
-type = "rot_bond"
-bond_tag = 1
-kn = 1000.0
-ks = 400.0
-kb = 30.0
-kt = 20.0
-rest_length = "sum_of_radii"
-max_normal_force = 2e-2
-criterion = "sum"
-[[interactions]]
-type = "rot_bond"
-bond_tag = 2
-kn = 1000.0
-ks = 400.0
-kb = 30.0
-kt = 20.0
-rest_length = "sum_of_radii"
-max_normal_force = 4e-2
-truncated = 0.25
-[particles]
-fixed_tags = [0, 1]
-)");
+  const auto group = [](int tag, const std::string& criterion) {
+    return "[[interactions]]\ntype = \"rot_bond\"\nbond_tag = " + std::to_string(tag) + "\n" + kSprings +
+           criterion;
+  };
+  const auto scene = basalt::test::scene_from(
+      kRun + group(1, "max_normal_force = 2e-2\ncriterion = \"sum\"\n") +
+      group(2, "max_normal_force = 4e-2\ntruncated = 0.25\n") + "[particles]\nfixed_tags = [0, 1]\n");
   Geometry g;
   g.add_particle(1, {0, 0, 0}, 0.5);
   g.add_particle(2, {1, 0, 0}, 0.5, 1);

@@ -439,17 +439,17 @@ struct RotBond {
       kCols
     };
     static constexpr int kSpan = 64;  ///< the widest batch evaluate_lanes may be given
-    static constexpr bool of_group(int j) { return j >= truncated; }
     std::vector<std::uint32_t> n1, n2;
     std::array<std::vector<Real>, kCols> col;
     bool one_group = false;
 
-    std::size_t size() const { return n1.size(); }
+    /// Column j holds a value per bond (else kSpan copies of the one group's).
+    bool per_bond(int j) const { return !one_group || j < truncated; }
     /// n bonds; one_group must be set first.
     void resize(std::size_t n) {
       n1.resize(n), n2.resize(n);
       for (int j = 0; j < kCols; ++j)
-        col[static_cast<std::size_t>(j)].resize(one_group && of_group(j) ? std::size_t(kSpan) : n);
+        col[static_cast<std::size_t>(j)].resize(per_bond(j) ? n : std::size_t(kSpan));
     }
     std::size_t bytes() const {
       std::size_t b = (n1.capacity() + n2.capacity()) * sizeof(std::uint32_t);
@@ -458,7 +458,7 @@ struct RotBond {
     }
     /// Where column j's values for bonds k0 ... start.
     const Real* at(int j, std::size_t k0) const {
-      return col[static_cast<std::size_t>(j)].data() + (one_group && of_group(j) ? 0 : k0);
+      return col[static_cast<std::size_t>(j)].data() + (per_bond(j) ? k0 : 0);
     }
     /// Bond k: ends n1 (first) and n2, its constants and its group's.
     void set(std::size_t k, std::uint32_t a, std::uint32_t b, const Coeffs<Real>& c,
@@ -469,7 +469,7 @@ struct RotBond {
                              bk.kt,       bk.ifn,  bk.ifs,  bk.imb,      bk.imt,
                              c.truncated, c.beta1, c.beta2, Real(c.sum), Real(bk.atan2_angles)};
       for (int j = 0; j < kCols; ++j) {
-        if (!(one_group && of_group(j))) {
+        if (per_bond(j)) {
           col[static_cast<std::size_t>(j)][k] = v[j];
         } else if (k == 0) {
           for (auto& x : col[static_cast<std::size_t>(j)]) x = v[j];
@@ -490,14 +490,13 @@ struct RotBond {
       };
       squeeze(n1), squeeze(n2);
       for (int j = 0; j < kCols; ++j)
-        if (!(one_group && of_group(j))) squeeze(col[static_cast<std::size_t>(j)]);
+        if (per_bond(j)) squeeze(col[static_cast<std::size_t>(j)]);
       return n - gone.size();
     }
     void copy(std::size_t to, std::size_t from) {
       n1[to] = n1[from], n2[to] = n2[from];
       for (int j = 0; j < kCols; ++j)
-        if (!(one_group && of_group(j)))
-          col[static_cast<std::size_t>(j)][to] = col[static_cast<std::size_t>(j)][from];
+        if (per_bond(j)) col[static_cast<std::size_t>(j)][to] = col[static_cast<std::size_t>(j)][from];
     }
     BondCoeffs<Real> coeffs(std::size_t k) const {
       return {col[kn][k],  col[ks][k],  col[kb][k],  col[kt][k],        col[ifn][k],
