@@ -388,23 +388,19 @@ class PairDriver final : public ForceCompute<Real> {
     const Real* __restrict y = p.y.data();
     const Real* __restrict z = p.z.data();
     const Real* __restrict rad = p.radius.data();
-    const Real* __restrict im = p.inv_mass.data();
-    const Real* __restrict vx = p.vx.data();
-    const Real* __restrict vy = p.vy.data();
-    const Real* __restrict vz = p.vz.data();
     Real* __restrict fx = p.fx.data();
     Real* __restrict fy = p.fy.data();
     Real* __restrict fz = p.fz.data();
-    [[maybe_unused]] const Real* __restrict wx = Rot ? p.wx.data() : nullptr;
-    [[maybe_unused]] const Real* __restrict wy = Rot ? p.wy.data() : nullptr;
-    [[maybe_unused]] const Real* __restrict wz = Rot ? p.wz.data() : nullptr;
     [[maybe_unused]] Real* __restrict tx = Rot ? p.tx.data() : nullptr;
     [[maybe_unused]] Real* __restrict ty = Rot ? p.ty.data() : nullptr;
     [[maybe_unused]] Real* __restrict tz = Rot ? p.tz.data() : nullptr;
     const Coeffs c = coeffs_[0];
     auto& L = lanes_;
     L.dt = dt_;
-    std::size_t lane_i[kLaneWidth], lane_j[kLaneWidth], lane_e[kLaneWidth];
+    // A batch's pairs: row, neighbour and list entry. The finding loop writes nothing else (a store per
+    // value costs more than loading it again): gather() loads the lanes' inputs from these, kLaneWidth
+    // at a time in vector registers.
+    alignas(64) std::uint32_t lane_i[kLaneWidth], lane_j[kLaneWidth], lane_e[kLaneWidth];
     // Row accumulators of particle `row` (the last row a scattered pair came from).
     std::size_t row = n;
     Real fxi = 0, fyi = 0, fzi = 0, txi = 0, tyi = 0, tzi = 0;
@@ -417,7 +413,6 @@ class PairDriver final : public ForceCompute<Real> {
     // The batch's size comes in as an argument, and the pairs that part are tallied apart, so that the
     // gathering loop keeps both in registers (a captured counter would go through memory every pair).
     const auto run = [&](const int filled) {
-      for (int l = filled; l < kLaneWidth; ++l) copy_lane(L, filled - 1, l);
       Model::template contact_lanes<Advance>(c, L);
       for (int l = 0; l < filled; ++l) {
         const std::size_t i = lane_i[l], j = lane_j[l];
@@ -446,22 +441,16 @@ class PairDriver final : public ForceCompute<Real> {
         }
       }
     };
-    // The rest of a batch's inputs, once its pairs are known: particle data of both ends and the history
-    // (loaded here, from pairs that touch only). Every listed pair up to `last` has then been seen: the
-    // history of those that do not touch is cleared (the pairs that do get theirs back at the scatter).
+    // The lanes' inputs, once a batch's pairs are known (a short last batch repeats its last pair): particle
+    // data of both ends and the history. Every listed pair up to `last` has then been seen: the history of
+    // those that do not touch is cleared (the pairs that do get theirs back at the scatter).
     std::size_t cleared = off[0];  // histories before this one are cleared
     const auto complete = [&](const int filled, const std::size_t last) {
-      for (int l = 0; l < filled; ++l) {
-        const std::size_t i = lane_i[l], j = lane_j[l];
-        L.ri[l] = rad[i];
-        L.imi[l] = im[i], L.imj[l] = im[j];
-        L.vx[l] = vx[i] - vx[j], L.vy[l] = vy[i] - vy[j], L.vz[l] = vz[i] - vz[j];
-        if constexpr (Rot) {
-          L.wix[l] = wx[i], L.wiy[l] = wy[i], L.wiz[l] = wz[i];
-          L.wjx[l] = wx[j], L.wjy[l] = wy[j], L.wjz[l] = wz[j];
-        }
-        if constexpr (kHistory) L.h[l] = hist[lane_e[l]];
-      }
+      for (int l = filled; l < kLaneWidth; ++l)
+        lane_i[l] = lane_i[filled - 1], lane_j[l] = lane_j[filled - 1], lane_e[l] = lane_e[filled - 1];
+      gather<Rot>(p, lane_i, lane_j, L);
+      if constexpr (kHistory)
+        for (int l = 0; l < kLaneWidth; ++l) L.h[l] = hist[lane_e[l]];
       if constexpr (kHistory && Advance) {
         for (std::size_t e = cleared; e < last; ++e) Model::apart(hist[e]);
         cleared = last;
@@ -480,12 +469,11 @@ class PairDriver final : public ForceCompute<Real> {
         const auto j = static_cast<std::size_t>(nb[e]);
         const Real dx = xi - x[j], dy = yi - y[j], dz = zi - z[j];
         const Real r2 = dx * dx + dy * dy + dz * dz;
-        const Real rj = rad[j], rsum = ri + rj;
+        const Real rsum = ri + rad[j];
         bool touch = r2 < rsum * rsum;
         if constexpr (Marked) touch = touch && bonded[e] == 0;  // (a bonded pair acts by its bond)
         const int l = filled;
-        lane_i[l] = i, lane_j[l] = j, lane_e[l] = e;
-        L.dx[l] = dx, L.dy[l] = dy, L.dz[l] = dz, L.r2[l] = r2, L.rj[l] = rj;
+        lane_i[l] = static_cast<std::uint32_t>(i), lane_j[l] = static_cast<std::uint32_t>(j), lane_e[l] = e;
         if constexpr (kHistory && Advance) {
           const double lost = Model::parting_energy(c, hist[e]);
           parted += !touch && (Newton || id[i] < id[j]) ? lost : 0.0;
@@ -498,8 +486,12 @@ class PairDriver final : public ForceCompute<Real> {
         }
       }
     }
-    complete(filled, off[n]);
-    if (filled > 0) run(filled);
+    if (filled > 0) {
+      complete(filled, off[n]);
+      run(filled);
+    } else if constexpr (kHistory && Advance) {
+      for (std::size_t e = cleared; e < off[n]; ++e) Model::apart(hist[e]);
+    }
     flush_row();
     dissipated += parted;
     dissipated_ += dissipated;
@@ -507,12 +499,40 @@ class PairDriver final : public ForceCompute<Real> {
     return energy;
   }
 
-  template <class Lanes>
-  static void copy_lane(Lanes& L, int from, int to) {
-    for (Real* a : {L.dx, L.dy, L.dz, L.r2, L.ri, L.rj, L.imi, L.imj, L.vx, L.vy, L.vz, L.wix, L.wiy, L.wiz,
-                    L.wjx, L.wjy, L.wjz})
-      a[to] = a[from];
-    L.h[to] = L.h[from];
+  /// The lanes' particle inputs of pairs (i[l], j[l]), loaded in vector registers (gathers); the same
+  /// values, in the same operations, as a pair found in the list sees (dx = x_i - x_j, r2).
+  template <bool Rot, class Lanes>
+  BASALT_WIDE_LANES static void gather(const Particles<Real>& p, const std::uint32_t* __restrict ii,
+                                       const std::uint32_t* __restrict jj, Lanes& L) {
+    const Real* __restrict x = p.x.data();
+    const Real* __restrict y = p.y.data();
+    const Real* __restrict z = p.z.data();
+    const Real* __restrict rad = p.radius.data();
+    const Real* __restrict im = p.inv_mass.data();
+    const Real* __restrict vx = p.vx.data();
+    const Real* __restrict vy = p.vy.data();
+    const Real* __restrict vz = p.vz.data();
+#pragma GCC ivdep
+    for (int l = 0; l < kLaneWidth; ++l) {
+      const std::uint32_t i = ii[l], j = jj[l];
+      const Real dx = x[i] - x[j], dy = y[i] - y[j], dz = z[i] - z[j];
+      L.dx[l] = dx, L.dy[l] = dy, L.dz[l] = dz;
+      L.r2[l] = dx * dx + dy * dy + dz * dz;
+      L.ri[l] = rad[i], L.rj[l] = rad[j];
+      L.imi[l] = im[i], L.imj[l] = im[j];
+      L.vx[l] = vx[i] - vx[j], L.vy[l] = vy[i] - vy[j], L.vz[l] = vz[i] - vz[j];
+    }
+    if constexpr (Rot) {
+      const Real* __restrict wx = p.wx.data();
+      const Real* __restrict wy = p.wy.data();
+      const Real* __restrict wz = p.wz.data();
+#pragma GCC ivdep
+      for (int l = 0; l < kLaneWidth; ++l) {
+        const std::uint32_t i = ii[l], j = jj[l];
+        L.wix[l] = wx[i], L.wiy[l] = wy[i], L.wiz[l] = wz[i];
+        L.wjx[l] = wx[j], L.wjy[l] = wy[j], L.wjz[l] = wz[j];
+      }
+    }
   }
 
   /// The pairs of `in` that pair compute `index` takes.
