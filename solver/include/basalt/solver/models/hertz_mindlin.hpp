@@ -214,51 +214,92 @@ struct HertzMindlin {
   }
   /// contact() for W pairs at once (model.hpp, ContactLanes): the same formulas in the same order, each
   /// branch of hertz::law computed in every lane and the right value selected, so that GCC vectorises the
-  /// loop (divisions and square roots of the unselected side may be inf or NaN; they are dropped).
+  /// loops (divisions and square roots of the unselected side may be inf or NaN; they are dropped).
+  /// The law is a chain of square roots and divisions, each waiting for the last: one loop over the lanes
+  /// would run at the chain's latency. So it runs in four passes over the lanes, each with a short chain,
+  /// whose iterations the processor overlaps; the values one pass hands to the next stay in L1 (`Stage`).
   template <bool Advance, class Real, int W>
-  static void contact_lanes(const Coeffs<Real>& c, ContactLanes<Real, W, History>& b) {
+  BASALT_WIDE_LANES static void contact_lanes(const Coeffs<Real>& c, ContactLanes<Real, W, History>& b) {
     const Real dt = b.dt, zero = 0, one = 1;
+    struct Stage {
+      alignas(64) Real inv_r[W], inv_sum[W], m[W], nx[W], ny[W], nz[W], tx[W], ty[W], tz[W];
+      alignas(64) Real px[W], py[W], pz[W], ratio[W], St[W], gt[W], fn[W], si[W], sj[W];
+      alignas(64) Real sx[W], sy[W], sz[W], ftx[W], fty[W], ftz[W], ft2[W], limit[W];
+    } g;
+    // 1: the distance and the three reciprocals.
 #pragma GCC ivdep
     for (int l = 0; l < W; ++l) {
-      const Real dx = b.dx[l], dy = b.dy[l], dz = b.dz[l], ri = b.ri[l], rj = b.rj[l];
       const Real r = std::sqrt(b.r2[l]);
-      const Real inv_r = one / r;
+      b.r[l] = r;
+      g.inv_r[l] = one / r;
+      g.inv_sum[l] = one / (b.ri[l] + b.rj[l]);
+      g.m[l] = one / (b.imi[l] + b.imj[l]);
+    }
+    // 2: the contact point's velocity, the stiffness and dashpots, the normal force, the history turned
+    // onto the tangent plane (its length ratio).
+#pragma GCC ivdep
+    for (int l = 0; l < W; ++l) {
+      const Real dx = b.dx[l], dy = b.dy[l], dz = b.dz[l], ri = b.ri[l], rj = b.rj[l], r = b.r[l];
+      const Real inv_r = g.inv_r[l], inv_sum = g.inv_sum[l];
       const Real nx = dx * inv_r, ny = dy * inv_r, nz = dz * inv_r;
-      const Real inv_sum = one / (ri + rj);
       const Real ai = r * ri * inv_sum, aj = r - ai;
       const Real ox = -(ai * b.wix[l] + aj * b.wjx[l]), oy = -(ai * b.wiy[l] + aj * b.wjy[l]),
                  oz = -(ai * b.wiz[l] + aj * b.wjz[l]);
       const Real ux = b.vx[l] + oy * nz - oz * ny, uy = b.vy[l] + oz * nx - ox * nz,
                  uz = b.vz[l] + ox * ny - oy * nx;
-      const Real R = ri * rj * inv_sum, m = one / (b.imi[l] + b.imj[l]), d = ri + rj - r;
+      const Real R = ri * rj * inv_sum, d = ri + rj - r;
       // hertz::law
       const Real root = std::sqrt(R * d);
       const Real St = 8 * c.G_star * root;
-      const Real q = std::sqrt(root * m);
+      const Real q = std::sqrt(root * g.m[l]);
       const Real gn = c.damp_n * q, gt = c.damp_t * q;
       const Real un = ux * nx + uy * ny + uz * nz;
       const Real tx = ux - un * nx, ty = uy - un * ny, tz = uz - un * nz;
       const Real fn = Real(4.0 / 3.0) * c.E_star * root * d - gn * un;
-      Real sx = Real(b.h[l].x), sy = Real(b.h[l].y), sz = Real(b.h[l].z);
+      const Real sx = Real(b.h[l].x), sy = Real(b.h[l].y), sz = Real(b.h[l].z);
+      g.nx[l] = nx, g.ny[l] = ny, g.nz[l] = nz, g.tx[l] = tx, g.ty[l] = ty, g.tz[l] = tz;
+      g.St[l] = St, g.gt[l] = gt, g.fn[l] = fn;
+      g.si[l] = -ai * inv_r, g.sj[l] = aj * inv_r;
+      g.sx[l] = sx, g.sy[l] = sy, g.sz[l] = sz;
       if constexpr (Advance) {
         const Real before = sx * sx + sy * sy + sz * sz;
         const Real sn = sx * nx + sy * ny + sz * nz;
         const Real px = sx - sn * nx, py = sy - sn * ny, pz = sz - sn * nz;
         const Real after = px * px + py * py + pz * pz;
-        const Real s = after > 0 ? std::sqrt(before / after) : one;
-        const bool turn = before > 0;
-        sx = turn ? px * s : sx;
-        sy = turn ? py * s : sy;
-        sz = turn ? pz * s : sz;
+        g.px[l] = px, g.py[l] = py, g.pz[l] = pz;
+        g.ratio[l] = after > 0 ? before / after : one;
+        g.ratio[l] = before > 0 ? g.ratio[l] : -one;  // (no turn)
+        b.dissipated[l] = double(gn * un * un + gt * (tx * tx + ty * ty + tz * tz)) * double(dt);
+      }
+    }
+    // 3: the history turned and loaded, the elastic-viscous tangential force and the Coulomb limit.
+#pragma GCC ivdep
+    for (int l = 0; l < W; ++l) {
+      Real sx = g.sx[l], sy = g.sy[l], sz = g.sz[l];
+      const Real tx = g.tx[l], ty = g.ty[l], tz = g.tz[l];
+      if constexpr (Advance) {
+        const Real ratio = g.ratio[l];
+        const bool turn = ratio >= zero;
+        const Real s = std::sqrt(turn ? ratio : one);
+        sx = turn ? g.px[l] * s : sx;
+        sy = turn ? g.py[l] * s : sy;
+        sz = turn ? g.pz[l] * s : sz;
         sx += tx * dt;
         sy += ty * dt;
         sz += tz * dt;
       }
-      Real ftx = -St * sx - gt * tx, fty = -St * sy - gt * ty, ftz = -St * sz - gt * tz;
-      const Real ft2 = ftx * ftx + fty * fty + ftz * ftz, limit = c.mu * (fn > 0 ? fn : zero);
-      double dissipated = 0;
-      if constexpr (Advance)
-        dissipated = double(gn * un * un + gt * (tx * tx + ty * ty + tz * tz)) * double(dt);
+      const Real St = g.St[l], gt = g.gt[l], fn = g.fn[l];
+      const Real ftx = -St * sx - gt * tx, fty = -St * sy - gt * ty, ftz = -St * sz - gt * tz;
+      g.ft2[l] = ftx * ftx + fty * fty + ftz * ftz;
+      g.limit[l] = c.mu * (fn > 0 ? fn : zero);
+      g.sx[l] = sx, g.sy[l] = sy, g.sz[l] = sz, g.ftx[l] = ftx, g.fty[l] = fty, g.ftz[l] = ftz;
+    }
+    // 4: the Coulomb cut, the history refitted, forces and torques out.
+#pragma GCC ivdep
+    for (int l = 0; l < W; ++l) {
+      Real sx = g.sx[l], sy = g.sy[l], sz = g.sz[l], ftx = g.ftx[l], fty = g.fty[l], ftz = g.ftz[l];
+      const Real ft2 = g.ft2[l], limit = g.limit[l], St = g.St[l], gt = g.gt[l];
+      const Real tx = g.tx[l], ty = g.ty[l], tz = g.tz[l];
       const bool slide = ft2 > limit * limit;
       const Real scale = limit / std::sqrt(ft2);
       const double stored = 0.5 * double(St) * double(sx * sx + sy * sy + sz * sz);
@@ -272,20 +313,19 @@ struct HertzMindlin {
       sz = refit ? -(ftz + gt * tz) * inv_St : sz;
       if constexpr (Advance) {
         const double kept = 0.5 * double(St) * double(sx * sx + sy * sy + sz * sz);
-        dissipated += slide ? stored - kept : 0.0;
+        b.dissipated[l] += slide ? stored - kept : 0.0;
         b.h[l].x = double(sx);
         b.h[l].y = double(sy);
         b.h[l].z = double(sz);
-        b.dissipated[l] = dissipated;
       }
       b.sliding[l] = slide ? one : zero;
+      const Real fn = g.fn[l], nx = g.nx[l], ny = g.ny[l], nz = g.nz[l];
       const Real fx = fn * nx + ftx, fy = fn * ny + fty, fz = fn * nz + ftz;
       b.fx[l] = fx;
       b.fy[l] = fy;
       b.fz[l] = fz;
-      b.r[l] = r;
       // Torques (c - x_i) x F on i and (c - x_j) x (-F) on j: arms -ai n and aj n, n = d / r.
-      const Real si = -ai * inv_r, sj = aj * inv_r;
+      const Real dx = b.dx[l], dy = b.dy[l], dz = b.dz[l], si = g.si[l], sj = g.sj[l];
       const Real cx = dy * fz - dz * fy, cy = dz * fx - dx * fz, cz = dx * fy - dy * fx;
       b.tix[l] = si * cx, b.tiy[l] = si * cy, b.tiz[l] = si * cz;
       b.tjx[l] = -(sj * cx), b.tjy[l] = -(sj * cy), b.tjz[l] = -(sj * cz);
