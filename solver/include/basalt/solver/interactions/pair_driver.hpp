@@ -492,8 +492,9 @@ class PairDriver final : public ForceCompute<Real> {
     return energy;
   }
 
-  /// The lanes' particle inputs of pairs (i[l], j[l]), loaded in vector registers (gathers); the same
-  /// values, in the same operations, as a pair found in the list sees (dx = x_i - x_j, r2).
+  /// The lanes' particle inputs of pairs (i[l], j[l]), loaded in vector registers (gathers). The lanes take
+  /// dx = x_i - x_j and r2 from here, not from the finding loop (whose r2 only decides whether the pair
+  /// touches).
   template <bool Rot, class Lanes>
   BASALT_WIDE_LANES static void gather(const Particles<Real>& p, const std::uint32_t* __restrict ii,
                                        const std::uint32_t* __restrict jj, Lanes& L) {
