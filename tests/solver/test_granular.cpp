@@ -542,6 +542,92 @@ e = 0.5
   EXPECT_EQ(records(), (std::vector<std::pair<std::int64_t, std::int64_t>>{{3, 4}}));
 }
 
+// The pair loop evaluates a model with one group in lanes (PairDriver::batches: contacts found in one loop
+// over the listed pairs with each pair's row from a table, gathered 16 at a time, forces added to both
+// particles) and a model with several groups pair by pair (rows, with the scalar contact()). Three groups of
+// the same material over tags 1 and 2 take the second path on the same cluster: a dense, spinning, shearing
+// cluster whose contacts open, close and slide, through several rebuilds, must move the same both ways.
+TEST(HertzMindlin, LanesDriverMovesAClusterAsThePairByPairDriver) {
+  const std::string law = "E = 1.0e5\nnu = 0.25\nmu = 0.4\ne = 0.6\n";
+  const std::string head = "[particles]\nrotation = true\n[run]\ndt = 1e-4\nsteps = 0\nskin = 0.05\n";
+  const auto one = basalt::test::scene_from(head + "[[interactions]]\ntype = \"hertz_mindlin\"\n" + law);
+  std::string groups = head;
+  for (const char* tags : {"[1, 1]", "[1, 2]", "[2, 2]"})
+    groups += std::string("[[interactions]]\ntype = \"hertz_mindlin\"\ntags = ") + tags + "\n" + law;
+  const auto three = basalt::test::scene_from(groups);
+  basalt::io::Geometry g;
+  const auto u = [](std::uint64_t k) { return 0.5 * basalt::test::hash_unit(k); };  // [-0.5, 0.5)
+  std::int64_t id = 1;
+  for (int a = 0; a < 8; ++a)
+    for (int b = 0; b < 8; ++b)
+      for (int c = 0; c < 8; ++c, ++id) {  // spacing about 1 for radii 0.48-0.52: some touch, some not
+        const auto k = static_cast<std::uint64_t>(7 * id);
+        g.add_particle(id, {a + 0.04 * u(k), b + 0.04 * u(k + 1), c + 0.04 * u(k + 2)}, 0.5 + 0.04 * u(k + 3),
+                       static_cast<std::int32_t>(1 + id % 2));
+      }
+  RunOptions opt;
+  opt.quiet = true;
+  Simulation<double> lanes(one, g, MPI_COMM_SELF, opt), rows(three, g, MPI_COMM_SELF, opt);
+  for (auto* sim : {&lanes, &rows}) {
+    auto& p = sim->particles();
+    for (std::size_t i = 0; i < p.n_owned; ++i) {
+      const auto k = static_cast<std::uint64_t>(1000 + 11 * p.id[i]);
+      p.vx[i] = 0.3 * p.y[i] + 0.2 * u(k), p.vy[i] = 0.2 * u(k + 1), p.vz[i] = -0.1 * p.x[i] + 0.2 * u(k + 2);
+      p.wx[i] = u(k + 3), p.wy[i] = u(k + 4), p.wz[i] = u(k + 5);
+    }
+    sim->state_changed();
+  }
+  const auto start = lanes.rebuilds();
+  for (int s = 0; s < 400; ++s) {
+    lanes.step();
+    rows.step();
+  }
+  ASSERT_GE(lanes.rebuilds() - start, 3)
+      << "the run must cross rebuilds (the row table is rebuilt with them)";
+  ASSERT_EQ(lanes.rebuilds(), rows.rebuilds());
+  const auto& a = lanes.particles();
+  const auto& b = rows.particles();
+  ASSERT_EQ(a.n_owned, b.n_owned);
+  double vmax = 0, wmax = 0;
+  for (std::size_t i = 0; i < a.n_owned; ++i) {
+    vmax = std::max({vmax, std::abs(b.vx[i]), std::abs(b.vy[i]), std::abs(b.vz[i])});
+    wmax = std::max({wmax, std::abs(b.wx[i]), std::abs(b.wy[i]), std::abs(b.wz[i])});
+  }
+  for (std::size_t i = 0; i < a.n_owned; ++i) {
+    ASSERT_EQ(a.id[i], b.id[i]);
+    EXPECT_NEAR(a.x[i], b.x[i], 1e-9) << "particle " << a.id[i];
+    EXPECT_NEAR(a.z[i], b.z[i], 1e-9) << "particle " << a.id[i];
+    EXPECT_NEAR(a.vx[i], b.vx[i], 1e-8 * vmax) << "particle " << a.id[i];
+    EXPECT_NEAR(a.vy[i], b.vy[i], 1e-8 * vmax) << "particle " << a.id[i];
+    EXPECT_NEAR(a.wz[i], b.wz[i], 1e-8 * wmax) << "particle " << a.id[i];
+  }
+  // The contacts slid and parted on the way: the run exercised the Coulomb cut and the history clearing.
+  EXPECT_GT(lanes.force_computes()[0]->dissipated(), 0.0);
+}
+
+// Each pair takes its own group's material: a tag-1 and a tag-2 sphere pressed together feel the [1, 2]
+// group's Hertz force, not the first group's (the lanes take one group's coefficients: several groups must
+// go pair by pair).
+TEST(HertzMindlin, APairTakesItsOwnGroupsMaterial) {
+  std::string scene = "[run]\ndt = 1e-8\nsteps = 0\nskin = 0.01\n";
+  for (const auto& [tags, E] : {std::pair{"[1, 1]", "1.0e5"}, {"[1, 2]", "4.0e5"}, {"[2, 2]", "1.0e5"}})
+    scene += std::string("[[interactions]]\ntype = \"hertz_mindlin\"\ntags = ") + tags + "\nE = " + E +
+             "\nnu = 0.25\n";
+  const double d = 0.01;  // overlap of two unit-radius spheres
+  basalt::io::Geometry g;
+  g.add_particle(1, {0, 0, 0}, 1.0, 1);
+  g.add_particle(2, {2 - d, 0, 0}, 1.0, 2);
+  RunOptions opt;
+  opt.quiet = true;
+  Simulation<double> sim(basalt::test::scene_from(scene), g, MPI_COMM_SELF, opt);
+  sim.step();
+  const auto& p = sim.particles();
+  const double E_star = 4.0e5 / (2 * (1 - 0.25 * 0.25)), R = 0.5;
+  const double want = 4.0 / 3.0 * E_star * std::sqrt(R) * std::pow(d, 1.5);
+  for (std::size_t i = 0; i < p.n_owned; ++i)
+    EXPECT_NEAR(std::abs(p.fx[i]), want, 1e-6 * want) << "particle " << p.id[i];
+}
+
 TEST(HertzMindlin, RestitutionAndContactDurationFollowTheClosedForms) {
   if (basalt::test::rank() != 0) return;
   // Undamped: duration 2.87 (m*^2 / (R* E*^2 v))^{1/5}; damped (Tsuji): the measured restitution equals

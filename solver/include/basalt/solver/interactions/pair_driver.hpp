@@ -237,15 +237,17 @@ class PairDriver final : public ForceCompute<Real> {
   template <bool Energy, bool Newton, bool Advance>
   double loop_kinematic(Particles<Real>& p, const PairList& list, History* hist) {
     const bool one = coeffs_.size() == 1;
+    // The lanes take one group's coefficients for every pair: several groups (tags) go pair by pair.
     if constexpr (kLanes) {
-      if (one)
+      if (one) {
         // (with bonded pairs listed, the contact test reads their marks: a loop of its own, so that the
         // granular scenes' loop has not even the test of the marks' pointer)
         if (!list.bonded.empty())
           return p.with_rotation ? batches<Energy, Newton, Advance, true, true>(p, list, hist)
                                  : batches<Energy, Newton, Advance, false, true>(p, list, hist);
-      return p.with_rotation ? batches<Energy, Newton, Advance, true, false>(p, list, hist)
-                             : batches<Energy, Newton, Advance, false, false>(p, list, hist);
+        return p.with_rotation ? batches<Energy, Newton, Advance, true, false>(p, list, hist)
+                               : batches<Energy, Newton, Advance, false, false>(p, list, hist);
+      }
     }
     if (p.with_rotation)
       return one ? rows<Energy, Newton, Advance, true, true>(p, list, hist)
