@@ -29,8 +29,8 @@ std::vector<T> sendrecv(MPI_Comm comm, const std::vector<T>& out, int dest, int 
 
 /// A ghost refresh travels array by array (all x, then all y, ...: step_arrays() order), so that
 /// packing is one gather per array and unpacking one contiguous copy per array into the ghosts'
-/// range [begin, begin + n). (Particle by particle, the 9 or 13 arrays of a rotating scene were
-/// an indirect load and store per value: a third of a 2-rank granular step's communication.)
+/// range [begin, begin + n), instead of an indirect load and store per value and particle through
+/// the 9 or 13 arrays of a rotating scene (its time gain was within the noise: docs/BENCHMARKS.md).
 template <class Real, class Arrays>
 void pack_step(std::vector<Real>& buf, const Arrays& arrays, std::size_t na,
                const std::vector<std::int32_t>& list) {
