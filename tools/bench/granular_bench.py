@@ -285,6 +285,8 @@ def main():
     # the rms speed is below --settle-vrms. A tall pile is still falling after one round (100k spheres:
     # 0.49 m/s rms after 9000 steps), and an unsettled pile rebuilds its lists every few tens of steps,
     # which is not the settled scene the benchmark promises.
+    if a.settle_rounds < 1:
+        raise SystemExit("--settle-rounds must be at least 1")
     geometry = "pack.h5"
     for rnd in range(a.settle_rounds):
         out = "settle_out" if rnd == 0 else f"settle_out{rnd}"
