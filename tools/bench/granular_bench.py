@@ -289,13 +289,12 @@ def main():
         raise SystemExit("--settle-rounds must be at least 1")
     geometry = "pack.h5"
     for rnd in range(a.settle_rounds):
-        out = "settle_out" if rnd == 0 else f"settle_out{rnd}"
+        sfx = str(rnd) if rnd else ""  # round 0 keeps the names of a one-round work folder
+        out = "settle_out" + sfx
         ck = sorted(glob.glob(os.path.join(W, out, "ckpt_*.h5")))
         if not ck:
-            scene = "settle.toml" if rnd == 0 else f"settle{rnd}.toml"
-            log = "settle.log" if rnd == 0 else f"settle{rnd}.log"
-            basalt_scene(os.path.join(W, scene), geometry, a.settle_steps, out, a.settle_steps)
-            sh(f"mpirun -np 2 {a.bin}/basalt-run {scene} --quiet", cwd=W, log=os.path.join(W, log))
+            basalt_scene(os.path.join(W, f"settle{sfx}.toml"), geometry, a.settle_steps, out, a.settle_steps)
+            sh(f"mpirun -np 2 {a.bin}/basalt-run settle{sfx}.toml --quiet", cwd=W, log=os.path.join(W, f"settle{sfx}.log"))
             ck = sorted(glob.glob(os.path.join(W, out, "ckpt_*.h5")))
         n, zmax, vrms = export(ck[-1], pack, W)
         print(f"settle round {rnd}: {n} particles, top {zmax:.4f} m, rms speed {vrms:.4g} m/s "
