@@ -47,16 +47,15 @@ class BodyDriver final : public ForceCompute<Real> {
   /// the rotational state (its inertia costs two divisions per particle).
   static constexpr bool kTurns = (Model::reads & kAngularVelocity) != 0 || (Model::writes & kTorque) != 0;
 
-  static constexpr int kLaneWidth = 8;
-  static constexpr bool kLanes = requires(const Coeffs& c, BodyLanes<Real, kLaneWidth>& b) {
-    Model::template apply_lanes<Real, kLaneWidth>(c, b);
+  static constexpr bool kAll = requires(const Coeffs& c, const BodyArrays<Real>& a) {
+    Model::apply_all(c, a);
   };
 
   template <bool Energy, bool Advance>
   double loop(Particles<Real>& p) {
-    if constexpr (kLanes) {
-      static_assert(Model::energy_term.empty(), "apply_lanes is for models without a potential");
-      if (coeffs_.size() == 1 && tags_[0].empty()) return lanes<Advance>(p);
+    if constexpr (kAll) {
+      static_assert(Model::energy_term.empty(), "apply_all is for models without a potential");
+      if (coeffs_.size() == 1 && tags_[0].empty()) return all<Advance>(p);
     }
     double e = 0, d = 0;
     const bool rot = kTurns && p.with_rotation;
@@ -95,46 +94,38 @@ class BodyDriver final : public ForceCompute<Real> {
     return e;
   }
 
-  /// loop() for a model with apply_lanes and one group taking every particle: kLaneWidth consecutive
-  /// particles at a time (a short last batch repeats its last particle), the same arithmetic per
+  /// loop() for a model with apply_all and one group taking every particle: the same arithmetic per
   /// particle as apply(), the dissipation added in particle order.
   template <bool Advance>
-  double lanes(Particles<Real>& p) {
+  double all(Particles<Real>& p) {
     const bool rot = kTurns && p.with_rotation;
     const std::size_t n = p.n_owned;
-    const Coeffs& c = coeffs_[0];
-    auto& L = lanes_;
-    L.dt = dt_;
-    double d = 0;
-    for (std::size_t i0 = 0; i0 < n; i0 += kLaneWidth) {
-      const int filled = static_cast<int>(std::min<std::size_t>(kLaneWidth, n - i0));
-      for (int l = 0; l < kLaneWidth; ++l) {
-        const std::size_t i = i0 + static_cast<std::size_t>(std::min(l, filled - 1));
-        L.m[l] = p.mass(i);
-        L.im[l] = p.inv_mass[i];
-        L.vx[l] = p.vx[i], L.vy[l] = p.vy[i], L.vz[l] = p.vz[i];
-        L.fx[l] = p.fx[i], L.fy[l] = p.fy[i], L.fz[l] = p.fz[i];
-        if (rot) {
-          L.inertia[l] = Real(1) / p.inverse_inertia(i);
-          L.wx[l] = p.wx[i], L.wy[l] = p.wy[i], L.wz[l] = p.wz[i];
-          L.tx[l] = p.tx[i], L.ty[l] = p.ty[i], L.tz[l] = p.tz[i];
-        }  // (else they stay zero: lanes_ starts zeroed, and only a turning model reads them)
-      }
-      Model::template apply_lanes<Real, kLaneWidth>(c, L);
-      for (int l = 0; l < filled; ++l) {
-        const std::size_t i = i0 + static_cast<std::size_t>(l);
-        p.fx[i] += L.gx[l], p.fy[i] += L.gy[l], p.fz[i] += L.gz[l];
-        if (rot) p.tx[i] += L.hx[l], p.ty[i] += L.hy[l], p.tz[i] += L.hz[l];
-        if constexpr (Advance) d += L.dissipated[l];
-      }
+    dissipation_.resize(n);
+    flags_.resize(n);
+    BodyArrays<Real> a;
+    a.n = n;
+    a.dt = dt_;
+    a.im = p.inv_mass.data(), a.radius = p.radius.data();
+    a.vx = p.vx.data(), a.vy = p.vy.data(), a.vz = p.vz.data();
+    a.fx = p.fx.data(), a.fy = p.fy.data(), a.fz = p.fz.data();
+    if (rot) {
+      a.wx = p.wx.data(), a.wy = p.wy.data(), a.wz = p.wz.data();
+      a.tx = p.tx.data(), a.ty = p.ty.data(), a.tz = p.tz.data();
     }
-    dissipated_ += d;
+    a.dissipated = dissipation_.data();
+    a.flag = flags_.data();
+    if (!rot && kTurns) return 0;  // (a turning model on particles that do not turn)
+    Model::apply_all(coeffs_[0], a);
+    if constexpr (Advance) {
+      double d = 0;
+      for (std::size_t i = 0; i < n; ++i) d += dissipation_[i];
+      dissipated_ += d;
+    }
     return 0;
   }
 
-  struct NoLanes {};
-  [[no_unique_address]] std::conditional_t<kLanes, BodyLanes<Real, kLaneWidth>, NoLanes> lanes_{};
-
+  std::vector<double> dissipation_;  ///< apply_all's energies per particle
+  std::vector<std::uint8_t> flags_;  ///< apply_all's scratch
   std::vector<Coeffs> coeffs_;
   std::vector<TagFilter> tags_;
   double dissipated_ = 0;

@@ -86,67 +86,79 @@ struct LinearDamping {
     return u;
   }
 
-  /// esys_velocity for W particles side by side (M and s per lane; v in, the damped velocity u out):
-  /// each lane iterates exactly as the scalar form and stops where it would, branch-free (a particle's
-  /// iteration count depends on its speed: the scalar loop mispredicted it). Inputs and outputs are
-  /// separate arrays: GCC 12 at -O2 lost a component of v in a form that overwrote it in place.
-  template <class Real, int W>
-  static void esys_velocity_lanes(Real nu, const Real* __restrict M, const Real* __restrict s, Real dt, int n,
-                                  const Real* __restrict vx, const Real* __restrict vy,
-                                  const Real* __restrict vz, const Real* __restrict Fx,
-                                  const Real* __restrict Fy, const Real* __restrict Fz, Real* __restrict ux,
-                                  Real* __restrict uy, Real* __restrict uz) {
-    alignas(64) Real count[W], on[W];
-    for (int l = 0; l < W; ++l) {
-      ux[l] = 0;
-      uy[l] = 0;
-      uz[l] = 0;
-      count[l] = 0;
-      on[l] = n > 0 ? 1 : 0;  // (the first test, error = 1 > 1e-6, always passes)
-    }
+  /// The first two of esys_velocity's iterations (n > 0; n = 0 leaves u = v), branch-free (a vector loop
+  /// runs it for many particles side by side): u after them, and whether the particle iterates on (then
+  /// only esys_velocity gives its u). The same arithmetic in the same order: where it stops, u is
+  /// esys_velocity's bit for bit. (ESyS's test stops nearly every particle after one or two: the second
+  /// update is nu dt times the first.)
+  template <class Real>
+  [[gnu::always_inline]] static inline bool esys_two(Real nu, Real M, Real s, Real dt, int n, Real vx,
+                                                     Real vy, Real vz, Real Fx, Real Fy, Real Fz, Real& ux,
+                                                     Real& uy, Real& uz) {
+    const bool iterated = n > 0;  // (else the explicit form: u = v)
     const Real limit = Real(n);
-    for (int it = 0; it < n; ++it) {
-      Real any = 0;
-      for (int l = 0; l < W; ++l) {
-        const Real x = vx[l] + s[l] * dt * (Fx[l] - ux[l] * nu * M[l]);
-        const Real y = vy[l] + s[l] * dt * (Fy[l] - uy[l] * nu * M[l]);
-        const Real z = vz[l] + s[l] * dt * (Fz[l] - uz[l] * nu * M[l]);
-        const double error =
-            double((x - ux[l]) * (x - ux[l]) + (y - uy[l]) * (y - uy[l]) + (z - uz[l]) * (z - uz[l]));
-        const bool step = on[l] != 0;
-        ux[l] = step ? x : ux[l];
-        uy[l] = step ? y : uy[l];
-        uz[l] = step ? z : uz[l];
-        count[l] += step ? 1 : 0;
-        on[l] = step && error * error > 1e-12 && count[l] < limit ? 1 : 0;
-        any += on[l];
-      }
-      if (any == 0) break;
+    Real count = 0;
+    // Whether the lane still iterates, as 0 or 1 (bools here let GCC branch on a comparison, which may
+    // trap, and then give up vectorising the loop). The first test, error = 1 > 1e-6, always passes.
+    Real on = iterated ? 1 : 0;
+    ux = iterated ? Real(0) : vx;
+    uy = iterated ? Real(0) : vy;
+    uz = iterated ? Real(0) : vz;
+    for (int it = 0; it < 2; ++it) {
+      const Real x = vx + s * dt * (Fx - ux * nu * M);
+      const Real y = vy + s * dt * (Fy - uy * nu * M);
+      const Real z = vz + s * dt * (Fz - uz * nu * M);
+      const double error = double((x - ux) * (x - ux) + (y - uy) * (y - uy) + (z - uz) * (z - uz));
+      const bool step = on != 0;
+      ux = step ? x : ux;
+      uy = step ? y : uy;
+      uz = step ? z : uz;
+      count += step ? 1 : 0;
+      on = step && error * error > 1e-12 && count < limit ? 1 : 0;
     }
-    for (int l = 0; l < W; ++l) {
-      const bool spent = count[l] >= limit;
-      ux[l] = spent ? 0 : ux[l];
-      uy[l] = spent ? 0 : uy[l];
-      uz[l] = spent ? 0 : uz[l];
-    }
+    const bool spent = iterated && count >= limit;
+    ux = spent ? 0 : ux;
+    uy = spent ? 0 : uy;
+    uz = spent ? 0 : uz;
+    return on != 0;
   }
 
-  template <class Real, int W>
-  static void apply_lanes(const Coeffs<Real>& c, BodyLanes<Real, W>& b) {
-    alignas(64) Real vx[W], vy[W], vz[W], ux[W], uy[W], uz[W];
-    for (int l = 0; l < W; ++l) vx[l] = b.vx[l] - c.vx, vy[l] = b.vy[l] - c.vy, vz[l] = b.vz[l] - c.vz;
-    if (c.iterations > 0)
-      esys_velocity_lanes<Real, W>(c.nu, b.m, b.im, b.dt, c.iterations, vx, vy, vz, b.fx, b.fy, b.fz, ux, uy,
-                                   uz);
-    else
-      for (int l = 0; l < W; ++l) ux[l] = vx[l], uy[l] = vy[l], uz[l] = vz[l];
-    for (int l = 0; l < W; ++l) {
-      const Real s = -c.nu * b.m[l];
-      b.gx[l] = s * ux[l];
-      b.gy[l] = s * uy[l];
-      b.gz[l] = s * uz[l];
-      b.hx[l] = b.hy[l] = b.hz[l] = 0;
-      b.dissipated[l] = -double(b.gx[l] * b.vx[l] + b.gy[l] * b.vy[l] + b.gz[l] * b.vz[l]) * double(b.dt);
+  /// F = -nu m u (u = v - v_ref, or ESyS's damped velocity) on every particle: one loop in vector
+  /// registers, then esys_velocity for the few particles still iterating after two updates (their force is
+  /// left out of the loop, so that both give exactly apply()'s force).
+  template <class Real>
+  BASALT_WIDE_LANES static void apply_all(const Coeffs<Real>& c, const BodyArrays<Real>& a) {
+    const Real nu = c.nu, dt = a.dt, rx = c.vx, ry = c.vy, rz = c.vz;
+    const int n = c.iterations;
+    const Real* __restrict im = a.im, * __restrict vx = a.vx, * __restrict vy = a.vy, * __restrict vz = a.vz;
+    Real* __restrict fx = a.fx, * __restrict fy = a.fy, * __restrict fz = a.fz;
+    double* __restrict out = a.dissipated;
+    std::uint8_t* __restrict more = a.flag;
+    const std::size_t np = a.n;  // (a local: the byte stores through `more` may alias a.n)
+    // (the arrays are distinct: without ivdep GCC wants more run-time alias tests than it makes)
+#pragma GCC ivdep
+    for (std::size_t i = 0; i < np; ++i) {
+      const Real m = Real(1) / im[i];
+      Real ux = vx[i] - rx, uy = vy[i] - ry, uz = vz[i] - rz;
+      const bool on = esys_two(nu, m, im[i], dt, n, ux, uy, uz, fx[i], fy[i], fz[i], ux, uy, uz);
+      const Real k = -nu * m;
+      const Real gx = k * ux, gy = k * uy, gz = k * uz;
+      out[i] = -double(gx * vx[i] + gy * vy[i] + gz * vz[i]) * double(dt);
+      fx[i] = on ? fx[i] : fx[i] + gx;
+      fy[i] = on ? fy[i] : fy[i] + gy;
+      fz[i] = on ? fz[i] : fz[i] + gz;
+      more[i] = on;
+    }
+    for (std::size_t i = 0; i < np; ++i) {
+      if (more[i] == 0) [[likely]]
+        continue;
+      BodyState<Real> b{};
+      b.m = Real(1) / im[i], b.im = im[i], b.dt = dt;
+      b.vx = vx[i], b.vy = vy[i], b.vz = vz[i], b.fx = fx[i], b.fy = fy[i], b.fz = fz[i];
+      BodyForce<Real> f;
+      apply(c, b, f);
+      fx[i] += f.fx, fy[i] += f.fy, fz[i] += f.fz;
+      out[i] = f.dissipated;
     }
   }
 
@@ -202,22 +214,48 @@ struct RotationalDamping {
   }
   static double max_stiffness(const Params&, double) { return 0; }
 
-  template <class Real, int W>
-  static void apply_lanes(const Coeffs<Real>& c, BodyLanes<Real, W>& b) {
-    alignas(64) Real ux[W], uy[W], uz[W], s[W];
-    for (int l = 0; l < W; ++l) s[l] = Real(1) / b.inertia[l];
-    if (c.iterations > 0)
-      LinearDamping::esys_velocity_lanes<Real, W>(c.nu, b.inertia, s, b.dt, c.iterations, b.wx, b.wy, b.wz,
-                                                  b.tx, b.ty, b.tz, ux, uy, uz);
-    else
-      for (int l = 0; l < W; ++l) ux[l] = b.wx[l], uy[l] = b.wy[l], uz[l] = b.wz[l];
-    for (int l = 0; l < W; ++l) {
-      const Real k = -c.nu * b.inertia[l];
-      b.gx[l] = b.gy[l] = b.gz[l] = 0;
-      b.hx[l] = k * ux[l];
-      b.hy[l] = k * uy[l];
-      b.hz[l] = k * uz[l];
-      b.dissipated[l] = -double(b.hx[l] * b.wx[l] + b.hy[l] * b.wy[l] + b.hz[l] * b.wz[l]) * double(b.dt);
+  /// I as BodyDriver::loop takes it: 1 / Particles::inverse_inertia.
+  template <class Real>
+  static Real inertia(Real im, Real r) {
+    return Real(1) / (Real(2.5) * im / (r * r));
+  }
+
+  /// T = -nu I w (w ESyS's damped spin) on every particle, as LinearDamping::apply_all.
+  template <class Real>
+  BASALT_WIDE_LANES static void apply_all(const Coeffs<Real>& c, const BodyArrays<Real>& a) {
+    const Real nu = c.nu, dt = a.dt;
+    const int n = c.iterations;
+    const Real* __restrict im = a.im, * __restrict rad = a.radius;
+    const Real* __restrict wx = a.wx, * __restrict wy = a.wy, * __restrict wz = a.wz;
+    Real* __restrict tx = a.tx, * __restrict ty = a.ty, * __restrict tz = a.tz;
+    double* __restrict out = a.dissipated;
+    std::uint8_t* __restrict more = a.flag;
+    const std::size_t np = a.n;  // (a local: the byte stores through `more` may alias a.n)
+    // (the arrays are distinct: without ivdep GCC wants more run-time alias tests than it makes)
+#pragma GCC ivdep
+    for (std::size_t i = 0; i < np; ++i) {
+      const Real I = inertia(im[i], rad[i]);
+      Real ux = wx[i], uy = wy[i], uz = wz[i];
+      const bool on =
+          LinearDamping::esys_two(nu, I, Real(1) / I, dt, n, ux, uy, uz, tx[i], ty[i], tz[i], ux, uy, uz);
+      const Real k = -nu * I;
+      const Real hx = k * ux, hy = k * uy, hz = k * uz;
+      out[i] = -double(hx * wx[i] + hy * wy[i] + hz * wz[i]) * double(dt);
+      tx[i] = on ? tx[i] : tx[i] + hx;
+      ty[i] = on ? ty[i] : ty[i] + hy;
+      tz[i] = on ? tz[i] : tz[i] + hz;
+      more[i] = on;
+    }
+    for (std::size_t i = 0; i < np; ++i) {
+      if (more[i] == 0) [[likely]]
+        continue;
+      BodyState<Real> b{};
+      b.inertia = inertia(im[i], rad[i]), b.dt = dt;
+      b.wx = wx[i], b.wy = wy[i], b.wz = wz[i], b.tx = tx[i], b.ty = ty[i], b.tz = tz[i];
+      BodyForce<Real> f;
+      apply(c, b, f);
+      tx[i] += f.tx, ty[i] += f.ty, tz[i] += f.tz;
+      out[i] = f.dissipated;
     }
   }
 

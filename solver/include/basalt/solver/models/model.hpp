@@ -153,16 +153,21 @@ struct BodyForce {
   double dissipated = 0;  ///< energy it takes out this step (damping)
 };
 
-/// W particles side by side for a body-force model with `apply_lanes` (BodyDriver): BodyState's fields
-/// that damping reads in, BodyForce's out. A model that defines it has no potential energy.
-template <class Real, int W>
-struct BodyLanes {
-  alignas(64) Real m[W], im[W], inertia[W];
-  alignas(64) Real vx[W], vy[W], vz[W], fx[W], fy[W], fz[W];
-  alignas(64) Real wx[W], wy[W], wz[W], tx[W], ty[W], tz[W];
-  alignas(64) Real gx[W], gy[W], gz[W];  ///< out: force added
-  alignas(64) Real hx[W], hy[W], hz[W];  ///< out: torque added
-  alignas(64) double dissipated[W];      ///< out
+/// Every owned particle at once, for a body-force model with `apply_all` (BodyDriver, one group taking
+/// every particle): the particles' arrays in (the rotational ones null without rotation), forces and
+/// torques added to in place, and each particle's dissipated energy out. A model that defines it has no
+/// potential energy. One loop over the arrays runs in vector registers, with no copy of the particles'
+/// state into lanes and back.
+template <class Real>
+struct BodyArrays {
+  std::size_t n = 0;
+  const Real *im = nullptr, *radius = nullptr;
+  const Real *vx = nullptr, *vy = nullptr, *vz = nullptr;
+  const Real *wx = nullptr, *wy = nullptr, *wz = nullptr;
+  Real *fx = nullptr, *fy = nullptr, *fz = nullptr;
+  Real *tx = nullptr, *ty = nullptr, *tz = nullptr;
+  double* dissipated = nullptr;  ///< out: n values
+  std::uint8_t* flag = nullptr;  ///< n bytes of scratch for the model
   Real dt = 0;
 };
 
