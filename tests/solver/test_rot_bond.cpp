@@ -927,6 +927,30 @@ convention = "esys"
   EXPECT_NEAR(fx[100], -pi * 1000.0 * 0.9 / 4 * overlap, 1e-9);  // still the contact at the end
 }
 
+TEST(PairList, UnbondKeepsTheLooseEntriesInListOrder) {
+  // The contact loops step over loose[loose_offset[i] .. loose_offset[i + 1]), the entries of row i not
+  // bonded: a break must add its entry at its place in list order (the loops then add the pair's force
+  // where a loop over every entry would, bit for bit). Four rows, some empty; breaks in scrambled order,
+  // including a pair listed from its other end (unbond(j, i)) and one broken twice.
+  PairList l;
+  l.offset = {0, 4, 4, 7, 9};
+  l.neigh = {1, 2, 5, 6, 2, 3, 7, 5, 8};
+  l.bonded = {1, 0, 1, 1, 1, 1, 0, 1, 1};
+  l.index_loose();
+  EXPECT_EQ(l.loose, (std::vector<std::uint32_t>{1, 6}));
+  EXPECT_EQ(l.loose_offset, (std::vector<std::uint32_t>{0, 1, 1, 2, 2}));
+  for (const auto& [i, j] : std::vector<std::array<std::size_t, 2>>{{0, 6}, {8, 3}, {2, 3}, {0, 1}, {0, 6}})
+    EXPECT_TRUE(l.unbond(i, j)) << i << " " << j;
+  EXPECT_FALSE(l.unbond(1, 4));  // not listed
+  EXPECT_EQ(l.loose, (std::vector<std::uint32_t>{0, 1, 3, 5, 6, 8}));
+  EXPECT_EQ(l.loose_offset, (std::vector<std::uint32_t>{0, 3, 3, 5, 6}));
+  // The same as indexing the marks afresh.
+  PairList fresh = l;
+  fresh.index_loose();
+  EXPECT_EQ(l.loose, fresh.loose);
+  EXPECT_EQ(l.loose_offset, fresh.loose_offset);
+}
+
 TEST(RotBondRun, BrokenBondsBecomeContactsWithoutARebuild) {
   // Where bonds can break, the contact lists hold the bonded pairs, marked, and a break clears the mark
   // (ForceField::lists_mark_bonds): the pair is a contact from the next step on, as after a rebuild

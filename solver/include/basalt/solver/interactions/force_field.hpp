@@ -68,6 +68,8 @@ class ForceField {
   void set_bond_marks(std::array<std::vector<std::uint8_t>, 2> marks) {
     own_.bonded = std::move(marks[0]);
     ghost_.bonded = std::move(marks[1]);
+    own_.index_loose();
+    ghost_.index_loose();
   }
 
   // Energy ledger.

@@ -16,13 +16,29 @@ namespace basalt::solver {
 
 /// Compressed rows over owned particles: neighbours of i are neigh[offset[i] .. offset[i+1]). With
 /// bonded pairs listed (`bonded` not empty), bonded[e] is 1 while entry e's pair is bonded: the pair
-/// models pass over it as over a pair apart.
+/// models pass over it as over a pair apart. They step over the entries of the pairs not bonded alone:
+/// loose[loose_offset[i] .. loose_offset[i+1]) are row i's, in list order (in an intact rock most listed
+/// pairs are bonded).
 struct PairList {
   std::vector<std::uint32_t> offset;
   std::vector<std::int32_t> neigh;
   std::vector<std::uint8_t> bonded;  ///< empty: bonded pairs are not listed at all
   std::size_t pairs() const { return neigh.size(); }
+  std::vector<std::uint32_t> loose_offset, loose;  ///< with bonded marks: the entries not bonded, by row
   bool is_bonded(std::size_t e) const { return !bonded.empty() && bonded[e] != 0; }
+  /// loose_offset and loose from the marks (after the list is built, or its marks are set).
+  void index_loose() {
+    loose_offset.clear();
+    loose.clear();
+    if (bonded.empty()) return;
+    const std::size_t n = offset.empty() ? 0 : offset.size() - 1;
+    loose_offset.assign(n + 1, 0);
+    for (std::size_t i = 0; i < n; ++i) {
+      for (auto e = offset[i]; e < offset[i + 1]; ++e)
+        if (bonded[e] == 0) loose.push_back(e);
+      loose_offset[i + 1] = static_cast<std::uint32_t>(loose.size());
+    }
+  }
   /// The bond of listed pair (i, j) broke (i owned; j owned or a ghost): from now on it is a contact.
   /// Returns whether the pair was listed (a pair beyond its cutoff at the last rebuild cannot touch
   /// before the next one).
@@ -32,7 +48,14 @@ struct PairList {
       if (row + 1 >= offset.size()) return false;
       for (auto e = offset[row]; e < offset[row + 1]; ++e)
         if (static_cast<std::size_t>(neigh[e]) == other) {
-          bonded[e] = 0;
+          if (bonded[e] != 0) {
+            bonded[e] = 0;
+            // e joins its row's loose entries, in list order.
+            const auto first = loose.begin() + loose_offset[row],
+                       last = loose.begin() + loose_offset[row + 1];
+            loose.insert(std::lower_bound(first, last, e), e);
+            for (auto k = row + 1; k < loose_offset.size(); ++k) ++loose_offset[k];
+          }
           return true;
         }
       return false;
@@ -40,8 +63,8 @@ struct PairList {
     return clear_in_row(i, j) || clear_in_row(j, i);
   }
   std::size_t memory_bytes() const {
-    return offset.capacity() * sizeof(std::uint32_t) + neigh.capacity() * sizeof(std::int32_t) +
-           bonded.capacity();
+    return (offset.capacity() + loose_offset.capacity() + loose.capacity()) * sizeof(std::uint32_t) +
+           neigh.capacity() * sizeof(std::int32_t) + bonded.capacity();
   }
 };
 
@@ -153,6 +176,8 @@ void build_pair_lists(const Particles<Real>& p, const CellGrid& owned, const Cel
   ghost.neigh.shrink_to_fit();
   own.bonded.shrink_to_fit();
   ghost.bonded.shrink_to_fit();
+  own.index_loose();
+  ghost.index_loose();
 }
 
 }  // namespace basalt::solver
