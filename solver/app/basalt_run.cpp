@@ -406,7 +406,8 @@ int run_world(int argc, char** argv) {
   app.add_option("--steps", cli.steps, "number of steps; overrides run.steps (with --restart: steps to add)")
       ->check(kNonNegative);
   app.add_option("--output", cli.output, "output folder; overrides output.directory");
-  app.add_option("--dims", cli.dims_text, "compute-rank grid x,y,z (default: MPI_Dims_create)");
+  app.add_option("--dims", cli.dims_text,
+                 "compute-rank grid x,y,z (default: the least cut area, docs/solver.md)");
   app.add_option("--io-ranks", cli.io_ranks,
                  "dedicated I/O ranks among the mpirun ranks (0: compute ranks write)")
       ->check(kNonNegative);

@@ -9,11 +9,33 @@
 
 namespace basalt::solver {
 
+std::array<int, 3> default_dims(int n, const std::array<double, 3>& box_min,
+                                const std::array<double, 3>& box_max) {
+  std::array<int, 3> dims{0, 0, 0};
+  MPI_Dims_create(n, 3, dims.data());
+  std::array<double, 3> len{};
+  for (int d = 0; d < 3; ++d) len[d] = std::max(box_max[d] - box_min[d], 0.0);
+  if (!std::isfinite(len[0] + len[1] + len[2])) return dims;
+  // The area of the interior cut planes: dims[d] - 1 planes across the box's other two extents.
+  const auto area = [&](const std::array<int, 3>& g) {
+    return (g[0] - 1) * len[1] * len[2] + (g[1] - 1) * len[0] * len[2] + (g[2] - 1) * len[0] * len[1];
+  };
+  std::array<int, 3> best = dims;
+  for (int a = 1; a <= n; ++a)
+    for (int b = 1; a * b <= n; ++b)
+      if (n % (a * b) == 0) {
+        const std::array<int, 3> g{a, b, n / (a * b)};
+        if (area(g) < area(best)) best = g;
+      }
+  return area(best) < 0.9 * area(dims) ? best : dims;
+}
+
 namespace {
-MPI_Comm make_cart(const Comm& comm, std::array<int, 3>& dims) {
+MPI_Comm make_cart(const Comm& comm, std::array<int, 3>& dims, const std::array<double, 3>& box_min,
+                   const std::array<double, 3>& box_max) {
   const int n = comm.size();
   if (dims[0] == 0 && dims[1] == 0 && dims[2] == 0) {
-    MPI_Dims_create(n, 3, dims.data());
+    dims = default_dims(n, box_min, box_max);
   } else if (dims[0] < 1 || dims[1] < 1 || dims[2] < 1 || dims[0] * dims[1] * dims[2] != n) {
     throw InputError(fmt::format("--dims {},{},{}: the product must equal the number of ranks ({})", dims[0],
                                  dims[1], dims[2], n));
@@ -27,7 +49,11 @@ MPI_Comm make_cart(const Comm& comm, std::array<int, 3>& dims) {
 
 Decomposition::Decomposition(const Comm& comm, std::array<int, 3> dims, const std::array<double, 3>& box_min,
                              const std::array<double, 3>& box_max)
-    : cart_raw_(make_cart(comm, dims)), cart_(cart_raw_), dims_(dims), box_min_(box_min), box_max_(box_max) {
+    : cart_raw_(make_cart(comm, dims, box_min, box_max)),
+      cart_(cart_raw_),
+      dims_(dims),
+      box_min_(box_min),
+      box_max_(box_max) {
   MPI_Cart_coords(cart_raw_, cart_.rank(), 3, coords_.data());
   for (int d = 0; d < 3; ++d) {
     MPI_Cart_shift(cart_raw_, d, 1, &nb_[d][0], &nb_[d][1]);

@@ -71,6 +71,28 @@ TEST(BalancedCuts, CheckpointTextRoundTripsExactly) {
   EXPECT_FALSE(parse_cuts("1;;;"));
 }
 
+TEST(DefaultDims, LeastCutAreaUnlessNearlyCubic) {
+  // With no --dims, the rank grid cuts the box with the least plane area when that is at least 10 % less
+  // than MPI_Dims_create's grid (which does not see the box); near-cubic boxes keep MPI's grid.
+  using A = std::array<double, 3>;
+  using G = std::array<int, 3>;
+  const A o{0, 0, 0};
+  const auto mpi = [](int n) {
+    G g{0, 0, 0};
+    MPI_Dims_create(n, 3, g.data());
+    return g;
+  };
+  EXPECT_EQ(default_dims(2, o, A{10, 10, 20}), (G{1, 1, 2}));  // the UCS specimen: across its length
+  EXPECT_EQ(default_dims(2, A{-1, -1, 5}, A{9, 19, 15}), (G{1, 2, 1}));
+  EXPECT_EQ(default_dims(4, o, A{10, 10, 40}), (G{1, 1, 4}));
+  EXPECT_EQ(default_dims(4, o, A{100, 1, 1}), (G{4, 1, 1}));    // a rod
+  EXPECT_EQ(default_dims(4, o, A{100, 100, 1}), (G{2, 2, 1}));  // a plate: MPI's grid is the least area
+  EXPECT_EQ(default_dims(2, o, A{15, 15, 15}), mpi(2));
+  EXPECT_EQ(default_dims(2, o, A{15, 15, 15.5}), mpi(2));  // 3 % longer: within 10 %
+  EXPECT_EQ(default_dims(8, o, A{15, 15, 15}), (G{2, 2, 2}));
+  EXPECT_EQ(default_dims(1, o, A{1, 2, 3}), (G{1, 1, 1}));
+}
+
 TEST(BalanceScene, KeysAreReadAndBadValuesNamed) {
   const std::string run = "[run]\ndt = 1e-3\nsteps = 1\nskin = 0.1\n";
   const auto s = basalt::test::scene_from(run + "balance = \"count\"\nbalance_threshold = 1.5\n");

@@ -14,9 +14,16 @@
 
 namespace basalt::solver {
 
+/// The rank grid for n ranks on this box when the user names none: MPI_Dims_create's, unless another
+/// grid cuts the box with at least 10 % less plane area (LAMMPS's `processors * * *` takes the least
+/// area; MPI_Dims_create ignores the box, and splits a 10 x 10 x 20 specimen across its length on 2
+/// ranks: twice the ghosts and the bonds evaluated on both sides). Near-cubic boxes keep MPI's grid.
+std::array<int, 3> default_dims(int n, const std::array<double, 3>& box_min,
+                                const std::array<double, 3>& box_max);
+
 class Decomposition {
  public:
-  /// dims: {0,0,0} lets MPI_Dims_create choose; else the product must equal the number of ranks.
+  /// dims: {0,0,0} lets default_dims choose; else the product must equal the number of ranks.
   /// Throws InputError when dims do not fit.
   Decomposition(const Comm& comm, std::array<int, 3> dims, const std::array<double, 3>& box_min,
                 const std::array<double, 3>& box_max);
