@@ -35,6 +35,9 @@ class BodyDriver final : public ForceCompute<Real> {
   void set_dissipated(double d) override { dissipated_ = d; }
   void set_time_step(double dt) override { dt_ = Real(dt); }
   double max_stiffness(double) const override { return 0; }
+  std::size_t memory_bytes() const override {
+    return dissipation_.capacity() * sizeof(double) + flags_.capacity();
+  }
 
   double compute(ForceState<Real>& s, Part part, bool energy, bool advance) override {
     if (part != Part::ghost) return 0;

@@ -302,7 +302,9 @@ class PairDriver final : public ForceCompute<Real> {
     ContactKinematics<Real> k{};
     k.dt = dt_;
     for (std::size_t i = 0; i < n; ++i) {
-      if (off[i] == off[i + 1]) continue;  // most rows of the ghost list
+      // Most rows of the ghost list, and in an intact rock most rows of the loose pairs: nothing to add (the
+      // sums start at +0 and no addition turns them to -0, so adding a zero row's +0 changes no bit).
+      if (from[i] == from[i + 1]) continue;
       const Real xi = x[i], yi = y[i], zi = z[i], ri = rad[i], imi = im[i];
       const Real vxi = vx[i], vyi = vy[i], vzi = vz[i];
       Real fxi = 0, fyi = 0, fzi = 0, txi = 0, tyi = 0, tzi = 0;
