@@ -287,9 +287,11 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
   const auto& st = sim->stability();
   const double imbalance_start = sim->imbalance();
   const auto balance_setting = [&] {
+    if (scene.balance == "none") return std::string("run.balance = \"none\"");
     return scene.balance == "count"
-               ? fmt::format("run.balance = \"count\", threshold {}", scene.balance_threshold)
-               : std::string("run.balance = \"none\"");
+               ? fmt::format("run.balance = \"count\", threshold {}", scene.balance_limit())
+               : fmt::format("run.balance = \"time\", threshold {}, every {} steps", scene.balance_limit(),
+                             scene.balance_every);
   };
   if (root) {
     fmt::print(
@@ -443,13 +445,13 @@ int run_world(int argc, char** argv) {
       ->check(CLI::IsMember({"double", "float", "mixed"}));
   app.add_option(
          "--balance", cli.balance,
-         "load balancing of the rank grid: none (even cuts) or count (cuts moved at rebuilds by particle "
-         "count; docs/solver.md); overrides run.balance")
-      ->check(CLI::IsMember({"none", "count"}));
+         "load balancing of the rank grid: none (even cuts), count (cuts moved at rebuilds by particle "
+         "count) or time (cuts moved by measured compute time; docs/solver.md); overrides run.balance")
+      ->check(CLI::IsMember({"none", "count", "time"}));
   app.add_option(
          "--balance-threshold", cli.balance_threshold,
-         "re-balance when the busiest rank holds more than this x the mean particles (>= 1); overrides "
-         "run.balance_threshold")
+         "re-balance when the busiest rank holds more than this x the mean particles, or compute time with "
+         "--balance time (>= 1); overrides run.balance_threshold")
       ->check(CLI::Range(1.0, 1e300));
   app.add_flag("--quiet", cli.quiet, "no progress line");
   app.add_flag("--whole-geometry", cli.whole_geometry,

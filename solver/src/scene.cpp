@@ -222,12 +222,16 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
     }
     s.energy_check_every = t.integer_or("energy_check_every", 100);
     if (s.energy_check_every < 0) t.fail("energy_check_every", "must be >= 0 (0 turns the guard off)");
-    s.balance = t.choice_or("balance", {"none", "count"}, "none");
+    s.balance = t.choice_or("balance", {"none", "count", "time"}, "none");
     if (t.has("balance_threshold")) {
       s.balance_threshold = t.positive("balance_threshold");
       if (s.balance_threshold < 1)
-        t.fail("balance_threshold", "must be >= 1 (the busiest rank's particles over the mean, e.g. 1.2)");
+        t.fail("balance_threshold",
+               "must be >= 1 (the busiest rank's particles or compute time over the mean, e.g. 1.2)");
     }
+    s.balance_every = t.integer_or("balance_every", 500);
+    if (s.balance_every < 1)
+      t.fail("balance_every", "must be >= 1 (steps between checks of the compute times)");
     t.finish();
   }
 

@@ -312,9 +312,12 @@ void Simulation<Real>::step(FieldSink* sink) {
     forces_.walls().advance_servos(scene_.dt);
     forces_.walls().move_to(double(step_ + 1) * scene_.dt);
   }
+  const bool balance_due = parallel && scene_.balance == "time" && !balance_paused_ && step_ > 0 &&
+                           step_ % scene_.balance_every == 0 && time_balance_due();
   double need =
-      bond_broke_ ? std::numeric_limits<double>::infinity()
-                  : std::max(moved2, forces_.walls().empty() ? 0.0 : forces_.walls().moved2_since_rebuild());
+      bond_broke_ || balance_due
+          ? std::numeric_limits<double>::infinity()
+          : std::max(moved2, forces_.walls().empty() ? 0.0 : forces_.walls().moved2_since_rebuild());
   if (parallel) need = comm().max(need);
   times_.communication += sw.lap();
   bool in_flight = false;

@@ -1,10 +1,13 @@
-// Load balancing at rebuilds (run.balance = "count", docs/solver.md "Load balancing"): when the
-// busiest rank owns more than run.balance_threshold x the mean, the cut planes of the rank grid move
-// to where the global particle-count marginal along each axis splits evenly (parallel/balance.hpp),
-// and the particles, with their bonds and contact history, migrate to their new owners.
+// Load balancing at rebuilds (run.balance = "count" or "time", docs/solver.md "Load balancing"): when
+// the busiest rank owns more than run.balance_threshold x the mean particles ("count"), or took more
+// than that x the mean compute time over the last run.balance_every steps ("time"), the cut planes of
+// the rank grid move to where the global marginal along each axis of the particles (each weighted by its
+// rank's time per particle for "time") splits evenly (parallel/balance.hpp), and the particles, with
+// their bonds and contact history, migrate to their new owners.
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 #include "basalt/solver/parallel/balance.hpp"
@@ -25,9 +28,36 @@ double Simulation<Real>::imbalance() const {
 }
 
 template <class Real>
+bool Simulation<Real>::time_balance_due() {
+  // Whole microseconds: the integer sums are exact, so every rank reaches the same decision and weights.
+  const auto work = static_cast<long long>(std::llround(1e6 * (work_total() - work_mark_)));
+  const long long most = comm().max(work), total = comm().sum(work);
+  time_imbalance_ = total > 0 ? double(most) * comm().size() / double(total) : 1.0;
+  time_weight_ = time_weight(work, static_cast<long long>(p_.n_owned), total, n_global_);
+  balance_by_time_ = time_imbalance_ > scene_.balance_limit();
+  if (!balance_by_time_) {
+    work_mark_ = work_total();
+    work_window_start_ = step_;
+  }
+  return balance_by_time_;
+}
+
+template <class Real>
 void Simulation<Real>::balance_at_rebuild() {
-  const double before = imbalance();
-  if (before <= scene_.balance_threshold) return;
+  // "time" moves the cuts only when its check asked for it, or at the first rebuild (no time measured
+  // yet: by count); any other rebuild leaves them.
+  const bool by_time = balance_by_time_;
+  balance_by_time_ = false;
+  if (scene_.balance == "time" && !by_time && rebuilds_ > 0) return;
+  const double before = by_time ? time_imbalance_ : imbalance();
+  const double weight = by_time ? time_weight_ : 1.0;
+  const std::int64_t window = step_ - work_window_start_;
+  if (by_time) {  // the next window starts now, whether or not the cuts move
+    work_mark_ = work_total();
+    work_window_start_ = step_;
+  }
+  if (before <= scene_.balance_limit()) return;
+  const double particles_before = by_time ? imbalance() : before;
   // The owned particles' extent, then their counts along each axis over it (one reduction).
   std::array<double, 3> lo{}, hi{};
   for (int d = 0; d < 3; ++d) {
@@ -48,7 +78,7 @@ void Simulation<Real>::balance_at_rebuild() {
     if (dec_->dims()[d] == 1) continue;
     AxisHistogram h(lo[k], hi[k], kBalanceBins);
     const auto& c = d == 0 ? p_.x : (d == 1 ? p_.y : p_.z);
-    for (std::size_t i = 0; i < p_.n_owned; ++i) h.add(double(c[i]));
+    for (std::size_t i = 0; i < p_.n_owned; ++i) h.add(double(c[i]), weight);
     std::copy(h.counts.begin(), h.counts.end(),
               counts.begin() + static_cast<std::ptrdiff_t>(k * kBalanceBins));
   }
@@ -77,16 +107,23 @@ void Simulation<Real>::balance_at_rebuild() {
   ++rebalances_;
   imbalance_before_ = before;
   const double after = imbalance();
-  if (comm().rank() == 0)
+  if (comm().rank() != 0) return;
+  if (by_time)
     fmt::print(
-        "balance: step {}: max/mean particles per rank {:.3f} -> {:.3f} (run.balance = \"count\", "
+        "balance: step {}: max/mean compute time per rank {:.3f} over the last {} steps; max/mean particles "
+        "per rank {:.3f} -> {:.3f} (run.balance = \"time\", threshold {})\n",
+        step_, before, window, particles_before, after, scene_.balance_limit());
+  else
+    fmt::print(
+        "balance: step {}: max/mean particles per rank {:.3f} -> {:.3f} (run.balance = \"{}\", "
         "threshold {})\n",
-        step_, before, after, scene_.balance_threshold);
+        step_, before, after, scene_.balance, scene_.balance_limit());
 }
 
-#define BASALT_INSTANTIATE(R)                       \
-  template double Simulation<R>::imbalance() const; \
-  template void Simulation<R>::balance_at_rebuild();
+#define BASALT_INSTANTIATE(R)                        \
+  template double Simulation<R>::imbalance() const;  \
+  template void Simulation<R>::balance_at_rebuild(); \
+  template bool Simulation<R>::time_balance_due();
 BASALT_INSTANTIATE(double)
 BASALT_INSTANTIATE(float)
 #undef BASALT_INSTANTIATE

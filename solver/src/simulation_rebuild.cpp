@@ -111,7 +111,7 @@ void Simulation<Real>::rebuild() {
     if (total != n_global_)
       stop(fmt::format("step {}: {} particles on the ranks, {} expected: particles were lost", step_, total,
                        n_global_));
-    if (scene_.balance == "count" && !balance_paused_) balance_at_rebuild();
+    if (scene_.balance != "none" && !balance_paused_) balance_at_rebuild();
   }
   times_.communication += sw.lap();
   spatial_sort();

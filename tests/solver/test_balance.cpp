@@ -4,7 +4,11 @@
 // - a dense column with one grain far away (the even grid puts nearly everything on one side) at np 2
 //   and 4: the imbalance (max/mean particles per rank) drops below run.balance_threshold, and the run's
 //   kinetic-energy series and final positions agree with the unbalanced run's to 1e-9 relative
-//   (decomposition invariance extended to balanced runs).
+//   (decomposition invariance extended to balanced runs);
+// - run.balance = "time": a particle's weight from its rank's time per particle, the cuts that weight
+//   gives (toward a third of the particles on a rank twice as slow per particle), and at np 2 a rank made to look slow
+//   (add_rank_work) sheds particles at the next check while the results still agree with the
+//   unbalanced run's to 1e-9.
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <mpi.h>
@@ -71,6 +75,26 @@ TEST(BalancedCuts, CheckpointTextRoundTripsExactly) {
   EXPECT_FALSE(parse_cuts("1;;;"));
 }
 
+TEST(TimeWeight, ParticlesWeighTheirRanksTimePerParticle) {
+  // Two ranks of 100 particles, one twice as slow: 2/3 and 4/3 of the mean time per particle.
+  EXPECT_EQ(time_weight(2000, 100, 3000, 200), std::round(1024 * 4.0 / 3.0));
+  EXPECT_EQ(time_weight(1000, 100, 3000, 200), std::round(1024 * 2.0 / 3.0));
+  EXPECT_EQ(time_weight(5, 100, 0, 200), 1024) << "no time measured: every particle alike (count)";
+  EXPECT_EQ(time_weight(0, 100, 3000, 200), 1) << "never below 1";
+  // 300 particles evenly along x on [0, 3); those left of x = 1.5 (one rank's) are twice as slow per
+  // particle. The cut splits the weight evenly at x = 1.125 (112.5 x 4/3 = 37.5 x 4/3 + 150 x 2/3): as in
+  // LAMMPS's weight time, a particle keeps its present rank's weight, so one move goes 3/4 of the way to
+  // equal times (x = 1, a third of the particles on the slow rank) and the next checks go on from there.
+  AxisHistogram h(0.0, 3.0, 3000);
+  for (int i = 0; i < 300; ++i) {
+    const double x = 0.005 + 0.01 * i;
+    h.add(x, time_weight(x < 1.5 ? 200 : 100, 150, 300, 300));
+  }
+  const auto cuts = balanced_cuts(h, 2, 0.0);
+  ASSERT_EQ(cuts.size(), 1u);
+  EXPECT_NEAR(cuts[0], 1.125, 0.011);
+}
+
 TEST(DefaultDims, LeastCutAreaUnlessNearlyCubic) {
   // With no --dims, the rank grid cuts the box with the least plane area when that is at least 10 % less
   // than MPI_Dims_create's grid (which does not see the box); near-cubic boxes keep MPI's grid.
@@ -98,8 +122,15 @@ TEST(BalanceScene, KeysAreReadAndBadValuesNamed) {
   const auto s = basalt::test::scene_from(run + "balance = \"count\"\nbalance_threshold = 1.5\n");
   EXPECT_EQ(s.balance, "count");
   EXPECT_EQ(s.balance_threshold, 1.5);
+  EXPECT_EQ(s.balance_limit(), 1.5);
   EXPECT_EQ(basalt::test::scene_from(run).balance, "none") << "off unless asked for";
-  for (const std::string bad : {"balance = \"rcb\"\n", "balance_threshold = 0.9\n"}) {
+  EXPECT_EQ(basalt::test::scene_from(run + "balance = \"count\"\n").balance_limit(), 1.2);
+  const auto t = basalt::test::scene_from(run + "balance = \"time\"\nbalance_every = 200\n");
+  EXPECT_EQ(t.balance, "time");
+  EXPECT_EQ(t.balance_every, 200);
+  EXPECT_EQ(t.balance_limit(), 1.05) << "time's own default threshold";
+  EXPECT_EQ(basalt::test::scene_from(run).balance_every, 500);
+  for (const std::string bad : {"balance = \"rcb\"\n", "balance_threshold = 0.9\n", "balance_every = 0\n"}) {
     try {
       (void)basalt::test::scene_from(run + bad);
       ADD_FAILURE() << bad << " accepted";
@@ -238,4 +269,61 @@ TEST(Balance, UnevenSceneIsBalancedAndDecompositionInvariant) {
         grid.c_str(), plain.start, balanced.before, balanced.start, balanced.end,
         static_cast<long long>(balanced.rebalances), worst_ke, worst_x);
   }
+}
+
+TEST(Balance, TimeMovesWorkOffASlowRankAndResultsAgree) {
+  // run.balance = "time" at np 2: rank 0 is made to look slow (1 s more compute time in the first window,
+  // far more than the real steps take), so at the check of step 100 its particles weigh more and its slab
+  // shrinks; the run then goes on (re-balancing by its real times as they come) and must agree with the
+  // unbalanced run to 1e-9, as the count-balanced one does.
+  if (basalt::test::size() != 2) GTEST_SKIP() << "the time balancer is checked at np 2";
+  constexpr int kSteps = 600;
+  const auto plain = run("none", basalt::test::world(), {0, 0, 0}, kSteps);
+  auto scene = basalt::test::scene_from(kScene);
+  scene.balance = "time";
+  scene.balance_threshold = 1.5;
+  scene.balance_every = 100;
+  const auto g = blob_and_grain();
+  RunOptions opt;
+  opt.quiet = true;
+  Simulation<double> sim(scene, g, basalt::test::world(), opt);
+  const auto counted = sim.rebalances();  // the first rebuild balances by count (no time measured yet)
+  const double mean = double(g.size()) / 2;
+  const auto owned = [&] { return double(sim.particles().n_owned); };
+  if (basalt::test::rank() == 0) sim.add_rank_work(1.0);
+  basalt::test::MemorySink sink;
+  sink.begin(field_columns(scene));
+  sim.run(101, &sink);  // the check at step 100 moves the cuts
+  EXPECT_EQ(counted, 1) << "the blob scene starts uneven: the first rebuild balances it by count";
+  EXPECT_EQ(sim.rebalances(), counted + 1);
+  EXPECT_GT(sim.imbalance_before_last_rebalance(), 1.5) << "the compute-time imbalance that moved them";
+  if (basalt::test::rank() == 0) {
+    EXPECT_LT(owned(), 0.75 * mean) << "the slow rank sheds particles";
+  } else {
+    EXPECT_GT(owned(), 1.25 * mean);
+  }
+  sim.run(kSteps - 101, &sink);
+  std::vector<double> xyz(3 * g.size(), 0.0);
+  const auto& p = sim.particles();
+  for (std::size_t i = 0; i < p.n_owned; ++i) {
+    const auto k = 3 * static_cast<std::size_t>(p.id[i] - 1);
+    xyz[k] = p.x[i];
+    xyz[k + 1] = p.y[i];
+    xyz[k + 2] = p.z[i];
+  }
+  MPI_Allreduce(MPI_IN_PLACE, xyz.data(), static_cast<int>(xyz.size()), MPI_DOUBLE, MPI_SUM,
+                basalt::test::world());
+  const auto ke = sink.column(0);
+  ASSERT_EQ(ke.size(), plain.ke.size());
+  double worst_ke = 0, worst_x = 0;
+  for (std::size_t s = 0; s < ke.size(); ++s)
+    if (plain.ke[s] > 1e-6 * plain.ke.back())
+      worst_ke = std::max(worst_ke, std::abs(ke[s] - plain.ke[s]) / plain.ke[s]);
+  for (std::size_t k = 0; k < xyz.size(); ++k)
+    worst_x = std::max(worst_x, std::abs(xyz[k] - plain.xyz[k]) / std::max(1.0, std::abs(plain.xyz[k])));
+  EXPECT_LT(worst_ke, 1e-9);
+  EXPECT_LT(worst_x, 1e-9);
+  if (basalt::test::rank() == 0)
+    std::printf("time balance: %lld re-balances; KE %.3g, positions %.3g relative to the unbalanced run\n",
+                static_cast<long long>(sim.rebalances()), worst_ke, worst_x);
 }

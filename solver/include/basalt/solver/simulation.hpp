@@ -164,7 +164,11 @@ class Simulation {
   void force_rebuild();
   /// Collective: the busiest rank's owned particles over the mean (1 = perfectly balanced).
   double imbalance() const;
-  /// Times the cuts moved (run.balance = "count"), and the imbalance before the last move.
+  /// run.balance = "time": adds seconds to this rank's measured compute time, as if its steps had taken
+  /// them (the balancer then moves work off this rank; tests stand in for a slower core with it).
+  void add_rank_work(double seconds) { extra_work_ += seconds; }
+  /// Times the cuts moved (run.balance = "count" or "time"), and the imbalance (of particles, or of
+  /// compute time for "time") before the last move.
   std::int64_t rebalances() const { return rebalances_; }
   double imbalance_before_last_rebalance() const { return imbalance_before_; }
   /// Rows this rank read and records it received at start-up (zeros when given a whole geometry).
@@ -220,9 +224,17 @@ class Simulation {
   /// so far from the origin that float rounds a distance between two of the smallest to a strain above
   /// kResolutionWarn (the load check sees only the start; docs/stability.md, "Energy drift over 1e7 steps").
   void warn_far_positions();
-  /// Collective, in a rebuild after migration (simulation_balance.cpp): with run.balance = "count", moves
-  /// the cuts when the busiest rank exceeds the mean by run.balance_threshold, and migrates to them.
+  /// Collective, in a rebuild after migration (simulation_balance.cpp): with run.balance = "count" (and
+  /// "time" at its first rebuild), moves the cuts when the busiest rank exceeds the mean particles by
+  /// run.balance_threshold, and migrates to them; with "time" after a time_balance_due() that said yes,
+  /// moves them by the particles' time weights (parallel/balance.hpp, time_weight).
   void balance_at_rebuild();
+  /// Collective, every run.balance_every steps with run.balance = "time": whether the busiest rank's compute
+  /// time since the last check exceeds the mean by the threshold (then the step rebuilds and re-balances);
+  /// otherwise starts a new measuring window.
+  bool time_balance_due();
+  /// This rank's compute time so far (forces and integration, and add_rank_work's).
+  double work_total() const { return times_.forces + times_.integration + extra_work_; }
   /// x0 = the owned positions relative to skin_origin (of the decomposition box), as float: the skin
   /// criterion's reference, set at every rebuild (and restored after the critical-step estimate).
   void set_skin_reference();
@@ -324,9 +336,15 @@ class Simulation {
   bool far_warned_ = false;        ///< warn_far_positions() has warned (or the load check did at the start)
   std::int64_t rebalances_ = 0;
   double imbalance_before_ = 1;
-  bool balance_paused_ = false;  ///< a restart replaying a rebuild with the checkpoint's own cuts
-  bool mixed_ = false;           ///< run.precision = "mixed" (set by configure_particles())
-  Origin origin_{};              ///< the frame's origin (mixed; zero otherwise)
+  bool balance_paused_ = false;         ///< a restart replaying a rebuild with the checkpoint's own cuts
+  double extra_work_ = 0;               ///< add_rank_work's seconds
+  double work_mark_ = 0;                ///< work_total() when the time balancer's window began
+  std::int64_t work_window_start_ = 0;  ///< the step it began
+  bool balance_by_time_ = false;        ///< set by time_balance_due(): the next rebuild moves the cuts
+  double time_weight_ = 1024;           ///< this rank's particles' weight for that move
+  double time_imbalance_ = 1;           ///< max/mean compute time per rank at that check
+  bool mixed_ = false;                  ///< run.precision = "mixed" (set by configure_particles())
+  Origin origin_{};                     ///< the frame's origin (mixed; zero otherwise)
 };
 
 /// The last step's force and (with rotation) torque in checkpoints, /particles/<name> float64 (N): what a

@@ -6,6 +6,7 @@
 // alone, so every rank computes the same ones. Pure: no MPI (the simulation does the reduction).
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <optional>
 #include <string>
@@ -20,11 +21,12 @@ struct AxisHistogram {
   std::vector<double> counts;
 
   AxisHistogram(double lo_, double hi_, std::size_t bins) : lo(lo_), hi(hi_), counts(bins, 0.0) {}
-  void add(double v) {
+  /// Adds one coordinate with a weight (1: a count); integer weights keep the summed histogram exact.
+  void add(double v, double weight = 1) {
     const double w = hi - lo;
     const double f = w > 0 ? (v - lo) / w * double(counts.size()) : 0.0;
     const auto b = f <= 0 ? std::size_t(0) : std::min(counts.size() - 1, static_cast<std::size_t>(f));
-    counts[b] += 1;
+    counts[b] += weight;
   }
 };
 
@@ -34,6 +36,17 @@ struct AxisHistogram {
 /// widened to at least min_width each (later cuts pushed up: a rank's region must hold its ghost
 /// band); the outer slabs are half-infinite and need no width. An empty histogram gives even cuts.
 std::vector<double> balanced_cuts(const AxisHistogram& h, int parts, double min_width);
+
+/// run.balance = "time": the weight in the marginal histograms of each particle a rank owns. The rank took
+/// work_us microseconds of compute for its n_owned particles, all ranks total_work_us for n_global; a
+/// particle weighs its rank's time per particle over the mean time per particle, x 1024, rounded to an
+/// integer >= 1 (integers keep the summed histogram exact, so every rank computes the same cuts). No
+/// measured time (total_work_us <= 0) weighs every particle alike: the cuts are then those of "count".
+inline double time_weight(long long work_us, long long n_owned, long long total_work_us, long long n_global) {
+  if (total_work_us <= 0 || n_owned <= 0 || n_global <= 0) return 1024;
+  const double per = double(work_us) / double(n_owned), mean = double(total_work_us) / double(n_global);
+  return std::max(1.0, std::round(1024 * per / mean));
+}
 
 /// The largest slab's count when `cuts` split the histogram (each bin counted in the slab of its centre):
 /// how the re-balance judges whether new cuts are worth the migration.
