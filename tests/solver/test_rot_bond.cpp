@@ -949,6 +949,14 @@ TEST(PairList, UnbondKeepsTheLooseEntriesInListOrder) {
   fresh.index_loose();
   EXPECT_EQ(l.loose, fresh.loose);
   EXPECT_EQ(l.loose_offset, fresh.loose_offset);
+  // A list whose marks were set without index_loose() is indexed at its first break.
+  PairList unindexed;
+  unindexed.offset = {0, 2, 3};
+  unindexed.neigh = {1, 2, 2};
+  unindexed.bonded = {1, 1, 0};
+  EXPECT_TRUE(unindexed.unbond(0, 2));
+  EXPECT_EQ(unindexed.loose, (std::vector<std::uint32_t>{1, 2}));
+  EXPECT_EQ(unindexed.loose_offset, (std::vector<std::uint32_t>{0, 1, 2}));
 }
 
 TEST(RotBondRun, BrokenBondsBecomeContactsWithoutARebuild) {

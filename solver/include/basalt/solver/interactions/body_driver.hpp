@@ -102,6 +102,7 @@ class BodyDriver final : public ForceCompute<Real> {
   template <bool Advance>
   double all(Particles<Real>& p) {
     const bool rot = kTurns && p.with_rotation;
+    if (!rot && kTurns) return 0;  // (a turning model on particles that do not turn)
     const std::size_t n = p.n_owned;
     dissipation_.resize(n);
     flags_.resize(n);
@@ -117,7 +118,6 @@ class BodyDriver final : public ForceCompute<Real> {
     }
     a.dissipated = dissipation_.data();
     a.flag = flags_.data();
-    if (!rot && kTurns) return 0;  // (a turning model on particles that do not turn)
     Model::apply_all(coeffs_[0], a);
     if constexpr (Advance) {
       double d = 0;

@@ -44,6 +44,7 @@ struct PairList {
   /// before the next one).
   bool unbond(std::size_t i, std::size_t j) {
     if (bonded.empty()) return false;
+    if (loose_offset.size() != offset.size()) index_loose();  // (a list whose marks were set by hand)
     const auto clear_in_row = [&](std::size_t row, std::size_t other) {
       if (row + 1 >= offset.size()) return false;
       for (auto e = offset[row]; e < offset[row + 1]; ++e)
