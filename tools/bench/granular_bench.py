@@ -56,9 +56,21 @@ def tangential_damping_ratio():
     return math.sqrt(4.0 * gstar / estar)
 
 
-def sh(cmd, cwd=None, log=None):
+def mpi_env(ranks):
+    """The environment of a run on `ranks` ranks: scripts/mpi-env.sh makes idle ranks yield their core (the
+    tests run up to 8 ranks on 2 cores); a run that fits the cores takes Open MPI's own default for a job
+    that is not oversubscribed, no yield (the yields cost every code here 5-10 % at 2 ranks on 2 cores:
+    docs/BENCHMARKS.md, "Two cores"). Every code gets the same."""
+    env = dict(os.environ)
+    if ranks <= (os.cpu_count() or 1):
+        env["OMPI_MCA_mpi_yield_when_idle"] = "0"
+    return env
+
+
+def sh(cmd, cwd=None, log=None, env=None):
     t = time.time()
-    p = subprocess.run(cmd, cwd=cwd, shell=True, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    p = subprocess.run(cmd, cwd=cwd, shell=True, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                       env=env)
     if log:
         open(log, "w").write(p.stdout)
     if p.returncode != 0:
@@ -334,7 +346,7 @@ def main():
         for np_ in ranks:
             for c in codes:
                 log = os.path.join(W, f"{c}.np{np_}.rep{rep}.log")
-                out, wall = sh(f"mpirun -np {np_} {cmds[c]}", cwd=W, log=log)
+                out, wall = sh(f"mpirun -np {np_} {cmds[c]}", cwd=W, log=log, env=mpi_env(np_))
                 if c.startswith("basalt"):
                     import shutil
                     shutil.copy(os.path.join(W, "bench_out", "fields.csv"), log[:-4] + ".fields.csv")
