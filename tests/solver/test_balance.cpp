@@ -6,9 +6,9 @@
 //   kinetic-energy series and final positions agree with the unbalanced run's to 1e-9 relative
 //   (decomposition invariance extended to balanced runs);
 // - run.balance = "time": a particle's weight from its rank's time per particle, the cuts that weight
-//   gives (toward a third of the particles on a rank twice as slow per particle), and at np 2 a rank made to look slow
-//   (add_rank_work) sheds particles at the next check while the results still agree with the
-//   unbalanced run's to 1e-9.
+//   gives (toward a third of the particles on a rank twice as slow per particle), and at np 2 a rank
+//   made to look slow (add_rank_work) sheds particles at the next check while the results still agree
+//   with the unbalanced run's to 1e-9.
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <mpi.h>
