@@ -312,8 +312,9 @@ void Simulation<Real>::step(FieldSink* sink) {
     forces_.walls().advance_servos(scene_.dt);
     forces_.walls().move_to(double(step_ + 1) * scene_.dt);
   }
-  const bool balance_due = parallel && scene_.balance == "time" && !balance_paused_ && step_ > 0 &&
-                           step_ % scene_.balance_every == 0 && time_balance_due();
+  // (the scene's string is compared once per balance_every steps, not at every step)
+  const bool balance_due = parallel && step_ > 0 && step_ % scene_.balance_every == 0 &&
+                           scene_.balance == "time" && !balance_paused_ && time_balance_due();
   double need =
       bond_broke_ || balance_due
           ? std::numeric_limits<double>::infinity()

@@ -18,6 +18,8 @@ of the smallest sphere, 8.6e-5 s); skin 0.2 mm (0.1 of the smallest diameter) in
 """
 import argparse, glob, math, os, re, statistics, subprocess, sys, time
 
+from mpi_jobs import mpi_env  # (this folder is on sys.path: the script's own)
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.normpath(os.path.join(HERE, "..", ".."))
 RHO, E, NU, REST, MU, G = 2500.0, 1.0e7, 0.25, 0.5, 0.5, 9.81
@@ -54,17 +56,6 @@ def tangential_damping_ratio():
     estar = E / (2.0 * (1.0 - NU * NU))
     gstar = E / (2.0 * (1.0 + NU)) / (2.0 * (2.0 - NU))
     return math.sqrt(4.0 * gstar / estar)
-
-
-def mpi_env(ranks):
-    """The environment of a run on `ranks` ranks: scripts/mpi-env.sh makes idle ranks yield their core (the
-    tests run up to 8 ranks on 2 cores); a run that fits the cores takes Open MPI's own default for a job
-    that is not oversubscribed, no yield (the yields cost every code here 5-10 % at 2 ranks on 2 cores:
-    docs/BENCHMARKS.md, "Two cores"). Every code gets the same."""
-    env = dict(os.environ)
-    if ranks <= (os.cpu_count() or 1):
-        env["OMPI_MCA_mpi_yield_when_idle"] = "0"
-    return env
 
 
 def sh(cmd, cwd=None, log=None, env=None):

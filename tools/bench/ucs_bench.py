@@ -21,21 +21,12 @@ import subprocess
 import sys
 import time
 
+from mpi_jobs import mpi_env  # (this folder is on sys.path: the script's own)
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.normpath(os.path.join(HERE, "..", ".."))
 GEO = os.path.join(ROOT, "docs", "data", "esys-ucs", "box.geo")
 SCENE = os.path.join(ROOT, "scenes", "ucs-esys.toml")
-
-
-def mpi_env(ranks):
-    """The environment of a Basalt run on `ranks` ranks: scripts/mpi-env.sh makes idle ranks yield their core
-    (the tests run up to 8 ranks on 2 cores); a run that fits the cores takes Open MPI's own default for a
-    job that is not oversubscribed, no yield (docs/BENCHMARKS.md, "Two cores"). ESyS keeps the caller's
-    environment: its master waits for its worker, and a spinning master would take the other core."""
-    env = dict(os.environ)
-    if ranks <= (os.cpu_count() or 1):
-        env["OMPI_MCA_mpi_yield_when_idle"] = "0"
-    return env
 
 
 def run(cmd, log, env=None):
