@@ -473,6 +473,181 @@ TEST(HertzMindlin, LanesMatchTheScalarContact) {
   }
 }
 
+// A Hertz-Mindlin wall evaluates kContactLaneWidth contacts at once too (HertzMindlinWall::contact_lanes,
+// WallDriver::lanes). On random wall contacts (sticking, sliding, with and without shear history, rotating,
+// history tilted out of the tangent plane, any wall normal) the lanes must give contact()'s force, history,
+// dissipation and sliding flag, and the torque the scalar loop makes from its arm, to rounding; and a
+// contact's result must not depend on its lane.
+TEST(HertzMindlinWall, LanesMatchTheScalarContact) {
+  constexpr int W = kContactLaneWidth;
+  using Lanes = WallLanes<double, W, HertzMindlinWall::History>;
+  const auto c =
+      HertzMindlinWall::coeffs<double>(HertzMindlinWall::Params{{1.0e7, 0.25}, {4.0e7, 0.3}, 0.5, 0.5});
+  const auto u = [](std::uint64_t k) { return 0.5 * basalt::test::hash_unit(k); };  // [-0.5, 0.5)
+  struct Case {
+    WallKinematics<double> k;
+    HertzMindlinWall::History h;
+  };
+  const auto random_case = [&](std::uint64_t s, const std::array<double, 3>& n) {
+    Case q{};
+    auto& k = q.k;
+    k.nx = n[0], k.ny = n[1], k.nz = n[2];
+    k.r = 1e-3 * (1 + u(s));
+    k.d = k.r * (1 - 1e-3 * (0.01 + u(s + 1) + 0.5));  // overlaps 1e-5 .. 1e-3 of the radius
+    k.im = 1 / (1e-5 * (1 + u(s + 2)));
+    const double v = s % 2 == 0 ? 0.1 : 1e-4;  // half of them slow: sticking
+    k.vx = v * u(s + 3), k.vy = v * u(s + 4), k.vz = v * u(s + 5);
+    k.wx = 500 * v * u(s + 6), k.wy = 500 * v * u(s + 7), k.wz = 500 * v * u(s + 8);
+    k.dt = 1e-5;
+    if (s % 3 != 0)  // a third without history (a new contact)
+      q.h = {v * 2e-5 * u(s + 9) * double(s % 5), v * 2e-5 * u(s + 10), v * 2e-5 * u(s + 11)};
+    return q;
+  };
+  const auto load = [](Lanes& L, int l, const Case& q) {
+    const auto& k = q.k;
+    L.d[l] = k.d, L.r[l] = k.r, L.im[l] = k.im, L.vx[l] = k.vx, L.vy[l] = k.vy, L.vz[l] = k.vz;
+    L.wx[l] = k.wx, L.wy[l] = k.wy, L.wz[l] = k.wz;
+    L.h[l] = q.h;
+    L.nx = k.nx, L.ny = k.ny, L.nz = k.nz, L.dt = k.dt;
+  };
+  const auto near = [](double got, double want, double scale) {
+    return std::abs(got - want) <= 1e-12 * scale;
+  };
+  int sliding = 0, sticking = 0;
+  for (const bool advance : {true, false}) {
+    for (std::uint64_t batch = 0; batch < 60; ++batch) {
+      const double a = u(batch + 90001), b = u(batch + 90002), e = u(batch + 90003) + 0.6;
+      const double nn = std::sqrt(a * a + b * b + e * e);
+      const std::array<double, 3> n = batch % 4 == 0 ? std::array<double, 3>{0, 0, 1}  // a floor too
+                                                     : std::array<double, 3>{a / nn, b / nn, e / nn};
+      Lanes L{};
+      std::array<Case, W> cases;
+      for (int l = 0; l < W; ++l) load(L, l, cases[l] = random_case(1000 * batch + 29 * l, n));
+      if (advance)
+        HertzMindlinWall::contact_lanes<true>(c, L);
+      else
+        HertzMindlinWall::contact_lanes<false>(c, L);
+      for (int l = 0; l < W; ++l) {
+        auto q = cases[l];
+        ContactForce<double> f;
+        if (advance)
+          HertzMindlinWall::contact<true>(c, q.h, q.k, f);
+        else
+          HertzMindlinWall::contact<false>(c, q.h, q.k, f);
+        const double F = std::sqrt(f.fx * f.fx + f.fy * f.fy + f.fz * f.fz);
+        const double H = std::sqrt(q.h.x * q.h.x + q.h.y * q.h.y + q.h.z * q.h.z) + 1e-300;
+        SCOPED_TRACE(::testing::Message() << "advance " << advance << " batch " << batch << " lane " << l);
+        EXPECT_TRUE(near(L.fx[l], f.fx, F) && near(L.fy[l], f.fy, F) && near(L.fz[l], f.fz, F))
+            << L.fx[l] << " " << f.fx << " " << L.fy[l] << " " << f.fy << " " << L.fz[l] << " " << f.fz;
+        // The torque as the scalar loop makes it: (c - x) x F + couple, c - x = -arm n.
+        const auto& k = q.k;
+        const double tx = -f.arm_i * (k.ny * f.fz - k.nz * f.fy) + f.mx,
+                     ty = -f.arm_i * (k.nz * f.fx - k.nx * f.fz) + f.my,
+                     tz = -f.arm_i * (k.nx * f.fy - k.ny * f.fx) + f.mz;
+        const double T = F * k.r;
+        EXPECT_TRUE(near(L.tx[l], tx, T) && near(L.ty[l], ty, T) && near(L.tz[l], tz, T))
+            << L.tx[l] << " " << tx << " " << L.ty[l] << " " << ty << " " << L.tz[l] << " " << tz;
+        EXPECT_EQ(L.sliding[l] != 0, f.sliding);
+        if (advance) {
+          EXPECT_TRUE(near(L.h[l].x, q.h.x, H) && near(L.h[l].y, q.h.y, H) && near(L.h[l].z, q.h.z, H));
+          EXPECT_NEAR(L.dissipated[l], f.dissipated, 1e-11 * std::abs(f.dissipated) + 1e-300);
+        } else {
+          EXPECT_EQ(L.h[l].x, cases[l].h.x);  // left alone
+        }
+        (f.sliding ? sliding : sticking) += 1;
+      }
+    }
+  }
+  EXPECT_GT(sliding, 200);  // both regimes covered
+  EXPECT_GT(sticking, 200);
+  std::printf("wall lanes against contact(): %d sliding, %d sticking contacts\n", sliding, sticking);
+  // One contact in every lane, the others different: bitwise the same result in each.
+  const std::array<double, 3> floor{0, 0, 1};
+  const Case one = random_case(4242, floor);
+  std::array<double, 7> want{};
+  for (int at = 0; at < W; ++at) {
+    Lanes L{};
+    for (int l = 0; l < W; ++l) load(L, l, l == at ? one : random_case(7000 + 31 * l + at, floor));
+    HertzMindlinWall::contact_lanes<true>(c, L);
+    const std::array<double, 7> got{L.fx[at],  L.fy[at],  L.fz[at],        L.h[at].x,
+                                    L.h[at].y, L.h[at].z, L.dissipated[at]};
+    if (at == 0) want = got;
+    for (std::size_t k = 0; k < got.size(); ++k)
+      EXPECT_EQ(got[k], want[k]) << "lane " << at << " value " << k;
+  }
+}
+
+// WallDriver::lanes finds a wall's candidates in contact first, evaluates them 16 at a time, and clears
+// the history of the candidates apart range by range. A row of 40 spheres (two full batches and a short
+// one) slides on a frictional floor, building shear histories; one sphere in the first batch and one in
+// the short batch then jump off: without a rebuild (they stay candidates), each must lose its wall history
+// at the first step apart while every other sphere keeps its own, and the spheres left on the floor must
+// feel the same force as in a run where nobody jumped.
+TEST(HertzMindlinWall, ASphereThatLeavesTheWallLosesItsHistoryWhileTheOthersKeepTheirs) {
+  const auto scene = basalt::test::scene_from(R"(
+[particles]
+rotation = true
+[run]
+dt = 2e-5
+steps = 0
+skin = 0.2
+[[walls]]
+name = "floor"
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
+interaction = "hertz_mindlin"
+E = 1.0e5
+nu = 0.25
+mu = 0.5
+e = 0.5
+)");
+  basalt::io::Geometry g;
+  for (int k = 0; k < 40; ++k) g.add_particle(k + 1, {1.5 * k, 0, 0.4995}, 0.5);
+  RunOptions opt;
+  opt.quiet = true;
+  Simulation<double> sim(scene, g, MPI_COMM_SELF, opt), stay(scene, g, MPI_COMM_SELF, opt);
+  for (auto* s : {&sim, &stay}) {
+    auto& p = s->particles();
+    for (std::size_t i = 0; i < p.n_owned; ++i) p.vx[i] = 0.01 * double(1 + p.id[i] % 3), p.vy[i] = 0.005;
+    s->state_changed();
+  }
+  const auto wall_records = [](const Simulation<double>& s) {
+    std::vector<std::int64_t> ids;
+    for (const auto& c : s.force_computes()) {
+      if (c->history_bytes() == 0 || c->kind() != ModelKind::wall) continue;
+      ContactRecords r;
+      c->history_records(s.particles(), r);
+      for (std::size_t k = 0; k < r.size(); ++k) {
+        EXPECT_EQ(r.b[k], -1) << "a contact with wall 0";
+        ids.push_back(r.a[k]);
+      }
+    }
+    std::sort(ids.begin(), ids.end());
+    return ids;
+  };
+  std::vector<std::int64_t> all(40);
+  for (int k = 0; k < 40; ++k) all[static_cast<std::size_t>(k)] = k + 1;
+  for (int s = 0; s < 5; ++s) sim.step(), stay.step();
+  ASSERT_EQ(wall_records(sim), all) << "every sphere slides on the floor with a shear history";
+  auto& p = sim.particles();
+  const auto rebuilds = sim.rebuilds();
+  for (std::size_t i = 0; i < p.n_owned; ++i)
+    if (p.id[i] == 5 || p.id[i] == 37) p.z[i] = 0.55;  // off the floor, within the skin
+  for (int s = 0; s < 3; ++s) sim.step(), stay.step();
+  ASSERT_EQ(sim.rebuilds(), rebuilds) << "the jumpers must have stayed candidates (no rebuild)";
+  std::vector<std::int64_t> left;
+  for (const auto id : all)
+    if (id != 5 && id != 37) left.push_back(id);
+  EXPECT_EQ(wall_records(sim), left);
+  const auto& q = stay.particles();
+  for (std::size_t i = 0; i < p.n_owned; ++i) {
+    ASSERT_EQ(p.id[i], q.id[i]);
+    if (p.id[i] == 5 || p.id[i] == 37) continue;
+    EXPECT_EQ(p.vx[i], q.vx[i]) << "sphere " << p.id[i];
+    EXPECT_EQ(p.wy[i], q.wy[i]) << "sphere " << p.id[i];
+  }
+}
+
 // The pair loop finds the pairs in contact first and clears the history of every listed pair apart as a
 // range (those in contact get theirs back after their force): a pair that parts while still listed (no
 // rebuild) must lose its shear history, and a pair that stays in contact beside it must keep its own.

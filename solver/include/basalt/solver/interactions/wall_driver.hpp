@@ -6,9 +6,12 @@
 // (wall, particle) beside the candidates: saved by (particle id, -1 - wall index) before a rebuild,
 // carried with a migrating particle, found again by those ids, and written to checkpoints as a
 // contact whose second id is -1 - wall index (docs/formats.md).
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <string_view>
+#include <type_traits>
 #include <vector>
 
 #include "basalt/solver/interactions/force_compute.hpp"
@@ -22,6 +25,12 @@ class WallDriver final : public ForceCompute<Real> {
   using History = typename Model::History;
   static constexpr bool kKinematic = (Model::reads & kVelocity) != 0;
   static constexpr bool kHistory = basalt::solver::history_bytes<Model>() > 0;
+  static constexpr int kLaneWidth = kContactLaneWidth;
+  using Lanes = WallLanes<Real, kLaneWidth, History>;
+  /// The model evaluates contacts side by side (Model::contact_lanes, model.hpp WallLanes).
+  static constexpr bool kLanes = requires(const Coeffs& c, Lanes& b) {
+    Model::template contact_lanes<true>(c, b);
+  };
 
   /// Takes the scene's walls whose model is Model.
   explicit WallDriver(const std::vector<WallSpec>& walls) {
@@ -144,8 +153,163 @@ class WallDriver final : public ForceCompute<Real> {
 
   template <bool Energy, bool Advance>
   double loop_kinematic(Particles<Real>& p, Walls& walls) {
-    return p.with_rotation ? loop_kinematic<Energy, Advance, true>(p, walls)
-                           : loop_kinematic<Energy, Advance, false>(p, walls);
+    if constexpr (kLanes)
+      return p.with_rotation ? lanes<Energy, Advance, true>(p, walls)
+                             : lanes<Energy, Advance, false>(p, walls);
+    else
+      return p.with_rotation ? loop_kinematic<Energy, Advance, true>(p, walls)
+                             : loop_kinematic<Energy, Advance, false>(p, walls);
+  }
+
+  /// loop_kinematic() for a model with contact_lanes: each wall's candidates in contact are found with
+  /// positions and radii alone (their data asked for kAhead candidates ahead), gathered kLaneWidth at a time
+  /// in candidate order, evaluated side by side, and their forces added in that order (a short last batch
+  /// repeats its last contact and drops it). Every contact goes through the lanes, so a contact's force does
+  /// not depend on the rank or on its place in a batch. The histories of the candidates apart are cleared
+  /// batch by batch (the contacts get theirs back at the scatter).
+  template <bool Energy, bool Advance, bool Rot>
+  double lanes(Particles<Real>& p, Walls& walls) {
+    walls_ = &walls;
+    double energy = 0, dissipated = 0, parted = 0;
+    std::size_t sliding = 0;
+    const Real* __restrict x = p.x.data();
+    const Real* __restrict y = p.y.data();
+    const Real* __restrict z = p.z.data();
+    const Real* __restrict rad = p.radius.data();
+    Real* __restrict fx = p.fx.data();
+    Real* __restrict fy = p.fy.data();
+    Real* __restrict fz = p.fz.data();
+    [[maybe_unused]] Real* __restrict tx = Rot ? p.tx.data() : nullptr;
+    [[maybe_unused]] Real* __restrict ty = Rot ? p.ty.data() : nullptr;
+    [[maybe_unused]] Real* __restrict tz = Rot ? p.tz.data() : nullptr;
+    auto& L = lanes_;
+    L.dt = dt_;
+    alignas(64) std::uint32_t lane_i[kLaneWidth], lane_c[kLaneWidth];
+    const auto ahead = lane_arrays<Rot>(p);
+    for (std::size_t k = 0; k < index_.size(); ++k) {
+      const std::size_t w = index_[k];
+      const auto& spec = walls.spec(w);
+      const auto c = coeffs_[k];
+      L.nx = Real(spec.normal[0]), L.ny = Real(spec.normal[1]), L.nz = Real(spec.normal[2]);
+      const Real nx = L.nx, ny = L.ny, nz = L.nz;
+      const auto& at = walls.point(w);
+      const auto& vw = walls.velocity(w);
+      const Real px = Real(at[0]), py = Real(at[1]), pz = Real(at[2]);
+      const Real vwx = Real(vw[0]), vwy = Real(vw[1]), vwz = Real(vw[2]);
+      double wfx = 0, wfy = 0, wfz = 0;
+      const auto& cand = walls.candidates(w);
+      auto& hist = hist_[k];
+      if (hist.size() != cand.size()) hist.assign(cand.size(), History{});
+      History* __restrict hs = hist.data();
+      const auto* __restrict ci_of = cand.data();
+      const std::size_t nc = cand.size();
+      std::size_t cleared = 0;  // histories before this candidate are cleared
+      const auto complete = [&](const int filled, const std::size_t last) {
+        for (int l = filled; l < kLaneWidth; ++l)
+          lane_i[l] = lane_i[filled - 1], lane_c[l] = lane_c[filled - 1], L.d[l] = L.d[filled - 1];
+        gather<Rot>(p, lane_i, vwx, vwy, vwz, L);
+        for (int l = 0; l < kLaneWidth; ++l) L.h[l] = hs[lane_c[l]];
+        if constexpr (Advance) {
+          for (std::size_t e = cleared; e < last; ++e) hs[e] = History{};
+          cleared = last;
+        }
+      };
+      const auto run = [&](const int filled) {
+        Model::template contact_lanes<Advance>(c, L);
+        for (int l = 0; l < filled; ++l) {
+          const std::size_t i = lane_i[l];
+          const Real gx = L.fx[l], gy = L.fy[l], gz = L.fz[l];
+          fx[i] += gx, fy[i] += gy, fz[i] += gz;
+          if constexpr (Rot) tx[i] += L.tx[l], ty[i] += L.ty[l], tz[i] += L.tz[l];
+          wfx -= double(gx);
+          wfy -= double(gy);
+          wfz -= double(gz);
+          if constexpr (Advance) {
+            hs[lane_c[l]] = L.h[l];
+            dissipated += L.dissipated[l];
+            sliding += L.sliding[l] != Real(0);
+          }
+          if constexpr (Energy) {
+            WallKinematics<Real> kin{};
+            kin.d = L.d[l], kin.r = L.r[l];
+            energy += double(Model::energy(c, L.h[l], kin));
+          }
+        }
+      };
+      int filled = 0;
+      for (std::size_t ci = 0; ci < nc; ++ci) {
+        if (ci + kAhead < nc) {
+          const auto a = static_cast<std::size_t>(ci_of[ci + kAhead]);
+          for (const Real* f : ahead) __builtin_prefetch(f + a);
+        }
+        const auto i = static_cast<std::uint32_t>(ci_of[ci]);
+        const Real d = (x[i] - px) * nx + (y[i] - py) * ny + (z[i] - pz) * nz;
+        const bool touch = d < rad[i];
+        lane_i[filled] = i, lane_c[filled] = static_cast<std::uint32_t>(ci), L.d[filled] = d;
+        if constexpr (Advance) parted += touch ? 0.0 : Model::parting_energy(c, hs[ci]);
+        filled += touch;
+        if (filled == kLaneWidth) {
+          complete(filled, ci + 1);
+          run(filled);
+          filled = 0;
+        }
+      }
+      if (filled > 0) {
+        complete(filled, nc);
+        run(filled);
+      } else if constexpr (Advance) {
+        for (std::size_t e = cleared; e < nc; ++e) hs[e] = History{};
+      }
+      walls.force(w) = {wfx, wfy, wfz};
+    }
+    dissipated_ += dissipated + parted;
+    if (Advance) sliding_ = sliding;
+    return energy;
+  }
+
+  /// Candidates ahead whose particle data the finding loop asks for (lanes(): the candidates are spread
+  /// over the particles, and their data no longer in cache since the pairs' pass).
+  static constexpr std::size_t kAhead = 24;
+  /// What the lanes read and write of a particle.
+  template <bool Rot>
+  static auto lane_arrays(const Particles<Real>& p) {
+    std::array<const Real*, Rot ? 17 : 11> a{p.x.data(),        p.y.data(),  p.z.data(),  p.radius.data(),
+                                             p.inv_mass.data(), p.vx.data(), p.vy.data(), p.vz.data(),
+                                             p.fx.data(),       p.fy.data(), p.fz.data()};
+    if constexpr (Rot) {
+      a[11] = p.wx.data(), a[12] = p.wy.data(), a[13] = p.wz.data();
+      a[14] = p.tx.data(), a[15] = p.ty.data(), a[16] = p.tz.data();
+    }
+    return a;
+  }
+
+  /// The lanes' inputs of particles i[l] against a wall moving at (vwx, vwy, vwz), but for the distances
+  /// (L.d, from the finding loop: the lanes see the distance that found the contact).
+  template <bool Rot>
+  BASALT_WIDE_LANES static void gather(const Particles<Real>& p, const std::uint32_t* __restrict ii, Real vwx,
+                                       Real vwy, Real vwz, Lanes& L) {
+    const Real* __restrict rad = p.radius.data();
+    const Real* __restrict im = p.inv_mass.data();
+    const Real* __restrict vx = p.vx.data();
+    const Real* __restrict vy = p.vy.data();
+    const Real* __restrict vz = p.vz.data();
+#pragma GCC ivdep
+    for (int l = 0; l < kLaneWidth; ++l) {
+      const std::uint32_t i = ii[l];
+      L.r[l] = rad[i];
+      L.im[l] = im[i];
+      L.vx[l] = vx[i] - vwx, L.vy[l] = vy[i] - vwy, L.vz[l] = vz[i] - vwz;
+    }
+    if constexpr (Rot) {
+      const Real* __restrict wx = p.wx.data();
+      const Real* __restrict wy = p.wy.data();
+      const Real* __restrict wz = p.wz.data();
+#pragma GCC ivdep
+      for (int l = 0; l < kLaneWidth; ++l) {
+        const std::uint32_t i = ii[l];
+        L.wx[l] = wx[i], L.wy[l] = wy[i], L.wz[l] = wz[i];
+      }
+    }
   }
 
   template <bool Energy, bool Advance, bool Rot>
@@ -229,6 +393,8 @@ class WallDriver final : public ForceCompute<Real> {
     return energy;
   }
 
+  struct NoLanes {};
+  [[no_unique_address]] std::conditional_t<kLanes, Lanes, NoLanes> lanes_{};  ///< (with contact_lanes)
   std::vector<std::size_t> index_;  ///< the walls this model acts through
   std::vector<typename Model::Params> params_;
   std::vector<Coeffs> coeffs_;

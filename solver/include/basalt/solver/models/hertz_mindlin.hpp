@@ -147,6 +147,110 @@ Real energy(const Coeffs<Real>& c, const History& h, Real R, Real d) {
          Real(0.5) * St * Real(h.x * h.x + h.y * h.y + h.z * h.z);
 }
 
+/// hertz::law for W contacts side by side (the pair's and the wall's contact_lanes): the same formulas in
+/// the same order, each branch computed in every lane and the right value selected, so that GCC vectorises
+/// the loops (divisions and square roots of the unselected side may be inf or NaN; they are dropped). The
+/// law is a chain of square roots and divisions, each waiting for the last: one loop over the lanes would
+/// run at the chain's latency. So a contact_lanes runs it in passes over the lanes, each with a short
+/// chain, whose iterations the processor overlaps; the values one pass hands to the next stay in L1 here.
+template <class Real, int W>
+struct Stage {
+  alignas(64) Real inv_r[W], inv_sum[W], m[W], nx[W], ny[W], nz[W], tx[W], ty[W], tz[W];
+  alignas(64) Real px[W], py[W], pz[W], ratio[W], St[W], gt[W], fn[W], si[W], sj[W];
+  alignas(64) Real sx[W], sy[W], sz[W], ftx[W], fty[W], ftz[W], ft2[W], limit[W];
+};
+
+/// Lane l of the second pass: with effective radius R, effective mass m, overlap d, normal n and the
+/// contact point's relative velocity u, the stiffness and dashpots, the normal force, the tangential
+/// velocity and the history turned onto the tangent plane (its length ratio, -1: no turn); on real steps
+/// the dashpots' dissipation.
+template <bool Advance, class Real, int W>
+[[gnu::always_inline]] inline void lane_normal(const Coeffs<Real>& c, Stage<Real, W>& g, int l, Real R,
+                                               Real d, Real m, Real nx, Real ny, Real nz, Real ux, Real uy,
+                                               Real uz, const History& h, Real dt, double& dissipated) {
+  const Real root = std::sqrt(R * d);
+  const Real St = 8 * c.G_star * root;
+  const Real q = std::sqrt(root * m);
+  const Real gn = c.damp_n * q, gt = c.damp_t * q;
+  const Real un = ux * nx + uy * ny + uz * nz;
+  const Real tx = ux - un * nx, ty = uy - un * ny, tz = uz - un * nz;
+  const Real fn = Real(4.0 / 3.0) * c.E_star * root * d - gn * un;
+  const Real sx = Real(h.x), sy = Real(h.y), sz = Real(h.z);
+  g.nx[l] = nx, g.ny[l] = ny, g.nz[l] = nz, g.tx[l] = tx, g.ty[l] = ty, g.tz[l] = tz;
+  g.St[l] = St, g.gt[l] = gt, g.fn[l] = fn;
+  g.sx[l] = sx, g.sy[l] = sy, g.sz[l] = sz;
+  if constexpr (Advance) {
+    const Real one = 1;
+    const Real before = sx * sx + sy * sy + sz * sz;
+    const Real sn = sx * nx + sy * ny + sz * nz;
+    const Real px = sx - sn * nx, py = sy - sn * ny, pz = sz - sn * nz;
+    const Real after = px * px + py * py + pz * pz;
+    g.px[l] = px, g.py[l] = py, g.pz[l] = pz;
+    g.ratio[l] = after > 0 ? before / after : one;
+    g.ratio[l] = before > 0 ? g.ratio[l] : -one;  // (no turn)
+    dissipated = double(gn * un * un + gt * (tx * tx + ty * ty + tz * tz)) * double(dt);
+  }
+}
+
+/// Lane l of the third pass: the history turned and loaded, the elastic-viscous tangential force and the
+/// Coulomb limit.
+template <bool Advance, class Real, int W>
+[[gnu::always_inline]] inline void lane_load(const Coeffs<Real>& c, Stage<Real, W>& g, int l, Real dt) {
+  const Real zero = 0, one = 1;
+  Real sx = g.sx[l], sy = g.sy[l], sz = g.sz[l];
+  const Real tx = g.tx[l], ty = g.ty[l], tz = g.tz[l];
+  if constexpr (Advance) {
+    const Real ratio = g.ratio[l];
+    const bool turn = ratio >= zero;
+    const Real s = std::sqrt(turn ? ratio : one);
+    sx = turn ? g.px[l] * s : sx;
+    sy = turn ? g.py[l] * s : sy;
+    sz = turn ? g.pz[l] * s : sz;
+    sx += tx * dt;
+    sy += ty * dt;
+    sz += tz * dt;
+  }
+  const Real St = g.St[l], gt = g.gt[l], fn = g.fn[l];
+  const Real ftx = -St * sx - gt * tx, fty = -St * sy - gt * ty, ftz = -St * sz - gt * tz;
+  g.ft2[l] = ftx * ftx + fty * fty + ftz * ftz;
+  g.limit[l] = c.mu * (fn > 0 ? fn : zero);
+  g.sx[l] = sx, g.sy[l] = sy, g.sz[l] = sz, g.ftx[l] = ftx, g.fty[l] = fty, g.ftz[l] = ftz;
+}
+
+/// Lane l of the fourth pass: the Coulomb cut and the history refitted (written on real steps, with the
+/// energy the cut dissipates), whether the contact slides, and the force.
+template <bool Advance, class Real, int W>
+[[gnu::always_inline]] inline void lane_cut(const Stage<Real, W>& g, int l, History& h, double& dissipated,
+                                            Real& sliding, Real& fx, Real& fy, Real& fz) {
+  const Real zero = 0, one = 1;
+  Real sx = g.sx[l], sy = g.sy[l], sz = g.sz[l], ftx = g.ftx[l], fty = g.fty[l], ftz = g.ftz[l];
+  const Real ft2 = g.ft2[l], limit = g.limit[l], St = g.St[l], gt = g.gt[l];
+  const Real tx = g.tx[l], ty = g.ty[l], tz = g.tz[l];
+  const bool slide = ft2 > limit * limit;
+  const Real scale = limit / std::sqrt(ft2);
+  const double stored = 0.5 * double(St) * double(sx * sx + sy * sy + sz * sz);
+  ftx = slide ? ftx * scale : ftx;
+  fty = slide ? fty * scale : fty;
+  ftz = slide ? ftz * scale : ftz;
+  const bool refit = slide && St > 0;
+  const Real inv_St = one / St;
+  sx = refit ? -(ftx + gt * tx) * inv_St : sx;
+  sy = refit ? -(fty + gt * ty) * inv_St : sy;
+  sz = refit ? -(ftz + gt * tz) * inv_St : sz;
+  if constexpr (Advance) {
+    const double kept = 0.5 * double(St) * double(sx * sx + sy * sy + sz * sz);
+    dissipated += slide ? stored - kept : 0.0;
+    h.x = double(sx);
+    h.y = double(sy);
+    h.z = double(sz);
+  }
+  sliding = slide ? one : zero;
+  const Real fn = g.fn[l], nx = g.nx[l], ny = g.ny[l], nz = g.nz[l];
+  fx = fn * nx + ftx;
+  fy = fn * ny + fty;
+  fz = fn * nz + ftz;
+}
+
 }  // namespace hertz
 
 struct HertzMindlin {
@@ -212,20 +316,11 @@ struct HertzMindlin {
     const Real R = k.ri * k.rj * inv_sum, m = Real(1) / (k.imi + k.imj);
     hertz::law<Advance>(c, h, R, m, k.ri + k.rj - k.r, nx, ny, nz, ux, uy, uz, k.dt, f);
   }
-  /// contact() for W pairs at once (model.hpp, ContactLanes): the same formulas in the same order, each
-  /// branch of hertz::law computed in every lane and the right value selected, so that GCC vectorises the
-  /// loops (divisions and square roots of the unselected side may be inf or NaN; they are dropped).
-  /// The law is a chain of square roots and divisions, each waiting for the last: one loop over the lanes
-  /// would run at the chain's latency. So it runs in four passes over the lanes, each with a short chain,
-  /// whose iterations the processor overlaps; the values one pass hands to the next stay in L1 (`Stage`).
+  /// contact() for W pairs at once (model.hpp, ContactLanes), in four passes over the lanes (hertz::Stage).
   template <bool Advance, class Real, int W>
   BASALT_WIDE_LANES static void contact_lanes(const Coeffs<Real>& c, ContactLanes<Real, W, History>& b) {
-    const Real dt = b.dt, zero = 0, one = 1;
-    struct Stage {
-      alignas(64) Real inv_r[W], inv_sum[W], m[W], nx[W], ny[W], nz[W], tx[W], ty[W], tz[W];
-      alignas(64) Real px[W], py[W], pz[W], ratio[W], St[W], gt[W], fn[W], si[W], sj[W];
-      alignas(64) Real sx[W], sy[W], sz[W], ftx[W], fty[W], ftz[W], ft2[W], limit[W];
-    } g;
+    const Real dt = b.dt, one = 1;
+    hertz::Stage<Real, W> g;
     // 1: the distance and the three reciprocals.
 #pragma GCC ivdep
     for (int l = 0; l < W; ++l) {
@@ -235,8 +330,7 @@ struct HertzMindlin {
       g.inv_sum[l] = one / (b.ri[l] + b.rj[l]);
       g.m[l] = one / (b.imi[l] + b.imj[l]);
     }
-    // 2: the contact point's velocity, the stiffness and dashpots, the normal force, the history turned
-    // onto the tangent plane (its length ratio).
+    // 2: the contact point's velocity, then the law's stiffness, dashpots, normal force and history turn.
 #pragma GCC ivdep
     for (int l = 0; l < W; ++l) {
       const Real dx = b.dx[l], dy = b.dy[l], dz = b.dz[l], ri = b.ri[l], rj = b.rj[l], r = b.r[l];
@@ -248,79 +342,17 @@ struct HertzMindlin {
       const Real ux = b.vx[l] + oy * nz - oz * ny, uy = b.vy[l] + oz * nx - ox * nz,
                  uz = b.vz[l] + ox * ny - oy * nx;
       const Real R = ri * rj * inv_sum, d = ri + rj - r;
-      // hertz::law
-      const Real root = std::sqrt(R * d);
-      const Real St = 8 * c.G_star * root;
-      const Real q = std::sqrt(root * g.m[l]);
-      const Real gn = c.damp_n * q, gt = c.damp_t * q;
-      const Real un = ux * nx + uy * ny + uz * nz;
-      const Real tx = ux - un * nx, ty = uy - un * ny, tz = uz - un * nz;
-      const Real fn = Real(4.0 / 3.0) * c.E_star * root * d - gn * un;
-      const Real sx = Real(b.h[l].x), sy = Real(b.h[l].y), sz = Real(b.h[l].z);
-      g.nx[l] = nx, g.ny[l] = ny, g.nz[l] = nz, g.tx[l] = tx, g.ty[l] = ty, g.tz[l] = tz;
-      g.St[l] = St, g.gt[l] = gt, g.fn[l] = fn;
       g.si[l] = -ai * inv_r, g.sj[l] = aj * inv_r;
-      g.sx[l] = sx, g.sy[l] = sy, g.sz[l] = sz;
-      if constexpr (Advance) {
-        const Real before = sx * sx + sy * sy + sz * sz;
-        const Real sn = sx * nx + sy * ny + sz * nz;
-        const Real px = sx - sn * nx, py = sy - sn * ny, pz = sz - sn * nz;
-        const Real after = px * px + py * py + pz * pz;
-        g.px[l] = px, g.py[l] = py, g.pz[l] = pz;
-        g.ratio[l] = after > 0 ? before / after : one;
-        g.ratio[l] = before > 0 ? g.ratio[l] : -one;  // (no turn)
-        b.dissipated[l] = double(gn * un * un + gt * (tx * tx + ty * ty + tz * tz)) * double(dt);
-      }
+      hertz::lane_normal<Advance>(c, g, l, R, d, g.m[l], nx, ny, nz, ux, uy, uz, b.h[l], dt, b.dissipated[l]);
     }
-    // 3: the history turned and loaded, the elastic-viscous tangential force and the Coulomb limit.
+    // 3: the history turned and loaded, the tangential force and the Coulomb limit.
+#pragma GCC ivdep
+    for (int l = 0; l < W; ++l) hertz::lane_load<Advance>(c, g, l, dt);
+      // 4: the Coulomb cut, the history refitted, forces and torques out.
 #pragma GCC ivdep
     for (int l = 0; l < W; ++l) {
-      Real sx = g.sx[l], sy = g.sy[l], sz = g.sz[l];
-      const Real tx = g.tx[l], ty = g.ty[l], tz = g.tz[l];
-      if constexpr (Advance) {
-        const Real ratio = g.ratio[l];
-        const bool turn = ratio >= zero;
-        const Real s = std::sqrt(turn ? ratio : one);
-        sx = turn ? g.px[l] * s : sx;
-        sy = turn ? g.py[l] * s : sy;
-        sz = turn ? g.pz[l] * s : sz;
-        sx += tx * dt;
-        sy += ty * dt;
-        sz += tz * dt;
-      }
-      const Real St = g.St[l], gt = g.gt[l], fn = g.fn[l];
-      const Real ftx = -St * sx - gt * tx, fty = -St * sy - gt * ty, ftz = -St * sz - gt * tz;
-      g.ft2[l] = ftx * ftx + fty * fty + ftz * ftz;
-      g.limit[l] = c.mu * (fn > 0 ? fn : zero);
-      g.sx[l] = sx, g.sy[l] = sy, g.sz[l] = sz, g.ftx[l] = ftx, g.fty[l] = fty, g.ftz[l] = ftz;
-    }
-    // 4: the Coulomb cut, the history refitted, forces and torques out.
-#pragma GCC ivdep
-    for (int l = 0; l < W; ++l) {
-      Real sx = g.sx[l], sy = g.sy[l], sz = g.sz[l], ftx = g.ftx[l], fty = g.fty[l], ftz = g.ftz[l];
-      const Real ft2 = g.ft2[l], limit = g.limit[l], St = g.St[l], gt = g.gt[l];
-      const Real tx = g.tx[l], ty = g.ty[l], tz = g.tz[l];
-      const bool slide = ft2 > limit * limit;
-      const Real scale = limit / std::sqrt(ft2);
-      const double stored = 0.5 * double(St) * double(sx * sx + sy * sy + sz * sz);
-      ftx = slide ? ftx * scale : ftx;
-      fty = slide ? fty * scale : fty;
-      ftz = slide ? ftz * scale : ftz;
-      const bool refit = slide && St > 0;
-      const Real inv_St = one / St;
-      sx = refit ? -(ftx + gt * tx) * inv_St : sx;
-      sy = refit ? -(fty + gt * ty) * inv_St : sy;
-      sz = refit ? -(ftz + gt * tz) * inv_St : sz;
-      if constexpr (Advance) {
-        const double kept = 0.5 * double(St) * double(sx * sx + sy * sy + sz * sz);
-        b.dissipated[l] += slide ? stored - kept : 0.0;
-        b.h[l].x = double(sx);
-        b.h[l].y = double(sy);
-        b.h[l].z = double(sz);
-      }
-      b.sliding[l] = slide ? one : zero;
-      const Real fn = g.fn[l], nx = g.nx[l], ny = g.ny[l], nz = g.nz[l];
-      const Real fx = fn * nx + ftx, fy = fn * ny + fty, fz = fn * nz + ftz;
+      Real fx, fy, fz;
+      hertz::lane_cut<Advance>(g, l, b.h[l], b.dissipated[l], b.sliding[l], fx, fy, fz);
       b.fx[l] = fx;
       b.fy[l] = fy;
       b.fz[l] = fz;
@@ -393,6 +425,40 @@ struct HertzMindlinWall {
     const Real ux = k.vx - k.d * (k.wy * k.nz - k.wz * k.ny), uy = k.vy - k.d * (k.wz * k.nx - k.wx * k.nz),
                uz = k.vz - k.d * (k.wx * k.ny - k.wy * k.nx);
     hertz::law<Advance>(c, h, k.r, Real(1) / k.im, k.r - k.d, k.nx, k.ny, k.nz, ux, uy, uz, k.dt, f);
+  }
+  /// contact() for W particles at once (model.hpp, WallLanes), in the passes of the pair's contact_lanes.
+  template <bool Advance, class Real, int W>
+  BASALT_WIDE_LANES static void contact_lanes(const Coeffs<Real>& c, WallLanes<Real, W, History>& b) {
+    const Real dt = b.dt, one = 1, nx = b.nx, ny = b.ny, nz = b.nz;
+    hertz::Stage<Real, W> g;
+    // 1: the mass.
+#pragma GCC ivdep
+    for (int l = 0; l < W; ++l) g.m[l] = one / b.im[l];
+      // 2: the contact point's velocity, then the law's stiffness, dashpots, normal force and history turn.
+#pragma GCC ivdep
+    for (int l = 0; l < W; ++l) {
+      const Real d = b.d[l], wx = b.wx[l], wy = b.wy[l], wz = b.wz[l];
+      const Real ux = b.vx[l] - d * (wy * nz - wz * ny), uy = b.vy[l] - d * (wz * nx - wx * nz),
+                 uz = b.vz[l] - d * (wx * ny - wy * nx);
+      hertz::lane_normal<Advance>(c, g, l, b.r[l], b.r[l] - d, g.m[l], nx, ny, nz, ux, uy, uz, b.h[l], dt,
+                                  b.dissipated[l]);
+    }
+    // 3: the history turned and loaded, the tangential force and the Coulomb limit.
+#pragma GCC ivdep
+    for (int l = 0; l < W; ++l) hertz::lane_load<Advance>(c, g, l, dt);
+      // 4: the Coulomb cut, the history refitted, force and torque out: (c - x) x F with c - x = -d n.
+#pragma GCC ivdep
+    for (int l = 0; l < W; ++l) {
+      Real fx, fy, fz;
+      hertz::lane_cut<Advance>(g, l, b.h[l], b.dissipated[l], b.sliding[l], fx, fy, fz);
+      b.fx[l] = fx;
+      b.fy[l] = fy;
+      b.fz[l] = fz;
+      const Real d = b.d[l];
+      b.tx[l] = -d * (ny * fz - nz * fy);
+      b.ty[l] = -d * (nz * fx - nx * fz);
+      b.tz[l] = -d * (nx * fy - ny * fx);
+    }
   }
   template <class Real>
   static Real energy(const Coeffs<Real>& c, const History& h, const WallKinematics<Real>& k) {

@@ -131,6 +131,23 @@ struct WallKinematics {
   Real dt;
 };
 
+/// W particles touching one planar wall side by side (structure of arrays), for a velocity-dependent wall
+/// model that also offers `template <bool Advance, class Real, int W> static void contact_lanes(const
+/// Coeffs<Real>&, WallLanes<Real, W, History>&)`: contact() for W particles at once, without branches. The
+/// driver fills the inputs (as in WallKinematics; angular velocities zero when particles do not rotate) and
+/// h, and reads back the outputs (the torque only when particles rotate) and, on real steps, h. A contact's
+/// result depends on its own inputs only, never on its lane.
+template <class Real, int W, class History>
+struct WallLanes {
+  alignas(64) Real d[W], r[W], im[W], vx[W], vy[W], vz[W], wx[W], wy[W], wz[W];
+  History h[W];
+  alignas(64) Real fx[W], fy[W], fz[W];  ///< out: force on the particle (the wall gets the opposite)
+  alignas(64) Real tx[W], ty[W], tz[W];  ///< out: torque on the particle about its centre
+  alignas(64) double dissipated[W];      ///< out, on real steps
+  alignas(64) Real sliding[W];           ///< out: 1 when the contact slides
+  Real nx = 0, ny = 0, nz = 0, dt = 0;   ///< the wall's unit normal, the time step
+};
+
 /// What a body-force model sees of one particle (velocities and torques zero where not kept).
 template <class Real>
 struct BodyState {
