@@ -11,7 +11,8 @@ Stages (each skipped when its output exists in --work):
             below --settle-vrms (0.015 m/s; the 20k pile: 0.011 after one round; the 100k pile falls at 0.49 after one)
   3. export the checkpoint's positions/radii -> settled.h5 (Basalt), data.lmp (LAMMPS, LIGGGHTS);
             velocities and contact history start at zero in all three codes
-  4. bench  interleaved repeats: for each repeat, each rank count, each code; particle-steps/s from wall time
+  4. bench  interleaved repeats: for each repeat, each code, each rank count (--order ranks: each rank count, each
+            code); particle-steps/s from wall time
             of the timed run as each code reports it (Basalt: its run time line; LAMMPS/LIGGGHTS: "Loop time")
 Material (SI): density 2500, E 1e7 Pa, nu 0.25, e 0.5, mu 0.5, g 9.81; dt 1e-5 s (0.14 of the Rayleigh time
 of the smallest sphere, 8.6e-5 s); skin 0.2 mm (0.1 of the smallest diameter) in every code.
@@ -277,6 +278,11 @@ def main():
     ap.add_argument("--ranks", default="1,2")
     ap.add_argument("--codes", default="basalt,lammps_granular,lammps_hertzhistory,liggghts")
     ap.add_argument("--base-bin", default="", help="a second basalt-run build (code basalt_base), e.g. main's, to time against --bin")
+    ap.add_argument("--balance", choices=["none", "time"], default="none",
+                    help="time: Basalt --balance time, LAMMPS fix balance ... weight time (LIGGGHTS 3.8 has no fix "
+                         "balance: unbalanced)")
+    ap.add_argument("--order", choices=["codes", "ranks"], default="codes",
+                    help="within a repeat: each code's rank counts back to back (codes), or each rank count's codes")
     ap.add_argument("--summarize", action="store_true", help="only print the table from the logs in --work")
     a = ap.parse_args()
     os.makedirs(a.work, exist_ok=True)
@@ -313,38 +319,48 @@ def main():
         return
     basalt_scene(os.path.join(W, "bench.toml"), "settled.h5", a.steps, "bench_out", 0, a.steps // 2)
     kn, kt, gn, gt = lammps_hertz_history_coeffs()
+    # The cuts' balancing, every 500 steps above 5 % imbalance in every code (Basalt's defaults for "time").
+    shift = "fix bal all balance 500 1.05 shift xyz 10 1.05"
+    lammps_balance = shift + " weight time 1.0" if a.balance == "time" else ""
+    liggghts_balance = ""  # (LIGGGHTS 3.8 has no fix balance)
     common = dict(DATA="data.lmp", SKIN=SKIN, LX=LX, LY=LY, G=G, DT=DT, STEPS=a.steps, THERMO=a.steps // 2)
     gran = f"hertz/material {E} {REST} {NU} tangential mindlin NULL {tangential_damping_ratio():.9g} {MU} damping tsuji"
     fill(os.path.join(ROOT, "tools/lammps/in.granular.lmp"), os.path.join(W, "in.lammps_granular"),
-         PAIR_STYLE="granular", PAIR_COEFF=gran, WALL="granular " + gran, **common)
+         PAIR_STYLE="granular", PAIR_COEFF=gran, WALL="granular " + gran, BALANCE=lammps_balance, **common)
     hh = f"{kn:.9g} {kt:.9g} {gn:.9g} {gt:.9g} {MU} 1"
     fill(os.path.join(ROOT, "tools/lammps/in.granular.lmp"), os.path.join(W, "in.lammps_hertzhistory"),
-         PAIR_STYLE="gran/hertz/history " + hh, PAIR_COEFF="", WALL="hertz/history " + hh, **common)
+         PAIR_STYLE="gran/hertz/history " + hh, PAIR_COEFF="", WALL="hertz/history " + hh, BALANCE=lammps_balance,
+         **common)
     fill(os.path.join(ROOT, "tools/liggghts/in.granular.liggghts"), os.path.join(W, "in.liggghts"),
-         E=E, NU=NU, REST=REST, MU=MU, **common)
+         E=E, NU=NU, REST=REST, MU=MU, BALANCE=liggghts_balance, **common)
+    bal = " --balance time" if a.balance == "time" else ""
     cmds = {
-        "basalt": f"{a.bin}/basalt-run bench.toml --quiet",
+        "basalt": f"{a.bin}/basalt-run bench.toml --quiet{bal}",
         "lammps_hertzhistory": "lmp -in in.lammps_hertzhistory -nocite",
         "liggghts": "liggghts -in in.liggghts",
     }
     cmds["lammps_granular"] = "lmp -in in.lammps_granular -nocite"
     if a.base_bin:
-        cmds["basalt_base"] = f"{a.base_bin}/basalt-run bench.toml --quiet"
+        cmds["basalt_base"] = f"{a.base_bin}/basalt-run bench.toml --quiet{bal}"
     codes = a.codes.split(",")
     ranks = [int(r) for r in a.ranks.split(",")]
     rates = {}
+    # Each code's rank counts back to back (its speed-up from runs seconds apart, which this shared host's
+    # drift moves least), the codes in turn within a repeat (--order ranks: each rank count's codes back to
+    # back instead, the order before 2026-12-05).
+    runs = [(c, np_) for c in codes for np_ in ranks] if a.order == "codes" else \
+           [(c, np_) for np_ in ranks for c in codes]
     for rep in range(a.repeats):
-        for np_ in ranks:
-            for c in codes:
-                log = os.path.join(W, f"{c}.np{np_}.rep{rep}.log")
-                out, wall = sh(f"mpirun -np {np_} {cmds[c]}", cwd=W, log=log, env=mpi_env(np_))
-                if c.startswith("basalt"):
-                    import shutil
-                    shutil.copy(os.path.join(W, "bench_out", "fields.csv"), log[:-4] + ".fields.csv")
-                r = parse_rate(c, out, n, a.steps)
-                rates.setdefault((c, np_), []).append(r)
-                load = os.getloadavg()[0]
-                print(f"rep {rep} np {np_} {c:20s} {r / 1e6:8.3f} M particle-steps/s (load {load:.1f})", flush=True)
+        for c, np_ in runs:
+            log = os.path.join(W, f"{c}.np{np_}.rep{rep}.log")
+            out, wall = sh(f"mpirun -np {np_} {cmds[c]}", cwd=W, log=log, env=mpi_env(np_))
+            if c.startswith("basalt"):
+                import shutil
+                shutil.copy(os.path.join(W, "bench_out", "fields.csv"), log[:-4] + ".fields.csv")
+            r = parse_rate(c, out, n, a.steps)
+            rates.setdefault((c, np_), []).append(r)
+            load = os.getloadavg()[0]
+            print(f"rep {rep} np {np_} {c:20s} {r / 1e6:8.3f} M particle-steps/s (load {load:.1f})", flush=True)
     print("\nmedians (M particle-steps/s):")
     for (c, np_), v in sorted(rates.items()):
         print(f"  {c:20s} np {np_}: {statistics.median(v) / 1e6:.3f}  all {[round(x / 1e6, 3) for x in v]}")
