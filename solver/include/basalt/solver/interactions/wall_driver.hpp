@@ -122,16 +122,31 @@ class WallDriver final : public ForceCompute<Real> {
     }
   }
 
+  /// Wall w's unit normal, point and velocity in the loops' precision.
+  struct Plane {
+    Real nx, ny, nz, px, py, pz, vx, vy, vz;
+  };
+  static Plane plane(const Walls& walls, std::size_t w) {
+    const auto& n = walls.spec(w).normal;
+    const auto& at = walls.point(w);
+    const auto& v = walls.velocity(w);
+    return {Real(n[0]),  Real(n[1]), Real(n[2]), Real(at[0]), Real(at[1]),
+            Real(at[2]), Real(v[0]), Real(v[1]), Real(v[2])};
+  }
+  /// The histories of the k-th wall's n candidates (cleared when the candidates changed without a rebuild).
+  History* histories(std::size_t k, std::size_t n) {
+    auto& h = hist_[k];
+    if (h.size() != n) h.assign(n, History{});
+    return h.data();
+  }
+
   template <bool Energy>
   double loop(Particles<Real>& p, Walls& walls) const {
     double energy = 0;
     for (std::size_t k = 0; k < index_.size(); ++k) {
       const std::size_t w = index_[k];
-      const auto& spec = walls.spec(w);
       const auto& c = coeffs_[k];
-      const Real nx = Real(spec.normal[0]), ny = Real(spec.normal[1]), nz = Real(spec.normal[2]);
-      const auto& at = walls.point(w);
-      const Real px = Real(at[0]), py = Real(at[1]), pz = Real(at[2]);
+      const auto [nx, ny, nz, px, py, pz, vwx, vwy, vwz] = plane(walls, w);
       double wfx = 0, wfy = 0, wfz = 0;
       for (const auto i : walls.candidates(w)) {
         const Real d = (p.x[i] - px) * nx + (p.y[i] - py) * ny + (p.z[i] - pz) * nz;
@@ -188,19 +203,12 @@ class WallDriver final : public ForceCompute<Real> {
     const auto ahead = lane_arrays<Rot>(p);
     for (std::size_t k = 0; k < index_.size(); ++k) {
       const std::size_t w = index_[k];
-      const auto& spec = walls.spec(w);
       const auto c = coeffs_[k];
-      L.nx = Real(spec.normal[0]), L.ny = Real(spec.normal[1]), L.nz = Real(spec.normal[2]);
-      const Real nx = L.nx, ny = L.ny, nz = L.nz;
-      const auto& at = walls.point(w);
-      const auto& vw = walls.velocity(w);
-      const Real px = Real(at[0]), py = Real(at[1]), pz = Real(at[2]);
-      const Real vwx = Real(vw[0]), vwy = Real(vw[1]), vwz = Real(vw[2]);
+      const auto [nx, ny, nz, px, py, pz, vwx, vwy, vwz] = plane(walls, w);
+      L.nx = nx, L.ny = ny, L.nz = nz;
       double wfx = 0, wfy = 0, wfz = 0;
       const auto& cand = walls.candidates(w);
-      auto& hist = hist_[k];
-      if (hist.size() != cand.size()) hist.assign(cand.size(), History{});
-      History* __restrict hs = hist.data();
+      History* __restrict hs = histories(k, cand.size());
       const auto* __restrict ci_of = cand.data();
       const std::size_t nc = cand.size();
       std::size_t cleared = 0;  // histories before this candidate are cleared
@@ -338,18 +346,12 @@ class WallDriver final : public ForceCompute<Real> {
     kin.dt = dt_;
     for (std::size_t k = 0; k < index_.size(); ++k) {
       const std::size_t w = index_[k];
-      const auto& spec = walls.spec(w);
       const auto c = coeffs_[k];
-      kin.nx = Real(spec.normal[0]), kin.ny = Real(spec.normal[1]), kin.nz = Real(spec.normal[2]);
-      const auto& at = walls.point(w);
-      const auto& vw = walls.velocity(w);
-      const Real px = Real(at[0]), py = Real(at[1]), pz = Real(at[2]);
-      const Real vwx = Real(vw[0]), vwy = Real(vw[1]), vwz = Real(vw[2]);
+      const auto [nx, ny, nz, px, py, pz, vwx, vwy, vwz] = plane(walls, w);
+      kin.nx = nx, kin.ny = ny, kin.nz = nz;
       double wfx = 0, wfy = 0, wfz = 0;
       const auto& cand = walls.candidates(w);
-      auto& hist = hist_[k];
-      if (hist.size() != cand.size()) hist.assign(cand.size(), History{});
-      History* __restrict hs = hist.data();
+      History* __restrict hs = histories(k, cand.size());
       const auto* __restrict ci_of = cand.data();
       const std::size_t nc = cand.size();
       for (std::size_t ci = 0; ci < nc; ++ci) {
