@@ -41,6 +41,7 @@
 #include "client_sink.hpp"
 #include "geometry_input.hpp"
 #include "picture_module.hpp"
+#include "rank_spread.hpp"
 #include "restart_support.hpp"
 
 namespace fs = std::filesystem;
@@ -365,6 +366,9 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
   const double n = std::max<double>(1, double(steps));
   const double parts[5] = {comm.max(t.forces), comm.max(t.neighbor), comm.max(t.communication),
                            comm.max(t.integration), comm.max(t.output)};
+  const std::vector<double> by_rank =
+      comm.size() > 1 ? comm.all_gather({t.forces, t.neighbor, t.communication, t.integration, t.output})
+                      : std::vector<double>{};
   const double mem = comm.sum(double(sim->memory_bytes()));
   const double imbalance_end = sim->imbalance();
   if (root) {
@@ -382,6 +386,7 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
       line += fmt::format(" {} {:.4f} ms ({:.1f} %){}", names[k], 1e3 * parts[k] / n,
                           100 * parts[k] / std::max(loop, 1e-12), k < 4 ? "," : "");
     fmt::print("{}\n", line);
+    if (comm.size() > 1) fmt::print("{}", basalt::run::rank_spread(by_rank, n));
     fmt::print("solver arrays: {:.1f} MB ({:.0f} bytes per particle)\n", mem / 1e6,
                mem / double(sim->total_particles()));
     if (comm.size() > 1)
