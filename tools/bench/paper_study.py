@@ -96,7 +96,9 @@ def parse_run(stdout):
     h = HEAD_RE.search(stdout)
     if not d or not h:
         raise SystemExit("cannot read basalt-run's summary:\n" + stdout)
-    parts = {k: float(v) for k, v in PART_RE.findall(stdout)}
+    # (the "time per step:" line's maxima over the ranks; at several ranks a "time per step by rank" line follows)
+    line = re.search(r"^time per step: (.*)$", stdout, re.M)
+    parts = {k: float(v) for k, v in PART_RE.findall(line.group(1) if line else "")}
     return {"particles": int(h.group(1)), "bonds": int(h.group(2)), "ranks": int(h.group(3)),
             "steps": int(d.group(1)), "loop_s": float(d.group(2)), "startup_s": float(d.group(3)),
             "rebuilds": int(d.group(4)), "forces_ms": parts["forces"], "neighbour_ms": parts["neighbour search"],
