@@ -364,8 +364,9 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
 
   const auto& t = sim->times();
   const double n = std::max<double>(1, double(steps));
-  const double parts[5] = {comm.max(t.forces), comm.max(t.neighbor), comm.max(t.communication),
-                           comm.max(t.integration), comm.max(t.output)};
+  const double parts[basalt::run::kPhases] = {comm.max(t.forces), comm.max(t.neighbor),
+                                              comm.max(t.communication), comm.max(t.integration),
+                                              comm.max(t.output)};
   const std::vector<double> by_rank =
       comm.size() > 1 ? comm.all_gather({t.forces, t.neighbor, t.communication, t.integration, t.output})
                       : std::vector<double>{};
@@ -380,11 +381,11 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
     fmt::print("cpu time of the loop: {:.3f} s per rank (max), {:.0f} % of the wall time{}\n", cpu,
                100 * cpu / std::max(loop, 1e-12),
                cpu < 0.8 * loop ? ": the machine is shared, the wall time is inflated" : "");
-    const char* names[5] = {"forces", "neighbour search", "communication", "integration", "output"};
     std::string line = "time per step:";
-    for (int k = 0; k < 5; ++k)
-      line += fmt::format(" {} {:.4f} ms ({:.1f} %){}", names[k], 1e3 * parts[k] / n,
-                          100 * parts[k] / std::max(loop, 1e-12), k < 4 ? "," : "");
+    for (int k = 0; k < basalt::run::kPhases; ++k)
+      line += fmt::format(" {} {:.4f} ms ({:.1f} %){}", basalt::run::kPhaseNames[static_cast<std::size_t>(k)],
+                          1e3 * parts[k] / n, 100 * parts[k] / std::max(loop, 1e-12),
+                          k + 1 < basalt::run::kPhases ? "," : "");
     fmt::print("{}\n", line);
     if (comm.size() > 1) fmt::print("{}", basalt::run::rank_spread(by_rank, n));
     fmt::print("solver arrays: {:.1f} MB ({:.0f} bytes per particle)\n", mem / 1e6,

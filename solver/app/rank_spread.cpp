@@ -3,7 +3,6 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <array>
 #include <cstddef>
 
 namespace basalt::run {
@@ -12,8 +11,6 @@ std::string rank_spread(const std::vector<double>& times, double steps) {
   const std::size_t ranks = times.size() / kPhases;
   if (ranks == 0 || steps <= 0) return {};
   const auto at = [&](std::size_t r, int k) { return times[r * kPhases + static_cast<std::size_t>(k)]; };
-  static constexpr std::array<const char*, kPhases> names{"forces", "neighbour search", "communication",
-                                                          "integration", "output"};
   const double ms = 1e3 / steps;
   std::string line = "time per step by rank (min / mean / max):";
   for (int k = 0; k < kPhases; ++k) {
@@ -23,8 +20,8 @@ std::string rank_spread(const std::vector<double>& times, double steps) {
       hi = std::max(hi, at(r, k));
       sum += at(r, k);
     }
-    line += fmt::format(" {} {:.4f} / {:.4f} / {:.4f} ms{}", names[static_cast<std::size_t>(k)], lo * ms,
-                        sum / double(ranks) * ms, hi * ms, k + 1 < kPhases ? "," : "\n");
+    line += fmt::format(" {} {:.4f} / {:.4f} / {:.4f} ms{}", kPhaseNames[static_cast<std::size_t>(k)],
+                        lo * ms, sum / double(ranks) * ms, hi * ms, k + 1 < kPhases ? "," : "\n");
   }
   // Compute: what a rank does on its own particles; waiting: what it spends in the exchanges, most of it
   // waiting for the slowest rank's compute.
