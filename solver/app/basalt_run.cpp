@@ -518,6 +518,13 @@ int run_world(int argc, char** argv) {
     scene.dt_fraction = cli.preset == "fast" ? 0.5 : cli.preset == "balanced" ? 0.25 : 0.05;
   }
   if (!cli.precision.empty()) scene.precision = cli.precision;
+  if (scene.precision != "double") {
+    try {
+      basalt::solver::refuse_single_precision(scene);
+    } catch (const InputError& e) {
+      throw InputError(fmt::format("{}: {}", cli.scene_file, e.what()));
+    }
+  }
   if (!cli.balance.empty()) scene.balance = cli.balance;
   if (cli.balance_threshold > 0) scene.balance_threshold = cli.balance_threshold;
 

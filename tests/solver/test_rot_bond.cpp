@@ -352,6 +352,32 @@ TEST(RotBondLaw, BendingSpringCarriesHalfTheRelativeTurn) {
   expect_vec(q.m2 + shear_couple2 * -1.0, n * (-0.5 * kK.kb * theta), 1e-10, "bending moment on 2");
 }
 
+TEST(RotBondLaw, EsysAnglesAreBlindToSmallBendsInFloatAtan2AnglesAreNot) {
+  // Why float runs refuse angles = "esys" (RotBond::float_problem): a bend of 1e-4 rad, a tenth of a UCS
+  // bond's angle at failure, is below what acos of a float cosine resolves (3.5e-4 rad).
+  using Vf = beam::Vec<float>;
+  using Qf = beam::Quat<float>;
+  const double theta = 1e-4;
+  const V e = kE * (1 / kE.norm()), n = V{2, -1, 0} * (1 / std::sqrt(5.0));
+  const Q q2 = axis_angle(n, theta);
+  RotBond::Geometry<float> g;
+  const auto f = [](V v) { return Vf{float(v.x), float(v.y), float(v.z)}; };
+  g.x1 = {0.1f, -0.2f, 0.3f};
+  g.d = f(e * kL);
+  g.x2 = g.x1 + g.d;
+  g.r1 = float(kR1), g.r2 = float(kR2), g.r0 = float(kL);
+  g.q2 = Qf{float(q2.w), float(q2.x), float(q2.y), float(q2.z)};
+  RotBond::BondCoeffs<float> k{1000, 400, 30, 20, 0, 0, 0, 0};
+  const double want = 0.5 * 30 * theta;  // kb theta / 2 (BendingSpringCarriesHalfTheRelativeTurn)
+  const double esys = RotBond::evaluate(k, g).mb;
+  k.atan2_angles = true;
+  const double exact = RotBond::evaluate(k, g).mb;
+  std::printf("bend of 1e-4 rad in float: Mb esys angles %.4g, atan2 %.4g, closed form %.4g\n", esys, exact,
+              want);
+  EXPECT_NEAR(exact, want, 1e-3 * want) << "atan2 angles in float";
+  EXPECT_GT(std::abs(esys - want), 0.5 * want) << "esys angles in float resolved a 1e-4 rad bend after all";
+}
+
 TEST(RotBondLaw, LoadsAreObjective) {
   // A general small deformation, then the same turned rigidly: same loads, turned force. With atan2 angles
   // the loads agree to rounding (1e-13 measured); ESyS's acos angles read the rounding of the turned
@@ -498,6 +524,32 @@ double period_of(const std::vector<double>& u, double dt) {
 }
 
 }  // namespace
+
+TEST(RotBondRun, FloatRefusesEsysAnglesAndRunsAtan2Angles) {
+  const auto scene_with = [](const std::string& angles) {
+    return basalt::test::scene_from(kRun + "[[interactions]]\nname = \"beams\"\ntype = \"rot_bond\"\n" +
+                                    kSprings + angles);
+  };
+  try {
+    Simulation<float> sim(scene_with(""), bonded_pair(0.5, 0.5, 1.0), MPI_COMM_SELF);
+    ADD_FAILURE() << "a float run took rot_bond's acos angles";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("\"beams\""), std::string::npos) << what;
+    EXPECT_NE(what.find("angles = \"atan2\""), std::string::npos) << what;
+  }
+  EXPECT_NO_THROW(Simulation<double>(scene_with(""), bonded_pair(0.5, 0.5, 1.0), MPI_COMM_SELF));
+  // With atan2 angles the float pair runs, and a stretched bond oscillates as in double.
+  const auto scene = scene_with("angles = \"atan2\"\n");
+  const auto stretch = [&](auto sim) {
+    for (int s = 0; s < 200; ++s) sim.step();
+    const auto& p = sim.particles();
+    return double(p.x[index_of(p, 2)]);
+  };
+  const double xf = stretch(Simulation<float>(scene, bonded_pair(0.5, 0.5, 1.001), MPI_COMM_SELF));
+  const double xd = stretch(Simulation<double>(scene, bonded_pair(0.5, 0.5, 1.001), MPI_COMM_SELF));
+  EXPECT_NEAR(xf, xd, 1e-5) << "float and double positions of the stretched pair after 200 steps";
+}
 
 TEST(RotBondRun, NormalAndTorsionOscillateAtClosedFormPeriods) {
   const double r1 = 0.5, r2 = 0.4, L = 0.9, dt = 1e-4;

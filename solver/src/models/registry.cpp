@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <set>
+#include <type_traits>
 
 #include "basalt/solver/core/errors.hpp"
 #include "basalt/solver/interactions/body_driver.hpp"
@@ -80,6 +81,16 @@ constexpr std::string_view dissipation_term_of() {
 }
 
 template <class Model>
+constexpr auto float_problem_of() -> std::string_view (*)(const std::any&) {
+  if constexpr (requires { Model::float_problem; })
+    return [](const std::any& p) {
+      return Model::float_problem(std::any_cast<const typename Model::Params&>(p));
+    };
+  else
+    return nullptr;
+}
+
+template <class Model>
 ModelEntry entry() {
   return {Model::name,
           Model::kind,
@@ -97,7 +108,8 @@ ModelEntry entry() {
           &make<double, Model>,
           &make<float, Model>,
           mesh_maker<double, Model>(),
-          mesh_maker<float, Model>()};
+          mesh_maker<float, Model>(),
+          float_problem_of<Model>()};
 }
 
 }  // namespace
@@ -175,8 +187,22 @@ std::string describe_models() {
   return s;
 }
 
+void refuse_single_precision(const Scene& scene) {
+  for (const auto* groups : {&scene.bonds, &scene.contacts})
+    for (const auto& g : *groups) {
+      const auto* m = find_model(g.model, g.kind);
+      const std::string_view why = m && m->float_problem ? m->float_problem(g.params) : std::string_view{};
+      if (why.empty()) continue;
+      throw InputError(fmt::format(
+          "[[interactions]] \"{}\" (type = \"{}\"): {} (run.precision = \"{}\"; --precision double "
+          "overrides the scene's precision and --preset fast's float)",
+          g.name, g.model, why, scene.precision == "double" ? "float" : scene.precision));
+    }
+}
+
 template <class Real>
 std::vector<std::unique_ptr<ForceCompute<Real>>> make_force_computes(const Scene& scene) {
+  if constexpr (!std::is_same_v<Real, double>) refuse_single_precision(scene);
   std::vector<std::unique_ptr<ForceCompute<Real>>> out;
   const auto add = [&](std::string_view name, ModelKind kind, std::set<std::string_view>& made) {
     if (!made.insert(name).second) return;

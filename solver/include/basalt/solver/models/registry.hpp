@@ -33,6 +33,9 @@ struct ModelEntry {
   /// Wall models: the driver of the scene's mesh walls that use it (null for other kinds).
   std::unique_ptr<ForceCompute<double>> (*make_mesh_double)(const Scene&) = nullptr;
   std::unique_ptr<ForceCompute<float>> (*make_mesh_float)(const Scene&) = nullptr;
+  /// Why a group with these parameters cannot run in single precision, or "" (Model::float_problem; null:
+  /// the model runs in float with any parameters).
+  std::string_view (*float_problem)(const std::any& params) = nullptr;
 };
 
 /// Every model, in the order --list-models prints them.
@@ -45,6 +48,11 @@ std::vector<std::string> model_names(ModelKind kind);
 std::string describe_models();
 /// Names of the fields in a bit set, comma-separated.
 std::string field_names(Fields f);
+
+/// Throws InputError naming the first interaction group whose model cannot compute it in single precision
+/// (run.precision "float" or "mixed": Simulation<float>), and why. basalt-run checks before it reads the
+/// geometry; make_force_computes<float> checks again for other callers.
+void refuse_single_precision(const Scene& scene);
 
 /// One force compute per model the scene uses: bond models first, then pair models (in the order the
 /// scene first names them), then wall models, then body forces. Throws InputError for combinations not

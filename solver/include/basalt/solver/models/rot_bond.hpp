@@ -213,6 +213,18 @@ struct RotBond {
     bool atan2_angles = false;
   };
 
+  /// Why a group with these parameters cannot run in single precision, or "" (the registry refuses such a
+  /// scene in float and mixed precision). ESyS's angles are arccosines of cosines near 1: a float cosine
+  /// is 1 or at most 1 - 2^-24 there, so no angle between 0 and sqrt(2 * 2^-24) = 3.5e-4 rad is resolved
+  /// (double: 1.5e-8), and a brittle bond fails at angles of that order (UCS-esys: about 1e-3 rad).
+  static std::string_view float_problem(const Params& p) {
+    if (p.atan2_angles) return {};
+    return "angles = \"esys\" (the default: ESyS's arccosines) cannot run in single precision: float "
+           "resolves the arccosine of a cosine near 1 no finer than 3.5e-4 rad, a large part of a bond's "
+           "angle at failure, and the bonds' jumps between 0 and that angle pump energy into the run. Set "
+           "angles = \"atan2\" (exact near zero, in float too), or run in double";
+  }
+
   static Params parse(TableReader& t) {
     Params p;
     const bool modulus = t.has("youngs_modulus");
