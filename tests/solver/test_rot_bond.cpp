@@ -140,80 +140,121 @@ RotBond::Geometry<double> deformed_bond(std::uint64_t seed, double size) {
   return g;
 }
 
+// With angles = "atan2" (atan_series in the lanes, std::atan2 in evaluate()) as with ESyS's acos angles.
 TEST(RotBondLaw, LanesMatchTheScalarEvaluation) {
-  constexpr int W = 8;
-  LaneBatch<W> B;
-  auto& L = B.L;
-  const auto group = RotBond::coeffs<double>(RotBond::Params{});
-  std::array<RotBond::Geometry<double>, W> gs;
-  std::array<RotBond::Fixed<double>, W> fs;
-  const auto h = [](std::uint64_t k) { return basalt::test::hash_unit(k) - 0.5; };
-  const auto fill = [&](int l, const RotBond::Geometry<double>& g) {
-    gs[l] = g;
-    fs[l] = RotBond::fixed(g);
-    B.fill(l, g, group, kK);
-  };
-  const auto general_bond = [](std::uint64_t seed, double size) { return deformed_bond(seed, size); };
-  int compared = 0;
-  for (std::uint64_t batch = 0; batch < 50; ++batch) {
-    for (int l = 0; l < W; ++l)
-      fill(l, general_bond(100 * batch + 13 * l, 1e-5 * (1 + 300 * h(batch * 7 + l) + 150)));
-    RotBond::evaluate_lanes(L);
-    for (int l = 0; l < W; ++l) {
-      ASSERT_EQ(L.general[l], 0.0) << "batch " << batch << " lane " << l;
-      const auto q = RotBond::evaluate(kK, gs[l], fs[l]);
-      const double F = q.f1.norm() + q.fs, M = q.m1.norm() + q.m2.norm() + q.mb + q.mt;
-      const double tf = 1e-12 * F, tm = 1e-12 * M;
-      EXPECT_NEAR(L.f1[0][l], q.f1.x, tf);
-      EXPECT_NEAR(L.f1[1][l], q.f1.y, tf);
-      EXPECT_NEAR(L.f1[2][l], q.f1.z, tf);
-      for (int c = 0; c < 3; ++c) {
-        EXPECT_NEAR(L.m1[c][l], (c == 0 ? q.m1.x : c == 1 ? q.m1.y : q.m1.z), tm);
-        EXPECT_NEAR(L.m2[c][l], (c == 0 ? q.m2.x : c == 1 ? q.m2.y : q.m2.z), tm);
+  for (const bool atan2 : {false, true}) {
+    SCOPED_TRACE(atan2 ? "atan2 angles" : "esys angles");
+    constexpr int W = 8;
+    LaneBatch<W> B;
+    auto& L = B.L;
+    RotBond::Params pr;
+    pr.atan2_angles = atan2;
+    const auto group = RotBond::coeffs<double>(pr);
+    auto kb = kK;
+    kb.atan2_angles = atan2;
+    const auto lanes = [&] {
+      if (atan2)
+        RotBond::evaluate_lanes<double, W, true>(L);
+      else
+        RotBond::evaluate_lanes<double, W, false>(L);
+    };
+    std::array<RotBond::Geometry<double>, W> gs;
+    std::array<RotBond::Fixed<double>, W> fs;
+    const auto h = [](std::uint64_t k) { return basalt::test::hash_unit(k) - 0.5; };
+    const auto fill = [&](int l, const RotBond::Geometry<double>& g) {
+      gs[l] = g;
+      fs[l] = RotBond::fixed(g);
+      B.fill(l, g, group, kb);
+    };
+    const auto general_bond = [](std::uint64_t seed, double size) { return deformed_bond(seed, size); };
+    int compared = 0;
+    for (std::uint64_t batch = 0; batch < 50; ++batch) {
+      for (int l = 0; l < W; ++l)
+        fill(l, general_bond(100 * batch + 13 * l, 1e-5 * (1 + 300 * h(batch * 7 + l) + 150)));
+      lanes();
+      for (int l = 0; l < W; ++l) {
+        ASSERT_EQ(L.general[l], 0.0) << "batch " << batch << " lane " << l;
+        const auto q = RotBond::evaluate(kb, gs[l], fs[l]);
+        const double F = q.f1.norm() + q.fs, M = q.m1.norm() + q.m2.norm() + q.mb + q.mt;
+        const double tf = 1e-12 * F, tm = 1e-12 * M;
+        EXPECT_NEAR(L.f1[0][l], q.f1.x, tf);
+        EXPECT_NEAR(L.f1[1][l], q.f1.y, tf);
+        EXPECT_NEAR(L.f1[2][l], q.f1.z, tf);
+        for (int c = 0; c < 3; ++c) {
+          EXPECT_NEAR(L.m1[c][l], (c == 0 ? q.m1.x : c == 1 ? q.m1.y : q.m1.z), tm);
+          EXPECT_NEAR(L.m2[c][l], (c == 0 ? q.m2.x : c == 1 ? q.m2.y : q.m2.z), tm);
+        }
+        EXPECT_NEAR(L.fn[l], q.fn, 1e-12 * (std::abs(q.fn) + F));
+        EXPECT_NEAR(L.fs[l], q.fs, tf);
+        EXPECT_NEAR(L.mb[l], q.mb, tm);
+        EXPECT_NEAR(L.mt[l], q.mt, tm);
+        ++compared;
       }
-      EXPECT_NEAR(L.fn[l], q.fn, 1e-12 * (std::abs(q.fn) + F));
-      EXPECT_NEAR(L.fs[l], q.fs, tf);
-      EXPECT_NEAR(L.mb[l], q.mb, tm);
-      EXPECT_NEAR(L.mt[l], q.mt, tm);
-      ++compared;
     }
-  }
-  EXPECT_EQ(compared, 50 * W);
-  // One bond in every lane, the others different: bitwise the same result in each.
-  const auto one = general_bond(777, 2e-4);
-  std::array<double, 10> want{};
-  for (int at = 0; at < W; ++at) {
-    for (int l = 0; l < W; ++l) fill(l, l == at ? one : general_bond(1000 + 17 * l + at, 3e-4));
-    RotBond::evaluate_lanes(L);
-    const std::array<double, 10> got{L.f1[0][at], L.f1[1][at], L.f1[2][at], L.m1[0][at], L.m1[1][at],
-                                     L.m1[2][at], L.m2[0][at], L.m2[1][at], L.m2[2][at], L.fn[at]};
-    if (at == 0) want = got;
-    for (std::size_t c = 0; c < got.size(); ++c)
-      EXPECT_EQ(got[c], want[c]) << "lane " << at << " value " << c;
-  }
-  // Flagged: a bend beyond 0.1 rad, a shear angle beyond it. A bond at rest need not be (its cross
-  // products of parallel vectors may round to 1e-17 rather than 0, depending on how the compiler fuses
-  // them), but its loads must stay at the acos noise of ESyS's angles (1.5e-8 rad: see the file's header).
-  auto big = general_bond(5, 1e-5);
-  big.q2 = big.q1 * axis_angle({1, 0, 0}, 0.3);
-  fill(0, big);
-  auto sheared = general_bond(9, 1e-5);
-  sheared.x2 = sheared.x1 + sheared.q1.to_world(sheared.d) + V{0.2, -0.1, 0.15};  // gamma ~ 0.2 rad
-  fill(1, sheared);
-  fill(2, at_rest(kE, kL, kR1, kR2));
-  for (int l = 3; l < W; ++l) fill(l, general_bond(40 + l, 1e-4));
-  RotBond::evaluate_lanes(L);
-  EXPECT_EQ(L.general[0], 1.0);
-  EXPECT_EQ(L.general[1], 1.0);
-  const double noise = 2e-8;
-  if (L.general[2] == 0.0) {
-    for (int c = 0; c < 3; ++c) {
-      EXPECT_LE(std::abs(L.f1[c][2]), noise * kK.ks * kL);
-      EXPECT_LE(std::abs(L.m1[c][2]), noise * (kK.kb + kK.kt + kK.ks * kL * kL));
-      EXPECT_LE(std::abs(L.m2[c][2]), noise * (kK.kb + kK.kt + kK.ks * kL * kL));
+    EXPECT_EQ(compared, 50 * W);
+    // One bond in every lane, the others different: bitwise the same result in each.
+    const auto one = general_bond(777, 2e-4);
+    std::array<double, 10> want{};
+    for (int at = 0; at < W; ++at) {
+      for (int l = 0; l < W; ++l) fill(l, l == at ? one : general_bond(1000 + 17 * l + at, 3e-4));
+      lanes();
+      const std::array<double, 10> got{L.f1[0][at], L.f1[1][at], L.f1[2][at], L.m1[0][at], L.m1[1][at],
+                                       L.m1[2][at], L.m2[0][at], L.m2[1][at], L.m2[2][at], L.fn[at]};
+      if (at == 0) want = got;
+      for (std::size_t c = 0; c < got.size(); ++c)
+        EXPECT_EQ(got[c], want[c]) << "lane " << at << " value " << c;
     }
+    // Flagged: a bend beyond 0.1 rad, a shear angle beyond it, a bond of the other kind of angles. A bond
+    // at rest need not be (its cross products of parallel vectors may round to 1e-17 rather than 0,
+    // depending on how the compiler fuses them), but its loads must stay at the acos noise of ESyS's angles
+    // (1.5e-8 rad: see the file's header).
+    auto big = general_bond(5, 1e-5);
+    big.q2 = big.q1 * axis_angle({1, 0, 0}, 0.3);
+    fill(0, big);
+    auto sheared = general_bond(9, 1e-5);
+    sheared.x2 = sheared.x1 + sheared.q1.to_world(sheared.d) + V{0.2, -0.1, 0.15};  // gamma ~ 0.2 rad
+    fill(1, sheared);
+    fill(2, at_rest(kE, kL, kR1, kR2));
+    auto other = kb;
+    other.atan2_angles = !atan2;
+    B.fill(3, general_bond(43, 1e-4), group, other);
+    for (int l = 4; l < W; ++l) fill(l, general_bond(40 + l, 1e-4));
+    lanes();
+    EXPECT_EQ(L.general[0], 1.0);
+    EXPECT_EQ(L.general[1], 1.0);
+    EXPECT_EQ(L.general[3], 1.0);
+    const double noise = 2e-8;
+    if (L.general[2] == 0.0) {
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_LE(std::abs(L.f1[c][2]), noise * kK.ks * kL);
+        EXPECT_LE(std::abs(L.m1[c][2]), noise * (kK.kb + kK.kt + kK.ks * kL * kL));
+        EXPECT_LE(std::abs(L.m2[c][2]), noise * (kK.kb + kK.kt + kK.ks * kL * kL));
+      }
+    }
+    for (int l = 4; l < W; ++l) EXPECT_EQ(L.general[l], 0.0) << l;
   }
-  for (int l = 3; l < W; ++l) EXPECT_EQ(L.general[l], 0.0) << l;
+}
+
+// atan_series, the lanes' atan2 for small angles: std::atan2 to rounding over the tangents it takes (|t| <=
+// 0.1), odd, exactly 0 at 0, in double and float.
+TEST(RotBondLaw, AtanSeriesMatchesAtan2ToRounding) {
+  const double eps = std::numeric_limits<double>::epsilon();
+  int checked = 0;
+  for (double t = 1e-12; t <= 0.1; t *= 1.003) {
+    for (const double x : {1.0, 0.37, 2.9}) {
+      const double y = t * x, want = std::atan2(y, x);
+      EXPECT_LE(std::abs(beam::atan_series(y / x) - want), 2 * eps * want) << "t = " << t << " x = " << x;
+      EXPECT_EQ(beam::atan_series(-y / x), -beam::atan_series(y / x));
+      ++checked;
+    }
+    const float tf = float(t);
+    EXPECT_LE(std::abs(beam::atan_series(tf) - std::atan(tf)),
+              2 * std::numeric_limits<float>::epsilon() * std::atan(tf))
+        << "float t = " << tf;
+  }
+  EXPECT_GT(checked, 20000);
+  EXPECT_EQ(beam::atan_series(0.0), 0.0);
+  EXPECT_EQ(beam::atan_series(0.0f), 0.0f);
 }
 
 // The lanes take failure()'s test too (the driver asks failure() only for the mode of a bond the lanes found

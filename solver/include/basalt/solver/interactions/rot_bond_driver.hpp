@@ -30,6 +30,8 @@ class RotBondDriver final : public ForceCompute<Real> {
       coeffs_.push_back(Model::template coeffs<Real>(params_.back()));
       breakable_ = breakable_ || Model::breakable(params_.back());
     }
+    atan2_lanes_ = !params_.empty() &&
+                   std::all_of(params_.begin(), params_.end(), [](const auto& p) { return p.atan2_angles; });
   }
 
   std::string_view model() const override { return Model::name; }
@@ -90,7 +92,10 @@ class RotBondDriver final : public ForceCompute<Real> {
     for (std::size_t k0 = begin; k0 < end; k0 += kLanes) {
       const int n = static_cast<int>(std::min<std::size_t>(kLanes, end - k0));
       L.k0 = k0;  // a short last batch reads the next bonds or the table's padding
-      Model::evaluate_lanes(L);
+      if (atan2_lanes_)
+        Model::template evaluate_lanes<Real, kLanes, true>(L);
+      else
+        Model::template evaluate_lanes<Real, kLanes, false>(L);
       for (int l = 0; l < n; ++l) {
         const std::size_t k = k0 + static_cast<std::size_t>(l);
         const std::size_t n1 = t.n1[k], n2 = t.n2[k];
@@ -184,6 +189,8 @@ class RotBondDriver final : public ForceCompute<Real> {
   std::vector<typename Model::Params> params_;
   std::vector<Coeffs> coeffs_;
   bool breakable_ = false;
+  bool atan2_lanes_ =
+      false;  ///< every group takes atan2 angles: the lanes evaluate them (else the acos ones)
   std::vector<std::size_t> gone_;
   typename Model::template Table<Real> table_;  ///< each bond's constants, padded by a batch
   std::size_t n_ = 0;                           ///< bonds in table_

@@ -130,6 +130,21 @@ template <class Real>
   return 2 * (s + s * t * p);
 }
 
+/// atan t for |t| <= 0.1 (angles below 0.0997 rad) by its series to t^15 (the next term is below 6e-18
+/// relative): atan2(y, x) = atan(y / x) for x > 0, |y| <= 0.1 x, within 1-2 ulp of std::atan2, in vector
+/// lanes (test RotBondLaw.AtanSeriesMatchesAtan2ToRounding).
+template <class Real>
+[[gnu::always_inline]] inline Real atan_series(Real t) {
+  const Real u = t * t;
+  // atan t = t - t u (1/3 - u (1/5 - u (1/7 - u (1/9 - u (1/11 - u (1/13 - u / 15))))))
+  const Real p =
+      Real(1.0 / 3) -
+      u * (Real(1.0 / 5) -
+           u * (Real(1.0 / 7) -
+                u * (Real(1.0 / 9) - u * (Real(1.0 / 11) - u * (Real(1.0 / 13) - u * Real(1.0 / 15))))));
+  return t - t * u * p;
+}
+
 template <class Real>
 Real acos_near_one(Real c) {
   if constexpr (std::is_same_v<Real, double>) {
@@ -535,10 +550,12 @@ struct RotBond {
   /// index (it needs -fno-math-errno, set for the whole project, to vectorise sqrt): the same formulas in the
   /// same order, with each of evaluate()'s special cases computed anyway and the lane marked `general`
   /// instead. Those are the bonds at exactly zero shear, bend or lateral offset (at the start of a run, the
-  /// bonds no load has reached yet), angles beyond acos's series (cosines <= 0.995, above 0.1 rad) and atan2
-  /// angles: the caller evaluates them with evaluate() and failure(). A bond's result depends on its own
-  /// inputs only, never on its lane or its neighbours in the batch.
-  template <class Real, int W>
+  /// bonds no load has reached yet), angles beyond the series (acos: cosines <= 0.995, above 0.1 rad; atan2:
+  /// tangents above 0.1) and bonds whose angles are not the batch's kind (Atan2: angles = "atan2", taken by
+  /// atan_series as atan(y / x), within 1-2 ulp of evaluate()'s std::atan2): the caller evaluates them with
+  /// evaluate() and failure(). A bond's result depends on its own inputs only, never on its lane or its
+  /// neighbours in the batch.
+  template <class Real, int W, bool Atan2 = false>
   BASALT_WIDE_LANES static void evaluate_lanes(Lanes<Real, W>& b) {
     using V = beam::Vec<Real>;
     using Q = beam::Quat<Real>;
@@ -567,7 +584,7 @@ struct RotBond {
       const V c0 = rb.cross(d);
       const Real n0 = c0.norm(), dot = rb.dot(d);
       const Real gc = dot * (inb * c[T::inv_d][l]);
-      const Real gamma = beam::acos_series(gc);
+      const Real gamma = Atan2 ? beam::atan_series(n0 / dot) : beam::acos_series(gc);
       const Real a = ks * r0 * gamma / (n0 != zero ? n0 : one);
       const V fst = rb.cross(c0) * (a * inb), mst = c0 * -a;
       const Real s = h * std::sqrt((nb - rb.z) * inb), rxy2 = rb.x * rb.x + rb.y * rb.y;
@@ -578,12 +595,15 @@ struct RotBond {
       const Real t0 = r.w * r.w + r.z * r.z, t2 = r.x * r.x + r.y * r.y;
       const Real ist = one / std::sqrt(t0 != zero ? t0 : one);
       const Real cpsi = r.w * ist, spsi = r.z * ist;
-      const Real apsi = beam::acos_series(cpsi);
-      const Real psi = 2 * (spsi > zero ? apsi : spsi < zero ? -apsi : zero);
+      const Real apsi = Atan2 ? zero : beam::acos_series(cpsi);
+      const Real psi = Atan2 ? 2 * beam::atan_series(r.z / r.w)
+                             : 2 * (spsi > zero   ? apsi
+                                    : spsi < zero ? -apsi
+                                                  : zero);
       const Real mt = c[T::kt][l] * psi;
       const V mtr{Rm.m[0][2] * mt, Rm.m[1][2] * mt, Rm.m[2][2] * mt};
-      const Real t1 = t0 - t2;
-      const Real theta = beam::acos_series(t1);
+      const Real t1 = t0 - t2, st2 = Atan2 ? std::sqrt(t2) : zero, st0 = Atan2 ? std::sqrt(t0) : one;
+      const Real theta = Atan2 ? 2 * beam::atan_series(st2 / st0) : beam::acos_series(t1);
       const Real iq = one / std::sqrt(t0 * t2 != zero ? t0 * t2 : one);
       const Real cf = (r.x * r.z + r.w * r.y) * iq, sf = (r.y * r.z - r.w * r.x) * iq;
       const Real bb = Real(0.5) * c[T::kb][l] * theta, sh = Real(0.5) * ks * theta * r0;
@@ -605,10 +625,17 @@ struct RotBond {
       const Real esys = Real((normal > c[T::truncated][l]) | (shear > one - normal));
       const Real sum = Real(((tn > zero ? tn : zero) + ts + tb + tt) >= one);
       b.broken[l] = esys + c[T::sum][l] * (sum - esys);  // (a select here would be a branch)
-      const Real lim = Real(0.995);
       // (& not &&: no branches in the loop)
-      b.general[l] = Real(!((n0 != zero) & (rxy2 != zero) & (t0 != zero) & (t2 != zero) & (gc > lim) &
-                            (t1 > lim) & ((cpsi > lim) | (spsi == zero)) & (c[T::atan2][l] == zero)));
+      const bool frames = (n0 != zero) & (rxy2 != zero) & (t0 != zero) & (t2 != zero);
+      if constexpr (Atan2) {
+        const Real lim = Real(0.1);  // atan_series' range: each angle's tangent
+        b.general[l] = Real(!(frames & (dot > zero) & (n0 <= lim * dot) & (r.w > zero) &
+                              (std::abs(r.z) <= lim * r.w) & (st2 <= lim * st0) & (c[T::atan2][l] != zero)));
+      } else {
+        const Real lim = Real(0.995);
+        b.general[l] = Real(
+            !(frames & (gc > lim) & (t1 > lim) & ((cpsi > lim) | (spsi == zero)) & (c[T::atan2][l] == zero)));
+      }
     }
   }
 
