@@ -140,7 +140,8 @@ type = "gravity_potential_energy"
   }
 }
 
-TEST(Damping, AllAtOnceMatchesTheScalarFormBitForBit) {
+template <class Real>
+void all_at_once_matches_the_scalar_form() {
   // BodyDriver evaluates linear_damping and rotational_damping on every particle in one vector loop
   // (apply_all) that stops after two of ESyS's iterations and leaves the particles still iterating to the
   // scalar form. ESyS's form iterates per particle until its update is small or the limit is reached
@@ -151,31 +152,32 @@ TEST(Damping, AllAtOnceMatchesTheScalarFormBitForBit) {
   constexpr std::size_t N = 37;  // (not a multiple of a vector's width)
   std::mt19937_64 rng(42);
   std::uniform_real_distribution<double> unit(-1, 1), exponent(-6, 1);
-  const auto value = [&] { return unit(rng) * std::pow(10.0, exponent(rng)); };
+  const auto value = [&] { return Real(unit(rng) * std::pow(10.0, exponent(rng))); };
   int zeroed = 0, damped = 0, beyond_two = 0;
   for (const double nu_dt : {2e-7, 0.3, 0.9})
     for (const int limit : {0, 1, 2, 5, 50})
       for (int batch = 0; batch < 10; ++batch) {
-        const double dt = 1e-3, nu = nu_dt / dt;
-        std::vector<double> im(N), rad(N), vx(N), vy(N), vz(N), fx(N), fy(N), fz(N), wx(N), wy(N), wz(N),
-            tx(N), ty(N), tz(N), lin_out(N), rot_out(N);
+        const Real dt = Real(1e-3), nu = Real(nu_dt / 1e-3);
+        std::vector<Real> im(N), rad(N), vx(N), vy(N), vz(N), fx(N), fy(N), fz(N), wx(N), wy(N), wz(N), tx(N),
+            ty(N), tz(N);
+        std::vector<double> lin_out(N), rot_out(N);
         std::vector<std::uint8_t> flag(N);
-        std::array<BodyState<double>, N> b{};
+        std::array<BodyState<Real>, N> b{};
         for (std::size_t l = 0; l < N; ++l) {
           auto& s = b[l];
           s.dt = dt;
-          im[l] = s.im = std::pow(10.0, exponent(rng));
+          im[l] = s.im = Real(std::pow(10.0, exponent(rng)));
           s.m = 1 / s.im;
-          rad[l] = std::pow(10.0, exponent(rng) / 2);
-          s.inertia = 1 / (2.5 * s.im / (rad[l] * rad[l]));
+          rad[l] = Real(std::pow(10.0, exponent(rng) / 2));
+          s.inertia = 1 / (Real(2.5) * s.im / (rad[l] * rad[l]));
           vx[l] = s.vx = value(), vy[l] = s.vy = value(), vz[l] = s.vz = value();
           fx[l] = s.fx = value(), fy[l] = s.fy = value(), fz[l] = s.fz = value();
           wx[l] = s.wx = value(), wy[l] = s.wy = value(), wz[l] = s.wz = value();
           tx[l] = s.tx = value(), ty[l] = s.ty = value(), tz[l] = s.tz = value();
         }
-        const LinearDamping::Coeffs<double> lin{nu, 0.01, -0.02, 0.0, limit};
-        const RotationalDamping::Coeffs<double> rot{nu, limit};
-        BodyArrays<double> a;
+        const LinearDamping::Coeffs<Real> lin{nu, Real(0.01), Real(-0.02), Real(0), limit};
+        const RotationalDamping::Coeffs<Real> rot{nu, limit};
+        BodyArrays<Real> a;
         a.n = N, a.dt = dt, a.im = im.data(), a.radius = rad.data();
         a.vx = vx.data(), a.vy = vy.data(), a.vz = vz.data(), a.wx = wx.data(), a.wy = wy.data(),
         a.wz = wz.data();
@@ -188,7 +190,7 @@ TEST(Damping, AllAtOnceMatchesTheScalarFormBitForBit) {
         RotationalDamping::apply_all(rot, a);
         for (std::size_t l = 0; l < N; ++l) {
           const auto& st = b[l];
-          BodyForce<double> f, g;
+          BodyForce<Real> f, g;
           LinearDamping::apply(lin, st, f);
           RotationalDamping::apply(rot, st, g);
           EXPECT_EQ(fx[l], st.fx + f.fx);
@@ -207,4 +209,18 @@ TEST(Damping, AllAtOnceMatchesTheScalarFormBitForBit) {
   // Both outcomes of the iteration limit occur in the sample.
   EXPECT_GT(zeroed, 100);
   EXPECT_GT(damped, 100);
+}
+
+TEST(Damping, AllAtOnceMatchesTheScalarFormBitForBit) { all_at_once_matches_the_scalar_form<double>(); }
+
+// In float the vector loop tests "iterate again" in float (a loop of floats vectorises; the scalar form
+// converts to double): the same decisions, so the same forces bit for bit.
+TEST(Damping, AllAtOnceMatchesTheScalarFormBitForBitInFloat) { all_at_once_matches_the_scalar_form<float>(); }
+
+// kFloatGo is esys_velocity's threshold for a float error e: double(e)^2 > 1e-12 (exact: a float's square
+// fits a double) exactly from kFloatGo up.
+TEST(Damping, FloatStopIsEsysStop) {
+  const float go = LinearDamping::kFloatGo, below = std::nextafter(go, 0.0f);
+  EXPECT_GT(double(go) * double(go), 1e-12);
+  EXPECT_LE(double(below) * double(below), 1e-12);
 }

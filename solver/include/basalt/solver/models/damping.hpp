@@ -15,6 +15,7 @@
 #include <cmath>
 #include <cstdint>
 #include <string_view>
+#include <type_traits>
 
 #include "basalt/solver/models/model.hpp"
 #include "basalt/solver/scene/table_reader.hpp"
@@ -86,6 +87,11 @@ struct LinearDamping {
     return u;
   }
 
+  /// The smallest float e with double(e)^2 > 1e-12 (the square of a float is exact in double):
+  /// esys_velocity goes on iterating from a float error e exactly when e >= kFloatGo (test
+  /// Damping.FloatStopIsEsysStop).
+  static constexpr float kFloatGo = 0x1.0c6f7cp-20f;
+
   /// The first two of esys_velocity's iterations (n > 0; n = 0 leaves u = v), branch-free (a vector loop
   /// runs it for many particles side by side): u after them, and whether the particle iterates on (then
   /// only esys_velocity gives its u). The same arithmetic in the same order: where it stops, u is
@@ -108,15 +114,22 @@ struct LinearDamping {
       const Real x = vx + s * dt * (Fx - ux * nu * M);
       const Real y = vy + s * dt * (Fy - uy * nu * M);
       const Real z = vz + s * dt * (Fz - uz * nu * M);
-      const double error = double((x - ux) * (x - ux) + (y - uy) * (y - uy) + (z - uz) * (z - uz));
+      const Real e = (x - ux) * (x - ux) + (y - uy) * (y - uy) + (z - uz) * (z - uz);
+      // (quiet comparisons, the isgreater family: an ordered one may trap on a NaN, and GCC then will not
+      // turn the loop's branches into selects, nor vectorise it)
+      Real go;  // (0 or 1 as Real, as `on`: GCC 12 does not vectorise a select between two masks)
+      if constexpr (std::is_same_v<Real, float>)
+        go = __builtin_isgreaterequal(e, kFloatGo) ? 1 : 0;  // esys_velocity's test on a float error
+      else
+        go = __builtin_isgreater(double(e) * double(e), 1e-12) ? 1 : 0;
       const bool step = on != 0;
       ux = step ? x : ux;
       uy = step ? y : uy;
       uz = step ? z : uz;
-      count += step ? 1 : 0;
-      on = step && error * error > 1e-12 && count < limit ? 1 : 0;
+      count += on;
+      on = on * go * (__builtin_isless(count, limit) ? Real(1) : Real(0));
     }
-    const bool spent = iterated && count >= limit;
+    const bool spent = iterated & __builtin_isgreaterequal(count, limit);
     ux = spent ? 0 : ux;
     uy = spent ? 0 : uy;
     uz = spent ? 0 : uz;
