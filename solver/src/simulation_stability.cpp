@@ -119,14 +119,18 @@ void Simulation<Real>::estimate_critical_step(bool fresh) {
   // force evaluation, as in a step. Peak memory: docs/bench/build_ab_granular.md.
   double lambda = 0;
   st.iterations = 0;
-  if (bound2 > 0) {
+  // A perturbation that breaks a bond (one strained near its strength at the start; float's perturbation is
+  // 1000x double's) is tried again 8x and 64x smaller before the start is refused.
+  for (int attempt = 0; bound2 > 0; ++attempt) {
+    lambda = 0;
+    st.iterations = 0;
     const bool parallel = comm().size() > 1;
     std::vector<float> scratch(fresh ? 0 : 3 * n);
     float* const sv[3] = {fresh ? p_.x0.data() : scratch.data(), fresh ? p_.y0.data() : scratch.data() + n,
                           fresh ? p_.z0.data() : scratch.data() + 2 * n};
     Real* const pos[3] = {p_.x.data(), p_.y.data(), p_.z.data()};
     Real* const frc[3] = {p_.fx.data(), p_.fy.data(), p_.fz.data()};
-    const double delta = stability::perturbation<Real>() * st.rmin;
+    const double delta = stability::perturbation<Real>() * st.rmin / std::pow(8.0, attempt);
     // Coordinates whose ulp is the same over [c - 2 delta, c + 2 delta] move by a multiple of it,
     // exactly; the others (within 2 delta of zero or of a power of two: a plane of particles at z = 0,
     // say) keep their value in a side list, sorted by 3 i + d.
@@ -259,11 +263,13 @@ void Simulation<Real>::estimate_critical_step(bool fresh) {
     // x0 back to the values rebuild() gives it (the same function sets both). The forces hold the last
     // product: the callers compute them again.
     if (fresh) set_skin_reference();
-    if (broken_.size() != broken_before)
+    // (each break is recorded by one rank: the sum counts each once)
+    const long long broke = comm().sum(static_cast<long long>(broken_.size() - broken_before));
+    if (broke > 0 && attempt == stability::kPerturbationRetries)
       throw InputError(fmt::format(
-          "the critical-step estimate broke {} bond(s) by perturbing positions by {:.3g}: bonds this close "
-          "to breaking at the start are not supported",
-          broken_.size() - broken_before, delta));
+          "the critical-step estimate broke {} bond(s) by perturbing positions by {:.3g} (after {} larger "
+          "tries): bonds this close to breaking at the start are not supported",
+          broke, delta, attempt));
     if (breakable) {
       bonds_ = bonds_at_start;
       p_.bonds_broken = damage_at_start;
@@ -271,6 +277,9 @@ void Simulation<Real>::estimate_critical_step(bool fresh) {
       bond_broke_ = bond_broke_at_start;
       forces_.set_bond_marks(std::move(marks_at_start));
     }
+    st.perturbation = delta;
+    st.retries = attempt;
+    if (broke == 0) break;
   }
   st.dt_power = stability::critical_step(lambda);
   // The power iterations approach omega_max from below (2 / omega_power >= the true step, by a few

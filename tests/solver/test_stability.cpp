@@ -62,6 +62,47 @@ TYPED_TEST_SUITE(CriticalStep, Reals);
 
 }  // namespace
 
+// A bond strained just short of its strength at the start: the estimate's perturbation (delta0, float's 1000x
+// double's) would break it, a perturbation 8x smaller does not. The estimate tries again smaller and leaves
+// the bond as it was; a bond closer still (within delta0 / 1000) is refused after the three tries.
+TYPED_TEST(CriticalStep, PerturbationThatBreaksABondIsRetriedSmaller) {
+  const double r = 0.5, strain = 0.01;
+  const double delta0 = stability::perturbation<TypeParam>() * r;
+  const auto scene = basalt::test::scene_from(R"([run]
+dt = 1e-4
+steps = 0
+skin = 0.05
+[[interactions]]
+type = "linear_bond"
+K = 1000.0
+break_strain = 0.01
+rest_length = "sum_of_radii"
+)");
+  const auto pair = [&](double gap) {  // the bond's stretch is its strength less `gap`
+    Geometry g;
+    g.add_particle(1, {0, 0, 0}, r);
+    g.add_particle(2, {2 * r * (1 + strain) - gap, 0, 0}, r);
+    g.add_bond(1, 2);
+    g.sort_by_id();
+    return g;
+  };
+  // The top mode stretches the bond by twice the perturbation: 2 delta0 > gap > 2 delta0 / 8.
+  Simulation<TypeParam> sim(scene, pair(0.5 * delta0), MPI_COMM_SELF);
+  EXPECT_EQ(sim.stability().retries, 1);
+  EXPECT_NEAR(sim.stability().perturbation, delta0 / 8, 1e-6 * delta0);
+  EXPECT_EQ(sim.bond_count(), 1);
+  EXPECT_TRUE(sim.broken_bonds().empty());
+  const double omega2 = 2 * 1000 / mass_of(r);
+  EXPECT_NEAR(sim.stability().dt_power, 2 / std::sqrt(omega2), 2e-3 * 2 / std::sqrt(omega2));
+  try {
+    Simulation<TypeParam> close(scene, pair(1e-3 * delta0), MPI_COMM_SELF);
+    ADD_FAILURE() << "a bond within delta0 / 1000 of its strength was not refused";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("broke 1 bond(s)"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("after 2 larger tries"), std::string::npos) << e.what();
+  }
+}
+
 // One spring between unequal masses: omega^2 = K (1/m1 + 1/m2) exactly; the bound is 2 K / m_min.
 TYPED_TEST(CriticalStep, TwoUnequalMassesIsExact) {
   Geometry g;

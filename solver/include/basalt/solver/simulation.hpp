@@ -54,9 +54,11 @@ struct StabilityReport {
   double dt_power = 0;  ///< 2 / omega from power iterations on M^-1 K (the real network)
   double dt_contact =
       0;  ///< one new contact of a lightest particle: 2 / sqrt(2 k_pair / m_min) or (wall) k_wall
-  int iterations = 0;      ///< power iterations done
-  double rmin = 0;         ///< smallest radius (the blow-up check's scale)
-  double dt_fraction = 0;  ///< run.dt_fraction when the scene chose dt that way
+  int iterations = 0;       ///< power iterations done
+  double perturbation = 0;  ///< the largest displacement of the products K u the estimate took
+  int retries = 0;          ///< times the perturbation was made 8x smaller because it broke bonds
+  double rmin = 0;          ///< smallest radius (the blow-up check's scale)
+  double dt_fraction = 0;   ///< run.dt_fraction when the scene chose dt that way
 };
 
 /// What a restart needs besides the checkpoint's particles to rebuild the SAME decomposition and

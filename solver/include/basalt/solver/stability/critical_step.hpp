@@ -98,6 +98,9 @@ constexpr double perturbation() {
   return sizeof(Real) >= 8 ? 1e-6 : 1e-3;
 }
 
+/// A perturbation that breaks a bond is tried again this many times, 8x smaller each time.
+inline constexpr int kPerturbationRetries = 2;
+
 /// The blow-up check: a particle that moved farther than skin/2 + kBlowupRadii x the smallest radius
 /// since the last rebuild (which happens as soon as one moved skin/2) moved more than that fraction
 /// of the smallest radius in one step.
