@@ -8,7 +8,8 @@ rot_compress run (tools/esys/ucs_esys.py) on the same GenGeo specimen and steps,
 
 Each repeat runs, back to back: ESyS-Particle (1 worker + its master, the smallest ESyS run: the master only
 coordinates), Basalt at 1 rank, Basalt at 2 ranks, and with --base-bin an older Basalt at 1 and 2 ranks
-(the before/after of a change, in the same run). Times are each code's own stepping loop (ESyS: the
+(the before/after of a change, in the same run); odd repeats run the older Basalt before the new one, so
+that each follows ESyS equally often (give an even number of repeats). Times are each code's own stepping loop (ESyS: the
 script's timer around runTimeLoop, timing.json's loop_s; Basalt: its `done: N steps in T s` line), so
 start-up is excluded from both. Output: a markdown table on stdout and W/ucs_bench.json.
 """
@@ -77,7 +78,14 @@ def main():
                   ("base2", "Basalt before (--base-bin), 2 ranks", a.base_bin, 2)]
     res = {c[0]: [] for c in codes}
     for r in range(a.repeats):
-        for key, label, bindir, ranks in codes:
+        # Odd repeats run the base build before the new one: the job right after ESyS (60-70 s of both
+        # cores busy) may run slow. In a fixed order a new build measured 1.06x and 1.14x the base's time
+        # (two runs of 3 repeats), and 0.92-0.95x in A/B runs that alternate the two (docs/BENCHMARKS.md,
+        # "Rock"); a rotation of the list keeps the same job after ESyS.
+        order = list(codes)
+        if a.base_bin and r % 2 == 1:
+            order = order[:-4] + order[-2:] + order[-4:-2]
+        for key, label, bindir, ranks in order:
             out = os.path.join(a.work, f"{key}_{r}")
             log = out + ".log"
             x = esys(a.steps, out, log) if key == "esys" else basalt(bindir, ranks, a.steps, out, log)
