@@ -68,16 +68,8 @@ TYPED_TEST_SUITE(CriticalStep, Reals);
 TYPED_TEST(CriticalStep, PerturbationThatBreaksABondIsRetriedSmaller) {
   const double r = 0.5, strain = 0.01;
   const double delta0 = stability::perturbation<TypeParam>() * r;
-  const auto scene = basalt::test::scene_from(R"([run]
-dt = 1e-4
-steps = 0
-skin = 0.05
-[[interactions]]
-type = "linear_bond"
-K = 1000.0
-break_strain = 0.01
-rest_length = "sum_of_radii"
-)");
+  const auto scene =
+      basalt::test::scene_from(kBonds + "break_strain = 0.01\nrest_length = \"sum_of_radii\"\n");
   const auto pair = [&](double gap) {  // the bond's stretch is its strength less `gap`
     Geometry g;
     g.add_particle(1, {0, 0, 0}, r);
