@@ -1,7 +1,8 @@
 // basalt-run: runs a scene (TOML) on P compute ranks with Q dedicated I/O ranks.
 //   mpirun -np P+Q basalt-run scenes/wave.toml [--io-ranks Q] [--geometry FILE] [--steps N] [--output DIR]
 //          [--dims x,y,z] [--checkpoint-every N] [--frames-every N] [--fields-every N]
-//          [--restart FILE|DIR [--whole-checkpoint]] [--balance none|count|time] [--balance-threshold X]
+//          [--restart FILE|DIR [--whole-checkpoint]] [--balance none|count|pairs|time] [--balance-threshold
+//          X]
 //          [--quiet] [--force-dt]
 //          [--render-every N [--render SPEC]]
 // The only code that touches MPI_COMM_WORLD: it creates the output folder (world rank 0, a failure
@@ -289,8 +290,8 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
   const double imbalance_start = sim->imbalance();
   const auto balance_setting = [&] {
     if (scene.balance == "none") return std::string("run.balance = \"none\"");
-    return scene.balance == "count"
-               ? fmt::format("run.balance = \"count\", threshold {}", scene.balance_limit())
+    return scene.balance == "count" || scene.balance == "pairs"
+               ? fmt::format("run.balance = \"{}\", threshold {}", scene.balance, scene.balance_limit())
                : fmt::format("run.balance = \"time\", threshold {}, every {} steps", scene.balance_limit(),
                              scene.balance_every);
   };
@@ -455,12 +456,13 @@ int run_world(int argc, char** argv) {
   app.add_option(
          "--balance", cli.balance,
          "load balancing of the rank grid: none (even cuts), count (cuts moved at rebuilds by particle "
-         "count) or time (cuts moved by measured compute time; docs/solver.md); overrides run.balance")
-      ->check(CLI::IsMember({"none", "count", "time"}));
+         "count), pairs (by particle count weighted by listed pairs, bonds and walls) or time (cuts moved "
+         "by measured compute time; docs/solver.md); overrides run.balance")
+      ->check(CLI::IsMember({"none", "count", "pairs", "time"}));
   app.add_option(
          "--balance-threshold", cli.balance_threshold,
-         "re-balance when the busiest rank holds more than this x the mean particles, or compute time with "
-         "--balance time (>= 1); overrides run.balance_threshold")
+         "re-balance when the busiest rank holds more than this x the mean particles, work with --balance "
+         "pairs, or compute time with --balance time (>= 1); overrides run.balance_threshold")
       ->check(CLI::Range(1.0, 1e300));
   app.add_flag("--quiet", cli.quiet, "no progress line");
   app.add_flag("--whole-geometry", cli.whole_geometry,

@@ -222,7 +222,7 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
     }
     s.energy_check_every = t.integer_or("energy_check_every", 100);
     if (s.energy_check_every < 0) t.fail("energy_check_every", "must be >= 0 (0 turns the guard off)");
-    s.balance = t.choice_or("balance", {"none", "count", "time"}, "none");
+    s.balance = t.choice_or("balance", {"none", "count", "pairs", "time"}, "none");
     if (t.has("balance_threshold")) {
       s.balance_threshold = t.positive("balance_threshold");
       if (s.balance_threshold < 1)

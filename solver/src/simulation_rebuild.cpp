@@ -101,6 +101,7 @@ void Simulation<Real>::rebuild() {
   const bool parallel = comm().size() > 1;
   if (parallel) error = comm().agree_error(error);
   if (error) stop(*error);
+  if (parallel && scene_.balance == "pairs" && !balance_paused_ && rebuilds_ > 0) weigh_pairs();
   forces_.save_history(p_);  // before the ghosts (and the pairs' ids) go
   p_.drop_ghosts();
   if (parallel) {

@@ -125,6 +125,8 @@ TEST(BalanceScene, KeysAreReadAndBadValuesNamed) {
   EXPECT_EQ(s.balance_limit(), 1.5);
   EXPECT_EQ(basalt::test::scene_from(run).balance, "none") << "off unless asked for";
   EXPECT_EQ(basalt::test::scene_from(run + "balance = \"count\"\n").balance_limit(), 1.2);
+  EXPECT_EQ(basalt::test::scene_from(run + "balance = \"pairs\"\n").balance_limit(), 1.02)
+      << "pairs' own default threshold";
   const auto t = basalt::test::scene_from(run + "balance = \"time\"\nbalance_every = 200\n");
   EXPECT_EQ(t.balance, "time");
   EXPECT_EQ(t.balance_every, 200);
@@ -326,4 +328,127 @@ TEST(Balance, TimeMovesWorkOffASlowRankAndResultsAgree) {
   if (basalt::test::rank() == 0)
     std::printf("time balance: %lld re-balances; KE %.3g, positions %.3g relative to the unbalanced run\n",
                 static_cast<long long>(sim.rebalances()), worst_ke, worst_x);
+}
+
+namespace {
+
+/// Two blocks of 6 x 3 x 3 grains each side of x = 11.5, the middle of the box: at x = 0.5 .. 5.5 spaced 1
+/// with radius 0.505 (each touching its lattice neighbours), and at x = 12.5 .. 22.5 spaced 2 with radius
+/// 0.45 (none within reach of another). Equal counts, so "count" leaves the even grid; the left block's
+/// contacts make its rank the busier.
+basalt::io::Geometry dense_and_sparse() {
+  basalt::io::Geometry g;
+  std::int64_t id = 1;
+  for (int side = 0; side < 2; ++side)
+    for (int k = 0; k < 3; ++k)
+      for (int j = 0; j < 3; ++j)
+        for (int i = 0; i < 6; ++i, ++id)
+          g.add_particle(id,
+                         {side == 0 ? 0.5 + i : 12.5 + 2.0 * i, 0.5 + (side == 0 ? 1.0 : 2.0) * j,
+                          0.5 + (side == 0 ? 1.0 : 2.0) * k},
+                         side == 0 ? 0.505 : 0.45);
+  return g;
+}
+
+const std::string kPairsScene = R"(
+[particles]
+rotation = true
+[run]
+dt = 2e-3
+steps = 0
+skin = 0.1
+[[interactions]]
+type = "rot_friction"
+K = 1000.0
+Ks = 500.0
+mu = 0.5
+[[output.fields]]
+type = "kinetic_energy"
+)";
+
+struct PairsOutcome {
+  std::vector<double> ke, xyz;
+  std::int64_t rebalances = 0;
+  double owned = 0, work = 0;  ///< this rank's particles and pair_work after the forced rebuild
+};
+
+PairsOutcome run_pairs(const std::string& balance, int steps) {
+  auto scene = basalt::test::scene_from(kPairsScene);
+  scene.balance = balance;
+  const auto g = dense_and_sparse();
+  RunOptions opt;
+  opt.quiet = true;
+  Simulation<double> sim(scene, g, basalt::test::world(), opt);
+  basalt::test::MemorySink sink;
+  sink.begin(field_columns(scene));
+  sim.run(1, &sink);
+  sim.force_rebuild();  // the first rebuild with lists to weigh: "pairs" moves the cut here
+  PairsOutcome o;
+  o.rebalances = sim.rebalances();
+  o.owned = double(sim.particles().n_owned);
+  for (const double w : sim.pair_work()) o.work += w;
+  sim.run(steps - 1, &sink);
+  o.ke = sink.column(0);
+  o.xyz.assign(3 * g.size(), 0.0);
+  const auto& p = sim.particles();
+  for (std::size_t i = 0; i < p.n_owned; ++i) {
+    const auto k = 3 * static_cast<std::size_t>(p.id[i] - 1);
+    o.xyz[k] = p.x[i];
+    o.xyz[k + 1] = p.y[i];
+    o.xyz[k + 2] = p.z[i];
+  }
+  MPI_Allreduce(MPI_IN_PLACE, o.xyz.data(), static_cast<int>(o.xyz.size()), MPI_DOUBLE, MPI_SUM,
+                basalt::test::world());
+  return o;
+}
+
+}  // namespace
+
+TEST(Balance, PairsWeighContactsAndRunBitForBitAlike) {
+  // run.balance = "pairs" at np 2: both ranks start with 54 grains, but rank 0's touch their neighbours
+  // and rank 1's touch nothing. "count" sees no imbalance; "pairs" weighs the contacts, moves the cut into
+  // the dense block and gives rank 0 fewer particles. The run must agree with the unbalanced one to 1e-9
+  // (the cut changes only which rank computes a pair and the order of sums) and, unlike "time", repeat
+  // itself bit for bit: its weights come from the lists and positions, not from a clock.
+  if (basalt::test::size() != 2) GTEST_SKIP() << "the pairs balancer is checked at np 2";
+  constexpr int kSteps = 300;
+  const auto plain = run_pairs("none", kSteps);
+  const auto counted = run_pairs("count", kSteps);
+  const auto weighed = run_pairs("pairs", kSteps);
+  const auto again = run_pairs("pairs", kSteps);
+  EXPECT_EQ(counted.rebalances, 0) << "equal counts: count leaves the even grid";
+  EXPECT_EQ(plain.owned, 54.0);
+  ASSERT_GE(weighed.rebalances, 1);
+  // Work per rank: the unbalanced grid's busy rank against the balanced one's.
+  const double plain_most = basalt::test::rank() == 0 ? plain.work : 0.0;
+  double busiest_before = 0, busiest_after = 0, total_after = 0;
+  MPI_Allreduce(&plain_most, &busiest_before, 1, MPI_DOUBLE, MPI_MAX, basalt::test::world());
+  MPI_Allreduce(&weighed.work, &busiest_after, 1, MPI_DOUBLE, MPI_MAX, basalt::test::world());
+  MPI_Allreduce(&weighed.work, &total_after, 1, MPI_DOUBLE, MPI_SUM, basalt::test::world());
+  if (basalt::test::rank() == 0) {
+    EXPECT_LT(weighed.owned, 0.8 * 54) << "the rank of the touching grains sheds particles";
+    EXPECT_LT(busiest_after, 1.1 * total_after / 2) << "the work is shared about evenly after the move";
+    EXPECT_GT(busiest_before, 1.5 * total_after / 2) << "and was not before";
+  }
+  EXPECT_EQ(weighed.xyz, again.xyz) << "pairs balancing must repeat bit for bit";
+  double worst_x = 0;
+  for (std::size_t k = 0; k < plain.xyz.size(); ++k)
+    worst_x =
+        std::max(worst_x, std::abs(weighed.xyz[k] - plain.xyz[k]) / std::max(1.0, std::abs(plain.xyz[k])));
+  EXPECT_LT(worst_x, 1e-9);
+  if (basalt::test::rank() != 0) return;  // (the field rows are rank 0's)
+  ASSERT_EQ(weighed.ke.size(), plain.ke.size());
+  ASSERT_FALSE(plain.ke.empty());
+  double worst_ke = 0;
+  for (std::size_t s = 0; s < plain.ke.size(); ++s)
+    if (plain.ke[s] > 1e-6 * plain.ke.back())
+      worst_ke = std::max(worst_ke, std::abs(weighed.ke[s] - plain.ke[s]) / plain.ke[s]);
+  EXPECT_GT(plain.ke.back(), 0.0) << "the touching block must move";
+  EXPECT_LT(worst_ke, 1e-9);
+  EXPECT_EQ(weighed.ke, again.ke) << "pairs balancing must repeat bit for bit";
+  std::printf(
+      "pairs balance: work of the busier rank %.0f -> %.0f of %.0f; %lld re-balances; KE %.3g, "
+      "positions %.3g relative to the unbalanced run\n",
+      busiest_before, busiest_after, total_after, static_cast<long long>(weighed.rebalances), worst_ke,
+      worst_x);
 }

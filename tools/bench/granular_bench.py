@@ -278,9 +278,9 @@ def main():
     ap.add_argument("--ranks", default="1,2")
     ap.add_argument("--codes", default="basalt,lammps_granular,lammps_hertzhistory,liggghts")
     ap.add_argument("--base-bin", default="", help="a second basalt-run build (code basalt_base), e.g. main's, to time against --bin")
-    ap.add_argument("--balance", choices=["none", "time"], default="none",
-                    help="time: Basalt --balance time, LAMMPS fix balance ... weight time (LIGGGHTS 3.8 has no fix "
-                         "balance: unbalanced)")
+    ap.add_argument("--balance", choices=["none", "pairs", "time"], default="none",
+                    help="time: Basalt --balance time, LAMMPS fix balance ... weight time; pairs: Basalt --balance "
+                         "pairs, LAMMPS fix balance ... weight neigh (LIGGGHTS 3.8 has no fix balance: unbalanced)")
     ap.add_argument("--order", choices=["codes", "ranks"], default="codes",
                     help="within a repeat: each code's rank counts back to back (codes), or each rank count's codes")
     ap.add_argument("--summarize", action="store_true", help="only print the table from the logs in --work")
@@ -321,7 +321,7 @@ def main():
     kn, kt, gn, gt = lammps_hertz_history_coeffs()
     # The cuts' balancing, every 500 steps above 5 % imbalance in every code (Basalt's defaults for "time").
     shift = "fix bal all balance 500 1.05 shift xyz 10 1.05"
-    lammps_balance = shift + " weight time 1.0" if a.balance == "time" else ""
+    lammps_balance = {"time": shift + " weight time 1.0", "pairs": shift + " weight neigh 1.0"}.get(a.balance, "")
     liggghts_balance = ""  # (LIGGGHTS 3.8 has no fix balance)
     common = dict(DATA="data.lmp", SKIN=SKIN, LX=LX, LY=LY, G=G, DT=DT, STEPS=a.steps, THERMO=a.steps // 2)
     gran = f"hertz/material {E} {REST} {NU} tangential mindlin NULL {tangential_damping_ratio():.9g} {MU} damping tsuji"
@@ -333,7 +333,7 @@ def main():
          **common)
     fill(os.path.join(ROOT, "tools/liggghts/in.granular.liggghts"), os.path.join(W, "in.liggghts"),
          E=E, NU=NU, REST=REST, MU=MU, BALANCE=liggghts_balance, **common)
-    bal = " --balance time" if a.balance == "time" else ""
+    bal = f" --balance {a.balance}" if a.balance != "none" else ""
     cmds = {
         "basalt": f"{a.bin}/basalt-run bench.toml --quiet{bal}",
         "lammps_hertzhistory": "lmp -in in.lammps_hertzhistory -nocite",

@@ -25,6 +25,7 @@
 #include "basalt/solver/neighbor/verlet_list.hpp"
 #include "basalt/solver/output/field_sink.hpp"
 #include "basalt/solver/output/output_sink.hpp"
+#include "basalt/solver/parallel/balance.hpp"
 #include "basalt/solver/parallel/decomposition.hpp"
 #include "basalt/solver/parallel/geometry_loader.hpp"
 #include "basalt/solver/parallel/halo.hpp"
@@ -166,6 +167,12 @@ class Simulation {
   void force_rebuild();
   /// Collective: the busiest rank's owned particles over the mean (1 = perfectly balanced).
   double imbalance() const;
+  /// run.balance = "pairs"'s estimate of each owned particle's work in a step, a whole number (units of
+  /// about 50 instructions): 2 for the particle; per end of a listed pair 1, 4 while the pair touches; per
+  /// end of a bond 3; 4 per wall or mesh the particle is a candidate of. A pair or bond with a ghost puts
+  /// both ends' share on the owned end (this rank evaluates all of it). From the lists and bonds of the last
+  /// rebuild, at the current positions (2 each before the first).
+  std::vector<double> pair_work() const;
   /// run.balance = "time": adds seconds to this rank's measured compute time, as if its steps had taken
   /// them (the balancer then moves work off this rank; tests stand in for a slower core with it).
   void add_rank_work(double seconds) { extra_work_ += seconds; }
@@ -231,6 +238,10 @@ class Simulation {
   /// run.balance_threshold, and migrates to them; with "time" after a time_balance_due() that said yes,
   /// moves them by the particles' time weights (parallel/balance.hpp, time_weight).
   void balance_at_rebuild();
+  /// Collective, with run.balance = "pairs", in a rebuild before its migration (the lists still index the
+  /// particles): each rank's work (pair_work) against the mean, and when that exceeds the threshold the
+  /// weighted marginals balance_at_rebuild then cuts by.
+  void weigh_pairs();
   /// Collective, every run.balance_every steps with run.balance = "time": whether the busiest rank's compute
   /// time since the last check exceeds the mean by the threshold (then the step rebuilds and re-balances);
   /// otherwise starts a new measuring window.
@@ -345,6 +356,9 @@ class Simulation {
   bool balance_by_time_ = false;        ///< set by time_balance_due(): the next rebuild moves the cuts
   double time_weight_ = 1024;           ///< this rank's particles' weight for that move
   double time_imbalance_ = 1;           ///< max/mean compute time per rank at that check
+  bool pairs_weighed_ = false;          ///< weigh_pairs() ran in this rebuild
+  double pairs_imbalance_ = 1;          ///< max/mean pair_work per rank it found
+  BalanceMarginals pairs_marginals_;    ///< its weighted marginals (when above the threshold)
   bool mixed_ = false;                  ///< run.precision = "mixed" (set by configure_particles())
   Origin origin_{};                     ///< the frame's origin (mixed; zero otherwise)
 };

@@ -30,6 +30,13 @@ struct AxisHistogram {
   }
 };
 
+/// The particles' extent along each axis (over all ranks) and their marginal histograms along the axes,
+/// bins x 3 summed over the ranks (axis d's at [d bins, (d + 1) bins); zeros for an axis not split).
+struct BalanceMarginals {
+  std::array<double, 3> lo{}, hi{};
+  std::vector<double> counts;
+};
+
 /// The parts - 1 increasing cut positions that split the histogram's total into `parts` slabs of
 /// (nearly) equal count: cut k where the cumulative count reaches k N / parts, linear within its bin,
 /// so a slab's count is within one bin's count of N / parts. Interior slabs (1 .. parts - 2) are then

@@ -180,18 +180,22 @@ struct Scene {
   double dt_safety = 0.2;                 ///< warn when dt > dt_safety * critical step
   std::int64_t energy_check_every = 100;  ///< 0: no energy-growth guard
   /// run.balance: "none" (the even grid, never moved), "count" (cuts moved at a rebuild so that each
-  /// slab of the rank grid holds an equal share of the particles: parallel/balance.hpp) or "time" (every
-  /// run.balance_every steps, cuts moved so that each slab takes an equal share of the measured compute
-  /// time: a particle weighs its rank's compute time over its particle count).
+  /// slab of the rank grid holds an equal share of the particles: parallel/balance.hpp), "pairs" (the
+  /// same, each particle weighted by its listed pairs, bonds and walls: Simulation::pair_work) or "time"
+  /// (every run.balance_every steps, cuts moved so that each slab takes an equal share of the measured
+  /// compute time: a particle weighs its rank's compute time over its particle count).
   std::string balance = "none";
   /// run.balance_threshold: re-balance when the busiest rank holds more than this x the mean particles
-  /// ("count") or took more than this x the mean compute time ("time"); 0: the mode's default.
+  /// ("count"), this x the mean work ("pairs") or took more than this x the mean compute time ("time");
+  /// 0: the mode's default.
   double balance_threshold = 0;
   /// run.balance_every: with "time", the steps between two checks of the ranks' compute times.
   std::int64_t balance_every = 500;
-  /// The threshold in force: balance_threshold, or 1.2 for "count" and 1.05 for "time" when it is 0.
+  /// The threshold in force: balance_threshold, or 1.2 for "count", 1.02 for "pairs" and 1.05 for "time"
+  /// when it is 0.
   double balance_limit() const {
-    return balance_threshold > 0 ? balance_threshold : (balance == "time" ? 1.05 : 1.2);
+    if (balance_threshold > 0) return balance_threshold;
+    return balance == "time" ? 1.05 : balance == "pairs" ? 1.02 : 1.2;
   }
   std::vector<InteractionSpec> bonds;     ///< bond groups, in scene order (a bond's group indexes these)
   std::vector<InteractionSpec> contacts;  ///< pair (contact) groups, in scene order
