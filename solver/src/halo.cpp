@@ -173,6 +173,7 @@ std::optional<std::string> Halo<Real>::migrate(Particles<Real>& p, Bonds<Real>& 
         const int dest = dec_.neighbor(d, side), src = dec_.neighbor(d, 1 - side);
         const auto in = sendrecv(comm, out[side], dest, src);
         const auto bin = sendrecv(comm, bout[side], dest, src);
+        p.make_room(p.n_owned + in.size() / record, p.size() + in.size() / record);
         for (std::size_t at = 0; at < in.size(); at += record) {
           p.unpack(in.data() + at, false);
           const std::size_t i = p.n_owned - 1;
@@ -222,6 +223,7 @@ void Halo<Real>::build_ghosts(Particles<Real>& p, double width) {
       const auto in = sendrecv(comm, out, dec_.neighbor(d, side), dec_.neighbor(d, 1 - side));
       recv_begin_[d][1 - side] = p.size();
       recv_count_[d][1 - side] = in.size() / record;
+      p.make_room(p.n_owned, p.size() + in.size() / record);
       for (std::size_t at = 0; at < in.size(); at += record) p.unpack(in.data() + at, true);
     }
   }

@@ -148,6 +148,17 @@ struct Particles {
       if (enabled(a)) v.reserve(n);
     });
   }
+  /// Room for `owned` owned particles and `total` particles with the ghosts, an eighth to spare where an
+  /// array must grow: the ghosts and migrants appended at a rebuild then leave no array at twice the
+  /// particles' count (std::vector's doubling did at 2 ranks, where the ghosts come on top of an exact
+  /// reserve).
+  void make_room(std::size_t owned, std::size_t total) {
+    for_each_array([&](const ArrayInfo& a, auto& v) {
+      if (!enabled(a)) return;
+      const std::size_t n = a.ghosts ? total : owned;
+      if (v.capacity() < n) v.reserve(n + n / 8);
+    });
+  }
   /// Drops ghosts, keeps owned particles.
   void drop_ghosts() { resize_all(n_owned); }
 
