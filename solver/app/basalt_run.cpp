@@ -1,9 +1,8 @@
 // basalt-run: runs a scene (TOML) on P compute ranks with Q dedicated I/O ranks.
 //   mpirun -np P+Q basalt-run scenes/wave.toml [--io-ranks Q] [--geometry FILE] [--steps N] [--output DIR]
 //          [--dims x,y,z] [--checkpoint-every N] [--frames-every N] [--fields-every N]
-//          [--restart FILE|DIR [--whole-checkpoint]] [--balance none|count|pairs|time] [--balance-threshold
-//          X]
-//          [--quiet] [--force-dt]
+//          [--restart FILE|DIR [--whole-checkpoint]] [--balance none|count|pairs|time]
+//          [--balance-threshold X] [--quiet] [--force-dt]
 //          [--render-every N [--render SPEC]]
 // The only code that touches MPI_COMM_WORLD: it creates the output folder (world rank 0, a failure
 // stops every rank before anything starts) and splits the world into compute and I/O ranks. Compute

@@ -144,7 +144,8 @@ TEST(BalanceScene, KeysAreReadAndBadValuesNamed) {
 
 namespace {
 
-const std::string kScene = R"(
+/// Rotating frictional grains, the kinetic energy saved every step; kScene adds walls, gravity and damping.
+const std::string kGrains = R"(
 [particles]
 rotation = true
 [run]
@@ -156,6 +157,11 @@ type = "rot_friction"
 K = 1000.0
 Ks = 500.0
 mu = 0.5
+[[output.fields]]
+type = "kinetic_energy"
+)";
+
+const std::string kScene = kGrains + R"(
 [[walls]]
 name = "floor"
 point = [0.0, 0.0, 0.0]
@@ -175,9 +181,22 @@ acceleration = [0.0, 0.0, -1.0]
 [[body_forces]]
 type = "linear_damping"
 viscosity = 0.05
-[[output.fields]]
-type = "kinetic_energy"
 )";
+
+/// Every particle's final position by id (3 per particle), the same on every rank.
+template <class Real>
+std::vector<double> positions_by_id(const Simulation<Real>& sim, std::size_t n, MPI_Comm comm) {
+  std::vector<double> xyz(3 * n, 0.0);
+  const auto& p = sim.particles();
+  for (std::size_t i = 0; i < p.n_owned; ++i) {
+    const auto k = 3 * static_cast<std::size_t>(p.id[i] - 1);
+    xyz[k] = p.x[i];
+    xyz[k + 1] = p.y[i];
+    xyz[k + 2] = p.z[i];
+  }
+  MPI_Allreduce(MPI_IN_PLACE, xyz.data(), static_cast<int>(xyz.size()), MPI_DOUBLE, MPI_SUM, comm);
+  return xyz;
+}
 
 /// A column of 12 x 2 x 10 grains (lattice, jittered radii 0.35-0.5) at x in [0, 12], and one grain resting
 /// on the floor at x = 40: the even grid cuts x at ~20, so one side holds every grain but one.
@@ -222,15 +241,7 @@ Outcome run(const std::string& balance, MPI_Comm comm, std::array<int, 3> dims, 
   o.ke = sink.column(0);
   o.end = sim.imbalance();
   o.rebalances = sim.rebalances();
-  o.xyz.assign(3 * g.size(), 0.0);
-  const auto& p = sim.particles();
-  for (std::size_t i = 0; i < p.n_owned; ++i) {
-    const auto k = 3 * static_cast<std::size_t>(p.id[i] - 1);
-    o.xyz[k] = p.x[i];
-    o.xyz[k + 1] = p.y[i];
-    o.xyz[k + 2] = p.z[i];
-  }
-  MPI_Allreduce(MPI_IN_PLACE, o.xyz.data(), static_cast<int>(o.xyz.size()), MPI_DOUBLE, MPI_SUM, comm);
+  o.xyz = positions_by_id(sim, g.size(), comm);
   return o;
 }
 
@@ -305,16 +316,7 @@ TEST(Balance, TimeMovesWorkOffASlowRankAndResultsAgree) {
     EXPECT_GT(owned(), 1.25 * mean);
   }
   sim.run(kSteps - 101, &sink);
-  std::vector<double> xyz(3 * g.size(), 0.0);
-  const auto& p = sim.particles();
-  for (std::size_t i = 0; i < p.n_owned; ++i) {
-    const auto k = 3 * static_cast<std::size_t>(p.id[i] - 1);
-    xyz[k] = p.x[i];
-    xyz[k + 1] = p.y[i];
-    xyz[k + 2] = p.z[i];
-  }
-  MPI_Allreduce(MPI_IN_PLACE, xyz.data(), static_cast<int>(xyz.size()), MPI_DOUBLE, MPI_SUM,
-                basalt::test::world());
+  const auto xyz = positions_by_id(sim, g.size(), basalt::test::world());
   const auto ke = sink.column(0);
   ASSERT_EQ(ke.size(), plain.ke.size());
   double worst_ke = 0, worst_x = 0;
@@ -350,22 +352,6 @@ basalt::io::Geometry dense_and_sparse() {
   return g;
 }
 
-const std::string kPairsScene = R"(
-[particles]
-rotation = true
-[run]
-dt = 2e-3
-steps = 0
-skin = 0.1
-[[interactions]]
-type = "rot_friction"
-K = 1000.0
-Ks = 500.0
-mu = 0.5
-[[output.fields]]
-type = "kinetic_energy"
-)";
-
 struct PairsOutcome {
   std::vector<double> ke, xyz;
   std::int64_t rebalances = 0;
@@ -373,7 +359,7 @@ struct PairsOutcome {
 };
 
 PairsOutcome run_pairs(const std::string& balance, int steps) {
-  auto scene = basalt::test::scene_from(kPairsScene);
+  auto scene = basalt::test::scene_from(kGrains);
   scene.balance = balance;
   const auto g = dense_and_sparse();
   RunOptions opt;
@@ -389,16 +375,7 @@ PairsOutcome run_pairs(const std::string& balance, int steps) {
   for (const double w : sim.pair_work()) o.work += w;
   sim.run(steps - 1, &sink);
   o.ke = sink.column(0);
-  o.xyz.assign(3 * g.size(), 0.0);
-  const auto& p = sim.particles();
-  for (std::size_t i = 0; i < p.n_owned; ++i) {
-    const auto k = 3 * static_cast<std::size_t>(p.id[i] - 1);
-    o.xyz[k] = p.x[i];
-    o.xyz[k + 1] = p.y[i];
-    o.xyz[k + 2] = p.z[i];
-  }
-  MPI_Allreduce(MPI_IN_PLACE, o.xyz.data(), static_cast<int>(o.xyz.size()), MPI_DOUBLE, MPI_SUM,
-                basalt::test::world());
+  o.xyz = positions_by_id(sim, g.size(), basalt::test::world());
   return o;
 }
 
@@ -459,7 +436,7 @@ TEST(Halo, GhostsAndMigrantsDoNotDoubleTheParticleArrays) {
   // count capacity (at 2 ranks it had been 1.5x the 1-rank figure per particle, nearly all of it slack).
   // Unbalanced, so that no rank sheds particles and keeps their room.
   if (basalt::test::size() == 1) GTEST_SKIP() << "no ghosts at np 1";
-  auto scene = basalt::test::scene_from(kPairsScene);
+  auto scene = basalt::test::scene_from(kGrains);
   const auto g = dense_and_sparse();
   RunOptions opt;
   opt.quiet = true;
