@@ -297,14 +297,23 @@ bool Simulation<Real>::kinetic_due(std::int64_t s) const {
 }
 
 template <class Real>
-void Simulation<Real>::step(FieldSink* sink) {
+void Simulation<Real>::advance(FieldSink* sink, bool may_defer) {
   ke_fresh_ = false;
   sink_ = sink;
   Stopwatch sw;
   // Forces are zeroed in the same pass: the non-finite check needs them only at a rebuild, and a
-  // non-finite force has already made the velocity non-finite.
-  const double moved2 = kick_zero_drift(p_, kick1_, Real(scene_.dt));
-  if (p_.with_rotation) rotate_kick_zero_drift(p_, kick1_, Real(scene_.dt));
+  // non-finite force has already made the velocity non-finite. A second half-kick the last step left
+  // (kick_pending_) is made in the same pass.
+  const Real dt = Real(scene_.dt);
+  const double moved2 =
+      kick_pending_ ? kick_kick_zero_drift(p_, kick2_, kick1_, dt) : kick_zero_drift(p_, kick1_, dt);
+  if (p_.with_rotation) {
+    if (kick_pending_)
+      rotate_kick_kick_zero_drift(p_, kick2_, kick1_, dt);
+    else
+      rotate_kick_zero_drift(p_, kick1_, dt);
+  }
+  kick_pending_ = false;
   forces_zeroed_ = true;
   times_.integration += sw.lap();
   const bool parallel = comm().size() > 1;
@@ -341,12 +350,16 @@ void Simulation<Real>::step(FieldSink* sink) {
   times_.forces += force_time - ghost_wait_;
   times_.communication += ghost_wait_;
   if (kick2_ != Real(0)) {
-    if (p_.with_rotation) rotate_kick(p_, kick2_);
-    if (kinetic_due(step_)) {
-      ke_local_ = kick_energy(p_, kick2_);
-      ke_fresh_ = true;
+    if (may_defer && !observed(step_)) {
+      kick_pending_ = true;
     } else {
-      kick(p_, kick2_);
+      if (p_.with_rotation) rotate_kick(p_, kick2_);
+      if (kinetic_due(step_)) {
+        ke_local_ = kick_energy(p_, kick2_);
+        ke_fresh_ = true;
+      } else {
+        kick(p_, kick2_);
+      }
     }
   }
   times_.integration += sw.lap();
@@ -357,6 +370,21 @@ void Simulation<Real>::step(FieldSink* sink) {
   save_fields(sink, pe);
   times_.output += sw.lap();
   if (scene_.energy_check_every > 0 && step_ % scene_.energy_check_every == 0) guard_energy(pe);
+}
+
+template <class Real>
+bool Simulation<Real>::observed(std::int64_t s) const {
+  for (const auto& f : scene_.fields)
+    if (s % f.every == 0) return true;
+  return scene_.energy_check_every > 0 && s % scene_.energy_check_every == 0;
+}
+
+template <class Real>
+void Simulation<Real>::settle_kick() {
+  if (!kick_pending_) return;
+  if (p_.with_rotation) rotate_kick(p_, kick2_);
+  kick(p_, kick2_);
+  kick_pending_ = false;
 }
 
 template <class Real>
@@ -434,8 +462,12 @@ void Simulation<Real>::run(std::int64_t steps, FieldSink* sink) {
   Stopwatch clock;
   double elapsed = 0, last = 0;
   const bool show = !options_.quiet && comm().rank() == 0;
+  struct Settle {
+    Simulation& s;
+    ~Settle() { s.settle_kick(); }
+  } settle{*this};
   for (std::int64_t k = 0; k < steps; ++k) {
-    step(sink);
+    advance(sink, k + 1 < steps);
     if (show && (k & 15) == 15) {
       elapsed += clock.lap();
       if (elapsed - last >= options_.progress_seconds) {

@@ -116,7 +116,7 @@ class Simulation {
   void run(std::int64_t steps = -1, FieldSink* sink = nullptr);
   /// One step. On more than one rank a step's field row reaches the sink during the next step (its
   /// reduction overlaps that step's work); run() and flush_fields() deliver the last one.
-  void step(FieldSink* sink = nullptr);
+  void step(FieldSink* sink = nullptr) { advance(sink, false); }
   /// Collective: delivers a field row still in flight to the sink.
   void flush_fields(FieldSink* sink) { finish_row(sink); }
 
@@ -266,6 +266,15 @@ class Simulation {
   const std::vector<double>& compute_forces(bool ghosts_in_flight = false, bool advance = false);
   /// Collective: each servo wall's velocity for the next step from the force on it summed over ranks.
   void steer_servos();
+  /// One step. With may_defer (run(), when the next thing it does is another step), velocity Verlet's
+  /// second half-kick is left for the next step's first pass, which then makes both (the same bits, one
+  /// pass over memory fewer) unless something reads the velocities at this step (a field saver, the
+  /// energy check).
+  void advance(FieldSink* sink, bool may_defer);
+  /// Makes a deferred second half-kick now (run() on its way out, whatever the way).
+  void settle_kick();
+  /// Whether anything reads the velocities after step s: a field saver or the energy check due.
+  bool observed(std::int64_t s) const;
   void save_fields(FieldSink* sink, const std::vector<double>& pe);
   bool field_partials(const std::vector<double>& pe, std::vector<double>& local,
                       std::vector<char>& due) const;
@@ -343,6 +352,7 @@ class Simulation {
   double ke_local_ = 0;         ///< this rank's kinetic energy, valid while ke_fresh_
   bool ke_fresh_ = false;       ///< set when the second half-kick computed ke_local_ this step
   bool forces_zeroed_ = false;  ///< set by the fused kick-zero-drift pass
+  bool kick_pending_ = false;   ///< the last step's second half-kick waits for the next step's pass
   StabilityReport stability_;
   OutputSink* output_ = nullptr;   ///< set during run(steps, OutputSink&)
   std::int64_t rebuild_step_ = 0;  ///< step of the last rebuild (checkpoints store it with p_.xr, yr, zr)

@@ -38,8 +38,10 @@ inline void drift_compensated(Real& x, Real& c, Real u, Real dt) {
   x = t;
 }
 
-template <bool Compensated, class Real>
-double kick_zero_drift(Particles<Real>& p, Real h, Real dt) {
+/// With Pending, the half-kick h0 left over from the step before comes first: v + h0 f / m rounded, then
+/// + h f / m, the operations of kick(p, h0) followed by the pass without it.
+template <bool Compensated, bool Pending, class Real>
+double kick_zero_drift(Particles<Real>& p, Real h0, Real h, Real dt) {
   const std::size_t n = p.n_owned;
   Real* __restrict x = p.x.data();
   Real* __restrict y = p.y.data();
@@ -67,8 +69,15 @@ double kick_zero_drift(Particles<Real>& p, Real h, Real dt) {
   // ivdep: GCC does not take __restrict on locals as proof that the arrays are distinct (they are).
 #pragma GCC ivdep
   for (std::size_t i = 0; i < n; ++i) {
+    Real wx = vx[i], wy = vy[i], wz = vz[i];
+    if constexpr (Pending) {
+      const Real s0 = h0 * im[i];
+      wx += s0 * fx[i];
+      wy += s0 * fy[i];
+      wz += s0 * fz[i];
+    }
     const Real s = h * im[i];
-    const Real ux = vx[i] + s * fx[i], uy = vy[i] + s * fy[i], uz = vz[i] + s * fz[i];
+    const Real ux = wx + s * fx[i], uy = wy + s * fy[i], uz = wz + s * fz[i];
     vx[i] = ux;
     vy[i] = uy;
     vz[i] = uz;
@@ -100,8 +109,18 @@ double kick_zero_drift(Particles<Real>& p, Real h, Real dt) {
 /// displacement since the last rebuild, or infinity when a position went non-finite.
 template <class Real>
 double kick_zero_drift(Particles<Real>& p, Real h, Real dt) {
-  return p.with_compensation ? detail::kick_zero_drift<true>(p, h, dt)
-                             : detail::kick_zero_drift<false>(p, h, dt);
+  return p.with_compensation ? detail::kick_zero_drift<true, false>(p, Real(0), h, dt)
+                             : detail::kick_zero_drift<false, false>(p, Real(0), h, dt);
+}
+
+/// kick(p, h0), then kick_zero_drift(p, h, dt), in one pass over memory: velocity Verlet's second half-kick
+/// of the step before (Simulation::step defers it when nothing reads the velocities in between) and this
+/// step's first. The same operations in the same order as the two calls, so the same bits, with one pass
+/// fewer over v, f and 1/m.
+template <class Real>
+double kick_kick_zero_drift(Particles<Real>& p, Real h0, Real h, Real dt) {
+  return p.with_compensation ? detail::kick_zero_drift<true, true>(p, h0, h, dt)
+                             : detail::kick_zero_drift<false, true>(p, h0, h, dt);
 }
 
 /// The half angle a^2 = (|w| dt / 2)^2 below which half_turn() takes the Taylor series.
@@ -157,8 +176,9 @@ inline void turn(Real c, Real sn, Real wx, Real wy, Real wz, Real& qw, Real& qx,
 /// keeps its orientation bit for bit. The pass has no branch, so that it runs in vector registers: a turn
 /// too large for the series (a2 >= kTaylorTurn, never in a stable run) leaves its orientation alone there
 /// and is made by sin and cos in a second pass, which only runs when there is one.
-template <class Real>
-void rotate_kick_zero_drift(Particles<Real>& p, Real h, Real dt) {
+namespace detail {
+template <bool Pending, class Real>
+void rotate_kick_zero_drift(Particles<Real>& p, Real h0, Real h, Real dt) {
   const std::size_t n = p.n_owned;
   const Real* __restrict im = p.inv_mass.data();
   const Real* __restrict rad = p.radius.data();
@@ -177,8 +197,15 @@ void rotate_kick_zero_drift(Particles<Real>& p, Real h, Real dt) {
   // ivdep: GCC does not take __restrict on locals as proof that the arrays are distinct (they are).
 #pragma GCC ivdep
   for (std::size_t i = 0; i < n; ++i) {
+    Real ox = wxs[i], oy = wys[i], oz = wzs[i];
+    if constexpr (Pending) {
+      const Real s0 = h0 * (Real(2.5) * im[i] / (rad[i] * rad[i]));  // as rotate_kick()
+      ox += s0 * tx[i];
+      oy += s0 * ty[i];
+      oz += s0 * tz[i];
+    }
     const Real s = h * (Real(2.5) * im[i] / (rad[i] * rad[i]));  // inverse_inertia(i)
-    const Real wx = wxs[i] + s * tx[i], wy = wys[i] + s * ty[i], wz = wzs[i] + s * tz[i];
+    const Real wx = ox + s * tx[i], wy = oy + s * ty[i], wz = oz + s * tz[i];
     wxs[i] = wx;
     wys[i] = wy;
     wzs[i] = wz;
@@ -207,6 +234,19 @@ void rotate_kick_zero_drift(Particles<Real>& p, Real h, Real dt) {
     half_turn(w2, dt, c, sn);
     detail::turn(c, sn, wx, wy, wz, qws[i], qxs[i], qys[i], qzs[i]);
   }
+}
+}  // namespace detail
+
+template <class Real>
+void rotate_kick_zero_drift(Particles<Real>& p, Real h, Real dt) {
+  detail::rotate_kick_zero_drift<false>(p, Real(0), h, dt);
+}
+
+/// rotate_kick(p, h0), then rotate_kick_zero_drift(p, h, dt), in one pass over memory (as
+/// kick_kick_zero_drift): the same bits.
+template <class Real>
+void rotate_kick_kick_zero_drift(Particles<Real>& p, Real h0, Real h, Real dt) {
+  detail::rotate_kick_zero_drift<true>(p, h0, h, dt);
 }
 
 /// The rotational half-kick w += h T / I.
