@@ -56,10 +56,9 @@ class BodyDriver final : public ForceCompute<Real> {
 
   template <bool Energy, bool Advance>
   double loop(Particles<Real>& p) {
-    if constexpr (kAll) {
-      static_assert(Model::energy_term.empty(), "apply_all is for models without a potential");
+    // A model with a potential (gravity) takes apply_all on the steps that do not tally it.
+    if constexpr (kAll && (!Energy || Model::energy_term.empty()))
       if (coeffs_.size() == 1 && tags_[0].empty()) return all<Advance>(p);
-    }
     double e = 0, d = 0;
     const bool rot = kTurns && p.with_rotation;
     BodyState<Real> b{};
@@ -104,8 +103,11 @@ class BodyDriver final : public ForceCompute<Real> {
     const bool rot = kTurns && p.with_rotation;
     if (!rot && kTurns) return 0;  // (a turning model on particles that do not turn)
     const std::size_t n = p.n_owned;
-    dissipation_.resize(n);
-    flags_.resize(n);
+    constexpr bool kDissipates = !Model::dissipation_term.empty();
+    if constexpr (kDissipates) {
+      dissipation_.resize(n);
+      flags_.resize(n);
+    }
     BodyArrays<Real> a;
     a.n = n;
     a.dt = dt_;
@@ -119,7 +121,7 @@ class BodyDriver final : public ForceCompute<Real> {
     a.dissipated = dissipation_.data();
     a.flag = flags_.data();
     Model::apply_all(coeffs_[0], a);
-    if constexpr (Advance) {
+    if constexpr (Advance && kDissipates) {
       double d = 0;
       for (std::size_t i = 0; i < n; ++i) d += dissipation_[i];
       dissipated_ += d;

@@ -172,9 +172,10 @@ struct BodyForce {
 
 /// Every owned particle at once, for a body-force model with `apply_all` (BodyDriver, one group taking
 /// every particle): the particles' arrays in (the rotational ones null without rotation), forces and
-/// torques added to in place, and each particle's dissipated energy out. A model that defines it has no
-/// potential energy. One loop over the arrays runs in vector registers, with no copy of the particles'
-/// state into lanes and back.
+/// torques added to in place, and each particle's dissipated energy out (a model with a dissipation
+/// term). A model with a potential energy takes it on the steps that do not tally the energy, and must
+/// give the bits of apply() there. One loop over the arrays runs in vector registers, with no copy of the
+/// particles' state into lanes and back.
 template <class Real>
 struct BodyArrays {
   std::size_t n = 0;
