@@ -462,10 +462,7 @@ void Simulation<Real>::run(std::int64_t steps, FieldSink* sink) {
   Stopwatch clock;
   double elapsed = 0, last = 0;
   const bool show = !options_.quiet && comm().rank() == 0;
-  struct Settle {
-    Simulation& s;
-    ~Settle() { s.settle_kick(); }
-  } settle{*this};
+  const SettleOnExit settle{*this};
   for (std::int64_t k = 0; k < steps; ++k) {
     advance(sink, k + 1 < steps);
     if (show && (k & 15) == 15) {

@@ -185,10 +185,7 @@ void Simulation<Real>::run(std::int64_t steps, OutputSink& out) {
   bool reported = false;
   std::vector<double> frame_seconds;  // pack + submit of each frame (BASALT_FRAME_TIMES=1 prints them)
   // A second half-kick deferred by the last step is made on every way out (an error, a stop signal).
-  struct Settle {
-    Simulation& s;
-    ~Settle() { s.settle_kick(); }
-  } settle{*this};
+  const SettleOnExit settle{*this};
   for (std::int64_t k = 0; k < steps; ++k) {
     // Frames read the velocities: the step before one makes its second half-kick.
     advance(nullptr, k + 1 < steps && out.frame_kinds(step_ + 1) == 0);

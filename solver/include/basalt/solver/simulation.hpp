@@ -273,6 +273,11 @@ class Simulation {
   void advance(FieldSink* sink, bool may_defer);
   /// Makes a deferred second half-kick now (run() on its way out, whatever the way).
   void settle_kick();
+  /// run()'s guard: settle_kick() when it leaves scope (the last step, an error, a stop signal).
+  struct SettleOnExit {
+    Simulation& sim;
+    ~SettleOnExit() { sim.settle_kick(); }
+  };
   /// Whether anything reads the velocities after step s: a field saver or the energy check due.
   bool observed(std::int64_t s) const;
   void save_fields(FieldSink* sink, const std::vector<double>& pe);

@@ -114,7 +114,7 @@ double kick_zero_drift(Particles<Real>& p, Real h, Real dt) {
 }
 
 /// kick(p, h0), then kick_zero_drift(p, h, dt), in one pass over memory: velocity Verlet's second half-kick
-/// of the step before (Simulation::step defers it when nothing reads the velocities in between) and this
+/// of the step before (Simulation::run() defers it when nothing reads the velocities in between) and this
 /// step's first. The same operations in the same order as the two calls, so the same bits, with one pass
 /// fewer over v, f and 1/m.
 template <class Real>
