@@ -181,10 +181,11 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
     t.finish();
   }
 
-  std::optional<bool> rotation;
+  std::optional<bool> rotation, orientation;
   if (const auto* m = top.subtable("particles")) {
     TableReader t(*m, label, "particles");
     if (t.has("rotation")) rotation = t.boolean_or("rotation", false);
+    if (t.has("orientation")) orientation = t.boolean_or("orientation", false);
     s.fixed_tags = t.integers_or("fixed_tags", {});
     t.finish();
   }
@@ -272,6 +273,24 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
                       "particles.rotation = true or choose a non-rotating model",
                       label, needs->name, needs->model));
     s.rotation = rotation.value_or(needs != nullptr);
+    // Orientations: kept when a model reads them (a sphere's own motion never does) or the scene asks.
+    const InteractionSpec* reads = nullptr;
+    for (const auto* list : {&s.bonds, &s.contacts})
+      for (const auto& g : *list) {
+        const ModelEntry* m = find_model(g.model, g.kind);
+        if (m && (m->reads & kOrientation) && !reads) reads = &g;
+      }
+    if (reads && orientation == false)
+      throw InputError(fmt::format(
+          "{}: particles.orientation = false, but interaction \"{}\" (type \"{}\") reads the particles' "
+          "orientations: set particles.orientation = true or leave it out",
+          label, reads->name, reads->model));
+    if (orientation == true && !s.rotation)
+      throw InputError(
+          fmt::format("{}: particles.orientation = true needs rotating particles: set "
+                      "particles.rotation = true (or leave orientation out)",
+                      label));
+    s.orientation = orientation.value_or(reads != nullptr);
   }
 
   if (const auto* arr = top.table_array("walls")) {

@@ -111,6 +111,7 @@ void Simulation<Real>::configure_particles() {
   p_.with_exact_rebuild = scene_.checkpoint_every > 0;
   p_.with_damage = forces_.bonds_can_break();
   p_.with_rotation = scene_.rotation;
+  p_.with_orientation = scene_.rotation && (scene_.orientation || forces_.needs_bond_frame());
   p_.with_bond_frame = forces_.needs_bond_frame();
   p_.ghost_velocity = forces_.needs_ghost_velocity();
 }

@@ -287,7 +287,9 @@ TEST(Granular, RunDefersTheSecondHalfKickToTheSameBitsAsSingleSteps) {
   auto text = hertz_column();
   text = text.substr(0, text.find("[[output.fields]]")) +
          "[[output.fields]]\ntype = \"kinetic_energy\"\nevery = 7\n";
+  text.replace(text.find("rotation = true"), 15, "rotation = true\norientation = true");  // (turned too)
   const auto scene = basalt::test::scene_from(text);
+  ASSERT_TRUE(scene.orientation);
   const auto g = column(4, 4, 8);
   RunOptions opt;
   opt.quiet = true;
@@ -315,6 +317,39 @@ TEST(Granular, RunDefersTheSecondHalfKickToTheSameBitsAsSingleSteps) {
   double speed = 0;
   for (std::size_t i = 0; i < n; ++i) speed = std::max(speed, std::abs(a.vx[i]));
   EXPECT_GT(speed, 0.1) << "the column must be collapsing at the end";
+}
+
+// A sphere's motion never reads its orientation: a scene that keeps none (the default without a model
+// that reads them) must move its particles bit for bit as one that keeps them, while it turns them, and
+// hold no orientation arrays at all. The collapsing Hertz-Mindlin column, 600 steps with rebuilds.
+TEST(Granular, OrientationsLeftOutChangeNoOtherBit) {
+  if (basalt::test::rank() != 0) return;
+  auto with = hertz_column();
+  with.replace(with.find("rotation = true"), 15, "rotation = true\norientation = true");
+  const auto scene_with = basalt::test::scene_from(with),
+             scene_without = basalt::test::scene_from(hertz_column());
+  ASSERT_TRUE(scene_with.orientation);
+  ASSERT_FALSE(scene_without.orientation);
+  const auto g = column(4, 4, 8);
+  RunOptions opt;
+  opt.quiet = true;
+  Simulation<double> a_sim(scene_with, g, MPI_COMM_SELF, opt), b_sim(scene_without, g, MPI_COMM_SELF, opt);
+  constexpr int kSteps = 600;
+  a_sim.run(kSteps);
+  b_sim.run(kSteps);
+  EXPECT_GT(a_sim.rebuilds(), 2);
+  const auto& a = a_sim.particles();
+  const auto& b = b_sim.particles();
+  ASSERT_EQ(a.n_owned, b.n_owned);
+  EXPECT_TRUE(b.qw.empty() && b.qx.empty() && b.qy.empty() && b.qz.empty());
+  ASSERT_EQ(a.qw.size(), a.x.size());
+  double turned = 0;
+  for (std::size_t i = 0; i < a.n_owned; ++i) turned = std::max(turned, 1.0 - std::abs(a.qw[i]));
+  EXPECT_GT(turned, 1e-3) << "the particles must have turned";
+  for (auto v : {&Particles<double>::x, &Particles<double>::y, &Particles<double>::z, &Particles<double>::vx,
+                 &Particles<double>::vy, &Particles<double>::vz, &Particles<double>::wx,
+                 &Particles<double>::wy, &Particles<double>::wz})
+    for (std::size_t i = 0; i < a.n_owned; ++i) ASSERT_EQ((a.*v)[i], (b.*v)[i]) << "particle " << a.id[i];
 }
 
 class ColumnInvariance : public ::testing::TestWithParam<int> {};

@@ -190,3 +190,28 @@ TEST(Scene, RotationalDampingOfParticlesThatDoNotRotateIsRefused) {
   ASSERT_EQ(s.body_forces.size(), 1u);
   EXPECT_TRUE(s.rotation);
 }
+
+TEST(Scene, OrientationsAreKeptWhenAModelReadsThemOrTheSceneAsks) {
+  const std::string run = "[run]\ndt = 1e-3\nsteps = 10\nskin = 0.1\n";
+  const std::string hertz =
+      "[[interactions]]\ntype = \"hertz_mindlin\"\nE = 1e7\nnu = 0.25\ne = 0.5\nmu = 0.5\n";
+  const std::string rot_bond =
+      "[[interactions]]\ntype = \"rot_bond\"\nkn = 1000.0\nks = 400.0\nkb = 30.0\nkt = 20.0\n"
+      "rest_length = \"sum_of_radii\"\n";
+  // Rotating spheres whose models read no orientation: none kept, unless the scene asks.
+  auto s = basalt::test::scene_from(run + hertz);
+  EXPECT_TRUE(s.rotation);
+  EXPECT_FALSE(s.orientation);
+  s = basalt::test::scene_from(run + "[particles]\norientation = true\n" + hertz);
+  EXPECT_TRUE(s.orientation);
+  // A model that reads them (rot_bond's frames): kept without asking.
+  s = basalt::test::scene_from(run + rot_bond);
+  EXPECT_TRUE(s.rotation);
+  EXPECT_TRUE(s.orientation);
+  // Refused: leaving them out under such a model, or asking for them without rotation.
+  auto msg = error_of(run + "[particles]\norientation = false\n" + rot_bond);
+  EXPECT_NE(msg.find("particles.orientation = false"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("rot_bond"), std::string::npos) << msg;
+  msg = error_of(kGood + "[particles]\norientation = true\n");
+  EXPECT_NE(msg.find("particles.rotation = true"), std::string::npos) << msg;
+}

@@ -171,14 +171,47 @@ inline void turn(Real c, Real sn, Real wx, Real wy, Real wz, Real& qw, Real& qx,
 }  // namespace detail
 
 /// Rotation (with_rotation), the twin of kick_zero_drift: w += h T / I (I = 2/5 m r^2: a sphere needs
-/// no gyroscopic term), torques zeroed, then the orientation turned by the angle |w| dt about w (an
-/// exact rotation for the step's constant w) and brought back to unit length. A particle at rest (w = 0)
-/// keeps its orientation bit for bit. The pass has no branch, so that it runs in vector registers: a turn
-/// too large for the series (a2 >= kTaylorTurn, never in a stable run) leaves its orientation alone there
-/// and is made by sin and cos in a second pass, which only runs when there is one.
+/// no gyroscopic term), torques zeroed, then (with_orientation) the orientation turned by the angle
+/// |w| dt about w (an exact rotation for the step's constant w) and brought back to unit length. A particle
+/// at rest (w = 0) keeps its orientation bit for bit. The pass has no branch, so that it runs in vector
+/// registers: a turn too large for the series (a2 >= kTaylorTurn, never in a stable run) leaves its
+/// orientation alone there and is made by sin and cos in a second pass, which only runs when there is one.
 namespace detail {
+/// The kick of rotate_kick_zero_drift alone, for particles without orientations (with_orientation
+/// false): the same operations on w, in the same order, so the same bits.
+template <bool Pending, class Real>
+void rotate_kick_zero(Particles<Real>& p, Real h0, Real h) {
+  const std::size_t n = p.n_owned;
+  const Real* __restrict im = p.inv_mass.data();
+  const Real* __restrict rad = p.radius.data();
+  Real* __restrict wxs = p.wx.data();
+  Real* __restrict wys = p.wy.data();
+  Real* __restrict wzs = p.wz.data();
+  Real* __restrict tx = p.tx.data();
+  Real* __restrict ty = p.ty.data();
+  Real* __restrict tz = p.tz.data();
+#pragma GCC ivdep
+  for (std::size_t i = 0; i < n; ++i) {
+    Real ox = wxs[i], oy = wys[i], oz = wzs[i];
+    if constexpr (Pending) {
+      const Real s0 = h0 * (Real(2.5) * im[i] / (rad[i] * rad[i]));  // as rotate_kick()
+      ox += s0 * tx[i];
+      oy += s0 * ty[i];
+      oz += s0 * tz[i];
+    }
+    const Real s = h * (Real(2.5) * im[i] / (rad[i] * rad[i]));  // inverse_inertia(i)
+    wxs[i] = ox + s * tx[i];
+    wys[i] = oy + s * ty[i];
+    wzs[i] = oz + s * tz[i];
+    tx[i] = 0;
+    ty[i] = 0;
+    tz[i] = 0;
+  }
+}
+
 template <bool Pending, class Real>
 void rotate_kick_zero_drift(Particles<Real>& p, Real h0, Real h, Real dt) {
+  if (!p.with_orientation) return rotate_kick_zero<Pending>(p, h0, h);
   const std::size_t n = p.n_owned;
   const Real* __restrict im = p.inv_mass.data();
   const Real* __restrict rad = p.radius.data();

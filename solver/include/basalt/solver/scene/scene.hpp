@@ -162,8 +162,11 @@ struct Scene {
   } units;
   std::filesystem::path geometry;  ///< resolved against the scene file's folder
   double density = 1;
-  /// [particles] rotation: particles rotate (angular velocity, torque, orientation; ESyS "RotSphere").
+  /// [particles] rotation: particles rotate (angular velocity and torque; ESyS "RotSphere").
   bool rotation = false;
+  /// [particles] orientation: rotating particles keep their orientation (a unit quaternion, in frames and
+  /// checkpoints); on when a model reads orientations (rot_bond), else off unless the scene asks for it.
+  bool orientation = false;
   /// [particles] fixed_tags: particles of these tags feel forces but never move or turn (ESyS
   /// setParticleNonDynamic): rough bases, anchors.
   std::vector<std::int64_t> fixed_tags;
