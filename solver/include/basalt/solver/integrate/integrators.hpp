@@ -177,41 +177,10 @@ inline void turn(Real c, Real sn, Real wx, Real wy, Real wz, Real& qw, Real& qx,
 /// registers: a turn too large for the series (a2 >= kTaylorTurn, never in a stable run) leaves its
 /// orientation alone there and is made by sin and cos in a second pass, which only runs when there is one.
 namespace detail {
-/// The kick of rotate_kick_zero_drift alone, for particles without orientations (with_orientation
-/// false): the same operations on w, in the same order, so the same bits.
-template <bool Pending, class Real>
-void rotate_kick_zero(Particles<Real>& p, Real h0, Real h) {
-  const std::size_t n = p.n_owned;
-  const Real* __restrict im = p.inv_mass.data();
-  const Real* __restrict rad = p.radius.data();
-  Real* __restrict wxs = p.wx.data();
-  Real* __restrict wys = p.wy.data();
-  Real* __restrict wzs = p.wz.data();
-  Real* __restrict tx = p.tx.data();
-  Real* __restrict ty = p.ty.data();
-  Real* __restrict tz = p.tz.data();
-#pragma GCC ivdep
-  for (std::size_t i = 0; i < n; ++i) {
-    Real ox = wxs[i], oy = wys[i], oz = wzs[i];
-    if constexpr (Pending) {
-      const Real s0 = h0 * (Real(2.5) * im[i] / (rad[i] * rad[i]));  // as rotate_kick()
-      ox += s0 * tx[i];
-      oy += s0 * ty[i];
-      oz += s0 * tz[i];
-    }
-    const Real s = h * (Real(2.5) * im[i] / (rad[i] * rad[i]));  // inverse_inertia(i)
-    wxs[i] = ox + s * tx[i];
-    wys[i] = oy + s * ty[i];
-    wzs[i] = oz + s * tz[i];
-    tx[i] = 0;
-    ty[i] = 0;
-    tz[i] = 0;
-  }
-}
-
-template <bool Pending, class Real>
+/// Turn: the particles keep orientations (with_orientation); without, the pass is the kick alone, the
+/// same operations on w in the same order, so the same bits.
+template <bool Pending, bool Turn, class Real>
 void rotate_kick_zero_drift(Particles<Real>& p, Real h0, Real h, Real dt) {
-  if (!p.with_orientation) return rotate_kick_zero<Pending>(p, h0, h);
   const std::size_t n = p.n_owned;
   const Real* __restrict im = p.inv_mass.data();
   const Real* __restrict rad = p.radius.data();
@@ -245,20 +214,22 @@ void rotate_kick_zero_drift(Particles<Real>& p, Real h0, Real h, Real dt) {
     tx[i] = 0;
     ty[i] = 0;
     tz[i] = 0;
-    const Real w2 = wx * wx + wy * wy + wz * wz, a2 = w2 * hh * hh;  // as half_turn(): the same bits
-    large += !(a2 < kTaylorTurn<Real>);
-    Real c, sn, qw = qws[i], qx = qxs[i], qy = qys[i], qz = qzs[i];
-    half_turn_series(a2, hh, c, sn);
-    detail::turn(c, sn, wx, wy, wz, qw, qx, qy, qz);
-    // At rest (w = 0) the orientation keeps its bits; a turn too large for the series waits for the pass
-    // below.
-    const bool keep = w2 == Real(0) || !(a2 < kTaylorTurn<Real>);
-    qws[i] = keep ? qws[i] : qw;
-    qxs[i] = keep ? qxs[i] : qx;
-    qys[i] = keep ? qys[i] : qy;
-    qzs[i] = keep ? qzs[i] : qz;
+    if constexpr (Turn) {
+      const Real w2 = wx * wx + wy * wy + wz * wz, a2 = w2 * hh * hh;  // as half_turn(): the same bits
+      large += !(a2 < kTaylorTurn<Real>);
+      Real c, sn, qw = qws[i], qx = qxs[i], qy = qys[i], qz = qzs[i];
+      half_turn_series(a2, hh, c, sn);
+      detail::turn(c, sn, wx, wy, wz, qw, qx, qy, qz);
+      // At rest (w = 0) the orientation keeps its bits; a turn too large for the series waits for the pass
+      // below.
+      const bool keep = w2 == Real(0) || !(a2 < kTaylorTurn<Real>);
+      qws[i] = keep ? qws[i] : qw;
+      qxs[i] = keep ? qxs[i] : qx;
+      qys[i] = keep ? qys[i] : qy;
+      qzs[i] = keep ? qzs[i] : qz;
+    }
   }
-  if (large == 0) return;
+  if (!Turn || large == 0) return;
   for (std::size_t i = 0; i < n; ++i) {
     const Real wx = wxs[i], wy = wys[i], wz = wzs[i];
     const Real w2 = wx * wx + wy * wy + wz * wz;
@@ -272,14 +243,20 @@ void rotate_kick_zero_drift(Particles<Real>& p, Real h0, Real h, Real dt) {
 
 template <class Real>
 void rotate_kick_zero_drift(Particles<Real>& p, Real h, Real dt) {
-  detail::rotate_kick_zero_drift<false>(p, Real(0), h, dt);
+  if (p.with_orientation)
+    detail::rotate_kick_zero_drift<false, true>(p, Real(0), h, dt);
+  else
+    detail::rotate_kick_zero_drift<false, false>(p, Real(0), h, dt);
 }
 
 /// rotate_kick(p, h0), then rotate_kick_zero_drift(p, h, dt), in one pass over memory (as
 /// kick_kick_zero_drift): the same bits.
 template <class Real>
 void rotate_kick_kick_zero_drift(Particles<Real>& p, Real h0, Real h, Real dt) {
-  detail::rotate_kick_zero_drift<true>(p, h0, h, dt);
+  if (p.with_orientation)
+    detail::rotate_kick_zero_drift<true, true>(p, h0, h, dt);
+  else
+    detail::rotate_kick_zero_drift<true, false>(p, h0, h, dt);
 }
 
 /// The rotational half-kick w += h T / I.
