@@ -17,6 +17,7 @@
 #include <numbers>
 #include <string>
 
+#include "basalt/solver/interactions/pair_driver.hpp"
 #include "basalt/solver/models/friction.hpp"
 #include "basalt/solver/models/hertz_mindlin.hpp"
 #include "basalt/solver/models/rolling_friction.hpp"
@@ -448,6 +449,62 @@ TEST(HertzMindlin, EffectiveModuliOfOneAndOfTwoMaterials) {
 // contacts (sticking, sliding, with and without shear history, rotating, history tilted out of the tangent
 // plane) the lanes must give contact()'s force, torques, history, dissipation and sliding flag to rounding,
 // with and without advancing the history; and a contact's result must not depend on its lane.
+// The lanes' first particles (PairDriver::first_ends): eight lanes within eight consecutive owned particles
+// take one vector load of each array and a permutation, others one load per lane. Every lane must get its
+// own particle's values either way, and the permutation must be taken exactly where it may: blocks in row
+// order within a span of eight, never for a block reaching past the owned particles or out of order.
+template <class Real>
+void expect_first_ends_are_the_lanes_particles() {
+  using Driver = PairDriver<Real, HertzMindlin>;
+  constexpr int W = kContactLaneWidth;
+  static_assert(W == 16);
+  Particles<Real> p;
+  p.with_rotation = true;
+  const std::size_t n = 40;
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto h = [&](std::uint64_t k) { return Real(basalt::test::hash_unit(13 * i + k)); };
+    p.push_owned(std::int64_t(i), h(0), h(1), h(2), Real(0.5) + h(3), 0, Real(1) + h(4), h(5), h(6), h(7));
+    p.wx[i] = h(8), p.wy[i] = h(9), p.wz[i] = h(10);
+  }
+  p.x.push_back(Real(99));  // a ghost: not read by a permuted block
+  const std::array<std::array<std::uint32_t, W>, 4> cases{{
+      {3, 3, 4, 5, 5, 6, 9, 10, 12, 12, 12, 13, 15, 16, 18,
+       19},  // two blocks, each within eight: both permuted
+      {0, 2, 4, 6, 8, 10, 12, 14, 20, 20, 20, 20, 20, 20, 20, 27},       // spans of 14 and 7: the second only
+      {30, 31, 32, 32, 33, 34, 35, 36, 33, 34, 35, 36, 37, 38, 39, 39},  // the second block reaches past n
+      {5, 2, 6, 7, 8, 9, 10, 11, 1, 1, 1, 1, 1, 1, 1, 1},  // out of order; eight times the same particle
+  }};
+  const std::array<int, 4> permuted{2, 1, 1, 1};
+  for (std::size_t c = 0; c < cases.size(); ++c) {
+    ContactLanes<Real, W, typename HertzMindlin::History> L{};
+    alignas(64) Real xi[W], yi[W], zi[W], vxi[W], vyi[W], vzi[W];
+    EXPECT_EQ(Driver::template first_ends<true>(p, cases[c].data(), L, xi, yi, zi, vxi, vyi, vzi),
+              permuted[c])
+        << "case " << c;
+    for (int l = 0; l < W; ++l) {
+      const auto i = cases[c][static_cast<std::size_t>(l)];
+      EXPECT_EQ(xi[l], p.x[i]) << c << " " << l;
+      EXPECT_EQ(yi[l], p.y[i]) << c << " " << l;
+      EXPECT_EQ(zi[l], p.z[i]) << c << " " << l;
+      EXPECT_EQ(vxi[l], p.vx[i]) << c << " " << l;
+      EXPECT_EQ(vyi[l], p.vy[i]) << c << " " << l;
+      EXPECT_EQ(vzi[l], p.vz[i]) << c << " " << l;
+      EXPECT_EQ(L.ri[l], p.radius[i]) << c << " " << l;
+      EXPECT_EQ(L.imi[l], p.inv_mass[i]) << c << " " << l;
+      EXPECT_EQ(L.wix[l], p.wx[i]) << c << " " << l;
+      EXPECT_EQ(L.wiy[l], p.wy[i]) << c << " " << l;
+      EXPECT_EQ(L.wiz[l], p.wz[i]) << c << " " << l;
+    }
+  }
+}
+
+TEST(HertzMindlin, LanesFirstParticlesByPermutationAreTheirOwnDouble) {
+  expect_first_ends_are_the_lanes_particles<double>();
+}
+TEST(HertzMindlin, LanesFirstParticlesByPermutationAreTheirOwnFloat) {
+  expect_first_ends_are_the_lanes_particles<float>();
+}
+
 TEST(HertzMindlin, LanesMatchTheScalarContact) {
   constexpr int W = kContactLaneWidth;
   using Lanes = ContactLanes<double, W, HertzMindlin::History>;

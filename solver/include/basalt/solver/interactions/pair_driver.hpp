@@ -31,6 +31,25 @@ inline bool holds(const History& h) {
   return any != 0;
 }
 
+namespace detail {
+/// Eight values of Real and eight indices of its width: the operands of a permutation
+/// (PairDriver::first_ends).
+template <class Real>
+struct Eight;
+template <>
+struct Eight<double> {
+  using Index = std::int64_t;
+  typedef double V __attribute__((vector_size(64)));
+  typedef std::int64_t M __attribute__((vector_size(64)));
+};
+template <>
+struct Eight<float> {
+  using Index = std::int32_t;
+  typedef float V __attribute__((vector_size(32)));
+  typedef std::int32_t M __attribute__((vector_size(32)));
+};
+}  // namespace detail
+
 template <class Real, class Model>
 class PairDriver final : public ForceCompute<Real> {
  public:
@@ -498,12 +517,17 @@ class PairDriver final : public ForceCompute<Real> {
     return energy;
   }
 
-  /// The lanes' particle inputs of pairs (i[l], j[l]), loaded in vector registers (gathers). The lanes take
+  /// The lanes' particle inputs of pairs (i[l], j[l]), loaded in vector registers. The lanes take
   /// dx = x_i - x_j and r2 from here, not from the finding loop (whose r2 only decides whether the pair
-  /// touches).
+  /// touches). The first particles come in row order, so eight lanes' usually lie within eight consecutive
+  /// particles: their values are one vector load of each array and a permutation (first_ends), not a
+  /// gather of eight loads; the second particles are gathered.
   template <bool Rot, class Lanes>
   BASALT_WIDE_LANES static void gather(const Particles<Real>& p, const std::uint32_t* __restrict ii,
                                        const std::uint32_t* __restrict jj, Lanes& L) {
+    alignas(64) Real xi[kLaneWidth], yi[kLaneWidth], zi[kLaneWidth], vxi[kLaneWidth], vyi[kLaneWidth],
+        vzi[kLaneWidth];
+    first_ends<Rot>(p, ii, L, xi, yi, zi, vxi, vyi, vzi);
     const Real* __restrict x = p.x.data();
     const Real* __restrict y = p.y.data();
     const Real* __restrict z = p.z.data();
@@ -514,13 +538,13 @@ class PairDriver final : public ForceCompute<Real> {
     const Real* __restrict vz = p.vz.data();
 #pragma GCC ivdep
     for (int l = 0; l < kLaneWidth; ++l) {
-      const std::uint32_t i = ii[l], j = jj[l];
-      const Real dx = x[i] - x[j], dy = y[i] - y[j], dz = z[i] - z[j];
+      const std::uint32_t j = jj[l];
+      const Real dx = xi[l] - x[j], dy = yi[l] - y[j], dz = zi[l] - z[j];
       L.dx[l] = dx, L.dy[l] = dy, L.dz[l] = dz;
       L.r2[l] = dx * dx + dy * dy + dz * dz;
-      L.ri[l] = rad[i], L.rj[l] = rad[j];
-      L.imi[l] = im[i], L.imj[l] = im[j];
-      L.vx[l] = vx[i] - vx[j], L.vy[l] = vy[i] - vy[j], L.vz[l] = vz[i] - vz[j];
+      L.rj[l] = rad[j];
+      L.imj[l] = im[j];
+      L.vx[l] = vxi[l] - vx[j], L.vy[l] = vyi[l] - vy[j], L.vz[l] = vzi[l] - vz[j];
     }
     if constexpr (Rot) {
       const Real* __restrict wx = p.wx.data();
@@ -528,13 +552,77 @@ class PairDriver final : public ForceCompute<Real> {
       const Real* __restrict wz = p.wz.data();
 #pragma GCC ivdep
       for (int l = 0; l < kLaneWidth; ++l) {
-        const std::uint32_t i = ii[l], j = jj[l];
-        L.wix[l] = wx[i], L.wiy[l] = wy[i], L.wiz[l] = wz[i];
+        const std::uint32_t j = jj[l];
         L.wjx[l] = wx[j], L.wjy[l] = wy[j], L.wjz[l] = wz[j];
       }
     }
   }
 
+  /// The first particles' values of the lanes (positions and velocities to xi ... vzi, radius, inverse
+  /// mass and angular velocity to the lanes), eight lanes at a time: where the eight lie within eight
+  /// consecutive owned particles (the rows of a settled pile hold 2-3 contacts each), one vector load of each
+  /// array and a permutation (GCC's vector extensions: vpermpd); else one load per lane. The same values
+  /// either way. Returns how many blocks of eight took the permutation (public: the tests count them).
+ public:
+  template <bool Rot, class Lanes>
+  BASALT_WIDE_LANES static int first_ends(const Particles<Real>& p, const std::uint32_t* __restrict ii,
+                                          Lanes& L, Real* __restrict xi, Real* __restrict yi,
+                                          Real* __restrict zi, Real* __restrict vxi, Real* __restrict vyi,
+                                          Real* __restrict vzi) {
+    const Real* __restrict x = p.x.data();
+    const Real* __restrict y = p.y.data();
+    const Real* __restrict z = p.z.data();
+    const Real* __restrict rad = p.radius.data();
+    const Real* __restrict im = p.inv_mass.data();
+    const Real* __restrict vx = p.vx.data();
+    const Real* __restrict vy = p.vy.data();
+    const Real* __restrict vz = p.vz.data();
+    [[maybe_unused]] const Real* __restrict wx = Rot ? p.wx.data() : nullptr;
+    [[maybe_unused]] const Real* __restrict wy = Rot ? p.wy.data() : nullptr;
+    [[maybe_unused]] const Real* __restrict wz = Rot ? p.wz.data() : nullptr;
+    constexpr int kBlock = 8;
+    static_assert(kLaneWidth % kBlock == 0);
+    using V = typename detail::Eight<Real>::V;
+    using M = typename detail::Eight<Real>::M;
+    using Index = typename detail::Eight<Real>::Index;
+    int permuted = 0;
+    for (int b = 0; b < kBlock * (kLaneWidth / kBlock); b += kBlock) {
+      const std::uint32_t i0 = ii[b];
+      // Lanes in row order: ii[b + 7] is the block's largest (a block out of order takes the loads). The
+      // eight values read must lie within the owned particles' arrays.
+      if (ii[b + kBlock - 1] - i0 < std::uint32_t(kBlock) && std::size_t(i0) + kBlock <= p.n_owned) {
+        M at;
+        bool ordered = true;
+        for (int l = 0; l < kBlock; ++l) {
+          at[l] = Index(ii[b + l] - i0);
+          ordered = ordered && ii[b + l] - i0 < std::uint32_t(kBlock);
+        }
+        if (ordered) {
+          const auto pick = [&](const Real* a, Real* out) {
+            V v;
+            std::memcpy(&v, a + i0, sizeof(V));
+            v = __builtin_shuffle(v, at);
+            std::memcpy(out + b, &v, sizeof(V));
+          };
+          pick(x, xi), pick(y, yi), pick(z, zi), pick(vx, vxi), pick(vy, vyi), pick(vz, vzi);
+          pick(rad, L.ri), pick(im, L.imi);
+          if constexpr (Rot) pick(wx, L.wix), pick(wy, L.wiy), pick(wz, L.wiz);
+          ++permuted;
+          continue;
+        }
+      }
+#pragma GCC ivdep
+      for (int l = b; l < b + kBlock; ++l) {
+        const std::uint32_t i = ii[l];
+        xi[l] = x[i], yi[l] = y[i], zi[l] = z[i], vxi[l] = vx[i], vyi[l] = vy[i], vzi[l] = vz[i];
+        L.ri[l] = rad[i], L.imi[l] = im[i];
+        if constexpr (Rot) L.wix[l] = wx[i], L.wiy[l] = wy[i], L.wiz[l] = wz[i];
+      }
+    }
+    return permuted;
+  }
+
+ private:
   /// Each listed pair's row (its first particle), for the lanes' single loop over the pairs.
   static void row_of(const PairList& list, std::vector<std::uint32_t>& rows) {
     rows.resize(list.pairs());
