@@ -229,6 +229,14 @@ def energy_table(work, codes, ranks):
                 print(f"| {c} | {np_} | {step} | {t:.6g} | {r:.6g} | {rel} |")
 
 
+def quartiles(v):
+    """First and third quartiles (statistics.quantiles, 'inclusive': within the values' range)."""
+    if len(v) < 2:
+        return (v[0], v[0])
+    q = statistics.quantiles(v, n=4, method="inclusive")
+    return (q[0], q[2])
+
+
 def summarize(work, n, steps, codes, ranks, repeats):
     """Markdown table from the saved logs: medians of wall rates, per-repeat ratios, and rates per CPU second."""
     med = statistics.median
@@ -261,7 +269,24 @@ def summarize(work, n, steps, codes, ranks, repeats):
             sc = ""
             if (c, 1) in cpu and (c, 2) in cpu:
                 sc = f"; per CPU-second {med(cpu[(c, 2)]) / med(cpu[(c, 1)]):.2f}x"
-            print(f"2-rank speed-up {c}: wall {med(s):.2f}x ({', '.join(f'{x:.2f}' for x in s)}){sc}")
+            q = quartiles(s)
+            print(f"2-rank speed-up {c}: wall {med(s):.2f}x (quartiles {q[0]:.2f}-{q[1]:.2f}; "
+                  f"{', '.join(f'{x:.2f}' for x in s)}){sc}")
+    # The fastest repeat of each: this host's speed flips between a fast and a slow phase for seconds at a
+    # time (docs/BENCHMARKS.md, "Fast and slow phases"), and a 2-rank run waits at every step for the slower
+    # of its two cores, so a phase that touches either core slows it; the fastest of many repeats measures
+    # each run on an undisturbed machine, as timeit's minimum does.
+    if repeats >= 5:
+        print("fastest repeat of each (M particle-steps/s): " + ", ".join(
+            f"{c} np {np_} {max(v) / 1e6:.2f}" for (c, np_), v in sorted(rate.items())))
+        for c in codes:
+            if (c, 1) in rate and (c, 2) in rate:
+                print(f"2-rank speed-up {c}, fastest repeats: {max(rate[(c, 2)]) / max(rate[(c, 1)]):.2f}x")
+        for np_ in ranks:
+            b = rate.get(("basalt", np_))
+            for c in codes:
+                if c != "basalt" and b and (c, np_) in rate:
+                    print(f"np {np_}: basalt / {c}, fastest repeats: {max(b) / max(rate[(c, np_)]):.2f}x")
     energy_table(work, codes, ranks)
 
 
