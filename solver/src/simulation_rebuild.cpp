@@ -96,14 +96,19 @@ void Simulation<Real>::set_skin_reference() {
 
 template <class Real>
 void Simulation<Real>::rebuild() {
+  // The phases as basalt-run reports them: the checks and the histories' save are the rebuild's own work
+  // (neighbour search), the agreement, migration and balancing are communication.
   Stopwatch sw;
   auto error = check_finite();
+  times_.neighbor += sw.lap();
   const bool parallel = comm().size() > 1;
   if (parallel) error = comm().agree_error(error);
   if (error) stop(*error);
   if (parallel && scene_.balance == "pairs" && !balance_paused_ && rebuilds_ > 0) weigh_pairs();
+  times_.communication += sw.lap();
   forces_.save_history(p_);  // before the ghosts (and the pairs' ids) go
   p_.drop_ghosts();
+  times_.neighbor += sw.lap();
   if (parallel) {
     error = halo_->migrate(p_, bonds_, forces_.pending_history());
     error = comm().agree_error(error);
