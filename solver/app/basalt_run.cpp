@@ -77,6 +77,18 @@ void bound_heap_growth() {
 #endif
 }
 
+/// Open MPI's shared-memory transport (btl vader) sends a message above 4 KiB by rendezvous: the
+/// receiver reads the rest from the sender's memory once both have met in an MPI call. The per-step
+/// ghost refresh is 10-60 kB each way in the benchmark scenes (e.g. 600 ghosts x 9 values for a granular
+/// pile cut in two), so every step paid that meeting. Sent eagerly (copied into shared memory at the
+/// send, taken at the wait), 2-rank steps of the 20k granular pile ran 5-6 % faster (docs/BENCHMARKS.md,
+/// "Ghost messages sent eagerly"). Set only where the user has not (mpirun --mca, the environment, which
+/// win); other MPI libraries and other transports ignore these names.
+void prefer_eager_shared_memory_messages() {
+  setenv("OMPI_MCA_btl_vader_eager_limit", "65536", 0);
+  setenv("OMPI_MCA_btl_vader_max_send_size", "65536", 0);
+}
+
 /// User + system CPU seconds of this process.
 double cpu_seconds() {
   rusage u{};
@@ -626,6 +638,7 @@ int run_world(int argc, char** argv) {
 
 int main(int argc, char** argv) {
   bound_heap_growth();
+  prefer_eager_shared_memory_messages();  // before MPI_Init, which reads them
   // A file-size limit (ulimit -f) must make the write fail with EFBIG, named, not kill the rank.
   std::signal(SIGXFSZ, SIG_IGN);
   // FUNNELED: I/O rank 0's picture thread (in-situ pictures) makes no MPI call, only the main thread does.

@@ -107,6 +107,11 @@ def main():
     p.add_argument("--output", default=None, help="report (default ROOT/docs/bench/wave.md)")
     p.add_argument("--inputs", default=None, help="folder of tools/bench/make_inputs.sh (default ROOT/bench-inputs)")
     a = p.parse_args()
+    # basalt-run sends messages up to 64 KiB eagerly through shared memory (basalt_run.cpp,
+    # prefer_eager_shared_memory_messages); LAMMPS gets the same from the environment, so both codes'
+    # messages travel alike.
+    os.environ.setdefault("OMPI_MCA_btl_vader_eager_limit", "65536")
+    os.environ.setdefault("OMPI_MCA_btl_vader_max_send_size", "65536")
     a.build = a.build or os.path.join(a.root, "build")
     a.peer_dir = a.peer_dir or a.root
     a.output = a.output or os.path.join(a.root, "docs", "bench", "wave.md")
