@@ -81,9 +81,9 @@ void bound_heap_growth() {
 /// receiver reads the rest from the sender's memory once both have met in an MPI call. The per-step
 /// ghost refresh is 10-60 kB each way in the benchmark scenes (e.g. 600 ghosts x 9 values for a granular
 /// pile cut in two), so every step paid that meeting. Sent eagerly (copied into shared memory at the
-/// send, taken at the wait), 2-rank steps of the 20k granular pile ran 5-6 % faster (docs/BENCHMARKS.md,
-/// "Ghost messages sent eagerly"). Set only where the user has not (mpirun --mca, the environment, which
-/// win); other MPI libraries and other transports ignore these names.
+/// send, taken at the wait), 2-rank runs took 0.90x the time on the wave cube and 0.98x on the granular
+/// piles (docs/BENCHMARKS.md, "Ghost messages sent eagerly"). Set only where the user has not (mpirun
+/// --mca, the environment, which win); other MPI libraries and other transports ignore these names.
 void prefer_eager_shared_memory_messages() {
   setenv("OMPI_MCA_btl_vader_eager_limit", "65536", 0);
   setenv("OMPI_MCA_btl_vader_max_send_size", "65536", 0);

@@ -3,8 +3,8 @@
 scripts/mpi-env.sh makes idle ranks yield their core (the tests run up to 8 ranks on 2 cores); a job that
 fits the cores takes Open MPI's own default for a job that is not oversubscribed, no yield (the yields cost
 5-10 % at 2 ranks on 2 cores: docs/BENCHMARKS.md, "Two cores"). Every code timed gets the same, except
-ESyS-Particle, whose master waits on its worker and would take the other core spinning. Every code also
-gets basalt-run's eager limit for shared-memory messages.
+ESyS-Particle, whose master waits on its worker and would take the other core spinning. Every code run
+through mpi_env() also gets basalt-run's eager limit for shared-memory messages.
 """
 import os
 
