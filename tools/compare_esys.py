@@ -24,7 +24,7 @@ def main():
     p.add_argument("--steps", type=int, default=2000)
     p.add_argument("--np", type=int, default=1, help="MPI ranks for basalt-run")
     p.add_argument("--build", default=os.path.join(ROOT, "build"))
-    p.add_argument("--geometry", default=os.path.join(ROOT, "..", "shared", "reference", "cube1.geo"))
+    p.add_argument("--geometry", default=os.path.join(ROOT, "tests", "data", "cube1.geo"))
     p.add_argument("--reference", default=None,
                    help="ESyS series (default docs/data/esys_cube1_ekin.csv, or _10000 for more than 2000 steps)")
     p.add_argument("--plot", default=os.path.join(ROOT, "docs", "data", "esys_compare.png"))

@@ -20,8 +20,15 @@ TEST(Harness, ScratchDirIsSharedAndEmpty) {
   MPI_Barrier(basalt::test::world());
 }
 
-TEST(Harness, ReferenceDataIsBesideTheClone) {
-  EXPECT_TRUE(std::filesystem::exists(basalt::test::reference_dir() / "cube1.geo"))
-      << "expected ../shared/reference/cube1.geo next to the source tree, looked in "
-      << basalt::test::reference_dir();
+// The data the tests read lives in the checkout (tests/data), never beside it: a clone with nothing
+// beside it must pass.
+TEST(Harness, ReferenceDataIsInsideTheCheckout) {
+  namespace fs = std::filesystem;
+  const fs::path geo = basalt::test::reference_dir() / "cube1.geo";
+  ASSERT_TRUE(fs::exists(geo)) << "expected tests/data/cube1.geo in the source tree, looked in "
+                               << basalt::test::reference_dir();
+  const fs::path src = fs::canonical(basalt::test::source_dir());
+  const fs::path rel = fs::canonical(geo).lexically_relative(src);
+  EXPECT_TRUE(!rel.empty() && *rel.begin() != "..")
+      << fs::canonical(geo) << " lies outside the checkout " << src;
 }

@@ -1,4 +1,4 @@
-// The real GenGeo packing (cube1.geo, shared/reference) through both formats and back:
+// The real GenGeo packing (tests/data/cube1.geo) through both formats and back:
 // .geo -> .h5 -> .geo loses nothing (ids, exact positions, radii, tags, bonds), and the
 // rewritten .geo has the original's particle lines, character for character.
 #include <fmt/format.h>

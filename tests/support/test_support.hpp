@@ -29,10 +29,10 @@ inline std::filesystem::path source_dir() {
   return s ? std::filesystem::path(s) : std::filesystem::current_path();
 }
 
-/// ../shared/reference beside the clone: data made by other codes (GenGeo's cube1.geo ...).
+/// tests/data of the checkout: data made by other codes (GenGeo's cube1.geo ...), see its README.md.
 inline std::filesystem::path reference_dir() {
   const char* s = std::getenv("BASALT_REFERENCE_DIR");
-  return s && *s ? std::filesystem::path(s) : source_dir() / ".." / "shared" / "reference";
+  return s && *s ? std::filesystem::path(s) : source_dir() / "tests" / "data";
 }
 
 /// A fresh scratch folder for one test, shared by all ranks (rank 0 creates it).

@@ -217,7 +217,7 @@ def main():
     ap.add_argument("--plot", default="", help="PNG: error against speed, one curve per precision")
     a = ap.parse_args()
     build = os.path.abspath(a.build)
-    ref_dir = os.environ.get("BASALT_REFERENCE_DIR", os.path.join(ROOT, "..", "shared", "reference"))
+    ref_dir = os.environ.get("BASALT_REFERENCE_DIR", os.path.join(ROOT, "tests", "data"))
     cube1 = os.path.join(ref_dir, "cube1.geo")
     sim_time = a.time or (1.0 if a.quick else 1.5)
     fracs = [0.05, 0.2, 0.5, 0.9] if a.quick else [0.02, 0.05, 0.1, 0.2, 0.35, 0.5, 0.7, 0.9]

@@ -69,7 +69,7 @@ def main():
     ap.add_argument("--callgrind", action="store_true", help="instructions per step at 1 rank (valgrind)")
     ap.add_argument("--out", default="", help="markdown report")
     a = ap.parse_args()
-    ref = os.environ.get("BASALT_REFERENCE_DIR", os.path.join(ROOT, "..", "shared", "reference"))
+    ref = os.environ.get("BASALT_REFERENCE_DIR", os.path.join(ROOT, "tests", "data"))
     cube15 = os.path.join(ref, "cube1.geo")
     tmp = tempfile.mkdtemp(prefix="build_ab_")
     tile = os.path.join(ROOT, "tools", "bench", "wave_tile_geo.py")

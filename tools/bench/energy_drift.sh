@@ -5,6 +5,7 @@
 #   tools/bench/energy_drift.sh [build dir] [geometry] [steps]
 set -eu
 build=${1:-build}
-geometry=${2:-${BASALT_REFERENCE_DIR:?set BASALT_REFERENCE_DIR or give the geometry}/cube1.geo}
+root=$(cd "$(dirname "$0")/../.." && pwd)
+geometry=${2:-${BASALT_REFERENCE_DIR:-$root/tests/data}/cube1.geo}
 steps=${3:-10000000}
 exec nice -n 5 "$build/bin/energy_drift" --geometry "$geometry" --steps "$steps" --every 10000

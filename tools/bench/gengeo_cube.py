@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Packs a cube with GenGeo exactly as the seed paper's base cube (shared/reference/README.md):
+"""Packs a cube with GenGeo exactly as the seed paper's base cube (tests/data/README.md):
 InsertGenerator3D(insertFails=1000, maxIterations=1000, tolerance=1e-6), bonds with tolerance 1e-5.
 Usage: gengeo_cube.py SIZE RMIN RMAX OUT.geo   -> prints one JSON line: particles, bonds, solid_fraction, seconds.
 Run with /usr/bin/python3 (Debian's python3-gengeo)."""

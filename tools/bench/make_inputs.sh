@@ -10,8 +10,8 @@
 #
 # A file that exists is kept (delete it to make it again); the same seed gives the same file.
 # BASALT_PACK names the packer (default: build/bin/basalt-pack of this checkout; build it first).
-# The 15 mm cube1.geo is the paper's reference GenGeo cube: it comes with the reference data
-# (BASALT_REFERENCE_DIR, default ../shared/reference, as for the tests), not from this script.
+# The 15 mm cube1.geo is the paper's reference GenGeo cube: it is kept in the repository
+# (tests/data/cube1.geo; BASALT_REFERENCE_DIR points elsewhere), not made by this script.
 set -euo pipefail
 
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"

@@ -66,7 +66,7 @@ def main():
     a = ap.parse_args()
     work = Path(a.work)
     work.mkdir(parents=True, exist_ok=True)
-    cube = Path(os.environ.get("BASALT_REFERENCE_DIR", ROOT.parent / "shared" / "reference")) / "cube1.geo"
+    cube = Path(os.environ.get("BASALT_REFERENCE_DIR", ROOT / "tests" / "data")) / "cube1.geo"
     tiled = work / "cube1-tiled2.geo"
     if "30" in a.cases and not tiled.exists():
         subprocess.run(["/usr/bin/python3", str(ROOT / "tools" / "bench" / "wave_tile_geo.py"), str(cube), "2",

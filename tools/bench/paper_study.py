@@ -32,7 +32,7 @@ import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
-# The paper (Weatherley et al. 2010; ../shared/BENCHMARK.md): SGI cluster, Xeon L5520, 10,000 steps.
+# The paper (Weatherley et al. 2010, Tables 1-2): SGI cluster, Xeon L5520, 10,000 steps.
 PAPER_STEPS = 10000
 PAPER_POINTS = {27: 1104.5, 1000: 1617.5}  # workers -> seconds, no output
 PAPER_PARTICLES = {27: 241540, 1000: 8700121}
@@ -480,7 +480,7 @@ def main():
     ap.add_argument("--build", default=os.path.join(ROOT, "build"))
     ap.add_argument("--data", default=os.path.join(ROOT, "docs", "data", "paper_study"))
     ap.add_argument("--plot", default=os.path.join(ROOT, "docs", "img", "weak_scaling.png"))
-    ap.add_argument("--cube1", default=(os.environ.get("BASALT_REFERENCE_DIR") or os.path.join(ROOT, "..", "shared", "reference")) +
+    ap.add_argument("--cube1", default=(os.environ.get("BASALT_REFERENCE_DIR") or os.path.join(ROOT, "tests", "data")) +
                     "/cube1.geo")
     ap.add_argument("--packed", default=os.path.join(ROOT, "out", "paper_study", "cube15_seed7.h5"))
     ap.add_argument("--max-n", type=int, default=10)

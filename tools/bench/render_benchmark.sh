@@ -14,7 +14,7 @@ build="${1:-$root/build}"
 repeats="${2:-3}"
 view="$build/bin/basalt-view"
 tile="$build/tools/bench/basalt-tile-frame"
-geo="${BASALT_REFERENCE_DIR:-$root/../shared/reference}/cube1.geo"
+geo="${BASALT_REFERENCE_DIR:-$root/tests/data}/cube1.geo"
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 

@@ -116,7 +116,7 @@ def main():
     a.peer_dir = a.peer_dir or a.root
     a.output = a.output or os.path.join(a.root, "docs", "bench", "wave.md")
     a.inputs = a.inputs or os.path.join(a.root, "bench-inputs")
-    ref = os.environ.get("BASALT_REFERENCE_DIR") or os.path.join(a.root, "..", "shared", "reference")
+    ref = os.environ.get("BASALT_REFERENCE_DIR") or os.path.join(a.root, "tests", "data")
     cube15 = os.path.join(ref, "cube1.geo")
     work = tempfile.mkdtemp(prefix="basalt-bench-")
     tile = os.path.join(a.root, "tools", "bench", "wave_tile_geo.py")

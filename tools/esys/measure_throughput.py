@@ -45,9 +45,9 @@ def run_one(code, ranks, args, rundir):
 def main():
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--geometry", default=os.path.join(os.environ.get("BASALT_REFERENCE_DIR") or
-                                                     os.path.join(HERE, "..", "..", "..", "shared", "reference"),
+                                                     os.path.join(HERE, "..", "..", "tests", "data"),
                                                      "cube1.geo"),
-                   help="default $BASALT_REFERENCE_DIR/cube1.geo (../shared/reference next to the checkout)")
+                   help="default $BASALT_REFERENCE_DIR/cube1.geo (default tests/data of this checkout)")
     p.add_argument("--steps", type=int, default=2000)
     p.add_argument("--repeats", type=int, default=3)
     p.add_argument("--ranks", default="1,2", help="comma list: ESyS workers / LAMMPS ranks")

@@ -31,8 +31,8 @@ import time
 
 CHILD_ENV = "BASALT_ESYS_CHILD"
 HERE = os.path.dirname(os.path.abspath(__file__))
-# The paper's reference cube: BASALT_REFERENCE_DIR (as for the tests), default ../shared/reference next to the checkout.
-DEFAULT_GEOMETRY = os.path.join(os.environ.get("BASALT_REFERENCE_DIR") or os.path.join(HERE, "..", "..", "..", "shared", "reference"),
+# The paper's reference cube: BASALT_REFERENCE_DIR (as for the tests), default tests/data of this checkout.
+DEFAULT_GEOMETRY = os.path.join(os.environ.get("BASALT_REFERENCE_DIR") or os.path.join(HERE, "..", "..", "tests", "data"),
                                 "cube1.geo")
 sys.path.insert(0, HERE)  # esysparticle's embedded interpreter does not add the script's folder
 

@@ -37,7 +37,7 @@ DT = 0.0025  # must match scenes/column-collapse.toml run.dt
 
 
 def bindir(args):
-    for b in (args.bin, os.path.join(ROOT, "build/bin"), "/work/main/build/bin"):
+    for b in (args.bin, os.path.join(ROOT, "build/bin")):
         if b and os.path.exists(os.path.join(b, "basalt-run")):
             return b
     sys.exit("basalt-run not found: give --bin")

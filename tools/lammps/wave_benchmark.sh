@@ -17,7 +17,7 @@
 set -euo pipefail
 
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
-geometry="${BASALT_REFERENCE_DIR:-$here/../../../shared/reference}/cube1.geo"
+geometry="${BASALT_REFERENCE_DIR:-$here/../../tests/data}/cube1.geo"
 steps=10000
 ranks=1
 ke=0
