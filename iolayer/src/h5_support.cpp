@@ -353,8 +353,8 @@ void Writer::group(const std::string& path) {
   if (!g.valid()) fail(path, "cannot create group");
 }
 
-void Writer::write_dataset(const std::string& path, hid_t file_type, hid_t mem_type, const void* data,
-                           std::size_t rows, std::size_t columns) {
+Handle Writer::create_dataset(const std::string& path, hid_t file_type, std::size_t rows,
+                              std::size_t columns) {
   const hsize_t dims[2] = {rows, columns};
   Handle space(H5Screate_simple(columns ? 2 : 1, dims, nullptr), H5Sclose);
   if (!space.valid()) fail(path, "cannot create dataspace");
@@ -371,9 +371,35 @@ void Writer::write_dataset(const std::string& path, hid_t file_type, hid_t mem_t
       H5Dcreate2(file_id_.get(), path.c_str(), file_type, space.get(), H5P_DEFAULT, dcpl.get(), H5P_DEFAULT),
       H5Dclose);
   if (!ds.valid()) fail(path, "cannot create dataset");
+  return ds;
+}
+
+void Writer::write_dataset(const std::string& path, hid_t file_type, hid_t mem_type, const void* data,
+                           std::size_t rows, std::size_t columns) {
+  Handle ds = create_dataset(path, file_type, rows, columns);
   if (rows * (columns ? columns : 1) > 0 &&
       H5Dwrite(ds.get(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0)
     fail(path, "cannot write dataset (disk full?)");
+  if (!ds.reset()) fail(path, "cannot close dataset (disk full?)");
+}
+
+void Writer::int64_dataset_by_slabs(const std::string& path, std::size_t rows, const Int64Slab& fill) {
+  static_assert(kSlabRows == 65536, "a slab is one compressed chunk (create_dataset): each is written once");
+  Handle ds = create_dataset(path, Type<std::int64_t>::file(), rows, 0);
+  Handle file_space(H5Dget_space(ds.get()), H5Sclose);
+  if (!file_space.valid()) fail(path, "cannot get dataspace");
+  std::vector<std::int64_t> slab(std::min(rows, kSlabRows));
+  for (std::size_t begin = 0; begin < rows; begin += kSlabRows) {
+    const std::size_t count = std::min(kSlabRows, rows - begin);
+    fill(begin, std::span<std::int64_t>(slab.data(), count));
+    const hsize_t start[1] = {begin}, n[1] = {count};
+    Handle mem_space(H5Screate_simple(1, n, nullptr), H5Sclose);
+    if (!mem_space.valid() ||
+        H5Sselect_hyperslab(file_space.get(), H5S_SELECT_SET, start, nullptr, n, nullptr) < 0 ||
+        H5Dwrite(ds.get(), Type<std::int64_t>::mem(), mem_space.get(), file_space.get(), H5P_DEFAULT,
+                 slab.data()) < 0)
+      fail(path, fmt::format("cannot write rows {} to {}", begin, begin + count));
+  }
   if (!ds.reset()) fail(path, "cannot close dataset (disk full?)");
 }
 

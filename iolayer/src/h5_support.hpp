@@ -12,7 +12,9 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <new>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -211,6 +213,13 @@ class Writer {
   void dataset(const std::string& path, const std::vector<T>& v) {
     dataset(path, v.data(), v.size());
   }
+  /// A one-dimensional int64 dataset of `rows` values made slab by slab: fill(begin, out) sets out[k]
+  /// to the value of row begin + k. Only one slab of kSlabRows values is held at a time (the file's
+  /// image still grows with what is written: compress() first for a small one).
+  using Int64Slab = std::function<void(std::size_t begin, std::span<std::int64_t> out)>;
+  void int64_dataset_by_slabs(const std::string& path, std::size_t rows, const Int64Slab& fill);
+  static constexpr std::size_t kSlabRows = 65536;  // a compressed chunk's rows for one column
+
   /// A UTF-8 variable-length string attribute.
   void attribute(const std::string& object, const std::string& name, const std::string& value);
   /// A numeric attribute: scalar when count == 1 and !as_array, else a 1-D array.
@@ -235,6 +244,8 @@ class Writer {
  private:
   void write_dataset(const std::string& path, hid_t file_type, hid_t mem_type, const void* data,
                      std::size_t rows, std::size_t columns);
+  /// Creates (does not write) a dataset of that shape, with the compression filters when compress() asked.
+  Handle create_dataset(const std::string& path, hid_t file_type, std::size_t rows, std::size_t columns);
   void write_numeric_attribute(const std::string& object, const std::string& name, hid_t file_type,
                                hid_t mem_type, const void* values, std::size_t count, bool as_array);
 
