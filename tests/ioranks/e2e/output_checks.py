@@ -17,8 +17,10 @@
   xdmf DIR STEPS              DIR/ckpt_series.xmf is a time-ordered temporal collection of exactly the
                               checkpoints STEPS (comma-separated), and each grid, read as an XDMF reader
                               does (the DataItem paths through h5py, their Dimensions and number types),
-                              gives the checkpoint's particle count, positions, velocity and radius; so
-                              does each ckpt_<step>.xmf alone
+                              gives the checkpoint's particle count, positions, velocity and radius, and
+                              one vertex cell per particle (the topology's HyperSlab of xdmf_vertices.h5:
+                              cell i is point i); so does each ckpt_<step>.xmf alone, a temporal collection
+                              of its one grid
 """
 import re
 import sys
@@ -165,8 +167,7 @@ def xdmf_grid(grid, folder):
     """Reads one particle grid the way an XDMF reader does; returns (time, n, arrays by name) or raises."""
     types = {("Float", "8"): np.float64, ("Float", "4"): np.float32, ("Int", "8"): np.int64, ("Int", "4"): np.int32}
 
-    def item(parent):
-        d = parent.find("DataItem")
+    def heavy(d):
         assert d.get("Format") == "HDF", d.attrib
         file, path = d.text.strip().split(":", 1)
         with h5py.File(folder / file, "r") as h:
@@ -177,11 +178,25 @@ def xdmf_grid(grid, folder):
         assert data.dtype == want, f"{d.text}: {data.dtype}, the XML says {want}"
         return data
 
+    def item(parent):
+        d = parent.find("DataItem")
+        if d.get("ItemType") != "HyperSlab":
+            return heavy(d)
+        # start, stride and count (one column each: a one-dimensional selection) of the second item.
+        selection, source = d.findall("DataItem")
+        assert selection.get("Format") == "XML" and selection.get("Dimensions") == "3 1", selection.attrib
+        start, stride, count = (int(x) for x in selection.text.split())
+        data = heavy(source)[start::stride][:count]
+        assert data.shape == (count,) and d.get("Dimensions") == str(count), d.attrib
+        return data
+
     assert grid.get("GridType") == "Uniform"
     time = float(grid.find("Time").get("Value"))
     topo = grid.find("Topology")
     assert topo.get("TopologyType") == "Polyvertex" and topo.get("NodesPerElement") == "1"
     n = int(topo.get("NumberOfElements"))
+    # ParaView's Xdmf3 readers make cells only from an explicit connectivity: particle i is vertex i.
+    assert np.array_equal(item(topo), np.arange(n)), "the connectivity is not 0..N-1"
     assert grid.find("Geometry").get("GeometryType") == "XYZ"
     arrays = {"position": item(grid.find("Geometry"))}
     for a in grid.findall("Attribute"):
@@ -193,21 +208,29 @@ def xdmf_grid(grid, folder):
     return time, n, arrays
 
 
+def temporal_grids(file):
+    """The grids of the temporal collection that is the file's one grid (the form all of ParaView's readers
+    take time from)."""
+    collections = ET.parse(file).getroot().findall("Domain/Grid")
+    assert len(collections) == 1, f"{file}: {len(collections)} top-level grids"
+    c = collections[0]
+    assert c.get("GridType") == "Collection" and c.get("CollectionType") == "Temporal", f"{file}: {c.attrib}"
+    return c.findall("Grid")
+
+
 def xdmf(folder, steps):
     folder = Path(folder)
     want = [int(s) for s in steps.split(",")]
-    root = ET.parse(folder / "ckpt_series.xmf").getroot()
-    collection = root.find("Domain/Grid")
-    assert collection.get("GridType") == "Collection" and collection.get("CollectionType") == "Temporal"
-    grids = collection.findall("Grid")
+    grids = temporal_grids(folder / "ckpt_series.xmf")
     got = [int(g.find("Information[@Name='step']").get("Value")) for g in grids]
     if got != want:
         print(f"ckpt_series.xmf lists steps {got}, expected {want}")
         return False
     times = []
     for step, grid in zip(got, grids):
-        alone = ET.parse(folder / f"ckpt_{step:06d}.xmf").getroot().find("Domain/Grid")
-        for g in (grid, alone):
+        alone = temporal_grids(folder / f"ckpt_{step:06d}.xmf")
+        assert len(alone) == 1, f"ckpt_{step:06d}.xmf: {len(alone)} grids"
+        for g in (grid, alone[0]):
             time, n, arrays = xdmf_grid(g, folder)
             with h5py.File(folder / f"ckpt_{step:06d}.h5", "r") as h:
                 if n != h["particles/id"].shape[0] or time != h.attrs["time"]:
@@ -222,7 +245,8 @@ def xdmf(folder, steps):
     if times != sorted(times) or len(set(times)) != len(times):
         print(f"times not increasing: {times}")
         return False
-    print(f"ckpt_series.xmf: {len(grids)} checkpoints in time order {times}, {n} particles each, read back equal")
+    print(f"ckpt_series.xmf: {len(grids)} checkpoints in time order {times}, {n} particles and cells each, "
+          "read back equal")
     return True
 
 
