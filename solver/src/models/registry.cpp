@@ -18,6 +18,7 @@
 #include "basalt/solver/interactions/wall_driver.hpp"
 #include "basalt/solver/models/bonded_wall.hpp"
 #include "basalt/solver/models/contact_age.hpp"
+#include "basalt/solver/models/contract.hpp"
 #include "basalt/solver/models/damping.hpp"
 #include "basalt/solver/models/elastic_wall.hpp"
 #include "basalt/solver/models/friction.hpp"
@@ -92,6 +93,7 @@ constexpr auto float_problem_of() -> std::string_view (*)(const std::any&) {
 
 template <class Model>
 ModelEntry entry() {
+  static_assert(check_model<Model>());
   return {Model::name,
           Model::kind,
           Model::summary,
