@@ -24,6 +24,7 @@
 #include "basalt/solver/models/friction.hpp"
 #include "basalt/solver/models/gravity.hpp"
 #include "basalt/solver/models/hertz_mindlin.hpp"
+#include "basalt/solver/models/jkr.hpp"
 #include "basalt/solver/models/linear_bond.hpp"
 #include "basalt/solver/models/linear_elastic.hpp"
 #include "basalt/solver/models/rolling_friction.hpp"
@@ -126,6 +127,7 @@ const std::vector<ModelEntry>& model_registry() {
       entry<RotFriction>(),        // pair, ESyS RotFriction
       entry<RollingFriction>(),    // pair, rot_friction with rolling resistance (Ai et al. 2011)
       entry<HertzMindlin>(),       // pair, LIGGGHTS hertz/history, ESyS HertzMindlinVisco
+      entry<Jkr>(),                // pair, JKR adhesion (cohesive powders)
       entry<ElasticWall>(),        // wall
       entry<FrictionWall>(),       // wall, with Coulomb friction
       entry<HertzMindlinWall>(),   // wall
