@@ -85,6 +85,13 @@ double ForceField<Real>::max_stiffness(double rmax) const {
 }
 
 template <class Real>
+double ForceField<Real>::pair_reach(double rmax) const {
+  double r = 0;
+  for (const auto* c : pair_computes_) r = std::max(r, c->reach(rmax));
+  return r;
+}
+
+template <class Real>
 int ForceField<Real>::pair_taker(std::int64_t ti, std::int64_t tj) const {
   for (std::size_t g = 0; g < pair_group_tags_.size(); ++g) {
     const auto& t = pair_group_tags_[g];
@@ -113,13 +120,21 @@ void ForceField<Real>::rebuild_lists(const Particles<Real>& p,
     ghost_grid_.fill(p.x, p.y, p.z, p.n_owned, p.size());
     exclusions_.bind(bond_bucket_end, bonds.ib, p.n_owned);
     const auto taker = [&](std::size_t i, std::size_t j) { return pair_taker(p.tag[i], p.tag[j]); };
+    // The lists keep pairs closer than ri + rj + reach + skin, the reach of the largest radius here
+    // (owned and ghosts): every pair that can interact before the next rebuild. 0 for contact by overlap.
+    double margin = skin;
+    if (pair_reach(1.0) > 0) {  // (scenes without a cohesive model skip the pass)
+      double rmax = 0;
+      for (std::size_t i = 0; i < p.size(); ++i) rmax = std::max(rmax, double(p.radius[i]));
+      margin = skin + pair_reach(rmax);
+    }
     if (pairs_take_all_) {
       build_pair_lists(
-          p, grid_, ghost_grid_, skin, exclusions_, [](std::size_t, std::size_t) { return true; }, own_,
+          p, grid_, ghost_grid_, margin, exclusions_, [](std::size_t, std::size_t) { return true; }, own_,
           ghost_, mark_bonds_);
     } else {
       build_pair_lists(
-          p, grid_, ghost_grid_, skin, exclusions_,
+          p, grid_, ghost_grid_, margin, exclusions_,
           [&](std::size_t i, std::size_t j) { return taker(i, j) >= 0; }, own_, ghost_, mark_bonds_);
     }
     const PairLists<Real> lists{p, own_, ghost_, pair_computes_.size(), taker};

@@ -184,8 +184,10 @@ void Simulation<Real>::distribute(io::Geometry& g, const GeometryExtent& e) {
   }
   longest = comm().max(longest);
   unassigned_bonds_ = static_cast<std::size_t>(comm().sum(static_cast<long long>(unassigned)));
-  ghost_width_ = std::max(forces_.has_pairs() ? 2 * rmax : 0.0, longest) + scene_.skin;
-  contact_cutoff_ = 2 * rmax + scene_.skin;
+  // (a cohesive pair model reaches beyond touching: forces_.pair_reach, 0 for contact by overlap)
+  const double reach = forces_.pair_reach(rmax);
+  ghost_width_ = std::max(forces_.has_pairs() ? 2 * rmax + reach : 0.0, longest) + scene_.skin;
+  contact_cutoff_ = 2 * rmax + reach + scene_.skin;
   if (dec_->min_interior_width() < ghost_width_)
     throw InputError(fmt::format(
         "too many ranks for this geometry: a rank's region would be {:.4g} wide, less than the ghost width "

@@ -108,8 +108,15 @@ struct Launch {
   V3 x, v;
 };
 
+/// Contacts that slid at the last step, over every force compute of a run.
+std::size_t sliding_contacts(const Simulation<double>& s) {
+  std::size_t n = 0;
+  for (const auto& c : s.force_computes()) n += c->sliding_contacts();
+  return n;
+}
+
 /// Runs the sphere on the planar floor and on the mesh floor side by side; returns the largest
-/// position and force differences over the run.
+/// position and force differences over the run. Both must count the same sliding contacts at every step.
 std::pair<double, double> floor_difference(const fs::path& mesh, bool friction, const Launch& l, int steps) {
   const auto planar_scene = basalt::test::scene_from(kFloorRun + floor_wall(false, mesh, friction));
   const auto mesh_scene = basalt::test::scene_from(kFloorRun + floor_wall(true, mesh, friction));
@@ -124,9 +131,12 @@ std::pair<double, double> floor_difference(const fs::path& mesh, bool friction, 
     s->state_changed();
   }
   double dx = 0, df = 0;
+  int slid = 0, sliding_differs = 0;
   for (int k = 0; k < steps; ++k) {
     a.step();
     b.step();
+    slid += sliding_contacts(a) > 0;
+    sliding_differs += sliding_contacts(a) != sliding_contacts(b);
     const auto &p = a.particles(), &q = b.particles();
     dx = std::max({dx, std::abs(p.x[0] - q.x[0]), std::abs(p.y[0] - q.y[0]), std::abs(p.z[0] - q.z[0])});
     df =
@@ -135,6 +145,8 @@ std::pair<double, double> floor_difference(const fs::path& mesh, bool friction, 
       dx = std::max(
           {dx, std::abs(p.wx[0] - q.wx[0]), std::abs(p.wy[0] - q.wy[0]), std::abs(p.wz[0] - q.wz[0])});
   }
+  EXPECT_EQ(sliding_differs, 0) << "sliding contacts of the mesh floor and the planar floor (" << slid
+                                << " steps sliding)";
   // The mesh's force tally is the planar wall's.
   const auto& fa = a.walls().force(0);
   const auto& fb = b.walls().mesh_force(0);

@@ -18,11 +18,13 @@
 #include "basalt/solver/interactions/wall_driver.hpp"
 #include "basalt/solver/models/bonded_wall.hpp"
 #include "basalt/solver/models/contact_age.hpp"
+#include "basalt/solver/models/contract.hpp"
 #include "basalt/solver/models/damping.hpp"
 #include "basalt/solver/models/elastic_wall.hpp"
 #include "basalt/solver/models/friction.hpp"
 #include "basalt/solver/models/gravity.hpp"
 #include "basalt/solver/models/hertz_mindlin.hpp"
+#include "basalt/solver/models/jkr.hpp"
 #include "basalt/solver/models/linear_bond.hpp"
 #include "basalt/solver/models/linear_elastic.hpp"
 #include "basalt/solver/models/rolling_friction.hpp"
@@ -92,6 +94,7 @@ constexpr auto float_problem_of() -> std::string_view (*)(const std::any&) {
 
 template <class Model>
 ModelEntry entry() {
+  static_assert(check_model<Model>());
   return {Model::name,
           Model::kind,
           Model::summary,
@@ -124,6 +127,7 @@ const std::vector<ModelEntry>& model_registry() {
       entry<RotFriction>(),        // pair, ESyS RotFriction
       entry<RollingFriction>(),    // pair, rot_friction with rolling resistance (Ai et al. 2011)
       entry<HertzMindlin>(),       // pair, LIGGGHTS hertz/history, ESyS HertzMindlinVisco
+      entry<Jkr>(),                // pair, JKR adhesion (cohesive powders)
       entry<ElasticWall>(),        // wall
       entry<FrictionWall>(),       // wall, with Coulomb friction
       entry<HertzMindlinWall>(),   // wall

@@ -81,6 +81,9 @@ class ForceCompute {
   virtual void set_time_step(double) {}
   /// Largest spring constant for particles up to radius rmax (critical time step).
   virtual double max_stiffness(double rmax) const = 0;
+  /// Pair models: how far beyond ri + rj a pair of particles up to radius rmax can interact (0: only
+  /// overlapping pairs; a cohesive neck reaches further, models/contract.hpp).
+  virtual double reach(double /*rmax*/) const { return 0; }
   /// Adds forces of one part; returns the potential energy when `energy`. `advance`: a real step, so
   /// contact history moves on (a force evaluation outside the step, e.g. at start or restart, reads it).
   virtual double compute(ForceState<Real>& s, Part part, bool energy, bool advance) = 0;

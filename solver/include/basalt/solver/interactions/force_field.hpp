@@ -32,6 +32,9 @@ class ForceField {
   /// model index counts these.
   const std::vector<ForceCompute<Real>*>& history_computes() const { return history_computes_; }
   bool has_pairs() const { return !pair_computes_.empty(); }
+  /// How far beyond ri + rj the scene's pair models reach for particles up to radius rmax (0 for
+  /// contact by overlap): the pair lists, ghosts and cells grow by it.
+  double pair_reach(double rmax) const;
   /// Whether a pair model reads velocities (then ghosts carry them, Particles::ghost_velocity).
   bool needs_ghost_velocity() const {
     for (const auto* c : pair_computes_)

@@ -59,6 +59,7 @@ class MeshWallDriver final : public ForceCompute<Real> {
     return {};
   }
   double dissipated() const override { return dissipated_; }
+  std::size_t sliding_contacts() const override { return sliding_; }
   void set_dissipated(double d) override { dissipated_ = d; }
   void set_time_step(double dt) override { dt_ = Real(dt); }
   double max_stiffness(double rmax) const override {
@@ -186,6 +187,7 @@ class MeshWallDriver final : public ForceCompute<Real> {
   template <bool Energy, bool Advance>
   double loop(Particles<Real>& p, Walls& walls) {
     double energy = 0, dissipated = 0;
+    std::size_t sliding = 0;
     const bool rot = p.with_rotation;
     thread_local std::vector<MeshContact> cs;
     for (std::size_t k = 0; k < index_.size(); ++k) {
@@ -233,7 +235,10 @@ class MeshWallDriver final : public ForceCompute<Real> {
               static const History zero{};
               if (std::memcmp(&h, &zero, sizeof(History)) != 0 && next.n < kSlots) next.h[next.n++] = h;
             }
-            if constexpr (Advance) dissipated += f.dissipated;
+            if constexpr (Advance) {
+              dissipated += f.dissipated;
+              sliding += f.sliding;
+            }
             if constexpr (Energy) energy += double(Model::energy(c, h, kin));
           } else {
             const Real o = p.radius[i] - Real(mc.distance);
@@ -272,6 +277,7 @@ class MeshWallDriver final : public ForceCompute<Real> {
       walls.mesh_power(w) = power;
     }
     dissipated_ += dissipated;
+    if (Advance) sliding_ = sliding;
     return energy;
   }
 
@@ -283,6 +289,7 @@ class MeshWallDriver final : public ForceCompute<Real> {
   ContactRecords pending_;
   const Walls* walls_ = nullptr;
   double dissipated_ = 0;
+  std::size_t sliding_ = 0;  ///< contacts that slid at the last real step (as the planar walls')
   Real dt_ = 0;
 };
 

@@ -4,8 +4,9 @@
 // Energies are tallied by the rank owning the smaller global id. With one group that takes every tag
 // the per-pair group lookup is skipped. A model with per-contact History gets it stored beside the
 // list (one entry per listed pair), carried across rebuilds by the pair's ids (contact_history.hpp),
-// and advanced only on real steps: Model::advance updates it for touching pairs, Model::apart for
-// listed pairs that do not touch, and Model::force reads it.
+// and advanced only on real steps: Model::advance updates it for interacting pairs, Model::apart for
+// listed pairs that do not interact, and Model::force reads it. A pair interacts when the model's
+// touching() says so (default: the spheres overlap); the model contract is models/contract.hpp.
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -15,6 +16,7 @@
 #include <vector>
 
 #include "basalt/solver/interactions/force_compute.hpp"
+#include "basalt/solver/models/contract.hpp"
 
 namespace basalt::solver {
 
@@ -92,8 +94,13 @@ class PairDriver final : public ForceCompute<Real> {
   bool takes_all() const { return uniform_; }
 
   std::string_view dissipation_term() const override {
-    if constexpr (kKinematic) return Model::dissipation_term;
+    if constexpr (kDissipates) return Model::dissipation_term;
     return {};
+  }
+  double reach(double rmax) const override {
+    double m = 0;
+    for (const auto& p : params_) m = std::max(m, pair_reach<Model>(p, rmax));
+    return m;
   }
   double dissipated() const override { return dissipated_; }
   std::size_t sliding_contacts() const override { return sliding_; }
@@ -187,16 +194,45 @@ class PairDriver final : public ForceCompute<Real> {
   }
 
   template <bool Energy, bool Uniform, bool Newton, bool Advance>
-  double loop(Particles<Real>& p, const PairList& list, History* hist) const {
+  double loop(Particles<Real>& p, const PairList& list, History* hist) {
     // (lists with bonded pairs marked get a loop of their own over the pairs not bonded: the wave
     // benchmark's has no indirection)
     return list.bonded.empty() ? loop_over<Energy, Uniform, Newton, Advance, false>(p, list, hist)
                                : loop_over<Energy, Uniform, Newton, Advance, true>(p, list, hist);
   }
 
+  /// A scalar law's force and energy, of the sum of radii or of both radii (models/contract.hpp).
+  static Real law_force(const Coeffs& c, const History& h, Real ri, Real rj, Real rsum, Real r) {
+    if constexpr (contract::ScalarPairLawOfRadii<Model, Real>) {
+      (void)rsum;
+      return Model::force(c, h, ri, rj, r);
+    } else {
+      (void)ri, (void)rj;
+      return Model::force(c, h, rsum, r);
+    }
+  }
+  static Real law_energy(const Coeffs& c, const History& h, Real ri, Real rj, Real rsum, Real r) {
+    if constexpr (contract::ScalarPairLawOfRadii<Model, Real>) {
+      (void)rsum;
+      return Model::energy(c, h, ri, rj, r);
+    } else {
+      (void)ri, (void)rj;
+      return Model::energy(c, h, rsum, r);
+    }
+  }
+  static void law_advance(const Coeffs& c, History& h, Real ri, Real rj, Real rsum, Real r) {
+    if constexpr (contract::ScalarPairLawOfRadii<Model, Real>) {
+      (void)rsum;
+      Model::advance(c, h, ri, rj, r);
+    } else {
+      (void)ri, (void)rj;
+      Model::advance(c, h, rsum, r);
+    }
+  }
+
   template <bool Energy, bool Uniform, bool Newton, bool Advance, bool Marked>
-  double loop_over(Particles<Real>& p, const PairList& list, [[maybe_unused]] History* hist) const {
-    double energy = 0;
+  double loop_over(Particles<Real>& p, const PairList& list, [[maybe_unused]] History* hist) {
+    double energy = 0, parted = 0;
     const std::size_t n = p.n_owned;
     const Real* __restrict x = p.x.data();
     const Real* __restrict y = p.y.data();
@@ -211,6 +247,10 @@ class PairDriver final : public ForceCompute<Real> {
     const std::uint32_t* __restrict from = Marked ? list.loose_offset.data() : off;
     [[maybe_unused]] const std::uint32_t* __restrict loose = list.loose.data();
     const Coeffs c0 = coeffs_.empty() ? Coeffs{} : coeffs_[0];
+    const auto coeffs_of = [&](std::size_t i, std::size_t j) -> const Coeffs& {
+      if constexpr (Uniform) return c0;
+      return coeffs_[static_cast<std::size_t>(group_of(p.tag[i], p.tag[j]))];
+    };
     for (std::size_t i = 0; i < n; ++i) {
       const Real xi = x[i], yi = y[i], zi = z[i], ri = rad[i];
       Real fxi = 0, fyi = 0, fzi = 0;
@@ -219,19 +259,28 @@ class PairDriver final : public ForceCompute<Real> {
         const auto j = static_cast<std::size_t>(nb[k]);
         const Real dx = xi - x[j], dy = yi - y[j], dz = zi - z[j];
         const Real r2 = dx * dx + dy * dy + dz * dz;
-        const Real rsum = ri + rad[j];
-        if (!(r2 < rsum * rsum)) {
-          if constexpr (kHistory && Advance) Model::apart(hist[k]);
+        const Real rj = rad[j];
+        const Real rsum = ri + rj;
+        History none{};
+        History& h = kHistory ? hist[k] : none;
+        // (a model with its own touching() needs the pair's coefficients first; the others look them up
+        // only for pairs that overlap)
+        const bool touch =
+            kTouching ? pair_touching<Model, Real>(coeffs_of(i, j), h, ri, rj, r2) : r2 < rsum * rsum;
+        if (!touch) {
+          if constexpr (kHistory && Advance) {
+            // What the history still held is lost with it: dissipated (models with a dissipation term).
+            if constexpr (kDissipates)
+              if (holds(h) && (Newton || p.id[i] < p.id[j]))
+                parted += Model::parting_energy(coeffs_of(i, j), h);
+            Model::apart(h);
+          }
           continue;
         }
-        const Coeffs& c = Uniform ? c0 : coeffs_[static_cast<std::size_t>(group_of(p.tag[i], p.tag[j]))];
+        const Coeffs& c = coeffs_of(i, j);
         const Real r = std::sqrt(r2);
-        History none{};
-        History* hp = &none;
-        if constexpr (kHistory) hp = &hist[k];
-        History& h = *hp;
-        if constexpr (kHistory && Advance) Model::advance(c, h, rsum, r);
-        const Real s = Model::force(c, h, rsum, r) / r;
+        if constexpr (kHistory && Advance) law_advance(c, h, ri, rj, rsum, r);
+        const Real s = law_force(c, h, ri, rj, rsum, r) / r;
         fxi += s * dx;
         fyi += s * dy;
         fzi += s * dz;
@@ -241,12 +290,13 @@ class PairDriver final : public ForceCompute<Real> {
           fz[j] -= s * dz;
         }
         if constexpr (Energy)
-          if (Newton || p.id[i] < p.id[j]) energy += double(Model::energy(c, h, rsum, r));
+          if (Newton || p.id[i] < p.id[j]) energy += double(law_energy(c, h, ri, rj, rsum, r));
       }
       fx[i] += fxi;
       fy[i] += fyi;
       fz[i] += fzi;
     }
+    if constexpr (kDissipates) dissipated_ += parted;
     return energy;
   }
 
@@ -336,7 +386,7 @@ class PairDriver final : public ForceCompute<Real> {
         const Real rj = rad[j], rsum = ri + rj;
         History none{};
         History& h = kHistory ? hist[e] : none;
-        if (!(r2 < rsum * rsum)) {
+        if (!(kTouching ? pair_touching<Model, Real>(coeffs_of(i, j), h, ri, rj, r2) : r2 < rsum * rsum)) {
           if constexpr (kHistory && Advance) {
             // What the history still held is lost with it (a shear spring's energy): dissipated. Most
             // pairs here were apart or bonded the step before too: their history is clear already.
@@ -697,6 +747,10 @@ class PairDriver final : public ForceCompute<Real> {
   }
 
   static constexpr int kLaneWidth = kContactLaneWidth;
+  /// The model decides when a pair interacts (models/contract.hpp, touching()).
+  static constexpr bool kTouching = contract::HasTouching<Model, Real>;
+  /// The model names a ledger term for the energy it dissipates.
+  static constexpr bool kDissipates = requires { Model::dissipation_term; };
   static constexpr bool kLanes = requires(const Coeffs& c, ContactLanes<Real, kLaneWidth, History>& b) {
     Model::template contact_lanes<true>(c, b);
   };
