@@ -88,7 +88,7 @@ def launch(argv):
               "(Debian package esys-particle). Nothing was run.", file=sys.stderr)
         return 3
     if not os.path.exists(args.geometry) and args.generate_side > 0:
-        gen = os.path.join(HERE, "gengeo_cube.py")
+        gen = os.path.join(HERE, "..", "bench", "gengeo_cube.py")
         print(f"{args.geometry} missing: generating a {args.generate_side} mm GenGeo cube (slow)", flush=True)
         rc = subprocess.call(["/usr/bin/python3", gen, "--side", str(args.generate_side), "--output", args.geometry])
         if rc != 0:
