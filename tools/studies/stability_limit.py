@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Measures the largest stable time step of a scene + geometry by bisection with basalt-run.
 
-    tools/bench/stability_limit.py --build build --scene scenes/wave.toml \\
+    tools/studies/stability_limit.py --build build --scene scenes/wave.toml \\
         --geometry $BASALT_REFERENCE_DIR/cube1.geo [--steps 2000] [--np 1] [--precision double]
 
 Each trial runs the scene with run.dt replaced (and --force-dt) for --steps steps, saving the kinetic

@@ -2,7 +2,7 @@
 """Kinetic-energy error of the wave scene when every coordinate (and the wall) is shifted by D, in double
 and in float, against the unshifted double run (docs/stability.md, "Coordinates far from the origin").
 
-    /usr/bin/python3 tools/bench/offset_precision.py --build build --geometry $BASALT_REFERENCE_DIR/cube1.geo \
+    /usr/bin/python3 tools/studies/offset_precision.py --build build --geometry $BASALT_REFERENCE_DIR/cube1.geo \
         [--steps 2000] [--work offset-work]
 
 Prints one row per (precision, D): L2 and max relative KE error, or basalt-run's last error line when it

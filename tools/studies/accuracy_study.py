@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Speed against accuracy on the wave benchmark (issue 13; results in docs/accuracy.md).
 
-    /usr/bin/python3 tools/bench/accuracy_study.py --build build --out docs/accuracy.md \\
+    /usr/bin/python3 tools/studies/accuracy_study.py --build build --out docs/accuracy.md \\
         --plot docs/img/accuracy.png [--quick]
 
 Knobs: precision (double, float) x run.dt_fraction (0.02 ... 0.9, the stability limit being ~0.95 with
@@ -327,13 +327,13 @@ def report(a, runs, skin_runs, ref, res, dt_c, sim_time, n1, top_z, elapsed):
     L = ["# Speed against accuracy: the measured trade-off", "",
          "Issue 13's study. Rerun (about " + f"{elapsed / 60:.0f}" + " min on the shared 2-core machine; `--quick` "
          "takes a few minutes):", "",
-         "    /usr/bin/python3 tools/bench/accuracy_study.py --build build --out docs/accuracy.md \\",
+         "    /usr/bin/python3 tools/studies/accuracy_study.py --build build --out docs/accuracy.md \\",
          "        --plot docs/img/accuracy.png" + (" --quick" if a.quick else ""), "",
          f"Wave benchmark (scenes/wave.toml) on cube1.geo ({n1:,} particles), 1 rank, {sim_time} ms simulated "
          f"(the pulse, its arrival at the top and {sim_time - 0.6:.1f} ms of the closed system after it). "
          f"Critical step dt_c = {dt_c} ms. Reference: double, velocity Verlet, dt_fraction 0.01 "
          f"({ref['steps']:,} steps), wave arrival {ref['arrival']:.4f} ms, drift {ref['drift']:.1g}. "
-         "Error measures and method: the docstring of tools/bench/accuracy_study.py. Speed is particle-steps "
+         "Error measures and method: the docstring of tools/studies/accuracy_study.py. Speed is particle-steps "
          "per second of loop CPU time (the machine is shared: wall time is inflated by other jobs; CPU time "
          "still varies by some 10-20 % with the load, so only differences larger than that mean anything); "
          "cost = CPU seconds per simulated ms per million particles = 1e6 / (rate x dt).", "",

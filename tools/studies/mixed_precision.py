@@ -2,7 +2,7 @@
 """Speed, memory and accuracy of run.precision = "mixed" against double and float (issue 13; results in
 docs/stability.md, "Mixed precision", and docs/accuracy.md).
 
-    /usr/bin/python3 tools/bench/mixed_precision.py --build build --work mixed-work [--repeats 3] [--steps 2000]
+    /usr/bin/python3 tools/studies/mixed_precision.py --build build --work mixed-work [--repeats 3] [--steps 2000]
 
 Cases: the wave scene (scenes/wave.toml) on the 15 mm cube ($BASALT_REFERENCE_DIR/cube1.geo, 8,948
 particles) and on the 30 mm cube (cube1 tiled 2x2x2 by tools/bench/wave_tile_geo.py, 71,584), 1 rank.
@@ -12,7 +12,7 @@ the 12 B/particle of remainders buy). Each repeat runs every setting once, one a
 time ("cpu time of the loop", CPU rather than wall time: the machine is shared), median and range over the
 repeats; the bytes per particle of the particle fields basalt-run prints ("fields: ... = N B/particle");
 the KE L2 relative error against the double run of the same case (rows where double's KE exceeds 1 % of
-its peak, as tools/bench/accuracy_study.py). With --fractions, the accuracy runs repeat at
+its peak, as tools/studies/accuracy_study.py). With --fractions, the accuracy runs repeat at
 run.dt_fraction = 0.02 (where float loses small increments v dt) and 0.5.
 """
 import argparse

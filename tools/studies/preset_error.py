@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Error and speed of basalt-run's presets (docs/stability.md, "Presets") on one scene + geometry.
 
-    tools/bench/preset_error.py --build build --scene scenes/wave.toml \\
+    tools/studies/preset_error.py --build build --scene scenes/wave.toml \\
         --geometry $BASALT_REFERENCE_DIR/cube1.geo [--time 2.0] [--np 1]
 
 Runs a reference (double, run.dt_fraction = 0.01) and each preset for the same simulated time, saving
