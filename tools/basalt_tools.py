@@ -26,7 +26,6 @@ import os
 import re
 import shutil
 import subprocess
-import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 """The repository's root (this file is ROOT/tools/basalt_tools.py)."""
