@@ -16,7 +16,10 @@ import tempfile
 
 import numpy as np
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import basalt_tools as bt  # noqa: E402  (tools/basalt_tools.py)
+
+ROOT = bt.ROOT
 
 
 def main():
@@ -34,24 +37,22 @@ def main():
         ROOT, "docs", "data", "esys_cube1_ekin.csv" if a.steps <= 2000 else "esys_cube1_ekin_10000.csv")
     if not os.path.exists(a.geometry):
         sys.exit(f"compare_esys: geometry {a.geometry} not found (--geometry)")
-    exe = os.path.join(a.build, "bin", "basalt-run")
+    exe = bt.binary("basalt-run", build=a.build)
     if not os.access(exe, os.X_OK):
         sys.exit(f"compare_esys: {exe} not built (cmake --build {a.build} --target basalt-run)")
     with tempfile.TemporaryDirectory() as out:
-        cmd = [exe, os.path.join(ROOT, "scenes", "wave-esys.toml"), "--geometry", a.geometry, "--steps",
-               str(a.steps), "--output", out, "--quiet"]
-        if a.np > 1:
-            cmd = ["mpirun", "-np", str(a.np)] + cmd
+        cmd = bt.basalt_run_command(exe, os.path.join(ROOT, "scenes", "wave-esys.toml"), "--geometry", a.geometry,
+                                    "--steps", a.steps, "--output", out, "--quiet", np=a.np)
         subprocess.run(cmd, check=True)
-        ours = np.loadtxt(os.path.join(out, "fields.csv"), delimiter=",", skiprows=1, ndmin=2)
+        ours = bt.read_fields(out)
     ref = np.loadtxt(ref_file, delimiter=",", skiprows=1, ndmin=2)
     ref = {int(s): ke for s, _, ke in ref}
-    steps = ours[:, 0].astype(int)
+    steps = np.array(ours["step"])
     missing = [s for s in steps if s not in ref]
     if missing:
         sys.exit(f"compare_esys: the reference {ref_file} lacks steps {missing[0]}..")
     r = np.array([ref[s] for s in steps])
-    b = ours[:, 2]
+    b = np.array(ours["kinetic_energy"])
     sig = r > 1e-3 * r.max()
     rel = np.abs(b - r)[sig] / r[sig]
     worst = rel.max()

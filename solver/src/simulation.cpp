@@ -105,7 +105,7 @@ void Simulation<Real>::configure_particles() {
   // The optional field groups this scene needs (Particles::enabled()): nothing else is allocated.
   mixed_ = scene_.precision == "mixed";
   // Compensated drift in mixed precision (BASALT_MIXED_COMPENSATION=0 leaves it out: the measurement of
-  // what it buys, tools/bench/mixed_precision.py).
+  // what it buys, tools/studies/mixed_precision.py).
   const char* comp = std::getenv("BASALT_MIXED_COMPENSATION");
   p_.with_compensation = mixed_ && !(comp && std::string(comp) == "0");
   p_.with_exact_rebuild = scene_.checkpoint_every > 0;

@@ -58,7 +58,7 @@ def run(basalt, geo_src, work, d, precision, fraction=None, dt=None, out_text=No
 def l2(ke, ref):
     m = min(len(ke), len(ref))
     peak = max(ref[:m])
-    keep = [k for k in range(m) if ref[k] >= 0.01 * peak]  # as tools/bench/accuracy_study.py
+    keep = [k for k in range(m) if ref[k] >= 0.01 * peak]  # as tools/studies/accuracy_study.py
     num = sum((ke[k] - ref[k]) ** 2 for k in keep)
     return (num / sum(ref[k] ** 2 for k in keep)) ** 0.5
 

@@ -51,7 +51,7 @@ const Geometry& cube1() {
 // 2 / omega_max of cube1's network at the start of the wave scene, from 1500 power iterations to a
 // relative change of 1e-9 (99 needed): the value the default iterations must reproduce.
 constexpr double kCube1Critical = 5.937e-3;
-// The largest dt with which the wave scene runs 2,000 steps stably on cube1 (tools/bench/
+// The largest dt with which the wave scene runs 2,000 steps stably on cube1 (tools/studies/
 // stability_limit.py, docs/stability.md): below the linear estimate, as contacts close during the run.
 constexpr double kCube1Measured = 5.657e-3;
 
@@ -413,7 +413,7 @@ TEST(Precision, FloatFarFromOriginIsRefused) {
   }
 }
 
-// The wave's arrival saver (mean_vz_above, used by tools/bench/accuracy_study.py): the mean vertical
+// The wave's arrival saver (mean_vz_above, used by tools/studies/accuracy_study.py): the mean vertical
 // velocity of the particles above z, against the particles themselves, on any number of ranks.
 TEST(WaveArrival, MeanVzAboveIsTheMeanOverTheParticlesAboveZ) {
   Scene scene = wave_scene();

@@ -24,30 +24,28 @@ import subprocess
 import sys
 import tempfile
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+import basalt_tools as bt  # noqa: E402  (tools/basalt_tools.py)
+
+ROOT = bt.ROOT
 
 
 def run(build, geo, np_, steps, out, timed=False):
-    cmd = [os.path.join(build, "bin", "basalt-run"), os.path.join(ROOT, "scenes", "wave.toml"), "--geometry", geo,
-           "--steps", str(steps), "--output", out, "--quiet", "--fields-every", "0"]
-    if np_ > 1:
-        cmd = ["mpirun", "-np", str(np_)] + cmd
-    if timed:
-        cmd = ["/usr/bin/time", "-v"] + cmd
+    cmd = bt.basalt_run_command(bt.binary("basalt-run", build=build), os.path.join(ROOT, "scenes", "wave.toml"),
+                                "--geometry", geo, "--steps", steps, "--output", out, "--quiet", "--fields-every", "0",
+                                np=np_, timed=timed)
     p = subprocess.run(cmd, capture_output=True, text=True)
     if p.returncode != 0:
         sys.exit(f"failed: {' '.join(cmd)}\n{p.stdout}\n{p.stderr}")
-    rate = float(re.search(r"([0-9.]+) M particle-steps/s", p.stdout).group(1)) * 1e6
-    arrays = float(re.search(r"solver arrays: .*\(([0-9.]+) bytes per particle\)", p.stdout).group(1))
-    rss = re.search(r"Maximum resident set size \(kbytes\): ([0-9]+)", p.stderr)
-    return rate, arrays, (int(rss.group(1)) if rss else 0)
+    r = bt.parse_run(p.stdout)
+    return r["particle_steps_per_s"], float(r["bytes_per_particle"]), bt.parse_time_v(p.stderr).get("max_rss_kb", 0)
 
 
 def instructions_per_step(build, geo, s1, s2, out):
     counts = []
     for steps in (s1, s2):
         cmd = ["valgrind", "--tool=callgrind", "--callgrind-out-file=/dev/null",
-               os.path.join(build, "bin", "basalt-run"), os.path.join(ROOT, "scenes", "wave.toml"), "--geometry", geo,
+               bt.binary("basalt-run", build=build), os.path.join(ROOT, "scenes", "wave.toml"), "--geometry", geo,
                "--steps", str(steps), "--output", out, "--quiet", "--fields-every", "0"]
         p = subprocess.run(cmd, capture_output=True, text=True)
         m = re.search(r"Collected : ([0-9]+)", p.stderr)
@@ -69,8 +67,7 @@ def main():
     ap.add_argument("--callgrind", action="store_true", help="instructions per step at 1 rank (valgrind)")
     ap.add_argument("--out", default="", help="markdown report")
     a = ap.parse_args()
-    ref = os.environ.get("BASALT_REFERENCE_DIR", os.path.join(ROOT, "tests", "data"))
-    cube15 = os.path.join(ref, "cube1.geo")
+    cube15 = bt.reference_cube()
     tmp = tempfile.mkdtemp(prefix="build_ab_")
     tile = os.path.join(ROOT, "tools", "bench", "wave_tile_geo.py")
     cube30 = os.path.join(tmp, "cube30-tiled.geo")

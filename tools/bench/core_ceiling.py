@@ -13,13 +13,13 @@ Prints one line per repeat and the medians; --json FILE keeps them.
 import argparse
 import json
 import os
-import re
 import statistics
 import subprocess
 import sys
 import tempfile
 
-DONE = re.compile(r"^done: \d+ steps in ([0-9.]+) s", re.M)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+import basalt_tools as bt  # noqa: E402  (tools/basalt_tools.py)
 
 
 def start(cmd):
@@ -28,10 +28,10 @@ def start(cmd):
 
 def loop_time(proc, what):
     out, _ = proc.communicate()
-    m = DONE.search(out)
-    if proc.returncode != 0 or not m:
+    r = bt.parse_run(out)
+    if proc.returncode != 0 or "loop_s" not in r:
         sys.exit(f"core_ceiling.py: {what} failed (exit {proc.returncode}):\n{out[-2000:]}")
-    return float(m.group(1))
+    return r["loop_s"]
 
 
 def main():
@@ -39,7 +39,7 @@ def main():
     ap.add_argument("--scene", required=True)
     ap.add_argument("--steps", type=int, required=True)
     ap.add_argument("--repeats", type=int, default=5)
-    ap.add_argument("--bin", default=os.path.join(os.path.dirname(__file__), "..", "..", "build", "bin"))
+    ap.add_argument("--bin", default=bt.bin_dir())
     ap.add_argument("--json")
     a = ap.parse_args()
     exe = os.path.realpath(os.path.join(a.bin, "basalt-run"))
@@ -56,7 +56,7 @@ def main():
             return start(cmd)
 
         def mpi(ranks):
-            cmd = ["mpirun", "-np", str(ranks), exe, scene, "--steps", str(a.steps), "--quiet",
+            cmd = bt.mpirun(ranks) + [exe, scene, "--steps", str(a.steps), "--quiet",
                    "--output", os.path.join(tmp, f"np{ranks}")]
             return loop_time(start(cmd), f"{ranks}-rank run")
 

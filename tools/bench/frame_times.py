@@ -18,23 +18,24 @@ import sys
 import tempfile
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+import basalt_tools as bt  # noqa: E402  (tools/basalt_tools.py)
+
+ROOT = Path(bt.ROOT)
 LINE = re.compile(r"frame times \(rank 0\): (\d+) frames, median ([0-9.]+) ms")
-LOOP = re.compile(r"done: \d+ steps in ([0-9.]+) s")
 
 
 def run(binary, a, out):
-    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
-               OMPI_MCA_rmaps_base_oversubscribe="1", HWLOC_COMPONENTS="-gl", BASALT_FRAME_TIMES="1")
+    env = bt.mpi_env(bt.RUN_AS_ROOT + bt.NO_GL, BASALT_FRAME_TIMES="1")
     shutil.rmtree(out, ignore_errors=True)
-    cmd = ["mpirun", "-np", str(a.compute_ranks + a.io_ranks), binary, a.scene, "--geometry", a.geometry,
+    cmd = bt.mpirun(a.compute_ranks + a.io_ranks) + [binary, a.scene, "--geometry", a.geometry,
            "--steps", str(a.steps), "--quiet", "--frames-every", "0", "--fields-every", "0",
            "--checkpoint-every", str(a.checkpoint_every), "--io-ranks", str(a.io_ranks), "--output", str(out)]
     p = subprocess.run(cmd, capture_output=True, text=True, env=env)
     m = LINE.search(p.stdout)
     if p.returncode != 0 or not m:
         sys.exit(f"failed or no frame times (BASALT_FRAME_TIMES support?): {' '.join(cmd)}\n{p.stdout}\n{p.stderr}")
-    return float(m.group(2)), float(LOOP.search(p.stdout).group(1))
+    return float(m.group(2)), bt.parse_run(p.stdout)["loop_s"]
 
 
 def main():

@@ -19,10 +19,16 @@ of the smallest sphere, 8.6e-5 s); skin 0.2 mm (0.1 of the smallest diameter) in
 """
 import argparse, glob, math, os, re, statistics, subprocess, sys, time
 
-from mpi_jobs import mpi_env  # (this folder is on sys.path: the script's own)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+import basalt_tools as bt  # noqa: E402  (tools/basalt_tools.py)
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.normpath(os.path.join(HERE, "..", ".."))
+ROOT = bt.ROOT
+
+
+def mpi_env(ranks):
+    """The environment of a timed job (every code alike): no yield when the ranks fit the cores, basalt-run's
+    eager limit for shared-memory messages (basalt_tools.mpi_env)."""
+    return bt.mpi_env((), ranks=ranks, eager=True)
 RHO, E, NU, REST, MU, G = 2500.0, 1.0e7, 0.25, 0.5, 0.5, 9.81
 DT, SKIN, LX, LY = 1.0e-5, 2.0e-4, 0.06, 0.06
 RMIN, RMAX = 0.001, 0.0015
@@ -131,11 +137,8 @@ every = {energy_every}
 def export(ckpt, pack, work):
     import h5py
     import numpy as np
-    with h5py.File(ckpt, "r") as f:
-        ids = f["particles/id"][...]
-        pos = f["particles/position"][...]
-        rad = f["particles/radius"][...]
-        vel = f["particles/velocity"][...]
+    ids, pos, rad, vel = bt.read_h5(ckpt, "particles/id", "particles/position", "particles/radius",
+                                    "particles/velocity")
     vrms = float(np.sqrt((vel ** 2).sum(axis=1).mean()))
     order = np.argsort(ids)
     ids, pos, rad = ids[order], pos[order], rad[order]
@@ -168,8 +171,8 @@ def fill(template, out, **kw):
 
 def parse_rate(code, text, n, steps):
     if code.startswith("basalt"):
-        m = re.search(r"done: (\d+) steps in ([0-9.]+) s", text)
-        return n * int(m.group(1)) / float(m.group(2))
+        r = bt.parse_run(text)
+        return n * r["loop_steps"] / r["loop_s"]
     m = re.search(r"Loop time of ([0-9.eE+-]+) on (\d+) procs for (\d+) steps with (\d+) atoms", text)
     return int(m.group(4)) * int(m.group(3)) / float(m.group(1))
 
@@ -177,7 +180,10 @@ def parse_rate(code, text, n, steps):
 def cpu_fraction(code, text):
     """Share of the wall time the ranks had a core (Basalt: "cpu time of the loop ... N % of the wall time";
     LAMMPS: "N% CPU use"; LIGGGHTS prints none)."""
-    m = re.search(r"cpu time of the loop: .*?, (\d+) % of the wall time", text) or re.search(r"([0-9.]+)% CPU use", text)
+    r = bt.parse_run(text)
+    if "cpu_percent" in r:
+        return r["cpu_percent"] / 100.0
+    m = re.search(r"([0-9.]+)% CPU use", text)
     return float(m.group(1)) / 100.0 if m else None
 
 
@@ -188,12 +194,10 @@ def energies(code, log):
     if code.startswith("basalt"):
         f = log[:-4] + ".fields.csv"
         if os.path.exists(f):
-            rows = [l.strip().split(",") for l in open(f) if l.strip()]
-            head = rows[0]
-            ik, ir = head.index("kinetic_energy"), head.index("rotational_kinetic_energy")
-            for r in rows[1:]:
-                if r[ik] and r[ir]:
-                    out[int(r[0])] = (float(r[ik]) - float(r[ir]), float(r[ir]))
+            c = bt.read_fields(f)
+            for s, k, r in zip(c["step"], c["kinetic_energy"], c["rotational_kinetic_energy"]):
+                if k == k and r == r:  # both saved at this step
+                    out[s] = (k - r, r)
         return out
     cols = None
     for line in open(log):
@@ -293,7 +297,7 @@ def summarize(work, n, steps, codes, ranks, repeats):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--work", default="/tmp/granular-bench")
-    ap.add_argument("--bin", default=os.path.join(ROOT, "build", "bin"))
+    ap.add_argument("--bin", default=bt.bin_dir())
     ap.add_argument("--height", type=float, default=0.12)
     ap.add_argument("--settle-steps", type=int, default=9000)
     ap.add_argument("--settle-rounds", type=int, default=8)

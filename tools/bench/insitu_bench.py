@@ -9,7 +9,6 @@ drawing time per picture, then medians and the ratio of the loop times.
 """
 import argparse
 import os
-import re
 import shutil
 import statistics
 import subprocess
@@ -17,12 +16,14 @@ import sys
 import tempfile
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+import basalt_tools as bt  # noqa: E402  (tools/basalt_tools.py)
+
+ROOT = Path(bt.ROOT)
 
 
 def run(a, render, out):
-    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
-               OMPI_MCA_rmaps_base_oversubscribe="1", HWLOC_COMPONENTS="-gl")
+    env = bt.mpi_env(bt.RUN_AS_ROOT + bt.NO_GL)
     env.pop("DISPLAY", None)
     shutil.rmtree(out, ignore_errors=True)
     cmd = ["mpirun", "-np", "2", a.basalt_run, a.scene, "--geometry", a.geometry, "--steps", str(a.steps), "--quiet",
@@ -33,13 +34,10 @@ def run(a, render, out):
     p = subprocess.run(cmd, capture_output=True, text=True, env=env)
     if p.returncode != 0:
         sys.exit(f"failed: {' '.join(cmd)}\n{p.stdout}\n{p.stderr}")
-    r = {"loop": float(re.search(r"done: \d+ steps in ([0-9.]+) s", p.stdout).group(1)),
-         "cpu": float(re.search(r"cpu time of the loop: ([0-9.]+) s", p.stdout).group(1)),
-         "wait": float(re.search(r"compute ranks waited ([0-9.]+) s", p.stdout).group(1)),
-         "io_cpu": float(re.search(r"I/O rank CPU time ([0-9.]+) s", p.stdout).group(1))}
-    m = re.search(r"pictures .*\(([0-9.]+) s per picture, longest ([0-9.]+) s\); (\d+) of (\d+) drawn", p.stdout)
-    if m:
-        r.update(per_picture=float(m.group(1)), longest=float(m.group(2)), drawn=int(m.group(3)), due=int(m.group(4)))
+    x = bt.parse_run(p.stdout)
+    r = {"loop": x["loop_s"], "cpu": x["cpu_s"], "wait": x["compute_wait_s"], "io_cpu": x["io_cpu_s"]}
+    if "per_picture_s" in x:
+        r.update(per_picture=x["per_picture_s"], longest=x["longest_s"], drawn=x["drawn"], due=x["due"])
     return r
 
 

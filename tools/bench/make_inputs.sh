@@ -6,7 +6,7 @@
 #   DIR/cube30.geo   30 mm cube, basalt-pack's dense mode, seed 7 (.geo, so ESyS-Particle reads it too)
 #   DIR/cube60.h5    60 mm cube, basalt-pack's GenGeo-like mode, seed 7 (590,156 particles, ~35 s)
 #   DIR/cube30-gengeo.geo   with --gengeo only: the 30 mm cube packed by GenGeo (python3-gengeo, the
-#                    recipe of the paper's cube1.geo, tools/esys/gengeo_cube.py; tens of minutes)
+#                    recipe of the paper's cube1.geo, tools/bench/gengeo_cube.py; tens of minutes)
 #
 # A file that exists is kept (delete it to make it again); the same seed gives the same file.
 # BASALT_PACK names the packer (default: build/bin/basalt-pack of this checkout; build it first).
@@ -59,6 +59,6 @@ if [ "$gengeo" = 1 ]; then
     echo "make_inputs: $dir/cube30-gengeo.geo exists, kept"
   else
     echo "make_inputs: $dir/cube30-gengeo.geo (GenGeo, tens of minutes)"
-    /usr/bin/python3 "$root/tools/esys/gengeo_cube.py" --side 30 --output "$dir/cube30-gengeo.geo"
+    /usr/bin/python3 "$root/tools/bench/gengeo_cube.py" --side 30 --output "$dir/cube30-gengeo.geo"
   fi
 fi

@@ -16,7 +16,6 @@ The time is the stepping loop's ("done: N steps in X s"), start-up excluded.
 import argparse
 import json
 import os
-import re
 import shutil
 import statistics
 import subprocess
@@ -24,7 +23,10 @@ import sys
 import tempfile
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+import basalt_tools as bt  # noqa: E402  (tools/basalt_tools.py)
+
+ROOT = Path(bt.ROOT)
 STAGES = {
     "none": ["--fields-every", "0", "--checkpoint-every", "0"],
     "fields every step": ["--fields-every", "1", "--checkpoint-every", "0"],
@@ -35,24 +37,20 @@ BASELINE = " (baseline build)"  # suffix of the stages run with --baseline-run's
 
 
 def run(a, q, extra, out):
-    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
-               OMPI_MCA_rmaps_base_oversubscribe="1", OMPI_MCA_mpi_yield_when_idle="0",
-               HWLOC_COMPONENTS="-gl")
+    env = bt.mpi_env(bt.RUN_AS_ROOT + bt.NO_GL, OMPI_MCA_mpi_yield_when_idle="0")
     # Compute ranks should not yield (the I/O rank sleeps by itself); hwloc's GL probe would connect to an
     # X server on :0 if another session runs one, and die when it goes away.
     shutil.rmtree(out, ignore_errors=True)
     binary = a.basalt_run
     if extra and extra[0] == "--baseline":
         binary, extra = a.baseline_run, extra[1:]
-    cmd = ["mpirun", "-np", str(1 + q), binary, a.scene, "--geometry", a.geometry,
-           "--steps", str(a.steps), "--quiet", "--frames-every", "0", "--io-ranks", str(q), "--output", str(out)] + extra
+    cmd = bt.mpirun(1 + q) + [binary, a.scene, "--geometry", a.geometry, "--steps", str(a.steps), "--quiet",
+                              "--frames-every", "0", "--io-ranks", str(q), "--output", str(out)] + extra
     p = subprocess.run(cmd, capture_output=True, text=True, env=env)
     if p.returncode != 0:
         sys.exit(f"failed: {' '.join(cmd)}\n{p.stdout}\n{p.stderr}")
-    loop = float(re.search(r"done: \d+ steps in ([0-9.]+) s", p.stdout).group(1))
-    wait = float(re.search(r"compute ranks waited ([0-9.]+) s", p.stdout).group(1))
-    cpu = float(re.search(r"cpu time of the loop: ([0-9.]+) s", p.stdout).group(1))
-    return loop, wait, cpu
+    r = bt.parse_run(p.stdout)
+    return r["loop_s"], r["compute_wait_s"], r["cpu_s"]
 
 
 def run_esys(a, stage, out):

@@ -23,20 +23,18 @@ import sys
 import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
+sys.path.insert(0, os.path.join(HERE, ".."))
+import basalt_tools as bt  # noqa: E402  (tools/basalt_tools.py)
+
+ROOT = bt.ROOT
 
 
 def run_timed(cmd):
     """Runs cmd under /usr/bin/time -v; returns (stdout, wall seconds, peak RSS in MiB, user seconds)."""
-    p = subprocess.run(["/usr/bin/time", "-v"] + cmd, capture_output=True, text=True)
+    p = bt.run(cmd, timed=True, check=False)
     if p.returncode != 0:
         sys.exit(f"failed: {' '.join(cmd)}\n{p.stdout}\n{p.stderr}")
-    wall = re.search(r"Elapsed \(wall clock\) time \(h:mm:ss or m:ss\): (\S+)", p.stderr).group(1)
-    parts = [float(x) for x in wall.split(":")]
-    seconds = sum(v * 60 ** (len(parts) - 1 - i) for i, v in enumerate(parts))
-    rss = int(re.search(r"Maximum resident set size \(kbytes\): (\d+)", p.stderr).group(1)) / 1024
-    user = float(re.search(r"User time \(seconds\): (\S+)", p.stderr).group(1))
-    return p.stdout, seconds, rss, user
+    return p.stdout, p.time["wall_s"], p.time["max_rss_kb"] / 1024, p.time["user_s"]
 
 
 def basalt(exe, args, out):
@@ -63,7 +61,7 @@ def med(rows, key):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--basalt-pack", default=os.path.join(ROOT, "build", "bin", "basalt-pack"))
+    ap.add_argument("--basalt-pack", default=bt.binary("basalt-pack"))
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--large", action="store_true", help="also the ~1 M and the 150 mm (~8.7 M) packs")
     ap.add_argument("--large-only", action="store_true", help="only the large packs")

@@ -30,7 +30,10 @@ import sys
 import tempfile
 import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+import basalt_tools as bt  # noqa: E402  (tools/basalt_tools.py)
+
+ROOT = bt.ROOT
 
 # The paper (Weatherley et al. 2010, Tables 1-2): SGI cluster, Xeon L5520, 10,000 steps.
 PAPER_STEPS = 10000
@@ -40,9 +43,6 @@ PAPER_PARTICLES = {27: 241540, 1000: 8700121}
 CLUSTER_LATENCY_S = 3e-6
 CLUSTER_BANDWIDTH_BPS = 2.5e9
 
-DONE_RE = re.compile(r"done: (\d+) steps in ([0-9.]+) s .*?start-up ([0-9.]+) s; (\d+) rebuilds")
-PART_RE = re.compile(r"(forces|neighbour search|communication|integration|output) ([0-9.]+) ms")
-HEAD_RE = re.compile(r"basalt-run \S+: (\d+) particles, (\d+) bonds on (\d+) (?:compute )?rank")
 
 
 def sh(cmd, **kw):
@@ -92,16 +92,14 @@ def read_pingpong(a):
 
 # ----------------------------------------------------------------------------------------------- runs
 def parse_run(stdout):
-    d = DONE_RE.search(stdout)
-    h = HEAD_RE.search(stdout)
-    if not d or not h:
+    r = bt.parse_run(stdout)
+    if "loop_s" not in r or "particles" not in r:
         raise SystemExit("cannot read basalt-run's summary:\n" + stdout)
     # (the "time per step:" line's maxima over the ranks; at several ranks a "time per step by rank" line follows)
-    line = re.search(r"^time per step: (.*)$", stdout, re.M)
-    parts = {k: float(v) for k, v in PART_RE.findall(line.group(1) if line else "")}
-    return {"particles": int(h.group(1)), "bonds": int(h.group(2)), "ranks": int(h.group(3)),
-            "steps": int(d.group(1)), "loop_s": float(d.group(2)), "startup_s": float(d.group(3)),
-            "rebuilds": int(d.group(4)), "forces_ms": parts["forces"], "neighbour_ms": parts["neighbour search"],
+    parts = {k: v[0] for k, v in r.get("phases", {}).items()}
+    return {"particles": r["particles"], "bonds": r["bonds"], "ranks": r["compute_ranks"],
+            "steps": r["loop_steps"], "loop_s": r["loop_s"], "startup_s": r["startup_s"],
+            "rebuilds": r["rebuilds"], "forces_ms": parts["forces"], "neighbour_ms": parts["neighbour search"],
             "comm_ms": parts["communication"], "integration_ms": parts["integration"], "output_ms": parts["output"]}
 
 
@@ -480,15 +478,14 @@ def main():
     ap.add_argument("--build", default=os.path.join(ROOT, "build"))
     ap.add_argument("--data", default=os.path.join(ROOT, "docs", "data", "paper_study"))
     ap.add_argument("--plot", default=os.path.join(ROOT, "docs", "img", "weak_scaling.png"))
-    ap.add_argument("--cube1", default=(os.environ.get("BASALT_REFERENCE_DIR") or os.path.join(ROOT, "tests", "data")) +
-                    "/cube1.geo")
+    ap.add_argument("--cube1", default=bt.reference_cube())
     ap.add_argument("--packed", default=os.path.join(ROOT, "out", "paper_study", "cube15_seed7.h5"))
     ap.add_argument("--max-n", type=int, default=10)
     ap.add_argument("--pack", type=int, default=4, help="step packed: pack the cubes n = 1 .. this")
     ap.add_argument("--steps", type=int, default=3000)
     ap.add_argument("--repeats", type=int, default=3)
     a = ap.parse_args()
-    a.bin = lambda name: os.path.join(a.build, "bin", name)
+    a.bin = lambda name: bt.binary(name, build=a.build)
     # hwloc's GL plugin (loaded by Open MPI) opens X display :0 when there is one; on this machine another job's
     # X server on :0 came and went, and processes died with "X connection to :0 broken" (failures.log).
     os.environ.setdefault("HWLOC_COMPONENTS", "-gl")

@@ -16,13 +16,16 @@ import subprocess
 import sys
 import tempfile
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+import basalt_tools as bt  # noqa: E402  (tools/basalt_tools.py)
+
 ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
 ap.add_argument("geometries", nargs="+")
 ap.add_argument("--np", type=int, default=2)
 ap.add_argument("--repeats", type=int, default=3)
-ap.add_argument("--run", default=os.path.join(os.path.dirname(__file__), "../../build/bin/basalt-run"))
+ap.add_argument("--run", default=bt.binary("basalt-run"))
 ap.add_argument("--baseline-run", help="another basalt-run (e.g. a build of an older commit) to time as well")
-ap.add_argument("--scene", default=os.path.join(os.path.dirname(__file__), "../../scenes/wave.toml"))
+ap.add_argument("--scene", default=bt.repo_path("scenes", "wave.toml"))
 a = ap.parse_args()
 
 variants = [("sliced", a.run, []), ("whole", a.run, ["--whole-geometry"])]
@@ -31,15 +34,14 @@ if a.baseline_run:
 
 
 def once(run, extra, geometry, out):
-    cmd = ["mpirun", "-np", str(a.np), "/usr/bin/time", "-f", "maxrss_kb %M", run, a.scene, "--geometry", geometry,
+    cmd = bt.mpirun(a.np) + ["/usr/bin/time", "-f", "maxrss_kb %M", run, a.scene, "--geometry", geometry,
            "--steps", "1", "--fields-every", "0", "--quiet", "--output", out] + extra
     p = subprocess.run(cmd, capture_output=True, text=True)
     if p.returncode != 0:
         sys.exit(f"failed: {' '.join(cmd)}\n{p.stdout}\n{p.stderr}")
-    start = float(re.search(r"start-up ([0-9.]+) s", p.stdout).group(1))
+    r = bt.parse_run(p.stdout)
     rss = max(int(v) for v in re.findall(r"maxrss_kb (\d+)", p.stderr))
-    n = int(re.search(r"(\d+) particles", p.stdout).group(1))
-    return start, rss, n
+    return r["startup_s"], rss, r["particles"]
 
 
 print(f"| geometry | particles | " + " | ".join(f"{v[0]}: start-up s, max RSS/rank MB" for v in variants) +

@@ -16,16 +16,15 @@ start-up is excluded from both. Output: a markdown table on stdout and W/ucs_ben
 import argparse
 import json
 import os
-import re
 import statistics
 import subprocess
 import sys
 import time
 
-from mpi_jobs import mpi_env  # (this folder is on sys.path: the script's own)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+import basalt_tools as bt  # noqa: E402  (tools/basalt_tools.py)
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.normpath(os.path.join(HERE, "..", ".."))
+ROOT = bt.ROOT
 GEO = os.path.join(ROOT, "docs", "data", "esys-ucs", "box.geo")
 SCENE = os.path.join(ROOT, "scenes", "ucs-esys.toml")
 
@@ -41,16 +40,12 @@ def run(cmd, log, env=None):
 
 
 def basalt(bindir, ranks, steps, out, log):
-    cmd = ["mpirun", "-np", str(ranks), os.path.join(bindir, "basalt-run"), SCENE, "--steps", str(steps),
-           "--output", out]
-    text, _ = run(cmd, log, mpi_env(ranks))
-    m = re.search(r"^done: (\d+) steps in ([0-9.]+) s", text, re.M)
-    if not m:
+    cmd = bt.mpirun(ranks) + [bt.binary("basalt-run", bindir), SCENE, "--steps", str(steps), "--output", out]
+    text, _ = run(cmd, log, bt.mpi_env((), ranks=ranks, eager=True))
+    r = bt.parse_run(text)
+    if "loop_s" not in r:
         sys.exit(f"error: no 'done:' line in {log}")
-    parts = re.search(r"^time per step: (.*)$", text, re.M)
-    rebuilds = re.search(r"; (\d+) rebuilds", text)
-    return {"loop_s": float(m.group(2)), "parts": parts.group(1) if parts else "",
-            "rebuilds": int(rebuilds.group(1)) if rebuilds else None}
+    return {"loop_s": r["loop_s"], "parts": r.get("time_per_step", ""), "rebuilds": r.get("rebuilds")}
 
 
 def esys(steps, out, log):
@@ -66,7 +61,7 @@ def main():
     ap.add_argument("--work", required=True)
     ap.add_argument("--steps", type=int, default=22000)
     ap.add_argument("--repeats", type=int, default=2)
-    ap.add_argument("--bin", default=os.path.join(ROOT, "build", "bin"))
+    ap.add_argument("--bin", default=bt.bin_dir())
     ap.add_argument("--base-bin", default="")
     ap.add_argument("--no-esys", action="store_true")
     a = ap.parse_args()

@@ -17,12 +17,14 @@ import argparse
 import datetime
 import json
 import os
-import re
 import shutil
 import statistics
 import subprocess
 import sys
 import tempfile
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+import basalt_tools as bt  # noqa: E402  (tools/basalt_tools.py)
 
 TARGETS = {("cube15", 1): 12e6, ("cube30", 1): 10e6}
 
@@ -32,18 +34,13 @@ def sh(cmd, **kw):
 
 
 def basalt(a, geo, np_, steps, out):
-    cmd = [os.path.join(a.build, "bin", "basalt-run"), os.path.join(a.root, "scenes", "wave.toml"),
-           "--geometry", geo, "--steps", str(steps), "--output", out, "--quiet"]
-    if np_ > 1:
-        cmd = ["mpirun", "-np", str(np_)] + cmd
-    text = sh(cmd).stdout
-    m = re.search(r"done: .* \(([0-9.]+) steps/s, ([0-9.]+) M particle-steps/s\)", text)
-    phases = re.search(r"time per step: (.*)", text)
-    cpu = re.search(r"cpu time of the loop: ([0-9.]+) s per rank \(max\), ([0-9]+) %", text)
-    ph = phases.group(1) if phases else ""
-    if cpu:
-        ph += f"; cpu {cpu.group(1)} s per rank = {cpu.group(2)} % of the wall time"
-    return float(m.group(2)) * 1e6, ph
+    cmd = bt.basalt_run_command(bt.binary("basalt-run", build=a.build), os.path.join(a.root, "scenes", "wave.toml"),
+                                "--geometry", geo, "--steps", steps, "--output", out, "--quiet", np=np_)
+    r = bt.parse_run(sh(cmd).stdout)
+    ph = r.get("time_per_step", "")
+    if "cpu_s" in r:
+        ph += f"; cpu {r['cpu_s']:.3f} s per rank = {r['cpu_percent']:.0f} % of the wall time"
+    return r["particle_steps_per_s"], ph
 
 
 def lammps(a, geo, np_, steps, out, bond_model="table"):
@@ -67,21 +64,19 @@ def esys(a, geo, np_, steps, out):
 
 
 def peak_rss_kb(a, geo, steps, out):
-    cmd = ["/usr/bin/time", "-v", os.path.join(a.build, "bin", "basalt-run"),
-           os.path.join(a.root, "scenes", "wave.toml"), "--geometry", geo, "--steps", str(steps), "--output", out,
-           "--quiet"]
-    r = subprocess.run(cmd, check=True, capture_output=True, text=True)
-    rss = int(re.search(r"Maximum resident set size \(kbytes\): (\d+)", r.stderr).group(1))
-    arrays = re.search(r"solver arrays: [0-9.]+ MB \(([0-9]+) bytes per particle\)", r.stdout)
-    return rss, int(arrays.group(1)) if arrays else None
+    cmd = bt.basalt_run_command(bt.binary("basalt-run", build=a.build), os.path.join(a.root, "scenes", "wave.toml"),
+                                "--geometry", geo, "--steps", steps, "--output", out, "--quiet")
+    p = bt.run(cmd, timed=True, check=False)
+    if p.returncode != 0:
+        raise subprocess.CalledProcessError(p.returncode, cmd, p.stdout, p.stderr)
+    return p.time["max_rss_kb"], bt.parse_run(p.stdout).get("bytes_per_particle")
 
 
 def count_particles(geo):
-    with open(geo) as f:
-        for line in f:
-            if line.strip() == "Simple":
-                return int(next(f))
-    raise SystemExit(f"{geo}: not a .geo file")
+    try:
+        return bt.geo_particle_count(geo)
+    except bt.GeoError:
+        raise SystemExit(f"{geo}: not a .geo file")
 
 
 def fmt_rate(v):
@@ -110,14 +105,12 @@ def main():
     # basalt-run sends messages up to 64 KiB eagerly through shared memory (basalt_run.cpp,
     # prefer_eager_shared_memory_messages); LAMMPS gets the same from the environment, so both codes'
     # messages travel alike.
-    os.environ.setdefault("OMPI_MCA_btl_vader_eager_limit", "65536")
-    os.environ.setdefault("OMPI_MCA_btl_vader_max_send_size", "65536")
+    os.environ.update(bt.mpi_env((), eager=True))
     a.build = a.build or os.path.join(a.root, "build")
     a.peer_dir = a.peer_dir or a.root
     a.output = a.output or os.path.join(a.root, "docs", "bench", "wave.md")
     a.inputs = a.inputs or os.path.join(a.root, "bench-inputs")
-    ref = os.environ.get("BASALT_REFERENCE_DIR") or os.path.join(a.root, "tests", "data")
-    cube15 = os.path.join(ref, "cube1.geo")
+    cube15 = bt.reference_cube(a.root)
     work = tempfile.mkdtemp(prefix="basalt-bench-")
     tile = os.path.join(a.root, "tools", "bench", "wave_tile_geo.py")
     cube30 = os.path.join(a.inputs, "cube30-gengeo.geo")

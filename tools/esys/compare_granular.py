@@ -17,12 +17,13 @@ Also prints ESyS against its own perturbed run, the yardstick for what chaos alo
 
 import argparse
 import csv
-import glob
 import os
 import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
+sys.path.insert(0, os.path.join(HERE, ".."))
+import basalt_tools as bt  # noqa: E402  (tools/basalt_tools.py)
 import deposit_metrics  # noqa: E402
 
 DATA = os.path.join(HERE, "..", "..", "docs", "data", "esys-granular")
@@ -46,20 +47,15 @@ def worst(ref, other, last_step=None):
 
 
 def positions_csv(run_dir, out_path):
-    try:
-        import h5py
-    except ImportError:
-        raise SystemExit("error: h5py is missing (apt-get install python3-h5py)")
-    files = sorted(glob.glob(os.path.join(run_dir, "ckpt_*.h5")))
-    if not files:
+    last = bt.last_checkpoint(run_dir)
+    if not last:
         raise SystemExit(f"error: {run_dir}: no checkpoint (the scene writes one at the last step)")
-    with h5py.File(files[-1], "r") as f:
-        pos, rad, ids = f["/particles/position"][()], f["/particles/radius"][()], f["/particles/id"][()]
+    pos, rad, ids = bt.read_h5(last, "/particles/position", "/particles/radius", "/particles/id")
     with open(out_path, "w") as o:
         o.write("id,x,y,z,r\n")
         for i, p, r in zip(ids, pos, rad):
             o.write(f"{i},{p[0]!r},{p[1]!r},{p[2]!r},{r!r}\n")
-    return files[-1]
+    return last
 
 
 def main():

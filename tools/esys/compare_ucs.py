@@ -27,6 +27,9 @@ import os
 import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, ".."))
+import basalt_tools as bt  # noqa: E402  (tools/basalt_tools.py)
+
 DATA = os.path.join(HERE, "..", "..", "docs", "data", "esys-ucs")
 
 
@@ -41,14 +44,14 @@ def esys_series(path):
 
 
 def basalt_series(run_dir):
-    path = os.path.join(run_dir, "fields.csv")
+    c = bt.read_fields(os.path.join(run_dir, "fields.csv"))
+    if "wall_force_top_wall_z" not in c:
+        return {}
     out = {}
-    with open(path, newline="") as f:
-        for r in csv.DictReader(f):
-            if r.get("wall_force_top_wall_z", "") == "":
-                continue
-            out[int(r["step"])] = (0.5 * (float(r["wall_force_top_wall_z"]) - float(r["wall_force_bottom_wall_z"])),
-                                   float(r["bond_count"]), float(r["kinetic_energy"]))
+    for s, top, bottom, bonds, ke in zip(c["step"], c["wall_force_top_wall_z"], c["wall_force_bottom_wall_z"],
+                                         c["bond_count"], c["kinetic_energy"]):
+        if top == top:  # saved at this step (an empty cell is nan)
+            out[s] = (0.5 * (top - bottom), bonds, ke)
     return out
 
 
@@ -148,7 +151,7 @@ def main():
     args = ap.parse_args()
     if args.basalt_run:
         import subprocess
-        scene = os.path.join(HERE, "..", "..", "scenes", "ucs-esys.toml")
+        scene = bt.repo_path("scenes", "ucs-esys.toml")
         cmd = [args.basalt_run, scene, "--output", args.run_dir, "--quiet"]
         if subprocess.call(cmd) != 0:
             print("FAIL: " + " ".join(cmd) + " exited non-zero")

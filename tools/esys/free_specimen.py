@@ -23,11 +23,12 @@ ESyS's checkpoints cp_t=N_W.txt at the steps of --checkpoints. Exit 3 if ESyS is
 import argparse
 import math
 import os
-import shutil
 import subprocess
 import sys
 
-CHILD_ENV = "BASALT_ESYS_CHILD"
+# tools/ (esysparticle's embedded interpreter does not add the script's folder either)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+import basalt_tools as bt  # noqa: E402  (tools/basalt_tools.py)
 SAVERS = [("kinetic_energy", "particle", "e_kin"), ("linear_kinetic_energy", "particle", "e_kin_linear"),
           ("rotational_kinetic_energy", "particle", "e_kin_rot"),
           ("bond_potential_energy", "bonds", "potential_energy"), ("bonds", "bonds", "count")]
@@ -74,7 +75,7 @@ def write_particles(geometry, path):
 
 def launch(argv):
     args = parse_args(argv)
-    missing = [exe for exe in ("esysparticle", "mpirun") if shutil.which(exe) is None]
+    missing = bt.esys_missing()
     if missing:
         print(f"ESyS-Particle is not available: {', '.join(missing)} not on PATH "
               "(Debian package esys-particle). Nothing was run.", file=sys.stderr)
@@ -88,13 +89,9 @@ def launch(argv):
         return 2
     print(f"{args.geometry}: {n} particles, {nb} bonds", flush=True)
     workers = args.dims[0] * args.dims[1] * args.dims[2]
-    env = dict(os.environ, **{CHILD_ENV: "1"})
-    env.setdefault("OMPI_ALLOW_RUN_AS_ROOT", "1")
-    env.setdefault("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
-    env.setdefault("OMPI_MCA_rmaps_base_oversubscribe", "1")
-    cmd = ["mpirun", "-np", str(workers + 1), "esysparticle", os.path.abspath(__file__)] + list(argv) + [
-        "--output", output, "--particles", os.path.join(output, "particles.txt")]
-    rc = subprocess.call(cmd, env=env, cwd=output)
+    cmd = bt.esys_command(__file__, workers + 1, list(argv) + [
+        "--output", output, "--particles", os.path.join(output, "particles.txt")])
+    rc = subprocess.call(cmd, env=bt.esys_env(), cwd=output)
     if rc != 0:
         print(f"esysparticle exited with {rc}", file=sys.stderr)
         return 1
@@ -115,9 +112,9 @@ def launch(argv):
 
 def simulate(argv):
     """Runs inside esysparticle (MPI rank 0 = ESyS master)."""
-    from esys.lsm import (LsmMpi, RotSphere, BrittleBeamPrms, RotFrictionPrms, LinDampingPrms, RotDampingPrms,
+    from esys.lsm import (RotSphere, BrittleBeamPrms, RotFrictionPrms, LinDampingPrms, RotDampingPrms,
                           ParticleScalarFieldSaverPrms, InteractionScalarFieldSaverPrms, CheckPointPrms)
-    from esys.lsm.util import Vec3, BoundingBox
+    from esys.lsm.util import Vec3
     from esys.lsm.geometry import TaggedIdConnection
 
     args = parse_args(argv)
@@ -133,11 +130,7 @@ def simulate(argv):
     rmax = max(p[4] for p in particles)
     lo = [min(p[i + 1] for p in particles) - 4 * rmax for i in range(3)]
     hi = [max(p[i + 1] for p in particles) + 4 * rmax for i in range(3)]
-    sim = LsmMpi(numWorkerProcesses=args.dims[0] * args.dims[1] * args.dims[2], mpiDimList=args.dims)
-    sim.initNeighbourSearch(particleType="RotSphere", gridSpacing=2.5 * rmax, verletDist=0.05)
-    sim.setSpatialDomain(BoundingBox(Vec3(*lo), Vec3(*hi)))
-    sim.setTimeStepSize(args.dt)
-    sim.setNumTimeSteps(args.steps)
+    sim = bt.esys_simulation(args.dims, "RotSphere", 2.5 * rmax, 0.05, lo, hi, dt=args.dt, steps=args.steps)
     sim.createParticles([RotSphere(id=pid, posn=Vec3(x, y, z), radius=r, mass=4.0 / 3.0 * math.pi * r ** 3)
                          for (pid, x, y, z, r) in particles])
     sim.createConnections([TaggedIdConnection(a, b, 0) for (a, b) in bonds])
@@ -166,7 +159,7 @@ def simulate(argv):
 
 
 if __name__ == "__main__":
-    if os.environ.get(CHILD_ENV) == "1":
+    if bt.esys_child():
         simulate(sys.argv[1:])  # inside esysparticle: sys.exit would skip MPI_Finalize
     else:
         sys.exit(launch(sys.argv[1:]))

@@ -28,16 +28,14 @@ import argparse
 import json
 import math
 import os
-import shutil
-import subprocess
 import sys
 import time
 
-CHILD_ENV = "BASALT_ESYS_CHILD"
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, HERE)  # esysparticle's embedded interpreter does not add the script's folder
-
-from geofile import GeoError, read_geo  # noqa: E402
+# tools/ (esysparticle's embedded interpreter does not add the script's folder either)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+import basalt_tools as bt  # noqa: E402  (tools/basalt_tools.py)
+from basalt_tools import GeoError, read_geo  # noqa: E402
 
 BOX = (16.0, 16.0, 24.0)
 
@@ -58,9 +56,7 @@ def parse_args(argv):
     p.add_argument("--rmax", type=float, default=1.0)
     args = p.parse_args(argv)
     try:
-        dims = [int(v) for v in args.workers_dims.split(",")]
-        if len(dims) != 3 or min(dims) < 1:
-            raise ValueError
+        dims = bt.parse_dims(args.workers_dims)
     except ValueError:
         p.error(f"--workers-dims: expected three positive integers 'nx,ny,nz', got '{args.workers_dims}'")
     args.dims = dims
@@ -102,7 +98,7 @@ def generate_column(path, rmin, rmax):
 
 def launch(argv):
     args = parse_args(argv)
-    missing = [exe for exe in ("esysparticle", "mpirun") if shutil.which(exe) is None]
+    missing = bt.esys_missing()
     if missing:
         print(f"ESyS-Particle is not available: {', '.join(missing)} not on PATH "
               "(Debian package esys-particle). Nothing was run.", file=sys.stderr)
@@ -132,34 +128,21 @@ def launch(argv):
         print(f"error: --perturb: no particle with id {args.perturb_id} in {geometry}", file=sys.stderr)
         return 2
     workers = args.dims[0] * args.dims[1] * args.dims[2]
-    env = dict(os.environ, **{CHILD_ENV: "1"})
-    env.setdefault("OMPI_ALLOW_RUN_AS_ROOT", "1")
-    env.setdefault("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
-    env.setdefault("OMPI_MCA_rmaps_base_oversubscribe", "1")
     child_args = list(argv) + ["--geometry", os.path.abspath(geometry), "--output", output]
-    cmd = ["mpirun", "-np", str(workers + 1), "esysparticle", os.path.abspath(__file__)] + child_args
-    print("running:", " ".join(cmd), flush=True)
-    return subprocess.call(cmd, env=env, cwd=output)
+    return bt.esys_relaunch(__file__, workers + 1, child_args, cwd=output)
 
 
 def read_checkpoint_positions(prefix, step, workers):
     """id -> (x, y, z, r) from ESyS's checkpoint files PREFIX_t=STEP_W.txt (one per worker W >= 1)."""
-    parts = {}
-    for w in range(1, workers + 1):
-        with open(f"{prefix}_t={step}_{w}.txt") as f:
-            lines = f.read().split("\n")
-        n = int(lines[0])
-        for line in lines[1:1 + n]:
-            v = line.split()
-            parts[int(v[4])] = (float(v[0]), float(v[1]), float(v[2]), float(v[3]))
-    return parts
+    rows, _ = bt.read_esys_checkpoint(prefix, step, workers)
+    return {pid: (v[0], v[1], v[2], v[3]) for pid, v in rows.items()}
 
 
 def simulate(argv):
     """Runs inside esysparticle (MPI rank 0 = ESyS master)."""
-    from esys.lsm import (LsmMpi, RotSphere, RotFrictionPrms, NRotElasticWallPrms, GravityPrms,
+    from esys.lsm import (RotSphere, RotFrictionPrms, NRotElasticWallPrms, GravityPrms,
                           LinDampingPrms, RotDampingPrms, ParticleScalarFieldSaverPrms, CheckPointPrms)
-    from esys.lsm.util import Vec3, BoundingBox
+    from esys.lsm.util import Vec3
 
     args = parse_args(argv)
     os.chdir(args.output)
@@ -171,14 +154,11 @@ def simulate(argv):
     # Room for the runout towards +x (no wall at x = 16; the walls are frictionless, so the bottom layer
     # slides far): ESyS drops particles that leave its domain. With x <= 96, 47 particles were lost by
     # step 20,000; with x <= 256 none are (checked at the end).
-    dom_lo = Vec3(-2.0 * rmax, -2.0 * rmax, -2.0 * rmax)
-    dom_hi = Vec3(args.domain_x, BOX[1] + 2.0 * rmax, BOX[2] + 4.0 * rmax)
+    dom_lo = (-2.0 * rmax, -2.0 * rmax, -2.0 * rmax)
+    dom_hi = (args.domain_x, BOX[1] + 2.0 * rmax, BOX[2] + 4.0 * rmax)
 
-    sim = LsmMpi(numWorkerProcesses=workers, mpiDimList=args.dims)
-    sim.initNeighbourSearch(particleType="RotSphere", gridSpacing=grid, verletDist=args.verlet_dist)
-    sim.setSpatialDomain(BoundingBox(dom_lo, dom_hi))
-    sim.setTimeStepSize(args.dt)
-    sim.setNumTimeSteps(args.steps)
+    sim = bt.esys_simulation(args.dims, "RotSphere", grid, args.verlet_dist, dom_lo, dom_hi, dt=args.dt,
+                             steps=args.steps)
     spheres = []
     for (pid, x, y, z, r, tag) in particles:
         if pid == args.perturb_id:
@@ -232,7 +212,7 @@ def simulate(argv):
 
 
 if __name__ == "__main__":
-    if os.environ.get(CHILD_ENV) == "1":
+    if bt.esys_child():
         simulate(sys.argv[1:])
     else:
         sys.exit(launch(sys.argv[1:]))

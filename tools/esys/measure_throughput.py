@@ -18,6 +18,9 @@ import subprocess
 import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, ".."))
+import basalt_tools as bt  # noqa: E402  (tools/basalt_tools.py)
+
 ESYS = os.path.join(HERE, "wave_benchmark.py")
 LAMMPS = os.path.join(HERE, "..", "lammps", "wave_benchmark.sh")
 
@@ -44,9 +47,7 @@ def run_one(code, ranks, args, rundir):
 
 def main():
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    p.add_argument("--geometry", default=os.path.join(os.environ.get("BASALT_REFERENCE_DIR") or
-                                                     os.path.join(HERE, "..", "..", "tests", "data"),
-                                                     "cube1.geo"),
+    p.add_argument("--geometry", default=bt.reference_cube(),
                    help="default $BASALT_REFERENCE_DIR/cube1.geo (default tests/data of this checkout)")
     p.add_argument("--steps", type=int, default=2000)
     p.add_argument("--repeats", type=int, default=3)

@@ -24,7 +24,9 @@ import shutil
 import subprocess
 import sys
 
-CHILD_ENV = "BASALT_ESYS_CHILD"
+# tools/ (esysparticle's embedded interpreter does not add the script's folder either)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+import basalt_tools as bt  # noqa: E402  (tools/basalt_tools.py)
 DT = 1e-3
 K = 1000.0
 PI_WALL = 3.141592654  # ESyS's literal in EWallInteraction.hpp (not M_PI)
@@ -386,15 +388,12 @@ def build_model(c, alt):
 
 
 def run_esys(case, workdir):
-    from esys.lsm import (LsmMpi, RotSphere, NRotSphere, RotFrictionPrms, NRotFrictionPrms, NRotElasticWallPrms,
+    from esys.lsm import (RotSphere, NRotSphere, RotFrictionPrms, NRotFrictionPrms, NRotElasticWallPrms,
                           GravityPrms, LinDampingPrms, RotDampingPrms, ParticleScalarFieldSaverPrms, CheckPointPrms)
-    from esys.lsm.util import Vec3, BoundingBox
+    from esys.lsm.util import Vec3
     c = sphere_defs(case)
     os.chdir(workdir)
-    sim = LsmMpi(numWorkerProcesses=1, mpiDimList=[1, 1, 1])
-    sim.initNeighbourSearch(particleType=c["ptype"], gridSpacing=2.5, verletDist=0.2)
-    sim.setSpatialDomain(BoundingBox(Vec3(-20, -20, -20), Vec3(20, 20, 20)))
-    sim.setTimeStepSize(DT)
+    sim = bt.esys_simulation([1, 1, 1], c["ptype"], 2.5, 0.2, (-20, -20, -20), (20, 20, 20), dt=DT)
     for (pid, x, r, m, v, w) in c["parts"]:
         cls = RotSphere if c["ptype"] == "RotSphere" else NRotSphere
         sim.createParticle(cls(id=pid, posn=Vec3(*x), radius=r, mass=m))
@@ -436,14 +435,10 @@ def run_esys(case, workdir):
 
 
 def read_state(workdir, step):
-    with open(os.path.join(workdir, f"cp_t={step}_1.txt")) as f:
-        lines = [l.split() for l in f.read().split("\n") if l.strip()]
-    parts = {}
-    for words in lines[1:1 + int(lines[0][0])]:
-        v = [float(w) for w in words]
-        parts[int(v[4])] = {"x": v[0:3], "m": v[6], "v": v[13:16], "f": v[16:19],
-                            "q": v[22:26] if len(v) >= 29 else None, "w": v[26:29] if len(v) >= 29 else None}
-    return parts
+    rows, _ = bt.read_esys_checkpoint(os.path.join(workdir, "cp"), step)
+    return {pid: {"x": v[0:3], "m": v[6], "v": v[13:16], "f": v[16:19],
+                  "q": v[22:26] if len(v) >= 29 else None, "w": v[26:29] if len(v) >= 29 else None}
+            for pid, v in rows.items()}
 
 
 def deviation(c, workdir, alt, scales):
@@ -525,17 +520,14 @@ def main():
     p.add_argument("--workdir", default="esys_probe_granular")
     p.add_argument("--check-only", action="store_true", help="re-check existing ESyS output in --workdir")
     args = p.parse_args()
-    if os.environ.get(CHILD_ENV) == "1":
+    if bt.esys_child():
         run_esys(args.case, args.workdir)
         return 0
-    missing = [exe for exe in ("esysparticle", "mpirun") if shutil.which(exe) is None]
+    missing = bt.esys_missing()
     if missing and not args.check_only:
         print(f"ESyS-Particle is not available: {', '.join(missing)} not on PATH. Nothing was run.", file=sys.stderr)
         return 3
-    env = dict(os.environ, **{CHILD_ENV: "1"})
-    env.setdefault("OMPI_ALLOW_RUN_AS_ROOT", "1")
-    env.setdefault("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
-    env.setdefault("OMPI_MCA_rmaps_base_oversubscribe", "1")
+    env = bt.esys_env()
     failures = 0
     for case in ([args.case] if args.case else CASES):
         workdir = os.path.abspath(os.path.join(args.workdir, case))
@@ -543,8 +535,8 @@ def main():
         if not args.check_only:
             shutil.rmtree(workdir, ignore_errors=True)
             os.makedirs(workdir)
-            rc = subprocess.call(["mpirun", "-np", "2", "esysparticle", os.path.abspath(__file__), "--case", case,
-                                  "--workdir", workdir], env=env, cwd=workdir, stdout=subprocess.DEVNULL,
+            rc = subprocess.call(bt.esys_command(__file__, 2, ["--case", case,
+                                  "--workdir", workdir]), env=env, cwd=workdir, stdout=subprocess.DEVNULL,
                                  stderr=subprocess.DEVNULL)
             if rc != 0:
                 print(f"  FAIL esysparticle exited with {rc}")
@@ -556,7 +548,7 @@ def main():
 
 
 if __name__ == "__main__":
-    if os.environ.get(CHILD_ENV) == "1":
+    if bt.esys_child():
         main()  # inside esysparticle: sys.exit would skip MPI_Finalize
     else:
         sys.exit(main())

@@ -20,7 +20,9 @@ import shutil
 import subprocess
 import sys
 
-CHILD_ENV = "BASALT_ESYS_CHILD"
+# tools/ (esysparticle's embedded interpreter does not add the script's folder either)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+import basalt_tools as bt  # noqa: E402  (tools/basalt_tools.py)
 DT = 1e-3
 E, NU, TAN = 1000.0, 0.25, 1.0
 R1, R2 = 0.5, 0.4
@@ -46,15 +48,12 @@ def geometry(case):
 
 
 def run_esys(case, workdir):
-    from esys.lsm import LsmMpi, RotSphere, BrittleBeamPrms, CheckPointPrms
-    from esys.lsm.util import Vec3, BoundingBox
+    from esys.lsm import RotSphere, BrittleBeamPrms, CheckPointPrms
+    from esys.lsm.util import Vec3
     from esys.lsm.geometry import TaggedIdConnection
     parts, coh, steps = geometry(case)
     os.chdir(workdir)
-    sim = LsmMpi(numWorkerProcesses=1, mpiDimList=[1, 1, 1])
-    sim.initNeighbourSearch(particleType="RotSphere", gridSpacing=2.5, verletDist=0.2)
-    sim.setSpatialDomain(BoundingBox(Vec3(-20, -20, -20), Vec3(20, 20, 20)))
-    sim.setTimeStepSize(DT)
+    sim = bt.esys_simulation([1, 1, 1], "RotSphere", 2.5, 0.2, (-20, -20, -20), (20, 20, 20), dt=DT)
     for (pid, x, r, m, v, w) in parts:
         sim.createParticle(RotSphere(id=pid, posn=Vec3(*x), radius=r, mass=m))
     sim.createConnections([TaggedIdConnection(1, 2, 0)])
@@ -74,13 +73,8 @@ def run_esys(case, workdir):
 
 
 def read_state(workdir, step):
-    with open(os.path.join(workdir, f"cp_t={step}_1.txt")) as f:
-        lines = [l.split() for l in f.read().split("\n") if l.strip()]
-    out = {}
-    for words in lines[1:1 + int(lines[0][0])]:
-        v = [float(w) for w in words]
-        out[int(v[4])] = v[0:3] + v[13:16] + v[22:26] + v[26:29]
-    return out
+    rows, _ = bt.read_esys_checkpoint(os.path.join(workdir, "cp"), step)
+    return {pid: v[0:3] + v[13:16] + v[22:26] + v[26:29] for pid, v in rows.items()}
 
 
 def main():
@@ -89,24 +83,21 @@ def main():
     p.add_argument("--workdir", default="out/esys_probe_rotbond")
     p.add_argument("--output", default="docs/data/esys-rotbond")
     args = p.parse_args()
-    if os.environ.get(CHILD_ENV) == "1":
+    if bt.esys_child():
         run_esys(args.case, args.workdir)
         return 0
-    if shutil.which("esysparticle") is None or shutil.which("mpirun") is None:
+    if bt.esys_missing():
         print("ESyS-Particle is not available (esysparticle, mpirun). Nothing was run.", file=sys.stderr)
         return 3
-    env = dict(os.environ, **{CHILD_ENV: "1"})
-    env.setdefault("OMPI_ALLOW_RUN_AS_ROOT", "1")
-    env.setdefault("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
-    env.setdefault("OMPI_MCA_rmaps_base_oversubscribe", "1")
+    env = bt.esys_env()
     os.makedirs(args.output, exist_ok=True)
     failures = 0
     for case in ([args.case] if args.case else list(CASES)):
         workdir = os.path.abspath(os.path.join(args.workdir, case))
         shutil.rmtree(workdir, ignore_errors=True)
         os.makedirs(workdir)
-        rc = subprocess.call(["mpirun", "-np", "2", "esysparticle", os.path.abspath(__file__), "--case", case,
-                              "--workdir", workdir], env=env, cwd=workdir, stdout=subprocess.DEVNULL,
+        rc = subprocess.call(bt.esys_command(__file__, 2, ["--case", case,
+                              "--workdir", workdir]), env=env, cwd=workdir, stdout=subprocess.DEVNULL,
                              stderr=subprocess.DEVNULL)
         if rc != 0:
             print(f"{case}: FAIL esysparticle exited with {rc}")
@@ -124,7 +115,7 @@ def main():
 
 
 if __name__ == "__main__":
-    if os.environ.get(CHILD_ENV) == "1":
+    if bt.esys_child():
         main()  # inside esysparticle: sys.exit would skip MPI_Finalize
     else:
         sys.exit(main())

@@ -20,7 +20,9 @@ import shutil
 import subprocess
 import sys
 
-CHILD_ENV = "BASALT_ESYS_CHILD"
+# tools/ (esysparticle's embedded interpreter does not add the script's folder either)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+import basalt_tools as bt  # noqa: E402  (tools/basalt_tools.py)
 DT = 1e-3
 E, NU = 1000.0, 0.25
 R1, R2 = 0.5, 0.4
@@ -40,16 +42,13 @@ CASES = {
 
 
 def run_case(case, workdir):
-    from esys.lsm import (LsmMpi, RotSphere, BrittleBeamPrms, FrictionPrms, NRotElasticWallPrms, CheckPointPrms,
+    from esys.lsm import (RotSphere, BrittleBeamPrms, FrictionPrms, NRotElasticWallPrms, CheckPointPrms,
                           Runnable)
-    from esys.lsm.util import Vec3, BoundingBox
+    from esys.lsm.util import Vec3
     from esys.lsm.geometry import TaggedIdConnection
 
     os.chdir(workdir)
-    sim = LsmMpi(numWorkerProcesses=1, mpiDimList=[1, 1, 1])
-    sim.initNeighbourSearch(particleType="RotSphere", gridSpacing=2.5, verletDist=VERLET)
-    sim.setSpatialDomain(BoundingBox(Vec3(-20, -20, -20), Vec3(20, 20, 20)))
-    sim.setTimeStepSize(DT)
+    sim = bt.esys_simulation([1, 1, 1], "RotSphere", 2.5, VERLET, (-20, -20, -20), (20, 20, 20), dt=DT)
     steps = STEPS
     if case.startswith("break"):
         sim.createParticle(RotSphere(id=1, posn=Vec3(0, 0, 0), radius=R1, mass=HEAVY))
@@ -95,13 +94,8 @@ def run_case(case, workdir):
 
 
 def read_state(workdir, step):
-    with open(os.path.join(workdir, f"cp_t={step}_1.txt")) as f:
-        lines = [l.split() for l in f.read().split("\n") if l.strip()]
-    out = {}
-    for words in lines[1:1 + int(lines[0][0])]:
-        v = [float(w) for w in words]
-        out[int(v[4])] = {"x": v[0:3], "v": v[13:16], "f": v[16:19]}
-    return out
+    rows, _ = bt.read_esys_checkpoint(os.path.join(workdir, "cp"), step)
+    return {pid: {"x": v[0:3], "v": v[13:16], "f": v[16:19]} for pid, v in rows.items()}
 
 
 class Checker:
@@ -183,25 +177,22 @@ def main():
     p.add_argument("--case", choices=sorted(CASES))
     p.add_argument("--workdir", default="out/esys_probe_ucs")
     args = p.parse_args()
-    if os.environ.get(CHILD_ENV) == "1":
+    if bt.esys_child():
         run_case(args.case, args.workdir)
         return 0
-    missing = [exe for exe in ("esysparticle", "mpirun") if shutil.which(exe) is None]
+    missing = bt.esys_missing()
     if missing:
         print(f"ESyS-Particle is not available: {', '.join(missing)} not on PATH. Nothing was run.", file=sys.stderr)
         return 3
-    env = dict(os.environ, **{CHILD_ENV: "1"})
-    env.setdefault("OMPI_ALLOW_RUN_AS_ROOT", "1")
-    env.setdefault("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
-    env.setdefault("OMPI_MCA_rmaps_base_oversubscribe", "1")
+    env = bt.esys_env()
     c = Checker()
     for case in ([args.case] if args.case else CASES):
         workdir = os.path.abspath(os.path.join(args.workdir, case))
         shutil.rmtree(workdir, ignore_errors=True)
         os.makedirs(workdir)
         print(f"{case}: {CASES[case]}", flush=True)
-        rc = subprocess.call(["mpirun", "-np", "2", "esysparticle", os.path.abspath(__file__), "--case", case,
-                              "--workdir", workdir], env=env, cwd=workdir, stdout=subprocess.DEVNULL,
+        rc = subprocess.call(bt.esys_command(__file__, 2, ["--case", case,
+                              "--workdir", workdir]), env=env, cwd=workdir, stdout=subprocess.DEVNULL,
                              stderr=subprocess.DEVNULL)
         if rc != 0:
             print(f"  FAIL esysparticle exited with {rc}")
@@ -213,7 +204,7 @@ def main():
 
 
 if __name__ == "__main__":
-    if os.environ.get(CHILD_ENV) == "1":
+    if bt.esys_child():
         main()  # inside esysparticle: sys.exit would skip MPI_Finalize
     else:
         sys.exit(main())

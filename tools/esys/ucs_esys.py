@@ -33,16 +33,14 @@ import argparse
 import json
 import math
 import os
-import shutil
-import subprocess
 import sys
 import time
 
-CHILD_ENV = "BASALT_ESYS_CHILD"
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, HERE)  # esysparticle's embedded interpreter does not add the script's folder
-
-from geofile import GeoError, read_geo  # noqa: E402
+# tools/ (esysparticle's embedded interpreter does not add the script's folder either)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+import basalt_tools as bt  # noqa: E402  (tools/basalt_tools.py)
+from basalt_tools import GeoError, read_geo  # noqa: E402
 
 BOX = (10.0, 10.0, 20.0)
 
@@ -66,9 +64,7 @@ def parse_args(argv):
     p.add_argument("--rmax", type=float, default=1.0)
     args = p.parse_args(argv)
     try:
-        dims = [int(v) for v in args.workers_dims.split(",")]
-        if len(dims) != 3 or min(dims) < 1:
-            raise ValueError
+        dims = bt.parse_dims(args.workers_dims)
     except ValueError:
         p.error(f"--workers-dims: expected three positive integers 'nx,ny,nz', got '{args.workers_dims}'")
     args.dims = dims
@@ -115,7 +111,7 @@ def launch(argv):
         rows = collect(args.output, args.every)
         print(f"{os.path.join(args.output, 'ucs.csv')}: {rows} rows (steps 0..{(rows - 1) * args.every})")
         return 0
-    missing = [exe for exe in ("esysparticle", "mpirun") if shutil.which(exe) is None]
+    missing = bt.esys_missing()
     if missing:
         print(f"ESyS-Particle is not available: {', '.join(missing)} not on PATH "
               "(Debian package esys-particle). Nothing was run.", file=sys.stderr)
@@ -144,14 +140,8 @@ def launch(argv):
         print(f"error: --perturb: no particle with id {args.perturb_id} in {geometry}", file=sys.stderr)
         return 2
     workers = args.dims[0] * args.dims[1] * args.dims[2]
-    env = dict(os.environ, **{CHILD_ENV: "1"})
-    env.setdefault("OMPI_ALLOW_RUN_AS_ROOT", "1")
-    env.setdefault("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
-    env.setdefault("OMPI_MCA_rmaps_base_oversubscribe", "1")
     child_args = list(argv) + ["--geometry", os.path.abspath(geometry), "--output", output]
-    cmd = ["mpirun", "-np", str(workers + 1), "esysparticle", os.path.abspath(__file__)] + child_args
-    print("running:", " ".join(cmd), flush=True)
-    return subprocess.call(cmd, env=env, cwd=output)
+    return bt.esys_relaunch(__file__, workers + 1, child_args, cwd=output)
 
 
 def read_sum(path):
@@ -183,10 +173,10 @@ def collect(output, every):
 
 def simulate(argv):
     """Runs inside esysparticle (MPI rank 0 = ESyS master)."""
-    from esys.lsm import (LsmMpi, RotSphere, BrittleBeamPrms, FrictionPrms, NRotElasticWallPrms,
+    from esys.lsm import (RotSphere, BrittleBeamPrms, FrictionPrms, NRotElasticWallPrms,
                           LinDampingPrms, RotDampingPrms, ParticleScalarFieldSaverPrms,
                           InteractionScalarFieldSaverPrms, WallVectorFieldSaverPrms, Runnable)
-    from esys.lsm.util import Vec3, BoundingBox
+    from esys.lsm.util import Vec3
     from esys.lsm.geometry import TaggedIdConnection
 
     args = parse_args(argv)
@@ -195,12 +185,8 @@ def simulate(argv):
     _, _, particles, bonds = read_geo(args.geometry)
     rmax = max(p[4] for p in particles)
     workers = args.dims[0] * args.dims[1] * args.dims[2]
-    sim = LsmMpi(numWorkerProcesses=workers, mpiDimList=args.dims)
-    sim.initNeighbourSearch(particleType="RotSphere", gridSpacing=2.5 * rmax, verletDist=args.verlet_dist)
-    sim.setSpatialDomain(BoundingBox(Vec3(-2.0 * rmax, -2.0 * rmax, -2.0 * rmax),
-                                     Vec3(BOX[0] + 2.0 * rmax, BOX[1] + 2.0 * rmax, BOX[2] + 2.0 * rmax)))
-    sim.setTimeStepSize(args.dt)
-    sim.setNumTimeSteps(args.steps)
+    sim = bt.esys_simulation(args.dims, "RotSphere", 2.5 * rmax, args.verlet_dist, (-2.0 * rmax, -2.0 * rmax, -2.0 * rmax),
+                             (BOX[0] + 2.0 * rmax, BOX[1] + 2.0 * rmax, BOX[2] + 2.0 * rmax), dt=args.dt, steps=args.steps)
     spheres = []
     for (pid, x, y, z, r, tag) in particles:
         if pid == args.perturb_id:
@@ -268,7 +254,7 @@ def simulate(argv):
 
 
 if __name__ == "__main__":
-    if os.environ.get(CHILD_ENV) == "1":
+    if bt.esys_child():
         simulate(sys.argv[1:])
     else:
         sys.exit(launch(sys.argv[1:]))

@@ -24,19 +24,18 @@ import argparse
 import json
 import math
 import os
-import shutil
 import subprocess
 import sys
 import time
 
-CHILD_ENV = "BASALT_ESYS_CHILD"
 HERE = os.path.dirname(os.path.abspath(__file__))
-# The paper's reference cube: BASALT_REFERENCE_DIR (as for the tests), default tests/data of this checkout.
-DEFAULT_GEOMETRY = os.path.join(os.environ.get("BASALT_REFERENCE_DIR") or os.path.join(HERE, "..", "..", "tests", "data"),
-                                "cube1.geo")
-sys.path.insert(0, HERE)  # esysparticle's embedded interpreter does not add the script's folder
+# tools/ (esysparticle's embedded interpreter does not add the script's folder either)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+import basalt_tools as bt  # noqa: E402  (tools/basalt_tools.py)
+from basalt_tools import GeoError, read_geo  # noqa: E402
 
-from geofile import GeoError, read_geo  # noqa: E402
+# The paper's reference cube: BASALT_REFERENCE_DIR (as for the tests), default tests/data of this checkout.
+DEFAULT_GEOMETRY = bt.reference_cube()
 
 
 def wall_position(t, amplitude, period):
@@ -64,9 +63,7 @@ def parse_args(argv):
                    help="if --geometry is missing, generate a GenGeo cube of this side there first")
     args = p.parse_args(argv)
     try:
-        dims = [int(v) for v in args.workers_dims.split(",")]
-        if len(dims) != 3 or min(dims) < 1:
-            raise ValueError
+        dims = bt.parse_dims(args.workers_dims)
     except ValueError:
         p.error(f"--workers-dims: expected three positive integers 'nx,ny,nz', got '{args.workers_dims}'")
     args.dims = dims
@@ -82,13 +79,13 @@ def parse_args(argv):
 def launch(argv):
     """Checks the installation and the input, then re-runs this script under mpirun + esysparticle."""
     args = parse_args(argv)
-    missing = [exe for exe in ("esysparticle", "mpirun") if shutil.which(exe) is None]
+    missing = bt.esys_missing()
     if missing:
         print(f"ESyS-Particle is not available: {', '.join(missing)} not on PATH "
               "(Debian package esys-particle). Nothing was run.", file=sys.stderr)
         return 3
     if not os.path.exists(args.geometry) and args.generate_side > 0:
-        gen = os.path.join(HERE, "gengeo_cube.py")
+        gen = os.path.join(HERE, "..", "bench", "gengeo_cube.py")
         print(f"{args.geometry} missing: generating a {args.generate_side} mm GenGeo cube (slow)", flush=True)
         rc = subprocess.call(["/usr/bin/python3", gen, "--side", str(args.generate_side), "--output", args.geometry])
         if rc != 0:
@@ -107,24 +104,17 @@ def launch(argv):
         print(f"error: output directory {args.output}: {e.strerror}", file=sys.stderr)
         return 2
     workers = args.dims[0] * args.dims[1] * args.dims[2]
-    env = dict(os.environ)
-    env[CHILD_ENV] = "1"
-    env.setdefault("OMPI_ALLOW_RUN_AS_ROOT", "1")
-    env.setdefault("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
-    env.setdefault("OMPI_MCA_rmaps_base_oversubscribe", "1")
     # Workers write checkpoints relative to their own working directory: start every rank in --output.
     output = os.path.abspath(args.output)
     child_args = list(argv) + ["--geometry", os.path.abspath(args.geometry), "--output", output]
-    cmd = ["mpirun", "-np", str(workers + 1), "esysparticle", os.path.abspath(__file__)] + child_args
-    print("running:", " ".join(cmd), flush=True)
-    return subprocess.call(cmd, env=env, cwd=output)
+    return bt.esys_relaunch(__file__, workers + 1, child_args, cwd=output)
 
 
 def simulate(argv):
     """Runs inside esysparticle (MPI rank 0 = ESyS master)."""
-    from esys.lsm import (LsmMpi, NRotSphere, NRotBondPrms, NRotElasticPrms, NRotElasticWallPrms,
+    from esys.lsm import (NRotSphere, NRotBondPrms, NRotElasticPrms, NRotElasticWallPrms,
                           ParticleScalarFieldSaverPrms, CheckPointPrms, Runnable)
-    from esys.lsm.util import Vec3, BoundingBox
+    from esys.lsm.util import Vec3
     from esys.lsm.geometry import TaggedIdConnection
 
     args = parse_args(argv)
@@ -143,11 +133,8 @@ def simulate(argv):
     grid = args.grid_spacing if args.grid_spacing > 0 else 2.5 * rmax
     workers = args.dims[0] * args.dims[1] * args.dims[2]
 
-    sim = LsmMpi(numWorkerProcesses=workers, mpiDimList=args.dims)
-    sim.initNeighbourSearch(particleType="NRotSphere", gridSpacing=grid, verletDist=args.verlet_dist)
-    sim.setSpatialDomain(BoundingBox(Vec3(*dom_lo), Vec3(*dom_hi)))
-    sim.setTimeStepSize(args.dt)
-    sim.setNumTimeSteps(args.steps)
+    sim = bt.esys_simulation(args.dims, "NRotSphere", grid, args.verlet_dist, dom_lo, dom_hi, dt=args.dt,
+                             steps=args.steps)
     sim.createParticles([NRotSphere(id=pid, posn=Vec3(x, y, z), radius=r, mass=4.0 / 3.0 * math.pi * r ** 3)
                          for (pid, x, y, z, r, tag) in particles])
     sim.createConnections([TaggedIdConnection(a, b, 0) for (a, b, t) in bonds])
@@ -220,7 +207,7 @@ def simulate(argv):
 
 
 if __name__ == "__main__":
-    if os.environ.get(CHILD_ENV) == "1":
+    if bt.esys_child():
         simulate(sys.argv[1:])
     else:
         sys.exit(launch(sys.argv[1:]))

@@ -32,12 +32,15 @@ import sys
 
 import numpy as np
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+import basalt_tools as bt  # noqa: E402  (tools/basalt_tools.py)
+
+ROOT = bt.ROOT
 DT = 0.0025  # must match scenes/column-collapse.toml run.dt
 
 
 def bindir(args):
-    for b in (args.bin, os.path.join(ROOT, "build/bin")):
+    for b in (args.bin, bt.bin_dir()):
         if b and os.path.exists(os.path.join(b, "basalt-run")):
             return b
     sys.exit("basalt-run not found: give --bin")
@@ -51,9 +54,7 @@ def front(x, gap=1.0):
 
 
 def measure(ckpt):
-    import h5py
-    with h5py.File(ckpt, "r") as f:
-        x = f["particles/position"][:, 0]
+    x = bt.read_h5(ckpt, "particles/position")[0][:, 0]
     return dict(front=front(x), p95=np.percentile(x, 95), p99=np.percentile(x, 99), max=x.max(), n=len(x))
 
 
@@ -77,10 +78,7 @@ def run_one(a, args, b):
                        stdout=open(os.path.join(d, "log.txt"), "w"), stderr=subprocess.STDOUT)
     m = measure(last)
     m34 = measure(os.path.join(out, f"ckpt_{3 * steps // 4:06d}.h5"))
-    ke = []
-    with open(os.path.join(out, "fields.csv")) as f:
-        for row in csv.DictReader(f):
-            ke.append(float(row["kinetic_energy"]))
+    ke = bt.read_fields(out)["kinetic_energy"]
     return dict(a=a, L=L, W=W, H=H, n=m["n"], T=T, steps=steps, front=m["front"], front_3T4=m34["front"],
                 p95=m["p95"], p99=m["p99"], max=m["max"], ke_end_over_peak=ke[-1] / max(ke),
                 norm_runout=(m["front"] - L) / L)

@@ -30,9 +30,9 @@ import os
 import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, "..", "esys"))
+sys.path.insert(0, os.path.join(HERE, ".."))
 
-from geofile import GeoError, read_geo  # noqa: E402
+from basalt_tools import GeoError, read_geo  # noqa: E402  (tools/basalt_tools.py)
 
 TABLES_PER_FILE = 100  # LAMMPS scans a table file from its start for every bond_coeff
 

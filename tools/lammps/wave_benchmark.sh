@@ -84,7 +84,7 @@ done
 
 if [[ ! -e "$geometry" && "$generate_side" != 0 ]]; then
   echo "$geometry missing: generating a ${generate_side} mm GenGeo cube (slow)"
-  /usr/bin/python3 "$here/../esys/gengeo_cube.py" --side "$generate_side" --output "$geometry"
+  /usr/bin/python3 "$here/../bench/gengeo_cube.py" --side "$generate_side" --output "$geometry"
 fi
 mkdir -p "$output" || { echo "error: cannot create output directory $output" >&2; exit 2; }
 output="$(cd "$output" && pwd)"

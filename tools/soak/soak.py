@@ -25,9 +25,12 @@ import sys
 import time
 from pathlib import Path
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+import basalt_tools as bt  # noqa: E402  (tools/basalt_tools.py)
+
 
 def mpirun(np_total):
-    return ["mpirun", "-np", str(np_total)] if np_total > 1 else []
+    return bt.mpirun(np_total) if np_total > 1 else []
 
 
 def newest_complete(out: Path):
@@ -83,7 +86,7 @@ def main():
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--work", default="soak-work")
     a = ap.parse_args()
-    exe = str(Path(a.build) / "bin" / "basalt-run")
+    exe = bt.binary("basalt-run", build=a.build)
     work = Path(a.work)
     shutil.rmtree(work, ignore_errors=True)
     work.mkdir(parents=True)

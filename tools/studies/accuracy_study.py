@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Speed against accuracy on the wave benchmark (issue 13; results in docs/accuracy.md).
 
-    /usr/bin/python3 tools/bench/accuracy_study.py --build build --out docs/accuracy.md \\
+    /usr/bin/python3 tools/studies/accuracy_study.py --build build --out docs/accuracy.md \\
         --plot docs/img/accuracy.png [--quick]
 
 Knobs: precision (double, float) x run.dt_fraction (0.02 ... 0.9, the stability limit being ~0.95 with
@@ -27,7 +27,6 @@ bound on the packing's speed), rho = total mass / V.
 Runs are interleaved (both precisions and integrators at one fraction run one after the other).
 """
 import argparse
-import csv
 import math
 import os
 import re
@@ -37,7 +36,10 @@ import sys
 import tempfile
 import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+import basalt_tools as bt  # noqa: E402  (tools/basalt_tools.py)
+
+ROOT = bt.ROOT
 PULSE_AMPLITUDE = 0.1  # mm/ms, scenes/wave.toml
 PULSE_END = 0.5        # ms: half of the period 1 ms
 CLOSED_FROM = 0.6      # ms: the wall is at rest from 0.5 ms on
@@ -45,29 +47,11 @@ HEIGHT = 15.0          # mm
 
 
 def read_geo(path):
-    """Particles (x, y, z, r) and bonds (i, j) of an ESyS .geo file (LSMGeometry 1.2)."""
-    parts, bonds = [], []
-    with open(path) as f:
-        lines = f.read().split("\n")
-    k = 0
-    while not lines[k].startswith("BeginParticles"):
-        k += 1
-    k += 2
-    n = int(lines[k])
-    ids = {}
-    for line in lines[k + 1:k + 1 + n]:
-        v = line.split()
-        ids[int(v[4])] = len(parts)
-        parts.append((float(v[0]), float(v[1]), float(v[2]), float(v[3])))
-    k += 1 + n
-    while k < len(lines) and not lines[k].startswith("BeginConnect"):
-        k += 1
-    if k < len(lines):
-        nb = int(lines[k + 1])
-        for line in lines[k + 2:k + 2 + nb]:
-            v = line.split()
-            bonds.append((ids[int(v[0])], ids[int(v[1])]))
-    return parts, bonds
+    """Particles (x, y, z, r) and bonds (i, j: indices into the particles) of an ESyS .geo file."""
+    _, _, particles, geo_bonds = bt.read_geo(path)
+    index = {p[0]: k for k, p in enumerate(particles)}
+    parts = [(x, y, z, r) for (_, x, y, z, r, _) in particles]
+    return parts, [(index[a], index[b]) for (a, b, _) in geo_bonds]
 
 
 def affine_p_wave_speed(path, stiffness=1000.0, density=1.0):
@@ -107,25 +91,15 @@ def basalt_run(build, work, tag, geometry, prec, frac, integ, skin, sim_time, dt
     with open(scene, "w") as f:
         f.write(scene_text(geometry, frac, integ, skin, every, top_z))
     out = os.path.join(work, tag)
-    cmd = ["/usr/bin/time", "-v", os.path.join(build, "bin", "basalt-run"), scene, "--steps", str(steps),
-           "--output", out, "--precision", prec, "--fields-every", str(every)]
+    cmd = bt.basalt_run_command(bt.binary("basalt-run", build=build), scene, "--steps", steps, "--output", out,
+                                "--precision", prec, "--fields-every", every, timed=True)
     p = subprocess.run(cmd, capture_output=True, text=True)
     if p.returncode != 0:
         sys.exit(f"failed: {' '.join(cmd)}\n{p.stdout[-2000:]}\n{p.stderr[-2000:]}")
-    cpu = float(re.search(r"cpu time of the loop: ([0-9.]+) s", p.stdout).group(1))
-    n = int(re.search(r"basalt-run [^:]*: ([0-9]+) particles", p.stdout).group(1))
-    dt = float(re.search(r"steps of dt = ([0-9.eE+-]+)", p.stdout).group(1))
-    arrays = float(re.search(r"\(([0-9.]+) bytes per particle\)", p.stdout).group(1))
-    rss = int(re.search(r"Maximum resident set size \(kbytes\): ([0-9]+)", p.stderr).group(1))
-    cols = {}
-    with open(os.path.join(out, "fields.csv")) as f:
-        r = csv.reader(f)
-        header = next(r)
-        for name in header:
-            cols[name] = []
-        for row in r:
-            for name, v in zip(header, row):
-                cols[name].append(float(v) if v not in ("", "nan") else float("nan"))
+    x = bt.parse_run(p.stdout)
+    cpu, n, dt, arrays = x["cpu_s"], x["particles"], x["dt"], float(x["bytes_per_particle"])
+    rss = bt.parse_time_v(p.stderr)["max_rss_kb"]
+    cols = bt.read_fields(out)
     shutil.rmtree(out, ignore_errors=True)
     return {"prec": prec, "frac": frac, "integ": integ, "skin": skin, "steps": steps, "dt": dt, "n": n,
             "cpu": cpu, "rate": n * steps / cpu if cpu > 0 else float("nan"), "arrays": arrays, "rss": rss,
@@ -190,12 +164,12 @@ def fmt(x, spec=".2g"):
 
 
 def probe(build, work, geometry):
-    cmd = [os.path.join(build, "bin", "basalt-run"), os.path.join(ROOT, "scenes", "wave.toml"), "--geometry",
+    cmd = [bt.binary("basalt-run", build=build), os.path.join(ROOT, "scenes", "wave.toml"), "--geometry",
            geometry, "--steps", "0", "--output", os.path.join(work, "probe")]
     p = subprocess.run(cmd, capture_output=True, text=True)
     if p.returncode != 0:
         sys.exit(f"failed: {' '.join(cmd)}\n{p.stderr}")
-    return float(re.search(r"critical step: ([0-9.eE+-]+)", p.stdout).group(1))
+    return bt.parse_run(p.stdout)["critical_step"]
 
 
 def pareto(runs):
@@ -217,8 +191,7 @@ def main():
     ap.add_argument("--plot", default="", help="PNG: error against speed, one curve per precision")
     a = ap.parse_args()
     build = os.path.abspath(a.build)
-    ref_dir = os.environ.get("BASALT_REFERENCE_DIR", os.path.join(ROOT, "tests", "data"))
-    cube1 = os.path.join(ref_dir, "cube1.geo")
+    cube1 = bt.reference_cube()
     sim_time = a.time or (1.0 if a.quick else 1.5)
     fracs = [0.05, 0.2, 0.5, 0.9] if a.quick else [0.02, 0.05, 0.1, 0.2, 0.35, 0.5, 0.7, 0.9]
     skins = [(0.05, 0.2), (0.3, 0.2)] if a.quick else [(0.05, 0.1), (0.2, 0.1), (0.4, 0.1), (0.05, 0.5),
@@ -266,7 +239,7 @@ def main():
     geos = [("cube1.geo (GenGeo)", cube1)]
     for rm in rmins:
         g = os.path.join(work, f"cube-r{rm}.geo")
-        subprocess.run([os.path.join(build, "bin", "basalt-pack"), "box", "--size", "15,15,15", "--rmin", str(rm),
+        subprocess.run([bt.binary("basalt-pack", build=build), "box", "--size", "15,15,15", "--rmin", str(rm),
                         "--rmax", str(5 * rm), "--seed", "7", "-o", g], check=True, capture_output=True)
         geos.append((f"basalt-pack rmin {rm}", g))
     for name, g in geos:
@@ -327,13 +300,13 @@ def report(a, runs, skin_runs, ref, res, dt_c, sim_time, n1, top_z, elapsed):
     L = ["# Speed against accuracy: the measured trade-off", "",
          "Issue 13's study. Rerun (about " + f"{elapsed / 60:.0f}" + " min on the shared 2-core machine; `--quick` "
          "takes a few minutes):", "",
-         "    /usr/bin/python3 tools/bench/accuracy_study.py --build build --out docs/accuracy.md \\",
+         "    /usr/bin/python3 tools/studies/accuracy_study.py --build build --out docs/accuracy.md \\",
          "        --plot docs/img/accuracy.png" + (" --quick" if a.quick else ""), "",
          f"Wave benchmark (scenes/wave.toml) on cube1.geo ({n1:,} particles), 1 rank, {sim_time} ms simulated "
          f"(the pulse, its arrival at the top and {sim_time - 0.6:.1f} ms of the closed system after it). "
          f"Critical step dt_c = {dt_c} ms. Reference: double, velocity Verlet, dt_fraction 0.01 "
          f"({ref['steps']:,} steps), wave arrival {ref['arrival']:.4f} ms, drift {ref['drift']:.1g}. "
-         "Error measures and method: the docstring of tools/bench/accuracy_study.py. Speed is particle-steps "
+         "Error measures and method: the docstring of tools/studies/accuracy_study.py. Speed is particle-steps "
          "per second of loop CPU time (the machine is shared: wall time is inflated by other jobs; CPU time "
          "still varies by some 10-20 % with the load, so only differences larger than that mean anything); "
          "cost = CPU seconds per simulated ms per million particles = 1e6 / (rate x dt).", "",

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Measures the largest stable time step of a scene + geometry by bisection with basalt-run.
 
-    tools/bench/stability_limit.py --build build --scene scenes/wave.toml \\
+    tools/studies/stability_limit.py --build build --scene scenes/wave.toml \\
         --geometry $BASALT_REFERENCE_DIR/cube1.geo [--steps 2000] [--np 1] [--precision double]
 
 Each trial runs the scene with run.dt replaced (and --force-dt) for --steps steps, saving the kinetic
@@ -12,12 +12,14 @@ by the blow-up check or the energy guard (exit status 1) or show the growth. The
 narrower than --rtol. Prints the estimate, the measured limit and their ratio (docs/stability.md).
 """
 import argparse
-import csv
 import os
 import re
 import subprocess
 import sys
 import tempfile
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+import basalt_tools as bt  # noqa: E402  (tools/basalt_tools.py)
 
 
 def scene_with_dt(text, dt):
@@ -45,27 +47,16 @@ def run(args, dt, work, tag):
     with open(scene, "w") as f:
         f.write(text)
     out = os.path.join(work, f"out_{tag}")
-    cmd = []
-    if args.np > 1:
-        cmd = ["mpiexec", "-n", str(args.np)]
-    cmd += [os.path.join(args.build, "bin", "basalt-run"), scene, "--geometry", args.geometry,
-            "--steps", str(args.steps), "--output", out, "--quiet", "--force-dt", "--fields-every", "1",
-            "--precision", args.precision]
+    cmd = bt.basalt_run_command(bt.binary("basalt-run", build=args.build), scene, "--geometry", args.geometry,
+                                "--steps", args.steps, "--output", out, "--quiet", "--force-dt", "--fields-every", "1",
+                                "--precision", args.precision, np=args.np, launcher="mpiexec", flag="-n")
     p = subprocess.run(cmd, capture_output=True, text=True)
-    m = re.search(r"critical step: ([0-9.eE+-]+)", p.stdout)
-    estimate = float(m.group(1)) if m else None
+    estimate = bt.parse_run(p.stdout).get("critical_step")
     ke = []
     fields = os.path.join(out, "fields.csv")
     if os.path.exists(fields):
-        with open(fields) as f:
-            r = csv.reader(f)
-            header = next(r)
-            col = header.index("kinetic_energy") if "kinetic_energy" in header else 2
-            for row in r:
-                try:
-                    ke.append(float(row[col]))
-                except (ValueError, IndexError):
-                    ke.append(float("nan"))
+        cols = bt.read_fields(fields)
+        ke = cols["kinetic_energy"] if "kinetic_energy" in cols else cols[list(cols)[2]]
     err = p.stderr.strip().splitlines()[-1] if p.returncode != 0 and p.stderr.strip() else ""
     return p.returncode, estimate, ke, err
 

@@ -2,19 +2,24 @@
 """Kinetic-energy error of the wave scene when every coordinate (and the wall) is shifted by D, in double
 and in float, against the unshifted double run (docs/stability.md, "Coordinates far from the origin").
 
-    /usr/bin/python3 tools/bench/offset_precision.py --build build --geometry $BASALT_REFERENCE_DIR/cube1.geo \
+    /usr/bin/python3 tools/studies/offset_precision.py --build build --geometry $BASALT_REFERENCE_DIR/cube1.geo \
         [--steps 2000] [--work offset-work]
 
 Prints one row per (precision, D): L2 and max relative KE error, or basalt-run's last error line when it
 refuses or stops the run.
 """
 import argparse
+import os
 import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+import basalt_tools as bt  # noqa: E402  (tools/basalt_tools.py)
+
+ROOT = Path(bt.ROOT)
 
 
 def shifted_geo(lines, d, out):
@@ -35,12 +40,12 @@ def run(a, work, lines, d, precision):
     shifted_geo(lines, d, g)
     scene = (ROOT / "scenes" / "wave.toml").read_text()
     s.write_text(scene.replace("point = [0.0, 0.0, 0.0]", f"point = [{d:.17g}, {d:.17g}, {d:.17g}]"))
-    r = subprocess.run([str(Path(a.build) / "bin" / "basalt-run"), str(s), "--geometry", str(g), "--steps",
+    r = subprocess.run([bt.binary("basalt-run", build=a.build), str(s), "--geometry", str(g), "--steps",
                         str(a.steps), "--output", str(o), "--quiet", "--precision", precision],
                        capture_output=True, text=True)
     if r.returncode:
         return None, r.stderr.strip().split("\n")[-1][:160]
-    return np.genfromtxt(o / "fields.csv", delimiter=",", names=True)["kinetic_energy"], ""
+    return np.array(bt.read_fields(o)["kinetic_energy"]), ""
 
 
 def main():

@@ -2,7 +2,7 @@
 """Speed, memory and accuracy of run.precision = "mixed" against double and float (issue 13; results in
 docs/stability.md, "Mixed precision", and docs/accuracy.md).
 
-    /usr/bin/python3 tools/bench/mixed_precision.py --build build --work mixed-work [--repeats 3] [--steps 2000]
+    /usr/bin/python3 tools/studies/mixed_precision.py --build build --work mixed-work [--repeats 3] [--steps 2000]
 
 Cases: the wave scene (scenes/wave.toml) on the 15 mm cube ($BASALT_REFERENCE_DIR/cube1.geo, 8,948
 particles) and on the 30 mm cube (cube1 tiled 2x2x2 by tools/bench/wave_tile_geo.py, 71,584), 1 rank.
@@ -12,17 +12,20 @@ the 12 B/particle of remainders buy). Each repeat runs every setting once, one a
 time ("cpu time of the loop", CPU rather than wall time: the machine is shared), median and range over the
 repeats; the bytes per particle of the particle fields basalt-run prints ("fields: ... = N B/particle");
 the KE L2 relative error against the double run of the same case (rows where double's KE exceeds 1 % of
-its peak, as tools/bench/accuracy_study.py). With --fractions, the accuracy runs repeat at
+its peak, as tools/studies/accuracy_study.py). With --fractions, the accuracy runs repeat at
 run.dt_fraction = 0.02 (where float loses small increments v dt) and 0.5.
 """
 import argparse
 import os
-import re
 import statistics
 import subprocess
+import sys
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+import basalt_tools as bt  # noqa: E402  (tools/basalt_tools.py)
+
+ROOT = Path(bt.ROOT)
 SETTINGS = [("double", "double", {}), ("float", "float", {}), ("mixed", "mixed", {}),
             ("mixed, no compensation", "mixed", {"BASALT_MIXED_COMPENSATION": "0"})]
 
@@ -34,18 +37,14 @@ def run(build, work, geo, tag, precision, env, steps, fraction=None):
     s = work / f"{tag}.toml"
     s.write_text(scene)
     out = work / tag
-    r = subprocess.run([str(Path(build) / "bin" / "basalt-run"), str(s), "--geometry", str(geo), "--steps",
+    r = subprocess.run([bt.binary("basalt-run", build=build), str(s), "--geometry", str(geo), "--steps",
                         str(steps), "--fields-every", "1", "--output", str(out), "--quiet", "--precision",
                         precision], capture_output=True, text=True, env={**os.environ, **env})
     if r.returncode:
         raise SystemExit(f"{tag}: {r.stderr.strip()[-300:]}")
-    cpu = float(re.search(r"cpu time of the loop: ([0-9.]+) s", r.stdout).group(1))
-    bpp = int(re.search(r"= (\d+) B/particle", r.stdout).group(1))
-    solver = float(re.search(r"solver arrays: [0-9.]+ MB \(([0-9.]+) bytes per particle\)", r.stdout).group(1))
-    rows = (out / "fields.csv").read_text().split("\n")
-    col = rows[0].split(",").index("kinetic_energy")
-    ke = [float(line.split(",")[col]) for line in rows[1:] if line]
-    return cpu, f"{bpp} / {solver:.0f}", ke
+    x = bt.parse_run(r.stdout)
+    ke = bt.read_fields(out)["kinetic_energy"]
+    return x["cpu_s"], f"{x['field_bytes']} / {x['bytes_per_particle']:.0f}", ke
 
 
 def l2(ke, ref):
@@ -66,7 +65,7 @@ def main():
     a = ap.parse_args()
     work = Path(a.work)
     work.mkdir(parents=True, exist_ok=True)
-    cube = Path(os.environ.get("BASALT_REFERENCE_DIR", ROOT / "tests" / "data")) / "cube1.geo"
+    cube = Path(bt.reference_cube())
     tiled = work / "cube1-tiled2.geo"
     if "30" in a.cases and not tiled.exists():
         subprocess.run(["/usr/bin/python3", str(ROOT / "tools" / "bench" / "wave_tile_geo.py"), str(cube), "2",

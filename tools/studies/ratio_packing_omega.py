@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 # The exact critical step of the radius-ratio packing of tests/solver/test_extremes.cpp (mixed_packing): a
 # dense eigen-solve of M^-1 K for its bonds and touching contacts (K = 1000, density 1), the reference
-# RadiusRatio.CriticalStepSeesTheSmallestParticle holds. Usage: /usr/bin/python3 tools/bench/ratio_packing_omega.py RATIO [0 = no contacts]
+# RadiusRatio.CriticalStepSeesTheSmallestParticle holds. Usage: /usr/bin/python3 tools/studies/ratio_packing_omega.py RATIO [0 = no contacts]
 import sys
 import numpy as np
 ratio=float(sys.argv[1]); contacts=int(sys.argv[2]) if len(sys.argv)>2 else 1

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Error and speed of basalt-run's presets (docs/stability.md, "Presets") on one scene + geometry.
 
-    tools/bench/preset_error.py --build build --scene scenes/wave.toml \\
+    tools/studies/preset_error.py --build build --scene scenes/wave.toml \\
         --geometry $BASALT_REFERENCE_DIR/cube1.geo [--time 2.0] [--np 1]
 
 Runs a reference (double, run.dt_fraction = 0.01) and each preset for the same simulated time, saving
@@ -10,7 +10,6 @@ the kinetic-energy curve against the reference (linearly interpolated at the pre
 the times where the reference KE exceeds 1 % of its maximum), and the throughput basalt-run reports.
 """
 import argparse
-import csv
 import math
 import os
 import re
@@ -18,28 +17,24 @@ import subprocess
 import sys
 import tempfile
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+import basalt_tools as bt  # noqa: E402  (tools/basalt_tools.py)
+
 PRESETS = {"fast": ("float", 0.5), "balanced": ("double", 0.25), "reference": ("double", 0.05)}
 
 
 def basalt_run(args, work, tag, extra, steps):
     out = os.path.join(work, tag)
-    cmd = (["mpiexec", "-n", str(args.np)] if args.np > 1 else []) + [
-        os.path.join(args.build, "bin", "basalt-run"), args.scene, "--geometry", args.geometry, "--steps",
-        str(steps), "--output", out, "--quiet", "--fields-every", "1"] + extra
+    cmd = bt.basalt_run_command(bt.binary("basalt-run", build=args.build), args.scene, "--geometry", args.geometry,
+                                "--steps", steps, "--output", out, "--quiet", "--fields-every", "1", *extra,
+                                np=args.np, launcher="mpiexec", flag="-n")
     p = subprocess.run(cmd, capture_output=True, text=True)
     if p.returncode != 0:
         raise SystemExit(f"{' '.join(cmd)} failed:\n{p.stderr}")
-    t, ke = [], []
-    with open(os.path.join(out, "fields.csv")) as f:
-        r = csv.reader(f)
-        header = next(r)
-        col = header.index("kinetic_energy")
-        for row in r:
-            t.append(float(row[1]))
-            ke.append(float(row[col]))
-    m = re.search(r"([0-9.]+) M particle-steps/s", p.stdout)
-    crit = re.search(r"critical step: ([0-9.eE+-]+)", p.stdout)
-    return t, ke, float(m.group(1)) if m else float("nan"), float(crit.group(1)) if crit else None
+    cols = bt.read_fields(out)
+    x = bt.parse_run(p.stdout)
+    return (cols["time"], cols["kinetic_energy"], x["particle_steps_per_s"] / 1e6 if "particle_steps_per_s" in x
+            else float("nan"), x.get("critical_step"))
 
 
 def interp(t, ke, x):
