@@ -179,26 +179,26 @@ class PairDriver final : public ForceCompute<Real> {
       if constexpr (kHistory) {
         if (advance) {
           if (uniform_)
-            return energy ? loop<true, true, Newton, true>(p, list, h)
-                          : loop<false, true, Newton, true>(p, list, h);
-          return energy ? loop<true, false, Newton, true>(p, list, h)
-                        : loop<false, false, Newton, true>(p, list, h);
+            return energy ? loop<true, true, Newton, true>(p, list, h, dissipated_)
+                          : loop<false, true, Newton, true>(p, list, h, dissipated_);
+          return energy ? loop<true, false, Newton, true>(p, list, h, dissipated_)
+                        : loop<false, false, Newton, true>(p, list, h, dissipated_);
         }
       }
       if (uniform_)
-        return energy ? loop<true, true, Newton, false>(p, list, h)
-                      : loop<false, true, Newton, false>(p, list, h);
-      return energy ? loop<true, false, Newton, false>(p, list, h)
-                    : loop<false, false, Newton, false>(p, list, h);
+        return energy ? loop<true, true, Newton, false>(p, list, h, dissipated_)
+                      : loop<false, true, Newton, false>(p, list, h, dissipated_);
+      return energy ? loop<true, false, Newton, false>(p, list, h, dissipated_)
+                    : loop<false, false, Newton, false>(p, list, h, dissipated_);
     }
   }
 
   template <bool Energy, bool Uniform, bool Newton, bool Advance>
-  double loop(Particles<Real>& p, const PairList& list, History* hist) {
+  double loop(Particles<Real>& p, const PairList& list, History* hist, double& dissipated) const {
     // (lists with bonded pairs marked get a loop of their own over the pairs not bonded: the wave
     // benchmark's has no indirection)
-    return list.bonded.empty() ? loop_over<Energy, Uniform, Newton, Advance, false>(p, list, hist)
-                               : loop_over<Energy, Uniform, Newton, Advance, true>(p, list, hist);
+    return list.bonded.empty() ? loop_over<Energy, Uniform, Newton, Advance, false>(p, list, hist, dissipated)
+                               : loop_over<Energy, Uniform, Newton, Advance, true>(p, list, hist, dissipated);
   }
 
   /// A scalar law's force and energy, of the sum of radii or of both radii (models/contract.hpp).
@@ -231,8 +231,11 @@ class PairDriver final : public ForceCompute<Real> {
   }
 
   template <bool Energy, bool Uniform, bool Newton, bool Advance, bool Marked>
-  double loop_over(Particles<Real>& p, const PairList& list, [[maybe_unused]] History* hist) {
-    double energy = 0, parted = 0;
+  /// Parting energies (models with a dissipation term) are added to `dissipated`.
+  double loop_over(Particles<Real>& p, const PairList& list, [[maybe_unused]] History* hist,
+                   [[maybe_unused]] double& dissipated) const {
+    double energy = 0;
+    [[maybe_unused]] double parted = 0;
     const std::size_t n = p.n_owned;
     const Real* __restrict x = p.x.data();
     const Real* __restrict y = p.y.data();
@@ -247,10 +250,6 @@ class PairDriver final : public ForceCompute<Real> {
     const std::uint32_t* __restrict from = Marked ? list.loose_offset.data() : off;
     [[maybe_unused]] const std::uint32_t* __restrict loose = list.loose.data();
     const Coeffs c0 = coeffs_.empty() ? Coeffs{} : coeffs_[0];
-    const auto coeffs_of = [&](std::size_t i, std::size_t j) -> const Coeffs& {
-      if constexpr (Uniform) return c0;
-      return coeffs_[static_cast<std::size_t>(group_of(p.tag[i], p.tag[j]))];
-    };
     for (std::size_t i = 0; i < n; ++i) {
       const Real xi = x[i], yi = y[i], zi = z[i], ri = rad[i];
       Real fxi = 0, fyi = 0, fzi = 0;
@@ -259,26 +258,36 @@ class PairDriver final : public ForceCompute<Real> {
         const auto j = static_cast<std::size_t>(nb[k]);
         const Real dx = xi - x[j], dy = yi - y[j], dz = zi - z[j];
         const Real r2 = dx * dx + dy * dy + dz * dz;
-        const Real rj = rad[j];
-        const Real rsum = ri + rj;
-        History none{};
-        History& h = kHistory ? hist[k] : none;
-        // (a model with its own touching() needs the pair's coefficients first; the others look them up
-        // only for pairs that overlap)
-        const bool touch =
-            kTouching ? pair_touching<Model, Real>(coeffs_of(i, j), h, ri, rj, r2) : r2 < rsum * rsum;
+        const Real rsum = ri + rad[j];
+        // (the pair's coefficients are looked up only for pairs that interact, unless the model's own
+        // touching() needs them)
+        bool touch;
+        if constexpr (kTouching) {
+          History none{};
+          touch = pair_touching<Model, Real>(
+              Uniform ? c0 : coeffs_[static_cast<std::size_t>(group_of(p.tag[i], p.tag[j]))],
+              kHistory ? hist[k] : none, ri, rad[j], r2);
+        } else {
+          touch = r2 < rsum * rsum;
+        }
         if (!touch) {
           if constexpr (kHistory && Advance) {
             // What the history still held is lost with it: dissipated (models with a dissipation term).
             if constexpr (kDissipates)
-              if (holds(h) && (Newton || p.id[i] < p.id[j]))
-                parted += Model::parting_energy(coeffs_of(i, j), h);
-            Model::apart(h);
+              if (holds(hist[k]) && (Newton || p.id[i] < p.id[j]))
+                parted += Model::parting_energy(
+                    Uniform ? c0 : coeffs_[static_cast<std::size_t>(group_of(p.tag[i], p.tag[j]))], hist[k]);
+            Model::apart(hist[k]);
           }
           continue;
         }
-        const Coeffs& c = coeffs_of(i, j);
+        const Coeffs& c = Uniform ? c0 : coeffs_[static_cast<std::size_t>(group_of(p.tag[i], p.tag[j]))];
         const Real r = std::sqrt(r2);
+        History none{};
+        History* hp = &none;
+        if constexpr (kHistory) hp = &hist[k];
+        History& h = *hp;
+        const Real rj = rad[j];
         if constexpr (kHistory && Advance) law_advance(c, h, ri, rj, rsum, r);
         const Real s = law_force(c, h, ri, rj, rsum, r) / r;
         fxi += s * dx;
@@ -296,7 +305,7 @@ class PairDriver final : public ForceCompute<Real> {
       fy[i] += fyi;
       fz[i] += fzi;
     }
-    if constexpr (kDissipates) dissipated_ += parted;
+    if constexpr (kDissipates) dissipated += parted;
     return energy;
   }
 
