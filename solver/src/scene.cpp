@@ -92,6 +92,8 @@ MeshWallSpec parse_mesh_wall(TableReader& t, const std::string& label, const std
                              const fs::path& base_dir) {
   MeshWallSpec w;
   fs::path file = t.string("file");
+  if (file.empty())
+    t.fail("file", "is empty: name the mesh file (.stl, .obj or .off), relative to the scene's folder");
   w.file = file.is_absolute() ? file : base_dir / file;
   io::MeshReadOptions opt;
   opt.weld_tolerance = t.non_negative_or("weld_tolerance", 0);
@@ -171,6 +173,9 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
     if (!g) top.fail("geometry", "missing (required): a [geometry] table with file = \"...\"");
     TableReader t(*g, label, "geometry");
     fs::path p = t.string("file");
+    // An empty path would resolve to the scene's folder and be refused as "a folder, not a file".
+    if (p.empty())
+      t.fail("file", "is empty: name the geometry file (.h5 or .geo), relative to the scene's folder");
     s.geometry = p.is_absolute() ? p : base_dir / p;
     t.finish();
   }
@@ -353,6 +358,11 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
     TableReader t(*o, label, "output");
     if (t.has("directory")) {
       fs::path d = t.string("directory");
+      // An empty path cannot be created ("Invalid argument"); leave the key out for the default "out".
+      if (d.empty())
+        t.fail("directory",
+               "is empty: name the output folder (relative to the scene's folder), or leave the key out for "
+               "\"out\"");
       s.output_dir = d.is_absolute() ? d : base_dir / d;
     }
     s.checkpoint_every = t.integer_or("checkpoint_every", 0);

@@ -153,6 +153,24 @@ wall = "base"
   EXPECT_NE(msg.find("output.fields[0].type"), std::string::npos) << msg;
 }
 
+// Issue 48: an empty path names its key and says it is empty (were "cases/scenes/: is a folder, not a
+// file" and ": cannot create the output folder: Invalid argument").
+TEST(Scene, EmptyPathsNameTheKey) {
+  auto msg = [] {
+    try {
+      (void)parse_scene_text("[geometry]\nfile = \"\"\n" + kGood, "test.toml", "cases/scenes");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  }();
+  EXPECT_NE(msg.find("test.toml:2: geometry.file: is empty"), std::string::npos) << msg;
+  msg = error_of(kGood + "[output]\ndirectory = \"\"\n");
+  EXPECT_NE(msg.find("output.directory: is empty"), std::string::npos) << msg;
+  msg = error_of(kGood + "[[mesh_walls]]\nname = \"m\"\nfile = \"\"\nK = 1.0\n");
+  EXPECT_NE(msg.find("mesh_walls[0].file: is empty"), std::string::npos) << msg;
+}
+
 TEST(Scene, MissingTablesAndSyntax) {
   auto msg = error_of(kGood + "[geometryy]\nfile = \"x\"\n");
   EXPECT_NE(msg.find("geometryy: unknown key"), std::string::npos) << msg;
