@@ -582,6 +582,13 @@ int run_world(int argc, char** argv) {
     throw InputError(
         fmt::format("{}: geometry file {} does not exist{}", cli.scene_file, scene.geometry.string(),
                     cli.geometry.empty() ? " (geometry.file; --geometry overrides it)" : " (--geometry)"));
+  } else if (!fs::is_directory(scene.geometry)) {  // (a folder is named as one when it is opened)
+    try {  // read by its extension: any other one is named before anything starts, not "not an HDF5 file"
+      (void)io::geometry_format(scene.geometry);
+    } catch (const io::FormatError& e) {
+      throw InputError(fmt::format("{}: {}: {}", cli.scene_file,
+                                   cli.geometry.empty() ? "geometry.file" : "--geometry", e.what()));
+    }
   }
 
   prepare_output_folder(scene.output_dir);
