@@ -110,7 +110,8 @@ void Simulation<Real>::rebuild() {
   p_.drop_ghosts();
   times_.neighbor += sw.lap();
   if (parallel) {
-    error = halo_->migrate(p_, bonds_, forces_.pending_history());
+    error = halo_->migrate(p_, bonds_, forces_.pending_history(), far_moves_);
+    far_moves_ = false;
     error = comm().agree_error(error);
     if (error) stop(*error);
     const long long total = comm().sum(static_cast<long long>(p_.n_owned));

@@ -222,8 +222,18 @@ class Simulation {
   /// Collective, after the first rebuild (simulation_stability.cpp): the network's critical step, dt
   /// from run.dt_fraction (fresh starts), and the refusal above it unless forced.
   void estimate_critical_step(bool fresh);
-  /// Collective, before a rebuild: stops the run when a particle moved absurdly far in one step.
+  /// Collective, before a rebuild: stops the run when a particle moved more than kBlowupRadii rmin in one
+  /// step and its path meets another particle or a wall (or it is bonded), or moved to a non-finite
+  /// position; a particle in free flight goes on (the rebuild then migrates it however far it went).
   void check_blowup();
+  /// Values per particle in blocked_path's list: id, tag, path start (3), path end (3), radius, bonded,
+  /// distance or speed (for the message).
+  static constexpr std::size_t kFastValues = 11;
+  /// Collective: the fast particles' paths (this rank's in `fast`, replaced by every rank's) against every
+  /// owned particle's own path (since the last rebuild when `since_rebuild`, else its next step), the
+  /// planar walls and the mesh walls. nullopt when all are clear; else, alike on every rank,
+  /// "<index in fast>: <what the path meets>".
+  std::optional<std::string> blocked_path(std::vector<double>& fast, bool since_rebuild) const;
   /// Collective, after the first rebuild: refuses coincident particles (naming both ids and their
   /// distance) and, at a fresh start unless forced, overlaps deeper than half the smaller radius
   /// between unbonded particles or into a wall; warns (rank 0) of the deepest overlap above 10 %.
@@ -361,7 +371,8 @@ class Simulation {
   StabilityReport stability_;
   OutputSink* output_ = nullptr;   ///< set during run(steps, OutputSink&)
   std::int64_t rebuild_step_ = 0;  ///< step of the last rebuild (checkpoints store it with p_.xr, yr, zr)
-  bool far_warned_ = false;        ///< warn_far_positions() has warned (or the load check did at the start)
+  bool far_moves_ = false;   ///< check_blowup let fast particles go on: the next migration goes any distance
+  bool far_warned_ = false;  ///< warn_far_positions() has warned (or the load check did at the start)
   std::int64_t rebalances_ = 0;
   double imbalance_before_ = 1;
   bool balance_paused_ = false;         ///< a restart replaying a rebuild with the checkpoint's own cuts
