@@ -439,16 +439,22 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
           f.z = tf.number("z");
           if (!std::isfinite(f.z)) tf.fail("z", "must be finite");
         }
-        // Two savers of one column would write two columns of one name (a reader takes one of them).
+        // Two savers of the same values would write two columns of one name: refused. Two of one name with
+        // other parameters (a runout's direction or origin, a height z) both save: the later one's
+        // columns take the suffix "_fields<k>" (k its index in output.fields).
         for (std::size_t j = 0; j < s.fields.size(); ++j) {
           const auto& earlier = s.fields[j];
-          if (earlier.type != f.type || earlier.name() != f.name() || earlier.wall != f.wall) continue;
+          if (earlier.base_name() != f.base_name() || earlier.wall != f.wall) continue;
+          if (!earlier.same_values(f)) {
+            f.suffix = fmt::format("_fields{}", k);
+            continue;
+          }
           const bool wall = f.per_wall();
           const bool force = f.type == FieldSpec::Type::wall_force;
           tf.fail(
               wall ? "wall" : "type",
-              fmt::format("{} is saved already by output.fields[{}]: two savers would write two columns "
-                          "named {}; keep one (its every = N sets how often)",
+              fmt::format("{} is saved already by output.fields[{}] with the same parameters: two savers "
+                          "would write the same column {} twice; keep one (its every = N sets how often)",
                           wall ? fmt::format("the {} of wall \"{}\"", force ? "force" : "position", f.wall)
                                : fmt::format("\"{}\"", f.name()),
                           j, wall ? fmt::format("{}_{}_x/y/z", f.name(), f.wall) : f.name()));
