@@ -243,6 +243,13 @@ class Simulation {
   /// so far from the origin that float rounds a distance between two of the smallest to a strain above
   /// kResolutionWarn (the load check sees only the start; docs/stability.md, "Energy drift over 1e7 steps").
   void warn_far_positions();
+  /// Collective, at rebuilds until it warned (every precision): warns (rank 0, once) when the rounding of
+  /// positions, epsilon |x|max / (2 r_min), exceeds kStrainLossWarn of the largest bond strain |r - r0| / r0
+  /// seen so far: the scene's own strains are then resolved to worse than that (docs/stability.md,
+  /// "Coordinates far from the origin"). Reads the positions and bonds only.
+  void warn_lost_strain();
+  /// The fraction of the scene's largest bond strain that rounding may take before warn_lost_strain warns.
+  static constexpr double kStrainLossWarn = 1e-3;
   /// Collective, in a rebuild after migration (simulation_balance.cpp): with run.balance = "count" (and
   /// "time" at its first rebuild), moves the cuts when the busiest rank exceeds the mean particles by
   /// run.balance_threshold, and migrates to them; with "time" after a time_balance_due() that said yes,
@@ -371,8 +378,10 @@ class Simulation {
   StabilityReport stability_;
   OutputSink* output_ = nullptr;   ///< set during run(steps, OutputSink&)
   std::int64_t rebuild_step_ = 0;  ///< step of the last rebuild (checkpoints store it with p_.xr, yr, zr)
-  bool far_moves_ = false;   ///< check_blowup let fast particles go on: the next migration goes any distance
-  bool far_warned_ = false;  ///< warn_far_positions() has warned (or the load check did at the start)
+  bool far_moves_ = false;  ///< check_blowup let fast particles go on: the next migration goes any distance
+  bool strain_warned_ = false;  ///< warn_lost_strain() has warned
+  double strain_max_ = 0;       ///< the largest bond strain warn_lost_strain has seen (all ranks)
+  bool far_warned_ = false;     ///< warn_far_positions() has warned (or the load check did at the start)
   std::int64_t rebalances_ = 0;
   double imbalance_before_ = 1;
   bool balance_paused_ = false;         ///< a restart replaying a rebuild with the checkpoint's own cuts
