@@ -243,7 +243,7 @@ class Simulation {
   /// so far from the origin that float rounds a distance between two of the smallest to a strain above
   /// kResolutionWarn (the load check sees only the start; docs/stability.md, "Energy drift over 1e7 steps").
   void warn_far_positions();
-  /// Collective, at rebuilds until it warned (every precision): warns (rank 0, once) when the rounding of
+  /// Double only, collective, at rebuilds until it warned: warns (rank 0, once) when the rounding of
   /// positions, epsilon |x|max / (2 r_min), exceeds kStrainLossWarn of the largest bond strain |r - r0| / r0
   /// seen so far: the scene's own strains are then resolved to worse than that (docs/stability.md,
   /// "Coordinates far from the origin"). Reads the positions and bonds only.
