@@ -124,18 +124,26 @@ static std::string lower_extension(const fs::path& file) {
   return ext;
 }
 
-Geometry read_geometry(const fs::path& file) {
+GeometryFormat geometry_format(const fs::path& file) {
   const auto ext = lower_extension(file);
-  if (ext == ".h5" || ext == ".hdf5") return read_h5(file);
-  if (ext == ".geo") return read_geo(file);
-  throw FormatError(file, "", "unknown geometry format (expected .h5, .hdf5 or .geo)");
+  if (ext == ".h5" || ext == ".hdf5") return GeometryFormat::h5;
+  if (ext == ".geo") return GeometryFormat::geo;
+  throw FormatError(
+      file, "",
+      fmt::format("unknown geometry format {}: Basalt reads .h5 or .hdf5 (Basalt's HDF5 geometry, "
+                  "docs/formats.md; basalt-pack writes it) and .geo (ESyS-Particle's text "
+                  "geometry, as GenGeo writes it)",
+                  ext.empty() ? std::string("(no extension)") : "'" + ext + "'"));
+}
+
+Geometry read_geometry(const fs::path& file) {
+  if (geometry_format(file) == GeometryFormat::geo) return read_geo(file);
+  return read_h5(file);
 }
 
 void write_geometry(const Geometry& g, const fs::path& file) {
-  const auto ext = lower_extension(file);
-  if (ext == ".h5" || ext == ".hdf5") return write_h5(g, file);
-  if (ext == ".geo") return write_geo(g, file);
-  throw FormatError(file, "", "unknown geometry format (expected .h5, .hdf5 or .geo)");
+  if (geometry_format(file) == GeometryFormat::geo) return write_geo(g, file);
+  return write_h5(g, file);
 }
 
 std::vector<std::size_t> sorting_order(const std::vector<std::int64_t>& id) {

@@ -113,6 +113,14 @@ const CLI::Validator kPositive(
     },
     "> 0");
 
+// An empty path would silently mean the scene's setting (the options are overrides) or no path at all.
+const CLI::Validator kNonEmptyPath(
+    [](const std::string& text) {
+      return text.empty() ? std::string("is empty: name a path, or leave the option out to use the scene's")
+                          : std::string{};
+    },
+    "PATH");
+
 std::array<int, 3> parse_dims(const std::string& s) {
   std::array<int, 3> d{0, 0, 0};
   if (s.empty()) return d;
@@ -425,10 +433,11 @@ int run_world(int argc, char** argv) {
   CLI::App app{"basalt-run: parallel DEM solver (Basalt)"};
   app.add_option("scene", cli.scene_file, "scene file (TOML, docs/scenes.md)")->required();
   app.add_option("--geometry", cli.geometry,
-                 "geometry file (.h5 or .geo); overrides the scene's geometry.file");
+                 "geometry file (.h5 or .geo); overrides the scene's geometry.file")
+      ->check(kNonEmptyPath);
   app.add_option("--steps", cli.steps, "number of steps; overrides run.steps (with --restart: steps to add)")
       ->check(kNonNegative);
-  app.add_option("--output", cli.output, "output folder; overrides output.directory");
+  app.add_option("--output", cli.output, "output folder; overrides output.directory")->check(kNonEmptyPath);
   app.add_option("--dims", cli.dims_text,
                  "compute-rank grid x,y,z (default: the least cut area, docs/solver.md)");
   app.add_option("--io-ranks", cli.io_ranks,
@@ -573,6 +582,13 @@ int run_world(int argc, char** argv) {
     throw InputError(
         fmt::format("{}: geometry file {} does not exist{}", cli.scene_file, scene.geometry.string(),
                     cli.geometry.empty() ? " (geometry.file; --geometry overrides it)" : " (--geometry)"));
+  } else if (!fs::is_directory(scene.geometry)) {  // (a folder is named as one when it is opened)
+    try {  // read by its extension: any other one is named before anything starts, not "not an HDF5 file"
+      (void)io::geometry_format(scene.geometry);
+    } catch (const io::FormatError& e) {
+      throw InputError(fmt::format("{}: {}: {}", cli.scene_file,
+                                   cli.geometry.empty() ? "geometry.file" : "--geometry", e.what()));
+    }
   }
 
   prepare_output_folder(scene.output_dir);

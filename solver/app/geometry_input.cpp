@@ -2,8 +2,6 @@
 
 #include <fmt/format.h>
 
-#include <algorithm>
-#include <cctype>
 #include <chrono>
 #include <optional>
 
@@ -16,9 +14,7 @@ namespace fs = std::filesystem;
 
 fs::path geometry_as_h5(const fs::path& file, const fs::path& output_dir, const solver::Comm& comm,
                         bool quiet) {
-  std::string ext = file.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-  if (ext != ".geo") return file;
+  if (io::geometry_format(file) != io::GeometryFormat::geo) return file;  // basalt-run checked it first
   const fs::path h5 = output_dir / (file.stem().string() + ".from-geo.h5");
   std::optional<std::string> error;
   if (comm.rank() == 0) {

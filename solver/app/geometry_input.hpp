@@ -8,7 +8,7 @@
 
 namespace basalt::run {
 
-/// `file` itself for .h5/.hdf5 (any extension but .geo); for .geo, collective over `comm`: compute rank 0
+/// `file` itself for .h5/.hdf5; for .geo, collective over `comm`: compute rank 0
 /// reads it and writes `<output_dir>/<stem>.from-geo.h5`, and every rank gets that path. A bad .geo is an
 /// InputError naming it on every rank.
 std::filesystem::path geometry_as_h5(const std::filesystem::path& file,

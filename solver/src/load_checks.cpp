@@ -232,7 +232,9 @@ std::string check_precision(const GeometrySummary& s, double epsilon, const std:
       : precision == "mixed"
           ? "run in double (--precision double): in mixed precision |x| is the distance from the geometry's "
             "centre, so it is the geometry's extent that is too large for float"
-          : "move the geometry nearer the origin (rounding grows with |x|, not with its size)";
+          : "run in mixed precision (--precision mixed: float offsets from the geometry's centre, which "
+            "round "
+            "to the geometry's size, not to |x|), or move the geometry nearer the origin";
   if (res > kResolutionRefuse)
     throw InputError(
         fmt::format("{}, above the limit {:g}: contact and bond forces would be mostly rounding; {}", what,

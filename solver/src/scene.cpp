@@ -92,6 +92,8 @@ MeshWallSpec parse_mesh_wall(TableReader& t, const std::string& label, const std
                              const fs::path& base_dir) {
   MeshWallSpec w;
   fs::path file = t.string("file");
+  if (file.empty())
+    t.fail("file", "is empty: name the mesh file (.stl, .obj or .off), relative to the scene's folder");
   w.file = file.is_absolute() ? file : base_dir / file;
   io::MeshReadOptions opt;
   opt.weld_tolerance = t.non_negative_or("weld_tolerance", 0);
@@ -171,6 +173,9 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
     if (!g) top.fail("geometry", "missing (required): a [geometry] table with file = \"...\"");
     TableReader t(*g, label, "geometry");
     fs::path p = t.string("file");
+    // An empty path would resolve to the scene's folder and be refused as "a folder, not a file".
+    if (p.empty())
+      t.fail("file", "is empty: name the geometry file (.h5 or .geo), relative to the scene's folder");
     s.geometry = p.is_absolute() ? p : base_dir / p;
     t.finish();
   }
@@ -353,6 +358,11 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
     TableReader t(*o, label, "output");
     if (t.has("directory")) {
       fs::path d = t.string("directory");
+      // An empty path cannot be created ("Invalid argument"); leave the key out for the default "out".
+      if (d.empty())
+        t.fail("directory",
+               "is empty: name the output folder (relative to the scene's folder), or leave the key out for "
+               "\"out\"");
       s.output_dir = d.is_absolute() ? d : base_dir / d;
     }
     s.checkpoint_every = t.integer_or("checkpoint_every", 0);
@@ -429,16 +439,22 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
           f.z = tf.number("z");
           if (!std::isfinite(f.z)) tf.fail("z", "must be finite");
         }
-        // Two savers of one column would write two columns of one name (a reader takes one of them).
+        // Two savers of the same values would write two columns of one name: refused. Two of one name with
+        // other parameters (a runout's direction or origin, a height z) both save: the later one's
+        // columns take the suffix "_fields<k>" (k its index in output.fields).
         for (std::size_t j = 0; j < s.fields.size(); ++j) {
           const auto& earlier = s.fields[j];
-          if (earlier.type != f.type || earlier.name() != f.name() || earlier.wall != f.wall) continue;
+          if (earlier.base_name() != f.base_name() || earlier.wall != f.wall) continue;
+          if (!earlier.same_values(f)) {
+            f.suffix = fmt::format("_fields{}", k);
+            continue;
+          }
           const bool wall = f.per_wall();
           const bool force = f.type == FieldSpec::Type::wall_force;
           tf.fail(
               wall ? "wall" : "type",
-              fmt::format("{} is saved already by output.fields[{}]: two savers would write two columns "
-                          "named {}; keep one (its every = N sets how often)",
+              fmt::format("{} is saved already by output.fields[{}] with the same parameters: two savers "
+                          "would write the same column {} twice; keep one (its every = N sets how often)",
                           wall ? fmt::format("the {} of wall \"{}\"", force ? "force" : "position", f.wall)
                                : fmt::format("\"{}\"", f.name()),
                           j, wall ? fmt::format("{}_{}_x/y/z", f.name(), f.wall) : f.name()));

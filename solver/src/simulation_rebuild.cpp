@@ -110,7 +110,8 @@ void Simulation<Real>::rebuild() {
   p_.drop_ghosts();
   times_.neighbor += sw.lap();
   if (parallel) {
-    error = halo_->migrate(p_, bonds_, forces_.pending_history());
+    error = halo_->migrate(p_, bonds_, forces_.pending_history(), far_moves_);
+    far_moves_ = false;
     error = comm().agree_error(error);
     if (error) stop(*error);
     const long long total = comm().sum(static_cast<long long>(p_.n_owned));
@@ -140,7 +141,11 @@ void Simulation<Real>::rebuild() {
   rebuild_step_ = step_;
   bond_broke_ = false;
   ++rebuilds_;
-  if constexpr (std::is_same_v<Real, float>) warn_far_positions();
+  if constexpr (std::is_same_v<Real, float>)
+    warn_far_positions();
+  else
+    warn_lost_strain();  // (float's and mixed's own rounding of the wave's strains is ~1e-3 of them at the
+                         // origin)
   if (std::getenv("BASALT_DEBUG_REBUILD"))
     fmt::print(stderr, "rank {} rebuild at step {} owned {} ghosts {} bonds {} (both owned {}) pairs {}+{}\n",
                comm().rank(), step_, p_.n_owned, p_.n_ghost(), bonds_.size(), bonds_.n_both_owned,
@@ -167,6 +172,47 @@ void Simulation<Real>::warn_far_positions() {
         "r_min), above {:g}: expect the energy to drift (docs/stability.md, \"Energy drift over 1e7 "
         "steps\"); run in double (--precision double)\n",
         step_, xmax, stability_.rmin, precision_name(), resolution, kResolutionWarn);
+}
+
+template <class Real>
+void Simulation<Real>::warn_lost_strain() {
+  if (strain_warned_ || !(stability_.rmin > 0)) return;
+  double xmax = 0, smax = 0;
+  for (std::size_t i = 0; i < p_.n_owned; ++i)
+    xmax = std::max({xmax, std::abs(double(p_.x[i])), std::abs(double(p_.y[i])), std::abs(double(p_.z[i]))});
+  for (std::size_t k = 0; k < bonds_.ia.size(); ++k) {
+    const auto i = static_cast<std::size_t>(bonds_.ia[k]), j = static_cast<std::size_t>(bonds_.ib[k]);
+    const double r0 = double(bonds_.r0[k]);
+    if (!(r0 > 0)) continue;
+    const double dx = double(p_.x[i]) - double(p_.x[j]), dy = double(p_.y[i]) - double(p_.y[j]),
+                 dz = double(p_.z[i]) - double(p_.z[j]);
+    smax = std::max(smax, std::abs(std::sqrt(dx * dx + dy * dy + dz * dz) - r0) / r0);
+  }
+  if (comm().size() > 1) {
+    xmax = comm().max(xmax);
+    smax = comm().max(smax);
+  }
+  strain_max_ = std::max(strain_max_, smax);
+  const double resolution = kEpsilon * xmax / (2 * stability_.rmin);
+  if (std::getenv("BASALT_DEBUG_STRAIN") && comm().rank() == 0)
+    fmt::print(stderr,
+               "strain: step {} |x|max {:.4g} resolution {:.3g} largest bond strain {:.3g} ratio {:.3g}\n",
+               step_, xmax, resolution, strain_max_, resolution / strain_max_);
+  if (!(strain_max_ > 0) || !(resolution > kStrainLossWarn * strain_max_)) return;
+  strain_warned_ = true;
+  if (comm().rank() == 0)
+    fmt::print(
+        stderr,
+        "basalt-run: warning: step {}: positions reach |x| = {:.4g} with a smallest radius of {:.4g}: in "
+        "{} a distance between particles there is rounded to a strain of {:.2g} (epsilon |x| / 2 r_min), "
+        "{:.2g} % of the largest bond strain of this run so far ({:.2g}), above {:g} %: expect results "
+        "off by about that fraction (docs/stability.md, \"Coordinates far from the origin\"); {}\n",
+        step_, xmax, stability_.rmin, precision_name(), resolution, 100 * resolution / strain_max_,
+        strain_max_, 100 * kStrainLossWarn,
+        precision_name() == std::string_view("double")
+            ? "run in mixed precision (--precision mixed: positions as offsets from the geometry's "
+              "centre), or move the geometry nearer the origin"
+            : "move the geometry nearer the origin of its frame, or run in double");
 }
 
 template <class Real>
@@ -263,6 +309,7 @@ void Simulation<Real>::check_start(bool fresh) {
   template void Simulation<R>::rebuild();                                  \
   template void Simulation<R>::set_skin_reference();                       \
   template void Simulation<R>::warn_far_positions();                       \
+  template void Simulation<R>::warn_lost_strain();                         \
   template void Simulation<R>::check_start(bool);
 BASALT_INSTANTIATE(double)
 BASALT_INSTANTIATE(float)

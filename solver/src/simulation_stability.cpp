@@ -316,21 +316,126 @@ void Simulation<Real>::estimate_critical_step(bool fresh) {
         scene_.dt_safety, scene_.dt_safety));
 }
 
+namespace {
+
+/// A path is blocked where a sphere of radius r swept along it comes within `reach` of something: the
+/// segment a + t (b - a), t in [0, 1], against the origin. Returns the closest distance.
+double segment_distance(const std::array<double, 3>& a, const std::array<double, 3>& b) {
+  const double ux = b[0] - a[0], uy = b[1] - a[1], uz = b[2] - a[2];
+  const double uu = ux * ux + uy * uy + uz * uz;
+  double t = uu > 0 ? -(a[0] * ux + a[1] * uy + a[2] * uz) / uu : 0.0;
+  t = std::clamp(t, 0.0, 1.0);
+  return std::hypot(a[0] + t * ux, a[1] + t * uy, a[2] + t * uz);
+}
+
+std::string xyz(const std::array<double, 3>& v) {
+  return fmt::format("({:.6g}, {:.6g}, {:.6g})", v[0], v[1], v[2]);
+}
+
+}  // namespace
+
+template <class Real>
+std::optional<std::string> Simulation<Real>::blocked_path(std::vector<double>& fast,
+                                                          bool since_rebuild) const {
+  // fast: kFastValues doubles per particle of this rank (id, tag, start, end, radius, bonded, velocity);
+  // replaced by every rank's, in rank order. The others' paths: since the last rebuild (x0 to x) when
+  // `since_rebuild`, else the next step's (x to x + v dt), as the fast ones'.
+  fast = comm().size() > 1 ? comm().all_gather(fast) : fast;
+  const std::size_t n = fast.size() / kFastValues;
+  const double dt = scene_.dt;
+  const auto& o = p_.skin_origin;
+  std::optional<std::string> hit;
+  std::vector<MeshContact> touching;
+  for (std::size_t f = 0; f < n && !hit; ++f) {
+    const double* v = &fast[f * kFastValues];
+    const auto id = static_cast<std::int64_t>(v[0]);
+    const std::array<double, 3> a{v[2], v[3], v[4]}, b{v[5], v[6], v[7]};
+    const double r = v[8];
+    if (v[9] != 0) {
+      hit = fmt::format("{}: it is bonded, and no bond follows a particle that far in one step", f);
+      break;
+    }
+    // Every owned particle (the fast one itself excepted): their relative path, within the sum of radii.
+    for (std::size_t j = 0; j < p_.n_owned && !hit; ++j) {
+      if (p_.id[j] == id) continue;
+      std::array<double, 3> s{}, e{};
+      if (since_rebuild) {
+        s = {double(p_.x0[j]) + o[0], double(p_.y0[j]) + o[1], double(p_.z0[j]) + o[2]};
+        e = {double(p_.x[j]), double(p_.y[j]), double(p_.z[j])};
+      } else {
+        s = {double(p_.x[j]), double(p_.y[j]), double(p_.z[j])};
+        e = {s[0] + double(p_.vx[j]) * dt, s[1] + double(p_.vy[j]) * dt, s[2] + double(p_.vz[j]) * dt};
+      }
+      const double reach = r + double(p_.radius[j]);
+      const double d =
+          segment_distance({a[0] - s[0], a[1] - s[1], a[2] - s[2]}, {b[0] - e[0], b[1] - e[1], b[2] - e[2]});
+      if (d < reach)
+        hit = fmt::format(
+            "{}: its path comes within {:.4g} of particle id {} (radius {:.4g}; the two touch below "
+            "{:.4g}): it could pass through it",
+            f, d, p_.id[j], double(p_.radius[j]), reach);
+    }
+    const auto& walls = forces_.walls();
+    const auto tag = static_cast<std::int64_t>(v[1]);
+    auto touches = [&](const TagFilter& tags) {
+      return tags.empty() || std::find(tags.begin(), tags.end(), tag) != tags.end();
+    };
+    for (std::size_t w = 0; w < walls.size() && !hit; ++w) {
+      if (!touches(walls.spec(w).tags)) continue;
+      const auto& q = walls.point(w);
+      const auto& nrm = walls.spec(w).normal;
+      auto side = [&](const std::array<double, 3>& x) {
+        return (x[0] - q[0]) * nrm[0] + (x[1] - q[1]) * nrm[1] + (x[2] - q[2]) * nrm[2];
+      };
+      const double d = std::min(side(a), side(b));  // linear along the path: the least at an end
+      if (d < r)
+        hit = fmt::format(
+            "{}: its path comes within {:.4g} of wall \"{}\" (or through it) and its radius is {:.4g}: "
+            "it could pass through the wall",
+            f, d, walls.spec(w).name, r);
+    }
+    // Mesh walls: spheres of radius 1.12 r every r along the path cover the swept sphere of radius r.
+    const double len = std::hypot(b[0] - a[0], b[1] - a[1], b[2] - a[2]);
+    const auto samples = static_cast<std::size_t>(std::ceil(len / std::max(r, 1e-300))) + 1;
+    for (std::size_t k = 0; k < walls.meshes() && !hit; ++k) {
+      if (!touches(walls.mesh_spec(k).tags)) continue;
+      for (std::size_t m = 0; m <= samples && !hit; ++m) {
+        const double t = double(m) / double(samples);
+        touching.clear();
+        const std::array<double, 3> c{a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]),
+                                      a[2] + t * (b[2] - a[2])};
+        if (walls.mesh(k).contacts(c, 1.12 * r, touching) > 0)
+          hit = fmt::format("{}: its path meets mesh wall \"{}\" at {}: it could pass through the wall", f,
+                            walls.mesh_spec(k).name, xyz(c));
+      }
+    }
+  }
+  if (comm().size() > 1) hit = comm().agree_error(hit);
+  return hit;
+}
+
 template <class Real>
 void Simulation<Real>::check_blowup() {
   // Called before a rebuild, when some particle (or wall) moved more than skin/2 since the last one.
   // Moving farther than skin/2 + kBlowupRadii rmin since then means moving more than kBlowupRadii rmin
-  // in this one step: no DEM contact is resolved that way, the run has blown up (or a position went
-  // non-finite). The positions at the last rebuild are p_.x0 (float, relative to p_.skin_origin).
+  // in this one step. That alone is not a blow-up: a particle in free flight (ejecta, a projectile) may
+  // move any distance per step, the lists being rebuilt as often as needed. It is one where the path
+  // could take it through something: a particle or a wall within reach of the path (a contact cannot be
+  // resolved in one step), or a bond (blocked_path); and where a position went non-finite. Runs in
+  // which no particle moves that far never get past the first return: nothing changes for them. The
+  // positions at the last rebuild are p_.x0 (float, relative to p_.skin_origin).
   const double limit = 0.5 * scene_.skin + stability::kBlowupRadii * stability_.rmin;
   double worst = 0;
   std::size_t wi = 0;
-  for (std::size_t i = 0; i < p_.n_owned; ++i) {
-    const auto& o = p_.skin_origin;
+  const auto& o = p_.skin_origin;
+  auto moved = [&](std::size_t i) {
     const double dx = double(p_.x[i]) - o[0] - double(p_.x0[i]),
                  dy = double(p_.y[i]) - o[1] - double(p_.y0[i]),
                  dz = double(p_.z[i]) - o[2] - double(p_.z0[i]);
-    const double d2 = dx * dx + dy * dy + dz * dz;
+    return dx * dx + dy * dy + dz * dz;
+  };
+  for (std::size_t i = 0; i < p_.n_owned; ++i) {
+    const double d2 = moved(i);
     if (!(d2 <= worst)) {  // NaN wins
       worst = d2;
       wi = i;
@@ -341,61 +446,130 @@ void Simulation<Real>::check_blowup() {
   const bool parallel = comm().size() > 1;
   const double top = parallel ? comm().max(mine) : mine;
   if (top <= limit) return;
-  const int who = parallel ? comm().max_loc(mine).second : 0;
-  std::string msg;
-  if (comm().rank() == who) {
-    const auto i = wi;
-    msg = fmt::format(
+  auto blowup = [&](std::size_t i, double far, const std::string& what) {
+    return fmt::format(
         "step {}: blow-up: particle id {} moved {} in one step (more than {} x the smallest radius {:.4g}; "
-        "{:.4g} since the last rebuild, limit skin/2 + that = {:.4g}): position ({:.6g}, {:.6g}, {:.6g}), "
+        "{:.4g} since the last rebuild, limit skin/2 + that = {:.4g}){}: position ({:.6g}, {:.6g}, {:.6g}), "
         "velocity ({:.6g}, {:.6g}, {:.6g}). dt = {:.6g} is {:.3g} x the critical time step {:.6g}{}",
         step_ + 1, p_.id[i],
-        mine >= std::numeric_limits<double>::max() ? "to a non-finite position" : "too far",
-        stability::kBlowupRadii, stability_.rmin, mine, limit, double(p_.x[i]), double(p_.y[i]),
+        far >= std::numeric_limits<double>::max() ? "to a non-finite position" : "too far",
+        stability::kBlowupRadii, stability_.rmin, far, limit, what, double(p_.x[i]), double(p_.y[i]),
         double(p_.z[i]), double(p_.vx[i]), double(p_.vy[i]), double(p_.vz[i]), scene_.dt, stability_.fraction,
         stability_.dt_critical, stability_.fraction > 1 ? " (forced): lower dt" : "");
+  };
+  if (!(top < std::numeric_limits<double>::max())) {
+    const int who = parallel ? comm().max_loc(mine).second : 0;
+    const std::string msg = comm().rank() == who ? blowup(wi, mine, "") : std::string();
+    stop(parallel ? comm().broadcast(msg, who) : msg);
   }
-  stop(parallel ? comm().broadcast(msg, who) : msg);
+  // The particles that moved that far, with their paths since the last rebuild.
+  std::vector<char> bonded(p_.n_owned, 0);
+  for (std::size_t k = 0; k < bonds_.ia.size(); ++k) {
+    if (static_cast<std::size_t>(bonds_.ia[k]) < p_.n_owned)
+      bonded[static_cast<std::size_t>(bonds_.ia[k])] = 1;
+    if (k < bonds_.n_both_owned && static_cast<std::size_t>(bonds_.ib[k]) < p_.n_owned)
+      bonded[static_cast<std::size_t>(bonds_.ib[k])] = 1;
+  }
+  std::vector<double> fast;
+  std::vector<std::size_t> mine_fast;
+  for (std::size_t i = 0; i < p_.n_owned; ++i) {
+    if (!(moved(i) > limit * limit)) continue;
+    mine_fast.push_back(i);
+    fast.insert(fast.end(),
+                {double(p_.id[i]), double(p_.tag[i]), double(p_.x0[i]) + o[0], double(p_.y0[i]) + o[1],
+                 double(p_.z0[i]) + o[2], double(p_.x[i]), double(p_.y[i]), double(p_.z[i]),
+                 double(p_.radius[i]), double(bonded[i]), std::sqrt(moved(i))});
+  }
+  // This rank's first fast particle's index in the gathered list.
+  std::size_t offset = 0;
+  if (parallel) {
+    const auto counts = comm().all_gather(static_cast<std::int64_t>(mine_fast.size()));
+    for (int r = 0; r < comm().rank(); ++r)
+      offset += static_cast<std::size_t>(counts[static_cast<std::size_t>(r)]);
+  }
+  auto hit = blocked_path(fast, true);
+  if (!hit) {
+    far_moves_ = true;  // the rebuild's migration may carry them across several ranks' regions
+    return;
+  }
+  // "<index>: reason": the owner of that fast particle writes the message.
+  const std::size_t colon = hit->find(':');
+  const auto f = static_cast<std::size_t>(std::stoull(hit->substr(0, colon)));
+  const std::string why = ", and " + hit->substr(colon + 2);
+  std::string msg;
+  const int owner = [&] {
+    if (!parallel) return 0;
+    const bool here = f >= offset && f < offset + mine_fast.size();
+    return comm().max_loc(here ? double(comm().rank()) : -1.0).second;
+  }();
+  if (comm().rank() == owner) {
+    const std::size_t i = mine_fast[f - offset];
+    msg = blowup(i, fast[f * kFastValues + 10], why);
+  }
+  stop(parallel ? comm().broadcast(msg, owner) : msg);
 }
 
 template <class Real>
 std::optional<std::string> Simulation<Real>::check_frame_state() const {
-  if (auto bad = check_finite()) return bad;
-  // A state that blew up but is still finite (speeds of 1e122) would pass check_finite and be saved
-  // as a valid restart point, with check_blowup stopping the run only at the next step's rebuild. A
-  // particle whose speed moves it farther in one step than check_blowup's whole allowance (skin/2 +
-  // kBlowupRadii rmin, from any position within skin/2 of its last rebuild) trips that check at the
-  // next step for certain; refusing the frame now leaves the newest checkpoint a state that ran.
+  const auto bad = check_finite();
+  // Collective (the caller agrees on the outcome). A state that blew up but is still finite (speeds of
+  // 1e122) would pass check_finite and be saved as a valid restart point, with check_blowup stopping
+  // the run only at the next step's rebuild. A particle whose speed moves it farther in one step than
+  // check_blowup's whole allowance (skin/2 + kBlowupRadii rmin, from any position within skin/2 of its
+  // last rebuild) and whose next step's path meets a particle or a wall, or that is bonded, trips that
+  // check at the next step; refusing the frame now leaves the newest checkpoint a state that ran. A
+  // particle in free flight, whose path is clear, is saved.
   const double limit = scene_.skin + stability::kBlowupRadii * stability_.rmin;
   const double vmax = limit / scene_.dt;
   double worst = 0;
-  std::size_t wi = 0;
-  for (std::size_t i = 0; i < p_.n_owned; ++i) {
+  std::vector<double> fast;
+  std::vector<std::size_t> mine_fast;
+  const double dt = scene_.dt;
+  for (std::size_t i = 0; i < p_.n_owned && !bad; ++i) {  // (every rank goes on to the reductions)
     const double v2 = double(p_.vx[i]) * double(p_.vx[i]) + double(p_.vy[i]) * double(p_.vy[i]) +
                       double(p_.vz[i]) * double(p_.vz[i]);
-    if (v2 > worst) {
-      worst = v2;
-      wi = i;
-    }
+    worst = std::max(worst, v2);
+    if (!(std::sqrt(v2) > vmax)) continue;
+    mine_fast.push_back(i);
+    const double x = double(p_.x[i]), y = double(p_.y[i]), z = double(p_.z[i]);
+    fast.insert(fast.end(), {double(p_.id[i]), double(p_.tag[i]), x, y, z, x + double(p_.vx[i]) * dt,
+                             y + double(p_.vy[i]) * dt, z + double(p_.vz[i]) * dt, double(p_.radius[i]), 0.0,
+                             std::sqrt(v2)});
   }
-  if (!(std::sqrt(worst) > vmax)) return std::nullopt;
-  const auto i = wi;
+  const bool parallel = comm().size() > 1;
+  const double top = parallel ? comm().max(std::sqrt(worst)) : std::sqrt(worst);
+  if (!(top > vmax)) return bad;
+  // Bonded: marked as check_blowup marks them.
+  std::vector<char> bonded(p_.n_owned, 0);
+  for (std::size_t k = 0; k < bonds_.ia.size(); ++k) {
+    if (static_cast<std::size_t>(bonds_.ia[k]) < p_.n_owned)
+      bonded[static_cast<std::size_t>(bonds_.ia[k])] = 1;
+    if (k < bonds_.n_both_owned && static_cast<std::size_t>(bonds_.ib[k]) < p_.n_owned)
+      bonded[static_cast<std::size_t>(bonds_.ib[k])] = 1;
+  }
+  for (std::size_t m = 0; m < mine_fast.size(); ++m) fast[m * kFastValues + 9] = double(bonded[mine_fast[m]]);
+  auto hit = blocked_path(fast, false);
+  if (bad || !hit) return bad;
+  const std::size_t colon = hit->find(':');
+  const auto f = static_cast<std::size_t>(std::stoull(hit->substr(0, colon)));
+  const double* v = &fast[f * kFastValues];
   return fmt::format(
       "step {}: blow-up: particle id {} has the speed {:.6g}, which moves it {:.6g} in one step of dt = "
       "{:.6g} "
-      "(more than skin + {} x the smallest radius = {:.4g}): position ({:.6g}, {:.6g}, {:.6g}), velocity "
-      "({:.6g}, {:.6g}, {:.6g}). dt is {:.3g} x the critical time step {:.6g}{}",
-      step_, p_.id[i], std::sqrt(worst), std::sqrt(worst) * scene_.dt, scene_.dt, stability::kBlowupRadii,
-      limit, double(p_.x[i]), double(p_.y[i]), double(p_.z[i]), double(p_.vx[i]), double(p_.vy[i]),
-      double(p_.vz[i]), stability_.fraction, stability_.dt_critical,
-      stability_.fraction > 1 ? " (forced): lower dt" : "");
+      "(more than skin + {} x the smallest radius = {:.4g}), and {}: position {}, next step at {}. dt is "
+      "{:.3g} x "
+      "the critical time step {:.6g}{}",
+      step_, static_cast<std::int64_t>(v[0]), v[10], v[10] * scene_.dt, scene_.dt, stability::kBlowupRadii,
+      limit, hit->substr(colon + 2), xyz({v[2], v[3], v[4]}), xyz({v[5], v[6], v[7]}), stability_.fraction,
+      stability_.dt_critical, stability_.fraction > 1 ? " (forced): lower dt" : "");
 }
 
 #define BASALT_INSTANTIATE(R)                                                   \
   template std::optional<std::string> Simulation<R>::check_frame_state() const; \
   template void Simulation<R>::check_stability(const GeometrySummary&);         \
   template void Simulation<R>::estimate_critical_step(bool);                    \
-  template void Simulation<R>::check_blowup();
+  template void Simulation<R>::check_blowup();                                  \
+  template std::optional<std::string> Simulation<R>::blocked_path(std::vector<double>&, bool) const;
 BASALT_INSTANTIATE(double)
 BASALT_INSTANTIATE(float)
 #undef BASALT_INSTANTIATE

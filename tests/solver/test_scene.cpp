@@ -153,6 +153,49 @@ wall = "base"
   EXPECT_NE(msg.find("output.fields[0].type"), std::string::npos) << msg;
 }
 
+// Issue 48: an empty path names its key and says it is empty (were "cases/scenes/: is a folder, not a
+// file" and ": cannot create the output folder: Invalid argument").
+TEST(Scene, EmptyPathsNameTheKey) {
+  auto msg = [] {
+    try {
+      (void)parse_scene_text("[geometry]\nfile = \"\"\n" + kGood, "test.toml", "cases/scenes");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  }();
+  EXPECT_NE(msg.find("test.toml:2: geometry.file: is empty"), std::string::npos) << msg;
+  msg = error_of(kGood + "[output]\ndirectory = \"\"\n");
+  EXPECT_NE(msg.find("output.directory: is empty"), std::string::npos) << msg;
+  msg = error_of(kGood + "[[mesh_walls]]\nname = \"m\"\nfile = \"\"\nK = 1.0\n");
+  EXPECT_NE(msg.find("mesh_walls[0].file: is empty"), std::string::npos) << msg;
+}
+
+// Issue 48: two savers of one kind with other parameters both save, under distinct column names (a second
+// runout was refused as a duplicate column); identical ones are still refused.
+TEST(Scene, SaversOfOneKindWithOtherParametersAreAllowed) {
+  const std::string runout = "[[output.fields]]\ntype = \"runout\"\n";
+  const auto s = basalt::test::scene_from(kGood + "[output]\n" + runout + "percentile = 100\n" + runout +
+                                          "percentile = 99\n" + runout + "percentile = 99.4\n" + runout +
+                                          "percentile = 99\ndirection = [0.0, 1.0, 0.0]\n" + runout +
+                                          "percentile = 99\norigin = [1.0, 0.0, 0.0]\n" +
+                                          "[[output.fields]]\ntype = \"mass_below\"\nz = "
+                                          "1.0\n[[output.fields]]\ntype = \"mass_below\"\nz = 2.0\n");
+  EXPECT_EQ(field_columns(s),
+            (std::vector<std::string>{"runout_max", "runout_p99", "runout_p99_4", "runout_p99_fields3",
+                                      "runout_p99_fields4", "mass_below", "mass_below_fields6"}));
+  auto msg = error_of(kGood + "[output]\n" + runout + "percentile = 99\nevery = 2\n" + runout +
+                      "percentile = 99\nevery = 5\n");
+  EXPECT_NE(
+      msg.find("output.fields[1].type: \"runout_p99\" is saved already by output.fields[0] with the same "
+               "parameters"),
+      std::string::npos)
+      << msg;
+  msg = error_of(kGood + "[output]\n" + runout + "direction = [0.0, 0.0, 1.0]\n" + runout +
+                 "direction = [0.0, 0.0, 2.0]\n");  // the same unit direction
+  EXPECT_NE(msg.find("\"runout_max\" is saved already"), std::string::npos) << msg;
+}
+
 TEST(Scene, MissingTablesAndSyntax) {
   auto msg = error_of(kGood + "[geometryy]\nfile = \"x\"\n");
   EXPECT_NE(msg.find("geometryy: unknown key"), std::string::npos) << msg;

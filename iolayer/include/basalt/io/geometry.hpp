@@ -89,6 +89,12 @@ struct Geometry {
   std::int64_t index_of(std::int64_t pid) const;
 };
 
+/// The geometry formats, told apart by the file's extension (any case): .h5/.hdf5 (Basalt's HDF5 schema,
+/// docs/formats.md) and .geo (ESyS-Particle's text geometry, as GenGeo writes it).
+enum class GeometryFormat { h5, geo };
+/// The format of `file` by its extension; any other extension is a FormatError naming the ones read.
+GeometryFormat geometry_format(const std::filesystem::path& file);
+
 /// Reads .h5/.hdf5 (Basalt schema) or .geo (ESyS-Particle) by extension; validates; sorts by id.
 Geometry read_geometry(const std::filesystem::path& file);
 /// Writes by extension (.h5/.hdf5 or .geo). Writes to a temporary name and renames, so a failed

@@ -222,8 +222,18 @@ class Simulation {
   /// Collective, after the first rebuild (simulation_stability.cpp): the network's critical step, dt
   /// from run.dt_fraction (fresh starts), and the refusal above it unless forced.
   void estimate_critical_step(bool fresh);
-  /// Collective, before a rebuild: stops the run when a particle moved absurdly far in one step.
+  /// Collective, before a rebuild: stops the run when a particle moved more than kBlowupRadii rmin in one
+  /// step and its path meets another particle or a wall (or it is bonded), or moved to a non-finite
+  /// position; a particle in free flight goes on (the rebuild then migrates it however far it went).
   void check_blowup();
+  /// Values per particle in blocked_path's list: id, tag, path start (3), path end (3), radius, bonded,
+  /// distance or speed (for the message).
+  static constexpr std::size_t kFastValues = 11;
+  /// Collective: the fast particles' paths (this rank's in `fast`, replaced by every rank's) against every
+  /// owned particle's own path (since the last rebuild when `since_rebuild`, else its next step), the
+  /// planar walls and the mesh walls. nullopt when all are clear; else, alike on every rank,
+  /// "<index in fast>: <what the path meets>".
+  std::optional<std::string> blocked_path(std::vector<double>& fast, bool since_rebuild) const;
   /// Collective, after the first rebuild: refuses coincident particles (naming both ids and their
   /// distance) and, at a fresh start unless forced, overlaps deeper than half the smaller radius
   /// between unbonded particles or into a wall; warns (rank 0) of the deepest overlap above 10 %.
@@ -233,6 +243,13 @@ class Simulation {
   /// so far from the origin that float rounds a distance between two of the smallest to a strain above
   /// kResolutionWarn (the load check sees only the start; docs/stability.md, "Energy drift over 1e7 steps").
   void warn_far_positions();
+  /// Double only, collective, at rebuilds until it warned: warns (rank 0, once) when the rounding of
+  /// positions, epsilon |x|max / (2 r_min), exceeds kStrainLossWarn of the largest bond strain |r - r0| / r0
+  /// seen so far: the scene's own strains are then resolved to worse than that (docs/stability.md,
+  /// "Coordinates far from the origin"). Reads the positions and bonds only.
+  void warn_lost_strain();
+  /// The fraction of the scene's largest bond strain that rounding may take before warn_lost_strain warns.
+  static constexpr double kStrainLossWarn = 1e-3;
   /// Collective, in a rebuild after migration (simulation_balance.cpp): with run.balance = "count" (and
   /// "time" at its first rebuild), moves the cuts when the busiest rank exceeds the mean particles by
   /// run.balance_threshold, and migrates to them; with "time" after a time_balance_due() that said yes,
@@ -361,7 +378,10 @@ class Simulation {
   StabilityReport stability_;
   OutputSink* output_ = nullptr;   ///< set during run(steps, OutputSink&)
   std::int64_t rebuild_step_ = 0;  ///< step of the last rebuild (checkpoints store it with p_.xr, yr, zr)
-  bool far_warned_ = false;        ///< warn_far_positions() has warned (or the load check did at the start)
+  bool far_moves_ = false;  ///< check_blowup let fast particles go on: the next migration goes any distance
+  bool strain_warned_ = false;  ///< warn_lost_strain() has warned
+  double strain_max_ = 0;       ///< the largest bond strain warn_lost_strain has seen (all ranks)
+  bool far_warned_ = false;     ///< warn_far_positions() has warned (or the load check did at the start)
   std::int64_t rebalances_ = 0;
   double imbalance_before_ = 1;
   bool balance_paused_ = false;         ///< a restart replaying a rebuild with the checkpoint's own cuts

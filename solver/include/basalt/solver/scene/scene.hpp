@@ -4,6 +4,7 @@
 // naming the file, line and key.
 #include <any>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -113,8 +114,19 @@ struct FieldSpec {
   /// Columns it writes: wall_force and wall_position 3 (x, y, z), broken_bonds 4 (per failure mode), the
   /// others 1.
   std::size_t width() const { return per_wall() ? 3 : (type == Type::broken_bonds ? 4 : 1); }
+  /// Appended to the name when an earlier saver has the same name with other parameters (another
+  /// direction or origin of a runout, another z): "_fields<k>", k its index in output.fields.
+  std::string suffix;
   /// The column name (wall_force, wall_position, broken_bonds: the prefix of their columns).
-  std::string name() const {
+  std::string name() const { return base_name() + suffix; }
+  /// Whether `o` saves the same values (its `every` aside).
+  bool same_values(const FieldSpec& o) const {
+    return type == o.type && term == o.term && wall == o.wall && origin == o.origin &&
+           direction == o.direction && percentile == o.percentile && z == o.z;
+  }
+  /// The name by type and parameters: a runout's percentile is in it, written whole ("runout_p99") or
+  /// with '_' for the decimal point ("runout_p99_5"): every percentile has its own name.
+  std::string base_name() const {
     switch (type) {
       case Type::energy:
         return term;
@@ -136,9 +148,17 @@ struct FieldSpec {
         return "mean_vz_above";
       case Type::broken_bonds:
         return "broken_bonds";
-      case Type::runout:
-        return percentile >= 100 ? std::string("runout_max")
-                                 : "runout_p" + std::to_string(static_cast<int>(std::lround(percentile)));
+      case Type::runout: {
+        if (percentile >= 100) return "runout_max";
+        if (percentile == std::floor(percentile))
+          return "runout_p" + std::to_string(static_cast<long long>(percentile));
+        // Up to 6 significant digits; a decimal point in a column name would be dropped by some CSV readers.
+        std::string p = std::to_string(percentile);  // e.g. "99.500000"
+        while (!p.empty() && p.back() == '0') p.pop_back();
+        for (auto& c : p)
+          if (c == '.') c = '_';
+        return "runout_p" + p;
+      }
     }
     return term;
   }
