@@ -30,6 +30,9 @@
 #include "basalt/io/geometry.hpp"
 #include "basalt/io/geometry_rows.hpp"
 #include "basalt/io/io_ranks.hpp"
+#if !defined(BASALT_WITH_VTK)
+#error "BASALT_WITH_VTK must be 0 or 1 (solver/CMakeLists.txt defines it for basalt-run)"
+#endif
 #if BASALT_WITH_VTK
 #include "basalt/io/vtk_frame_writer.hpp"
 #endif
