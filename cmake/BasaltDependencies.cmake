@@ -35,15 +35,16 @@ if(BASALT_WITH_VTK)
       "Basalt: VTK 9.1's development files (Debian: libvtk9-dev) were not found: building without VTK "
       "(BASALT_WITH_VTK=OFF). basalt-pack, basalt-run, checkpoints, XDMF (open ckpt_series.xmf in ParaView) "
       "and field series work; VTK frames (--frames-every), in-situ pictures (--render-every) and basalt-view's "
-      "render/movie/plot/convert are left out. Install libvtk9-dev and configure again to have them. "
+      "commands (render, movie, plot, convert, info) are left out. Install libvtk9-dev and configure again to "
+      "have them. "
       "${VTK_NOT_FOUND_MESSAGE}")
   endif()
 else()
   set(BASALT_WITHOUT_VTK_REASON "configured with -DBASALT_WITH_VTK=OFF")
   message(STATUS
     "Basalt: BASALT_WITH_VTK=OFF: nothing links or includes VTK; no VTK frames (--frames-every), in-situ "
-    "pictures (--render-every) or basalt-view render/movie/plot/convert; checkpoints, XDMF and field series "
-    "as always")
+    "pictures (--render-every) or basalt-view commands (render, movie, plot, convert, info); checkpoints, XDMF "
+    "and field series as always")
 endif()
 if(BASALT_WITH_VTK)
   message(STATUS "Basalt: with VTK ${VTK_VERSION} (BASALT_WITH_VTK=ON)")

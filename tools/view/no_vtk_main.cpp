@@ -19,8 +19,7 @@ void print_help() {
       "This build has no VTK (BASALT_WITH_VTK=OFF: {}), and every command needs it: render, movie, convert, "
       "plot, info are refused.\n"
       "Open a run's ckpt_series.xmf (checkpoints, written by basalt-run) in ParaView instead, or build "
-      "Basalt "
-      "with libvtk9-dev installed.\n"
+      "Basalt with libvtk9-dev installed.\n"
       "Usage: basalt-view [--help] [--version]\n",
       BASALT_WITHOUT_VTK_REASON);
 }
