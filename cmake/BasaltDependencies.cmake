@@ -14,11 +14,43 @@ find_package(CGAL REQUIRED)
 find_package(tomlplusplus REQUIRED)
 find_package(CLI11 REQUIRED)
 find_package(fmt REQUIRED)
-find_package(VTK 9.1 REQUIRED COMPONENTS
+# VTK is optional (BASALT_WITH_VTK, CMakeLists.txt): without it there are no VTK frames, no pictures (in situ
+# or basalt-view's), and basalt-view only says why; packing, runs, checkpoints, XDMF and field series stay.
+# Debian 12's python3-paraview conflicts with libvtk9-dev's python3-vtk9, so a machine with ParaView's
+# Python module has no VTK development files (scripts/install-deps.sh, docs/reliability.md).
+set(BASALT_VTK_COMPONENTS
   CommonCore CommonDataModel CommonColor IOXML IOParallelXML IOImage
   FiltersCore FiltersSources FiltersGeneral FiltersExtraction
   RenderingCore RenderingOpenGL2 RenderingFreeType RenderingAnnotation InteractionStyle
   ChartsCore ViewsContext2D RenderingContext2D RenderingContextOpenGL2)
+set(BASALT_WITHOUT_VTK_REASON "")
+if(BASALT_WITH_VTK)
+  find_package(VTK 9.1 QUIET COMPONENTS ${BASALT_VTK_COMPONENTS})
+  if(NOT VTK_FOUND)
+    # A normal variable shadows the cache's ON for this configuration only: once VTK is installed, the
+    # next configuration finds it without being told.
+    set(BASALT_WITH_VTK OFF)
+    set(BASALT_WITHOUT_VTK_REASON "VTK 9.1's development files (libvtk9-dev) were not found when configured")
+    message(WARNING
+      "Basalt: VTK 9.1's development files (Debian: libvtk9-dev) were not found: building without VTK "
+      "(BASALT_WITH_VTK=OFF). basalt-pack, basalt-run, checkpoints, XDMF (open ckpt_series.xmf in ParaView) "
+      "and field series work; VTK frames (--frames-every), in-situ pictures (--render-every) and basalt-view's "
+      "commands (render, movie, plot, convert, info) are left out. Install libvtk9-dev and configure again to "
+      "have them. "
+      "${VTK_NOT_FOUND_MESSAGE}")
+  endif()
+else()
+  set(BASALT_WITHOUT_VTK_REASON "configured with -DBASALT_WITH_VTK=OFF")
+  message(STATUS
+    "Basalt: BASALT_WITH_VTK=OFF: nothing links or includes VTK; no VTK frames (--frames-every), in-situ "
+    "pictures (--render-every) or basalt-view commands (render, movie, plot, convert, info); checkpoints, XDMF "
+    "and field series as always")
+endif()
+if(BASALT_WITH_VTK)
+  message(STATUS "Basalt: with VTK ${VTK_VERSION} (BASALT_WITH_VTK=ON)")
+endif()
+# What this configuration chose, for scripts that read the cache (scripts/demo.sh).
+set(BASALT_HAS_VTK ${BASALT_WITH_VTK} CACHE INTERNAL "VTK is used by this build (BASALT_WITH_VTK, found)")
 
 if(BASALT_BUILD_TESTS)
   find_package(GTest REQUIRED)

@@ -30,7 +30,12 @@
 #include "basalt/io/geometry.hpp"
 #include "basalt/io/geometry_rows.hpp"
 #include "basalt/io/io_ranks.hpp"
+#if !defined(BASALT_WITH_VTK)
+#error "BASALT_WITH_VTK must be 0 or 1 (solver/CMakeLists.txt defines it for basalt-run)"
+#endif
+#if BASALT_WITH_VTK
 #include "basalt/io/vtk_frame_writer.hpp"
+#endif
 #include "basalt/solver/core/errors.hpp"
 #include "basalt/solver/core/stop_request.hpp"
 #include "basalt/solver/models/registry.hpp"
@@ -63,6 +68,30 @@ struct Cli {
   std::string balance;
   double balance_threshold = 0;
 };
+
+#if !BASALT_WITH_VTK
+/// A build without VTK (BASALT_WITH_VTK off, solver/CMakeLists.txt) writes no VTK frames and draws no
+/// pictures: asking for either (command line or scene) stops every rank before anything starts, in one line
+/// that names the option, why and the way round. Every rank raises it alike (it depends on the scene and
+/// options only).
+void refuse_without_vtk(const Scene& scene, const Cli& cli) {
+  const auto refuse = [](const std::string& what, std::int64_t every, const char* needs,
+                         const char* instead) {
+    throw InputError(fmt::format("{} {}: {} VTK, and this build has none (BASALT_WITH_VTK=OFF: {}); {}", what,
+                                 every, needs, BASALT_WITHOUT_VTK_REASON, instead));
+  };
+  if (scene.frames_every > 0)
+    refuse(cli.frames_every >= 0 ? "--frames-every" : "output.frames_every", scene.frames_every,
+           "VTK frames need",
+           "write checkpoints (--checkpoint-every N) and open ckpt_series.xmf in ParaView instead");
+  if (scene.render_every > 0)
+    refuse(cli.render_every >= 0 ? "--render-every" : "output.render_every", scene.render_every,
+           "in-situ pictures need",
+           "write checkpoints (--checkpoint-every N), open ckpt_series.xmf in ParaView, or draw them with a "
+           "basalt-view built with VTK");
+}
+#endif
+
 /// glibc keeps freed memory in the heap and raises its mmap threshold to the largest block freed (up to
 /// 32 MB), so the arrays rebuilt at every neighbour-list rebuild come back from a heap that only grows: the
 /// 60 mm wave cube's two ranks went from 274 to 401 MB of RSS in 2,000 steps (25 rebuilds), the 9.47 M cube
@@ -425,6 +454,18 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
   return 0;
 }
 
+#if BASALT_WITH_VTK
+constexpr const char* kFramesHelp = "VTK frame every N steps (0 = off)";
+constexpr const char* kRenderHelp =
+    "in-situ PNG picture every N steps, drawn by I/O rank 0 while the run goes on (needs --io-ranks "
+    ">= 1; 0 = off; docs/io-ranks.md)";
+#else
+constexpr const char* kFramesHelp =
+    "VTK frame every N steps (0 = off); not in this build (BASALT_WITH_VTK=OFF)";
+constexpr const char* kRenderHelp =
+    "in-situ PNG picture every N steps (0 = off); not in this build (BASALT_WITH_VTK=OFF)";
+#endif
+
 int run_world(int argc, char** argv) {
   int world_rank = 0;
   MPI_Comm_rank(MPI_COMM_WORLD, &world_rank);
@@ -445,15 +486,10 @@ int run_world(int argc, char** argv) {
       ->check(kNonNegative);
   app.add_option("--checkpoint-every", cli.checkpoint_every, "HDF5 checkpoint every N steps (0 = off)")
       ->check(kNonNegative);
-  app.add_option("--frames-every", cli.frames_every, "VTK frame every N steps (0 = off)")
-      ->check(kNonNegative);
+  app.add_option("--frames-every", cli.frames_every, kFramesHelp)->check(kNonNegative);
   app.add_option("--fields-every", cli.fields_every, "every field saver every N steps (0 = off)")
       ->check(kNonNegative);
-  app.add_option(
-         "--render-every", cli.render_every,
-         "in-situ PNG picture every N steps, drawn by I/O rank 0 while the run goes on (needs --io-ranks "
-         ">= 1; 0 = off; docs/io-ranks.md)")
-      ->check(kNonNegative);
+  app.add_option("--render-every", cli.render_every, kRenderHelp)->check(kNonNegative);
   app.add_option(
       "--render", cli.render,
       "the pictures' settings: KEY=VALUE,... with keys color, cut, view, range, size, as basalt-view "
@@ -523,6 +559,9 @@ int run_world(int argc, char** argv) {
   // In-situ pictures: the spec is checked here on every rank, before anything starts.
   if (cli.render_every >= 0) scene.render_every = cli.render_every;
   if (cli.render) scene.render = *cli.render;
+#if !BASALT_WITH_VTK
+  refuse_without_vtk(scene, cli);
+#endif
   io::RenderSpec render_spec;
   try {
     render_spec = io::parse_render_spec(scene.render, cli.render ? "--render" : "output.render");
@@ -617,9 +656,13 @@ int run_world(int argc, char** argv) {
   cfg.throttle_mb_per_s = cli.throttle_mbps;
   cfg.append_fields = header.has_value();
   cfg.render_every = scene.render_every;
+#if BASALT_WITH_VTK
   const auto vtk = io::make_vtk_frame_writer(
       io::Units{scene.units.length, scene.units.time, scene.units.force, io::Units{}.mass},
       header ? header->run.time : -1.0);
+#else
+  const io::VtkFrameWriter vtk;  // none: VTK frames were refused above (refuse_without_vtk)
+#endif
 
   io::RankLayout layout;
   try {

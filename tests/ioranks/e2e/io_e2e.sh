@@ -549,6 +549,58 @@ PY
       done
     done
     ;;
+  without_vtk)
+    # A build without VTK (BASALT_WITH_VTK off; registered only there): VTK frames and in-situ pictures, asked
+    # for on the command line or in the scene, are refused before anything starts (no output folder), non-zero,
+    # in one line naming the option, why and the way round; nothing links VTK; a run still writes its
+    # checkpoints, their XDMF descriptions and the field series, and restarts from them; basalt-view's commands
+    # are refused alike.
+    if ldd "$BASALT_RUN" "$BASALT_VIEW" | grep -i 'libvtk'; then fail "a VTK library is linked (above)"; fi
+    why='this build has none \(BASALT_WITH_VTK=OFF: [^;]+\); '
+    refused() {  # refused REGEX OUTPUT_FOLDER NP ARGS...: refused, in one line of basalt-run's, nothing written
+      local regex=$1 out=$2; shift 2
+      must_fail "^basalt-run: error: $regex" "$@" --output "$out"
+      [ "$(grep -c 'basalt-run' "$W/last.log")" -eq 1 ] || fail "the error is not one line of basalt-run's"
+      [ ! -e "$out" ] || fail "the refused run created its output folder $out"
+    }
+    refused "--frames-every 25: VTK frames need VTK, and ${why}write checkpoints \(--checkpoint-every N\) and open ckpt_series.xmf in ParaView instead\$" \
+      "$W/frames" 3 --io-ranks 1 --steps 100 --checkpoint-every 50 --frames-every 25
+    refused "--render-every 50: in-situ pictures need VTK, and ${why}write checkpoints" \
+      "$W/pictures" 3 --io-ranks 1 --steps 100 --render-every 50 --render "color=speed"
+    refused "--render-every 5: in-situ pictures need VTK" "$W/pictures_q0" 1 --steps 10 --render-every 5
+    sed 's|^\[output\]|[output]\nframes_every = 10|' "$SCENE" >"$W/frames.toml"
+    SCENE=$W/frames.toml refused "output.frames_every 10: VTK frames need VTK, and $why" "$W/frames_key" 2 --steps 10
+    sed 's|^\[output\]|[output]\nrender_every = 10|' "$SCENE" >"$W/render.toml"
+    SCENE=$W/render.toml refused "output.render_every 10: in-situ pictures need VTK, and $why" "$W/render_key" 2 \
+      --io-ranks 1 --steps 10
+    # 0 means off: accepted. Then checkpoints, XDMF and fields with Q = 1 and Q = 0, and a restart.
+    for q in 1 0; do
+      must_run $((2 + q)) --io-ranks $q --steps 100 --checkpoint-every 25 --fields-every 1 --frames-every 0 \
+        --render-every 0 --output "$W/q$q"
+      $CHECK xdmf "$W/q$q" 25,50,75,100 || fail "--io-ranks $q: the XDMF descriptions are wrong"
+      [ "$(wc -l <"$W/q$q/fields.csv")" -eq 101 ] || fail "--io-ranks $q: fields.csv: expected a header and 100 rows"
+      [ -z "$(ls "$W/q$q" | grep -E '\.(vtp|pvtp|pvd)$|^frame_|^pictures')" ] || fail "--io-ranks $q: VTK output written"
+    done
+    cmp "$W/q0/fields.csv" "$W/q1/fields.csv" || fail "fields.csv differs between --io-ranks 0 and 1"
+    must_run 3 --io-ranks 1 --steps 50 --checkpoint-every 25 --fields-every 1 --output "$W/q1" --restart "$W/q1/ckpt_000050.h5"
+    grep -q "continuing from step 50" "$W/last.log" || fail "the restart did not continue from step 50"
+    $CHECK same "$W/q0/ckpt_000100.h5" "$W/q1/ckpt_000100.h5" || fail "the restarted run's step-100 checkpoint differs"
+    $CHECK xdmf "$W/q1" 25,50,75,100 || fail "after the restart from step 50: the XDMF series is wrong"
+    # basalt-view: --version answers; every command is refused in one line, naming the option; nothing written.
+    [ "$("$BASALT_VIEW" --version)" = "$("$BASALT_RUN" --version)" ] || fail "basalt-view --version"
+    for cmd in "render $W/q1/ckpt_000100.h5 -o $W/view.png" "movie $W/q1 -o $W/view.apng" \
+               "convert $W/q1/ckpt_000100.h5 -o $W/view.vtp" "plot $W/q1/fields.csv -o $W/plot.png" \
+               "info $W/q1/ckpt_000100.h5"; do
+      # shellcheck disable=SC2086
+      if "$BASALT_VIEW" $cmd >"$W/bv.log" 2>&1; then fail "basalt-view $cmd succeeded"; fi
+      cat "$W/bv.log"
+      [ "$(wc -l <"$W/bv.log")" -eq 1 ] || fail "basalt-view ${cmd%% *}: not one line"
+      grep -Eq "^basalt-view: error: ${cmd%% *} needs VTK, and ${why}open the run's ckpt_series.xmf in ParaView instead\$" \
+        "$W/bv.log" || fail "basalt-view ${cmd%% *}: the error does not say why"
+    done
+    [ -z "$(ls "$W" | grep -E '^view\.|^plot\.')" ] || fail "basalt-view wrote a file"
+    echo "without VTK: frames and pictures refused (command line and scene), checkpoints + XDMF + fields written, restart bit for bit"
+    ;;
   *) fail "unknown case" ;;
 esac
 echo "PASS ($case_name)"
