@@ -244,9 +244,10 @@ class Simulation {
   /// kResolutionWarn (the load check sees only the start; docs/stability.md, "Energy drift over 1e7 steps").
   void warn_far_positions();
   /// Double only, collective, at rebuilds until it warned: warns (rank 0, once) when the rounding of
-  /// positions, epsilon |x|max / (2 r_min), exceeds kStrainLossWarn of the largest bond strain |r - r0| / r0
-  /// seen so far: the scene's own strains are then resolved to worse than that (docs/stability.md,
-  /// "Coordinates far from the origin"). Reads the positions and bonds only.
+  /// positions, epsilon |x|max / (2 r_min), exceeds kStrainLossWarn of the largest strain seen so far, of a
+  /// bond (|r - r0| / r0) or a contact (overlap / (ri + rj)): the scene's own strains are then resolved to
+  /// worse than that (docs/stability.md, "Coordinates far from the origin"). Reads positions, bonds and pair
+  /// lists; where the resolution is below 1e-12 (near the origin) only the positions.
   void warn_lost_strain();
   /// The fraction of the scene's largest bond strain that rounding may take before warn_lost_strain warns.
   static constexpr double kStrainLossWarn = 1e-3;
@@ -380,7 +381,7 @@ class Simulation {
   std::int64_t rebuild_step_ = 0;  ///< step of the last rebuild (checkpoints store it with p_.xr, yr, zr)
   bool far_moves_ = false;  ///< check_blowup let fast particles go on: the next migration goes any distance
   bool strain_warned_ = false;  ///< warn_lost_strain() has warned
-  double strain_max_ = 0;       ///< the largest bond strain warn_lost_strain has seen (all ranks)
+  double strain_max_ = 0;       ///< the largest bond or contact strain warn_lost_strain has seen (all ranks)
   bool far_warned_ = false;     ///< warn_far_positions() has warned (or the load check did at the start)
   std::int64_t rebalances_ = 0;
   double imbalance_before_ = 1;
