@@ -328,6 +328,18 @@ double segment_distance(const std::array<double, 3>& a, const std::array<double,
   return std::hypot(a[0] + t * ux, a[1] + t * uy, a[2] + t * uz);
 }
 
+/// 1 for each owned particle (index < n_owned) at an end of a bond, else 0.
+template <class Real>
+std::vector<char> owned_with_bonds(const Bonds<Real>& bonds, std::size_t n_owned) {
+  std::vector<char> bonded(n_owned, 0);
+  for (std::size_t k = 0; k < bonds.ia.size(); ++k) {
+    if (static_cast<std::size_t>(bonds.ia[k]) < n_owned) bonded[static_cast<std::size_t>(bonds.ia[k])] = 1;
+    if (k < bonds.n_both_owned && static_cast<std::size_t>(bonds.ib[k]) < n_owned)
+      bonded[static_cast<std::size_t>(bonds.ib[k])] = 1;
+  }
+  return bonded;
+}
+
 std::string xyz(const std::array<double, 3>& v) {
   return fmt::format("({:.6g}, {:.6g}, {:.6g})", v[0], v[1], v[2]);
 }
@@ -463,13 +475,7 @@ void Simulation<Real>::check_blowup() {
     stop(parallel ? comm().broadcast(msg, who) : msg);
   }
   // The particles that moved that far, with their paths since the last rebuild.
-  std::vector<char> bonded(p_.n_owned, 0);
-  for (std::size_t k = 0; k < bonds_.ia.size(); ++k) {
-    if (static_cast<std::size_t>(bonds_.ia[k]) < p_.n_owned)
-      bonded[static_cast<std::size_t>(bonds_.ia[k])] = 1;
-    if (k < bonds_.n_both_owned && static_cast<std::size_t>(bonds_.ib[k]) < p_.n_owned)
-      bonded[static_cast<std::size_t>(bonds_.ib[k])] = 1;
-  }
+  const std::vector<char> bonded = owned_with_bonds(bonds_, p_.n_owned);
   std::vector<double> fast;
   std::vector<std::size_t> mine_fast;
   for (std::size_t i = 0; i < p_.n_owned; ++i) {
@@ -540,13 +546,7 @@ std::optional<std::string> Simulation<Real>::check_frame_state() const {
   const double top = parallel ? comm().max(std::sqrt(worst)) : std::sqrt(worst);
   if (!(top > vmax)) return bad;
   // Bonded: marked as check_blowup marks them.
-  std::vector<char> bonded(p_.n_owned, 0);
-  for (std::size_t k = 0; k < bonds_.ia.size(); ++k) {
-    if (static_cast<std::size_t>(bonds_.ia[k]) < p_.n_owned)
-      bonded[static_cast<std::size_t>(bonds_.ia[k])] = 1;
-    if (k < bonds_.n_both_owned && static_cast<std::size_t>(bonds_.ib[k]) < p_.n_owned)
-      bonded[static_cast<std::size_t>(bonds_.ib[k])] = 1;
-  }
+  const std::vector<char> bonded = owned_with_bonds(bonds_, p_.n_owned);
   for (std::size_t m = 0; m < mine_fast.size(); ++m) fast[m * kFastValues + 9] = double(bonded[mine_fast[m]]);
   auto hit = blocked_path(fast, false);
   if (bad || !hit) return bad;
