@@ -496,3 +496,19 @@ def esys_simulation(dims, particle_type, grid_spacing, verlet_dist, lo, hi, dt=N
         sim.setNumTimeSteps(steps)
     return sim
 
+
+def interp(t, y, x):
+    """y at x by linear interpolation in the increasing samples t (held constant beyond the ends)."""
+    lo, hi = 0, len(t) - 1
+    if x <= t[0]:
+        return y[0]
+    if x >= t[-1]:
+        return y[-1]
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if t[mid] <= x:
+            lo = mid
+        else:
+            hi = mid
+    w = (x - t[lo]) / (t[hi] - t[lo])
+    return (1 - w) * y[lo] + w * y[hi]

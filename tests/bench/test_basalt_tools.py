@@ -174,6 +174,12 @@ def test_places():
             os.environ["BASALT_REFERENCE_DIR"] = saved
 
 
+def test_interp():
+    t, y = [0.0, 1.0, 3.0], [10.0, 20.0, 0.0]
+    assert bt.interp(t, y, -1.0) == 10.0 and bt.interp(t, y, 5.0) == 0.0, "held beyond the ends"
+    assert bt.interp(t, y, 1.0) == 20.0 and close(bt.interp(t, y, 0.25), 12.5) and close(bt.interp(t, y, 2.0), 10.0)
+
+
 def test_mpi():
     s = bt.mpi_settings()
     assert s["OMPI_ALLOW_RUN_AS_ROOT"] == "1" and s["HWLOC_COMPONENTS"] == "-gl", s

@@ -107,22 +107,6 @@ def basalt_run(build, work, tag, geometry, prec, frac, integ, skin, sim_time, dt
             "vz": cols["mean_vz_above"]}
 
 
-def interp(t, y, x):
-    lo, hi = 0, len(t) - 1
-    if x <= t[0]:
-        return y[0]
-    if x >= t[-1]:
-        return y[-1]
-    while hi - lo > 1:
-        mid = (lo + hi) // 2
-        if t[mid] <= x:
-            lo = mid
-        else:
-            hi = mid
-    w = (x - t[lo]) / (t[hi] - t[lo])
-    return (1 - w) * y[lo] + w * y[hi]
-
-
 def arrival(run):
     level = 0.1 * PULSE_AMPLITUDE
     t, v = run["t"], run["vz"]
@@ -136,7 +120,7 @@ def errors(run, ref):
     peak = max(ref["ke"])
     num = den = worst = 0.0
     for x, k in zip(run["t"], run["ke"]):
-        r = interp(ref["t"], ref["ke"], x)
+        r = bt.interp(ref["t"], ref["ke"], x)
         if r < 0.01 * peak:
             continue
         num += (k - r) ** 2

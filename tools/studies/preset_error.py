@@ -37,22 +37,6 @@ def basalt_run(args, work, tag, extra, steps):
             else float("nan"), x.get("critical_step"))
 
 
-def interp(t, ke, x):
-    lo, hi = 0, len(t) - 1
-    if x <= t[0]:
-        return ke[0]
-    if x >= t[-1]:
-        return ke[-1]
-    while hi - lo > 1:
-        mid = (lo + hi) // 2
-        if t[mid] <= x:
-            lo = mid
-        else:
-            hi = mid
-    w = (x - t[lo]) / (t[hi] - t[lo])
-    return (1 - w) * ke[lo] + w * ke[hi]
-
-
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--build", default="build")
@@ -85,7 +69,7 @@ def main():
             t, ke, speed, _ = basalt_run(args, work, name, ["--preset", name], steps)
             num = den = worst = 0.0
             for x, k in zip(t, ke):
-                r = interp(rt, rke, x)
+                r = bt.interp(rt, rke, x)
                 if r < 0.01 * peak:
                     continue
                 num += (k - r) ** 2
