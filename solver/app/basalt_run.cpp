@@ -42,9 +42,11 @@
 #include "basalt/solver/parallel/communicator.hpp"
 #include "basalt/solver/scene/scene.hpp"
 #include "basalt/solver/simulation.hpp"
+#include "basalt/solver/stages.hpp"
 #include "basalt/version.hpp"
 #include "client_sink.hpp"
 #include "geometry_input.hpp"
+#include "output_folder.hpp"
 #include "picture_module.hpp"
 #include "rank_spread.hpp"
 #include "restart_support.hpp"
@@ -159,28 +161,6 @@ std::array<int, 3> parse_dims(const std::string& s) {
       c2 != ',' || static_cast<std::size_t>(n) != s.size() || d[0] < 1 || d[1] < 1 || d[2] < 1)
     throw InputError(fmt::format("--dims {}: expected three positive integers, e.g. --dims 2,1,1", s));
   return d;
-}
-
-/// World rank 0 creates the output folder and checks it can write there; every rank learns the outcome.
-void prepare_output_folder(const fs::path& dir) {
-  int rank = 0;
-  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  std::optional<std::string> error;
-  if (rank == 0) {
-    std::error_code ec;
-    fs::create_directories(dir, ec);
-    if (ec) {
-      error = fmt::format("{}: cannot create the output folder: {}", dir.string(), ec.message());
-    } else {
-      const fs::path probe = dir / ".basalt-write-probe";
-      std::ofstream f(probe);
-      if (!f || !(f << "ok\n") || !f.flush())
-        error = fmt::format("{}: the output folder is not writable", dir.string());
-      f.close();
-      fs::remove(probe, ec);
-    }
-  }
-  if (auto e = Comm(MPI_COMM_WORLD).agree_error(error)) throw InputError(*e);
 }
 
 std::string mb(std::uint64_t bytes) { return fmt::format("{:.2f} MB", double(bytes) * 1e-6); }
@@ -333,6 +313,8 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
   }
 
   std::int64_t steps = scene.steps;
+  for (std::size_t k = 0; k < scene.stages.size(); ++k)
+    steps = (k ? steps : 0) + scene.stages[k].steps;  // at most
   if (header) steps = cli.steps >= 0 ? cli.steps : std::max<std::int64_t>(0, scene.steps - header->run.step);
   const auto& st = sim->stability();
   const double imbalance_start = sim->imbalance();
@@ -398,7 +380,13 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
     run_error = *client.error();
   } else {
     try {
-      sim->run(steps, sink);
+      if (scene.stages.empty()) {
+        sim->run(steps, sink);
+      } else {
+        steps = basalt::solver::run_stages(*sim, sink, scene.stages, [&](const auto& stage, const auto& r) {
+          if (root) fmt::print("{}\n", basalt::solver::describe(stage, r));
+        });
+      }
     } catch (const std::exception& e) {
       run_error = e.what();  // raised alike on every compute rank
     }
@@ -581,6 +569,14 @@ int run_world(int argc, char** argv) {
         "compute ranks go on, which never wait for a picture; without I/O ranks, write checkpoints and draw "
         "them afterwards (basalt-view render out/ckpt_*.h5 -o pictures/)",
         cli.render_every > 0 ? "--render-every" : "output.render_every", scene.render_every));
+  if (!scene.stages.empty() && cli.steps >= 0)
+    throw InputError(fmt::format(
+        "{}: --steps: the scene runs [[stages]], whose steps = N say how long each runs", cli.scene_file));
+  if (!scene.stages.empty() && !cli.restart.empty())
+    throw InputError(
+        fmt::format("{}: --restart: a run of [[stages]] cannot continue from a checkpoint yet (the "
+                    "checkpoint does not store which stage it was in); start the run again",
+                    cli.scene_file));
   if (!cli.preset.empty()) {  // docs/stability.md, "Presets": the error and speed measured for each
     scene.precision = cli.preset == "fast" ? "float" : "double";
     scene.dt = 0;
@@ -635,7 +631,7 @@ int run_world(int argc, char** argv) {
     }
   }
 
-  prepare_output_folder(scene.output_dir);
+  basalt::run::prepare_output_folder(scene.output_dir, MPI_COMM_WORLD);
   if (header && world_root && !scene.fields.empty()) {
     const fs::path csv = scene.output_dir / "fields.csv";
     const auto last = basalt::run::truncate_fields(csv, header->run.step);

@@ -13,6 +13,7 @@
 #include "basalt/io/mesh_file.hpp"
 #include "basalt/io/render_options.hpp"
 #include "basalt/solver/models/registry.hpp"
+#include "basalt/solver/stages.hpp"
 
 namespace basalt::solver {
 
@@ -213,8 +214,11 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
           "fraction of the critical step");
     }
     s.precision = t.choice_or("precision", {"double", "float", "mixed"}, "double");
-    s.steps = t.integer("steps");
+    // With [[stages]] each stage's steps say how long it runs: run.steps may be left out (or 0).
+    s.steps = top.has("stages") ? t.integer_or("steps", 0) : t.integer("steps");
     if (s.steps < 0) t.fail("steps", fmt::format("must be >= 0, got {}", s.steps));
+    if (s.steps > 0 && top.has("stages"))
+      t.fail("steps", "the scene has [[stages]], whose steps = N say how long each runs: leave run.steps out");
     s.skin = t.positive("skin");
     s.integrator = t.choice_or("integrator", {"velocity_verlet", "symplectic_euler"}, "velocity_verlet") ==
                            "symplectic_euler"
@@ -464,6 +468,12 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
       }
     }
     t.finish();
+  }
+  if (const auto* arr = top.table_array("stages")) {
+    for (std::size_t k = 0; k < arr->size(); ++k) {
+      TableReader t(*(*arr)[k].as_table(), label, fmt::format("stages[{}]", k));
+      s.stages.push_back(parse_stage(t, s.walls));
+    }
   }
   top.finish();
   return s;

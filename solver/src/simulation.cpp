@@ -36,9 +36,7 @@ template <class Real>
 void Simulation<Real>::start(const Scene& scene) {
   configure_particles();
   if (scene.bonds.size() > 254) throw InputError("interactions: at most 254 bond groups");
-  const bool se = scene.integrator == Integrator::symplectic_euler;
-  kick1_ = Real(se ? scene.dt : scene.dt / 2);
-  kick2_ = Real(se ? 0.0 : scene.dt / 2);
+  apply_dt(scene_.dt);
   rebuild_limit2_ = 0.25 * scene.skin * scene.skin;
 }
 
@@ -118,7 +116,7 @@ void Simulation<Real>::configure_particles() {
 
 template <class Real>
 double Simulation<Real>::kinetic_energy_local() const {
-  return (ke_fresh_ ? ke_local_ : basalt::solver::kinetic_energy(p_)) + rotational_energy(p_);
+  return integrator_.kinetic_energy().value_or(basalt::solver::kinetic_energy(p_)) + rotational_energy(p_);
 }
 
 template <class Real>
@@ -238,8 +236,7 @@ template <class Real>
 template <bool Energy>
 const std::vector<double>& Simulation<Real>::compute_forces(bool ghosts_in_flight, bool advance) {
   // Interactions among owned particles first: a ghost update still in flight overlaps them.
-  if (!forces_zeroed_) zero_forces(p_);
-  forces_zeroed_ = false;
+  if (!integrator_.take_zeroed()) zero_forces(p_);
   if (Energy) forces_.zero_energies();
   const std::size_t before = broken_.size();
   if (!forces_.walls().empty()) forces_.walls().move_to(time_);
@@ -300,97 +297,6 @@ bool Simulation<Real>::kinetic_due(std::int64_t s) const {
 }
 
 template <class Real>
-void Simulation<Real>::advance(FieldSink* sink, bool may_defer) {
-  ke_fresh_ = false;
-  sink_ = sink;
-  Stopwatch sw;
-  // Forces are zeroed in the same pass: the non-finite check needs them only at a rebuild, and a
-  // non-finite force has already made the velocity non-finite. A second half-kick the last step left
-  // (kick_pending_) is made in the same pass.
-  const Real dt = Real(scene_.dt);
-  const double moved2 =
-      kick_pending_ ? kick_kick_zero_drift(p_, kick2_, kick1_, dt) : kick_zero_drift(p_, kick1_, dt);
-  if (p_.with_rotation) {
-    if (kick_pending_)
-      rotate_kick_kick_zero_drift(p_, kick2_, kick1_, dt);
-    else
-      rotate_kick_zero_drift(p_, kick1_, dt);
-  }
-  kick_pending_ = false;
-  forces_zeroed_ = true;
-  times_.integration += sw.lap();
-  const bool parallel = comm().size() > 1;
-  if (!forces_.walls().empty()) {
-    forces_.walls().advance_servos(scene_.dt);
-    forces_.walls().move_to(double(step_ + 1) * scene_.dt);
-  }
-  // (the scene's string is compared once per balance_every steps, not at every step)
-  const bool balance_due = parallel && step_ > 0 && step_ % scene_.balance_every == 0 &&
-                           scene_.balance == "time" && !balance_paused_ && time_balance_due();
-  double need =
-      bond_broke_ || balance_due
-          ? std::numeric_limits<double>::infinity()
-          : std::max(moved2, forces_.walls().empty() ? 0.0 : forces_.walls().moved2_since_rebuild());
-  if (parallel) need = comm().max(need);
-  times_.communication += sw.lap();
-  bool in_flight = false;
-  if (!(need <= rebuild_limit2_)) {
-    check_blowup();  // simulation_stability.cpp: stops a run that moved absurdly far in this step
-    rebuild();
-    rebuild_step_ = step_ + 1;  // the positions it used are those of the step being completed
-    sw.lap();
-  } else if (parallel) {
-    halo_->begin_update_ghosts(p_);
-    in_flight = true;
-    times_.communication += sw.lap();
-  }
-  ++step_;
-  time_ = double(step_) * scene_.dt;
-  const bool energy = energy_due(step_);
-  ghost_wait_ = 0;
-  const auto pe = energy ? compute_forces<true>(in_flight, true) : compute_forces<false>(in_flight, true);
-  const double force_time = sw.lap();
-  times_.forces += force_time - ghost_wait_;
-  times_.communication += ghost_wait_;
-  if (kick2_ != Real(0)) {
-    if (may_defer && !observed(step_)) {
-      kick_pending_ = true;
-    } else {
-      if (p_.with_rotation) rotate_kick(p_, kick2_);
-      if (kinetic_due(step_)) {
-        ke_local_ = kick_energy(p_, kick2_);
-        ke_fresh_ = true;
-      } else {
-        kick(p_, kick2_);
-      }
-    }
-  }
-  times_.integration += sw.lap();
-  if (!forces_.walls().empty()) {
-    wall_work_in_ += std::max(0.0, forces_.walls().power()) * scene_.dt;
-    steer_servos();
-  }
-  save_fields(sink, pe);
-  times_.output += sw.lap();
-  if (scene_.energy_check_every > 0 && step_ % scene_.energy_check_every == 0) guard_energy(pe);
-}
-
-template <class Real>
-bool Simulation<Real>::observed(std::int64_t s) const {
-  for (const auto& f : scene_.fields)
-    if (s % f.every == 0) return true;
-  return scene_.energy_check_every > 0 && s % scene_.energy_check_every == 0;
-}
-
-template <class Real>
-void Simulation<Real>::settle_kick() {
-  if (!kick_pending_) return;
-  if (p_.with_rotation) rotate_kick(p_, kick2_);
-  kick(p_, kick2_);
-  kick_pending_ = false;
-}
-
-template <class Real>
 void Simulation<Real>::steer_servos() {
   // The force on a servo wall is every rank's share summed (the same sum on every rank, so each moves
   // it alike); its control law (WallMotion::servo) is free of MPI.
@@ -409,87 +315,74 @@ void Simulation<Real>::steer_servos() {
 }
 
 template <class Real>
-void Simulation<Real>::save_fields(FieldSink* sink, const std::vector<double>& pe) {
-  if (output_) return output_fields(pe);
-  std::vector<double> local;
-  std::vector<char> due;
-  const bool any = field_partials(pe, local, due);
-  if (!any) return;
-  if (comm().size() == 1) {
-    if (!sink) return;
-    std::vector<std::optional<double>> row(local.size());
-    for (std::size_t c = 0; c < local.size(); ++c)
-      if (due[c]) row[c] = local[c];
-    sink->row(step_, time_, row);
-    return;
+void Simulation<Real>::apply_dt(double dt) {
+  scene_.dt = dt;
+  integrator_.configure(dt, scene_.integrator == Integrator::symplectic_euler);
+  for (const auto& c : forces_.computes()) c->set_time_step(dt);  // velocity-dependent models' increments
+}
+
+template <class Real>
+void Simulation<Real>::set_dt(double dt) {
+  if (!(dt > 0) || !std::isfinite(dt))
+    throw InputError(fmt::format("dt = {}: must be positive and finite", dt));
+  apply_dt(dt);
+}
+
+template <class Real>
+void Simulation<Real>::set_fixed_tags(std::vector<std::int64_t> tags) {
+  scene_.fixed_tags = std::move(tags);
+  find_fixed();
+  // Held from now on: at rest, and the forces of this step (the next kick's) zeroed as hold_fixed() does.
+  for (const auto i : fixed_) {
+    p_.vx[i] = p_.vy[i] = p_.vz[i] = 0;
+    if (p_.with_rotation) p_.wx[i] = p_.wy[i] = p_.wz[i] = 0;
   }
-  finish_row(sink);
-  if (!row_sum_) row_sum_ = std::make_unique<AsyncSum>(comm());
-  row_sum_->start(std::move(local));
-  row_step_ = step_;
-  row_time_ = time_;
-  row_due_ = std::move(due);
+  hold_fixed();
 }
 
 template <class Real>
-void Simulation<Real>::stop(const std::string& message) {
-  // Collective (every caller has agreed on the error): deliver the row in flight, then stop.
-  finish_row(sink_);
-  if (sink_ && comm().rank() == 0) sink_->flush();
-  throw RunError(message);
+void Simulation<Real>::find_fixed() {
+  fixed_.clear();
+  if (!scene_.fixed_tags.empty())
+    for (std::size_t i = 0; i < p_.n_owned; ++i)
+      if (std::find(scene_.fixed_tags.begin(), scene_.fixed_tags.end(), p_.tag[i]) != scene_.fixed_tags.end())
+        fixed_.push_back(static_cast<std::uint32_t>(i));
 }
 
 template <class Real>
-void Simulation<Real>::finish_row(FieldSink* sink) {
-  if (!row_sum_ || !row_sum_->active()) return;
-  const auto& sums = row_sum_->finish();
-  if (comm().rank() != 0 || !sink) return;
-  std::vector<std::optional<double>> row(sums.size());
-  for (std::size_t c = 0; c < sums.size(); ++c)
-    if (row_due_[c]) row[c] = sums[c];
-  sink->row(row_step_, row_time_, row);
+std::size_t Simulation<Real>::wall_index(std::string_view name) const {
+  const auto& walls = forces_.walls();
+  for (std::size_t w = 0; w < walls.size(); ++w)
+    if (walls.spec(w).name == name) return w;
+  std::string names;
+  for (std::size_t w = 0; w < walls.size(); ++w) names += (w ? ", " : "") + walls.spec(w).name;
+  throw InputError(fmt::format("no planar wall named \"{}\" (the scene's walls: {})", name,
+                               names.empty() ? "none" : names));
 }
 
 template <class Real>
-void Simulation<Real>::progress(std::int64_t done, std::int64_t total, double seconds) const {
-  const double sps = done / std::max(seconds, 1e-9);
-  fmt::print("step {:>8}/{}  {:8.1f} steps/s  {:6.2f} M particle-steps/s  ETA {:.1f} s\n", step_,
-             step_ + (total - done), sps, sps * double(n_global_) * 1e-6,
-             (total - done) / std::max(sps, 1e-9));
-  std::fflush(stdout);
+void Simulation<Real>::set_wall_velocity(std::string_view name, const std::array<double, 3>& v) {
+  for (double c : v)
+    if (!std::isfinite(c)) throw InputError(fmt::format("wall \"{}\": the velocity must be finite", name));
+  forces_.walls().set_velocity(wall_index(name), v, time_);
 }
 
 template <class Real>
-void Simulation<Real>::run(std::int64_t steps, FieldSink* sink) {
-  if (steps < 0) steps = scene_.steps;
-  Stopwatch clock;
-  double elapsed = 0, last = 0;
-  const bool show = !options_.quiet && comm().rank() == 0;
-  const SettleOnExit settle{*this};
-  for (std::int64_t k = 0; k < steps; ++k) {
-    advance(sink, k + 1 < steps);
-    if (show && (k & 15) == 15) {
-      elapsed += clock.lap();
-      if (elapsed - last >= options_.progress_seconds) {
-        progress(k + 1, steps, elapsed);
-        last = elapsed;
-      }
-    }
-  }
-  finish_row(sink);
-  if (sink && comm().rank() == 0) sink->flush();
+void Simulation<Real>::remove_wall(std::string_view name) {
+  forces_.walls().remove(wall_index(name));
+  force_rebuild();
 }
 
 template <class Real>
 void Simulation<Real>::state_changed() {
-  ke_fresh_ = false;
+  integrator_.forget_energy();
   wall_work_in_ = 0;
   start_ledger(compute_forces<true>());
 }
 
 template <class Real>
 void Simulation<Real>::force_rebuild() {
-  ke_fresh_ = false;
+  integrator_.forget_energy();
   rebuild();
   compute_forces<false>();
 }
@@ -513,5 +406,11 @@ std::size_t Simulation<Real>::memory_bytes() const {
 
 template class Simulation<double>;
 template class Simulation<float>;
+// The step (simulation_step.cpp) and the stability estimate call both; explicit, as they are member
+// templates.
+template const std::vector<double>& Simulation<double>::compute_forces<true>(bool, bool);
+template const std::vector<double>& Simulation<double>::compute_forces<false>(bool, bool);
+template const std::vector<double>& Simulation<float>::compute_forces<true>(bool, bool);
+template const std::vector<double>& Simulation<float>::compute_forces<false>(bool, bool);
 
 }  // namespace basalt::solver

@@ -1,6 +1,5 @@
-// The run loop with output (OutputSink): field-saver partial sums from every compute rank, frames
-// (checkpoints, VTK) written by this rank's SimulationFrame straight into the output buffer, output
-// errors agreed on by all ranks.
+// Output of a run (OutputSink): field-saver partial sums from every compute rank, the decomposition's
+// layout for checkpoints, the frame timing report. The run loop that writes frames is simulation_step.cpp.
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -170,81 +169,6 @@ RestartLayout Simulation<Real>::restart_layout() const {
 }
 
 template <class Real>
-void Simulation<Real>::run(std::int64_t steps, OutputSink& out) {
-  if (steps < 0) steps = scene_.steps;
-  output_ = &out;
-  struct Reset {
-    OutputSink*& p;
-    ~Reset() { p = nullptr; }
-  } reset{output_};
-  out.begin(field_columns(scene_));
-  Stopwatch clock;
-  double elapsed = 0, last = 0;
-  const bool show = !options_.quiet && comm().rank() == 0;
-  const bool parallel = comm().size() > 1;
-  bool reported = false;
-  std::vector<double> frame_seconds;  // pack + submit of each frame (BASALT_FRAME_TIMES=1 prints them)
-  // A second half-kick deferred by the last step is made on every way out (an error, a stop signal).
-  const SettleOnExit settle{*this};
-  for (std::int64_t k = 0; k < steps; ++k) {
-    // Frames read the velocities: the step before one makes its second half-kick.
-    advance(nullptr, k + 1 < steps && out.frame_kinds(step_ + 1) == 0);
-    Stopwatch sw;
-    const std::uint32_t kinds = out.frame_kinds(step_);
-    if (kinds != 0) {
-      // No checkpoint or frame from a state with non-finite values or blown up (simulation_stability.cpp):
-      // the last complete checkpoint stays the newest, a valid restart point.
-      auto bad = check_frame_state();
-      if (parallel) bad = comm().agree_error(bad);
-      if (bad)
-        throw RunError(
-            fmt::format("{}; the {} of step {} is not written (the checkpoints written before stay)", *bad,
-                        (kinds & io::kFrameCheckpoint) ? "checkpoint" : "frame", step_));
-      Stopwatch frame_clock;
-      out.frame(SimulationFrame<Real>(*this, kinds));
-      frame_seconds.push_back(frame_clock.lap());
-    }
-    // Completed sends and errors from the I/O ranks are picked up at output steps and every 32 steps,
-    // where the ranks also agree on errors so that all stop at the same step (one small reduction,
-    // not one per step; polling every step costs more than it gains: MPI's progress engine yields
-    // the core when idle).
-    if (kinds != 0 || (k & 31) == 31 || k + 1 == steps) {
-      // A stop asked by a signal (SIGTERM, SIGINT) is agreed here too: every rank stops at this step,
-      // and the rows and frames handed over so far are written before basalt-run exits.
-      int sig = stop_signal;
-      if (parallel) sig = static_cast<int>(comm().max(static_cast<double>(sig)));
-      if (sig != 0)
-        throw RunError(
-            fmt::format("stopped by {} at step {}: the output due up to this step is written; "
-                        "--restart from the last checkpoint continues the run",
-                        signal_name(sig), step_));
-      auto error = out.poll();
-      if (parallel) error = comm().agree_error(error);
-      if (error && !reported) {
-        if (!out.continue_on_error())
-          throw RunError(fmt::format("output failed at step {}: {}", step_, *error));
-        if (comm().rank() == 0)
-          fmt::print(stderr,
-                     "basalt-run: warning: output failed at step {} (on_error = \"continue\"; the run goes "
-                     "on without it): {}\n",
-                     step_, *error);
-        reported = true;
-      }
-    }
-    times_.output += sw.lap();
-    if (show && (k & 15) == 15) {
-      elapsed += clock.lap();
-      if (elapsed - last >= options_.progress_seconds) {
-        progress(k + 1, steps, elapsed);
-        last = elapsed;
-      }
-    }
-  }
-  out.flush();
-  report_frame_times(frame_seconds);
-}
-
-template <class Real>
 void Simulation<Real>::report_frame_times(std::vector<double> seconds) const {
   // Benchmark aid (tools/bench): this compute rank's cost of handing frames to the output.
   const char* want = std::getenv("BASALT_FRAME_TIMES");
@@ -263,8 +187,7 @@ void Simulation<Real>::report_frame_times(std::vector<double> seconds) const {
   template void Simulation<R>::output_fields(const std::vector<double>&);                       \
   template double Simulation<R>::runout(const FieldSpec&) const;                                \
   template RestartLayout Simulation<R>::restart_layout() const;                                 \
-  template void Simulation<R>::report_frame_times(std::vector<double>) const;                   \
-  template void Simulation<R>::run(std::int64_t, OutputSink&);
+  template void Simulation<R>::report_frame_times(std::vector<double>) const;
 BASALT_INSTANTIATE(double)
 BASALT_INSTANTIATE(float)
 #undef BASALT_INSTANTIATE

@@ -133,11 +133,7 @@ void Simulation<Real>::rebuild() {
     p_.yr.assign(p_.y.begin(), p_.y.begin() + static_cast<std::ptrdiff_t>(p_.n_owned));
     p_.zr.assign(p_.z.begin(), p_.z.begin() + static_cast<std::ptrdiff_t>(p_.n_owned));
   }
-  fixed_.clear();
-  if (!scene_.fixed_tags.empty())
-    for (std::size_t i = 0; i < p_.n_owned; ++i)
-      if (std::find(scene_.fixed_tags.begin(), scene_.fixed_tags.end(), p_.tag[i]) != scene_.fixed_tags.end())
-        fixed_.push_back(static_cast<std::uint32_t>(i));
+  find_fixed();
   rebuild_step_ = step_;
   bond_broke_ = false;
   ++rebuilds_;

@@ -32,9 +32,7 @@ void Simulation<Real>::begin_restart(std::size_t particles, double dt, const Res
   if (dt != scene_.dt)
     throw InputError(
         fmt::format("the checkpoint was written with dt = {}, the scene has run.dt = {}", dt, scene_dt));
-  const bool se = scene_.integrator == Integrator::symplectic_euler;
-  kick1_ = Real(se ? scene_.dt : scene_.dt / 2);
-  kick2_ = Real(se ? 0.0 : scene_.dt / 2);
+  apply_dt(scene_.dt);
   rebuild_limit2_ = 0.25 * scene_.skin * scene_.skin;
 }
 

@@ -201,7 +201,7 @@ void Simulation<Real>::estimate_critical_step(bool fresh) {
       zero_forces(p_);  // ghosts' forces and the torques too
       for (int d = 0; d < 3; ++d)
         for (std::size_t i = 0; i < n; ++i) frc[d][i] = -f_at_x[d * n + i];
-      forces_zeroed_ = true;  // the next evaluation adds F(x + d) onto -F(x)
+      integrator_.mark_zeroed();  // the next evaluation adds F(x + d) onto -F(x)
       // x + d: delta u / umax, rounded to a multiple of the coordinate's ulp where it is movable.
       for (std::size_t i = 0, k = 0; i < n; ++i)
         for (int d = 0; d < 3; ++d) {
@@ -294,10 +294,7 @@ void Simulation<Real>::estimate_critical_step(bool fresh) {
       throw InputError(
           "run.dt_fraction: the scene has no stiffness (no bonds, contacts or walls touching particles), so "
           "there is no critical step to take a fraction of: give run.dt instead");
-    scene_.dt = scene_.dt_fraction * st.dt_critical;
-    const bool se = scene_.integrator == Integrator::symplectic_euler;
-    kick1_ = Real(se ? scene_.dt : scene_.dt / 2);
-    kick2_ = Real(se ? 0.0 : scene_.dt / 2);
+    apply_dt(scene_.dt_fraction * st.dt_critical);
   }
   if (!(st.dt_critical > 0)) return;
   st.fraction = scene_.dt / st.dt_critical;

@@ -111,6 +111,19 @@ std::vector<std::int64_t> TableReader::integers_or(const std::string& key,
   return out;
 }
 
+std::vector<std::string> TableReader::strings_or(const std::string& key, std::vector<std::string> fallback) {
+  if (!has(key)) return fallback;
+  const auto* arr = node(key).as_array();
+  if (!arr) fail(key, "must be an array of strings");
+  std::vector<std::string> out;
+  for (const auto& e : *arr) {
+    auto s = e.value_exact<std::string>();
+    if (!s) fail(key, "must be an array of strings");
+    out.push_back(*s);
+  }
+  return out;
+}
+
 const toml::table* TableReader::subtable(const std::string& key) {
   if (!has(key)) return nullptr;
   const auto& n = node(key);

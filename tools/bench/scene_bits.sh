@@ -8,7 +8,8 @@
 #   bash tools/bench/scene_bits.sh [--steps N] A/bin B/bin
 #
 # Scenes: wave and wave-esys on the GenGeo cube (tests/data/cube1.geo), granular-esys and ucs-esys on their
-# ESyS inputs (docs/data); N steps each (default 2000; the scenes' own step counts take minutes).
+# ESyS inputs (docs/data), the column collapse and the hopper on packings made here; N steps each (default
+# 2000; the scenes' own step counts take minutes).
 set -euo pipefail
 steps=2000
 while [[ $# -gt 0 ]]; do
@@ -27,8 +28,15 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 cube="$root/tests/data/cube1.geo"
+# The column collapse and the hopper ship no geometry: packed here as their scenes say (the packer is
+# deterministic; B's packer for both sides).
+"$B/basalt-pack" box --size 10,8,10 --rmin 0.4 --rmax 0.6 --no-bonds --seed 1 -o "$work/column.h5" >/dev/null
+"$B/basalt-pack" cylinder --radius 19.3 --height 15 --origin 0,0,0 --rmin 0.5 --rmax 0.7 --no-bonds --seed 1 \
+  -o "$work/hopper.h5" >/dev/null
 cases=(
   "wave|$root/scenes/wave.toml|--geometry $cube"
+  "column-collapse|$root/scenes/column-collapse.toml|--geometry $work/column.h5"
+  "hopper|$root/scenes/hopper.toml|--geometry $work/hopper.h5"
   "wave-esys|$root/scenes/wave-esys.toml|--geometry $cube"
   "granular-esys|$root/scenes/granular-esys.toml|"
   "ucs-esys|$root/scenes/ucs-esys.toml|"

@@ -8,6 +8,7 @@
 #include <limits>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <type_traits>
@@ -21,8 +22,10 @@
 #include "basalt/solver/core/id_map.hpp"
 #include "basalt/solver/core/ledger.hpp"
 #include "basalt/solver/core/particles.hpp"
+#include "basalt/solver/integrate/verlet.hpp"
 #include "basalt/solver/interactions/force_field.hpp"
 #include "basalt/solver/neighbor/verlet_list.hpp"
+#include "basalt/solver/output/field_rows.hpp"
 #include "basalt/solver/output/field_sink.hpp"
 #include "basalt/solver/output/output_sink.hpp"
 #include "basalt/solver/parallel/balance.hpp"
@@ -76,6 +79,14 @@ struct RestartLayout {
   std::array<double, 3> origin{0, 0, 0};
 };
 
+/// A caller's job between steps (Python callbacks, stop conditions): run() calls it after every step s with
+/// s % every == 0 (the step before it then makes its second half-kick: it may read velocities). It returns
+/// false to end the run after this step, and must decide alike on every rank (on collective values).
+struct StepHook {
+  std::int64_t every = 1;
+  std::function<bool(std::int64_t step)> call;
+};
+
 template <class Real>
 class SimulationFrame;  // output/simulation_frame.hpp: this rank's frame, written for the output
 
@@ -105,10 +116,11 @@ class Simulation {
   Simulation(const Scene& scene, const io::CheckpointFile& file, const RestartLayout& layout, MPI_Comm comm,
              const RunOptions& options = {});
 
-  /// Runs `steps` steps with output through `out` (simulation_output.cpp): field partials every
-  /// saved step, frames (SimulationFrame) when out.frame_kinds() asks. An output error stops the run on every
-  /// rank at the same step (RunError naming it) unless out.continue_on_error().
-  void run(std::int64_t steps, OutputSink& out);
+  /// Runs `steps` steps (scene.steps when negative) with output through `out` (simulation_step.cpp): field
+  /// partials every saved step, frames (SimulationFrame) when out.frame_kinds() asks, then the hooks due.
+  /// An output error stops the run on every rank at the same step (RunError naming it) unless
+  /// out.continue_on_error(). Returns the steps made (fewer when a hook ended the run).
+  std::int64_t run(std::int64_t steps, OutputSink& out, std::span<const StepHook> hooks = {});
   /// The decomposition's box, ghost width and contact cut-off (stored in checkpoints).
   RestartLayout restart_layout() const;
 
@@ -116,9 +128,9 @@ class Simulation {
   void run(std::int64_t steps = -1, FieldSink* sink = nullptr);
   /// One step. On more than one rank a step's field row reaches the sink during the next step (its
   /// reduction overlaps that step's work); run() and flush_fields() deliver the last one.
-  void step(FieldSink* sink = nullptr) { advance(sink, false); }
+  void step(FieldSink* sink = nullptr);
   /// Collective: delivers a field row still in flight to the sink.
-  void flush_fields(FieldSink* sink) { finish_row(sink); }
+  void flush_fields(FieldSink* sink);
 
   // State and diagnostics (collective where noted).
   std::int64_t current_step() const { return step_; }
@@ -128,7 +140,7 @@ class Simulation {
   const Particles<Real>& particles() const { return p_; }
   /// Mutable access (tests, set-up) drops the kinetic energy cached by the last step.
   Particles<Real>& particles() {
-    ke_fresh_ = false;
+    integrator_.forget_energy();
     return p_;
   }
   const Bonds<Real>& bonds() const { return bonds_; }
@@ -165,6 +177,19 @@ class Simulation {
   void state_changed();
   /// Collective: rebuilds the lists now (migrating particles), then recomputes forces.
   void force_rebuild();
+
+  // Steering between steps (the Python package, docs/python.md): collective, called alike on every rank.
+  /// The time step from now on (velocity-dependent models follow it). InputError unless positive and finite.
+  void set_dt(double dt);
+  /// Particles of these tags are held from now on (stopped; they feel forces but never move or turn);
+  /// replaces the scene's particles.fixed_tags.
+  void set_fixed_tags(std::vector<std::int64_t> tags);
+  /// The planar wall of that name (InputError naming the scene's walls when none is).
+  std::size_t wall_index(std::string_view name) const;
+  /// The wall moves at velocity v from now on, from where it is (a servo wall stops steering itself).
+  void set_wall_velocity(std::string_view name, const std::array<double, 3>& v);
+  /// The wall stops touching particles (a gate taken away): the lists are rebuilt at once.
+  void remove_wall(std::string_view name);
   /// Collective: the busiest rank's owned particles over the mean (1 = perfectly balanced).
   double imbalance() const;
   /// run.balance = "pairs"'s estimate of each owned particle's work in a step, a whole number (units of
@@ -210,6 +235,10 @@ class Simulation {
   void configure_particles();
   /// Zeroes the forces and torques of fixed particles (scene particles.fixed_tags).
   void hold_fixed();
+  /// fixed_ from the owned particles' tags (at rebuilds, and when the fixed tags change).
+  void find_fixed();
+  /// The run's time step: the integrator's kicks and the models' time step (set_time_step).
+  void apply_dt(double dt);
   double kinetic_energy_local() const;
   /// Bonds of this rank counted once across ranks (a bond to a ghost by the rank owning the lower id).
   std::int64_t local_bond_count() const;
@@ -284,11 +313,36 @@ class Simulation {
   const std::vector<double>& compute_forces(bool ghosts_in_flight = false, bool advance = false);
   /// Collective: each servo wall's velocity for the next step from the force on it summed over ranks.
   void steer_servos();
-  /// One step. With may_defer (run(), when the next thing it does is another step), velocity Verlet's
-  /// second half-kick is left for the next step's first pass, which then makes both (the same bits, one
-  /// pass over memory fewer) unless something reads the velocities at this step (a field saver, the
-  /// energy check).
-  void advance(FieldSink* sink, bool may_defer);
+  /// One step (simulation_step.cpp lists its parts in order). With may_defer (run(), when the next thing it
+  /// does is another step), velocity Verlet's second half-kick is left for the next step's first pass, which
+  /// then makes both (the same bits, one pass over memory fewer) unless something reads the velocities at
+  /// this step (a field saver, the energy check).
+  void advance(bool may_defer);
+  // The parts of a step, in its order; each times itself (times_).
+  /// The first half-kick and the drift; returns the largest squared move since the skin reference.
+  double drift();
+  /// Prescribed and servo walls to the time of `step`.
+  void move_walls(std::int64_t step);
+  /// Rebuilds the lists when the skin is exceeded, a bond broke or the time balancer asks; otherwise (ranks
+  /// > 1) begins the ghosts' update and returns true (it completes inside the force computation).
+  bool refresh_neighbours(double moved2);
+  /// The step's forces (energies when a saver or the guard reads them); this rank's potentials by term.
+  const std::vector<double>& step_forces(bool in_flight);
+  /// The second half-kick, deferred when `defer`.
+  void second_kick(bool defer);
+  /// The walls' work on the particles (energy ledger) and the servo walls' steering.
+  void wall_work();
+  /// Field savers due and the energy guard.
+  void observe(const std::vector<double>& pe);
+  /// Whether any hook is due after step s.
+  static bool hooks_due(std::span<const StepHook> hooks, std::int64_t s);
+  /// Collective: checks the state and hands this rank's share of a frame to `out`.
+  void write_frame(OutputSink& out, std::uint32_t kinds, std::vector<double>& seconds);
+  /// Collective: a stop signal or an output error on any rank stops every rank here (RunError), unless the
+  /// output may fail (on_error = "continue": warned once, `reported`).
+  bool agree_on_output(OutputSink& out, bool& reported);
+  /// The FieldRows adapter of step()/run() given a FieldSink (kept across calls: a row may be in flight).
+  FieldRows& field_rows(FieldSink* sink);
   /// Makes a deferred second half-kick now (run() on its way out, whatever the way).
   void settle_kick();
   /// run()'s guard: settle_kick() when it leaves scope (the last step, an error, a stop signal).
@@ -298,7 +352,6 @@ class Simulation {
   };
   /// Whether anything reads the velocities after step s: a field saver or the energy check due.
   bool observed(std::int64_t s) const;
-  void save_fields(FieldSink* sink, const std::vector<double>& pe);
   bool field_partials(const std::vector<double>& pe, std::vector<double>& local,
                       std::vector<char>& due) const;
   void output_fields(const std::vector<double>& pe);
@@ -329,8 +382,6 @@ class Simulation {
   /// Restart: servo walls' point and velocity from the checkpoint (at_rebuild: their point at the last
   /// rebuild, for replay_rebuild()). InputError when the checkpoint lacks them.
   void restore_servos(const io::Checkpoint& c, bool at_rebuild);
-  /// Writes the row whose reduction is still in flight (ranks > 1), if any.
-  void finish_row(FieldSink* sink);
   /// Collective: delivers pending output, then throws RunError(message).
   [[noreturn]] void stop(const std::string& message);
   void guard_energy(const std::vector<double>& pe);
@@ -344,11 +395,7 @@ class Simulation {
   RunOptions options_;
   std::unique_ptr<Decomposition> dec_;
   std::unique_ptr<Halo<Real>> halo_;
-  std::unique_ptr<AsyncSum> row_sum_;  ///< the last field row's reduction, finished one step later
-  std::int64_t row_step_ = 0;
-  double row_time_ = 0;
-  std::vector<char> row_due_;
-  FieldSink* sink_ = nullptr;  ///< the sink of the current step (for output delivered on errors)
+  std::unique_ptr<FieldRows> rows_;  ///< field rows of step()/run() given a FieldSink
   Particles<Real> p_;
   Bonds<Real> bonds_;
   IdMap ids_;
@@ -357,7 +404,7 @@ class Simulation {
   std::vector<std::uint32_t> fixed_;  ///< owned particles of a fixed tag (from the last rebuild)
   bool bond_broke_ = false;
 
-  Real kick1_ = 0, kick2_ = 0;
+  VelocityVerlet<Real> integrator_;
   double ghost_width_ = 0;
   double contact_cutoff_ = 0;
   std::size_t unassigned_bonds_ = 0;
@@ -372,12 +419,8 @@ class Simulation {
   PhaseTimes times_;
   LoadStats load_stats_;
   double ghost_wait_ = 0;
-  double ke_local_ = 0;         ///< this rank's kinetic energy, valid while ke_fresh_
-  bool ke_fresh_ = false;       ///< set when the second half-kick computed ke_local_ this step
-  bool forces_zeroed_ = false;  ///< set by the fused kick-zero-drift pass
-  bool kick_pending_ = false;   ///< the last step's second half-kick waits for the next step's pass
   StabilityReport stability_;
-  OutputSink* output_ = nullptr;   ///< set during run(steps, OutputSink&)
+  OutputSink* output_ = nullptr;   ///< the output of the step being made (run(), step())
   std::int64_t rebuild_step_ = 0;  ///< step of the last rebuild (checkpoints store it with p_.xr, yr, zr)
   bool far_moves_ = false;  ///< check_blowup let fast particles go on: the next migration goes any distance
   bool strain_warned_ = false;  ///< warn_lost_strain() has warned

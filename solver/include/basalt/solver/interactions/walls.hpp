@@ -139,6 +139,23 @@ class Walls {
     return pw;
   }
 
+  /// From time t on, wall w moves at the constant velocity v from where it is (a wall steered between steps,
+  /// e.g. from Python; a servo wall stops being one). The next move_to() continues from its point now.
+  void set_velocity(std::size_t w, const std::array<double, 3>& v, double t) {
+    auto& m = walls_[w].motion;
+    m = WallMotion{};
+    m.type = WallMotion::Type::ramp;  // a step to v at t: u(t') = v (t' - t)
+    m.velocity = v;
+    m.start_time = t;
+    walls_[w].point = point_[w];
+  }
+  /// Wall w touches no particle from the next rebuild on (a gate taken away); it keeps its place and motion.
+  void remove(std::size_t w) {
+    removed_.resize(walls_.size(), 0);
+    removed_[w] = 1;
+  }
+  bool removed(std::size_t w) const { return w < removed_.size() && removed_[w]; }
+
   /// At a rebuild: the owned particles within reach of each wall (centre closer than radius + skin,
   /// taking the wall's tags), so that steps loop over those only.
   template <class Real>
@@ -149,6 +166,7 @@ class Walls {
       const auto& spec = walls_[w];
       auto& c = candidates_[w];
       c.clear();
+      if (removed(w)) continue;
       for (std::size_t i = 0; i < p.n_owned; ++i) {
         if (!spec.bond_tags.empty() && spec.bonds(p.tag[i])) {  // tied to the wall wherever it is
           c.push_back(static_cast<std::int32_t>(i));
@@ -218,6 +236,7 @@ class Walls {
   std::vector<std::array<double, 3>> velocity_;
   std::vector<std::array<double, 3>> point_at_rebuild_;
   std::vector<std::vector<std::int32_t>> candidates_;
+  std::vector<char> removed_;  ///< remove(): no candidates from the next rebuild on
 
   struct Mesh {
     Mesh(const MeshWallSpec& s, ContactMesh m) : spec(s), mesh(std::move(m)), axis_point(s.axis_point) {}

@@ -34,6 +34,9 @@ class OutputSink {
   virtual bool continue_on_error() const = 0;
   /// End of the run (collective over the compute ranks).
   virtual void flush() = 0;
+  /// Collective, before the run stops on an error every rank agreed on: delivers what is still held back
+  /// (FieldRows: the row being summed). basalt-run's sink delivers on its own way out.
+  virtual void deliver_pending() {}
 };
 
 }  // namespace basalt::solver

@@ -21,6 +21,7 @@ class TableReader {
       : table_(table), file_(std::move(file)), path_(std::move(path)) {}
 
   const std::string& path() const { return path_; }
+  const std::string& file() const { return file_; }
   bool has(const std::string& key) const { return table_.contains(key); }
 
   /// "<file>:<line>: <path>.<key>: <what>"
@@ -40,6 +41,7 @@ class TableReader {
   std::array<double, 3> vec3(const std::string& key);
   std::optional<std::array<double, 3>> vec3_opt(const std::string& key);
   std::vector<std::int64_t> integers_or(const std::string& key, std::vector<std::int64_t> fallback);
+  std::vector<std::string> strings_or(const std::string& key, std::vector<std::string> fallback);
   /// A sub-table (must be a table); marks the key used.
   const toml::table* subtable(const std::string& key);
   /// An array of tables (may be absent).

@@ -1,0 +1,34 @@
+#pragma once
+// One [[stages]] entry of a scene (docs/scenes.md, "Stages"): the changes made at its start, then its steps,
+// or steps until a condition holds. basalt-run (and basalt.Simulation.run_stages) runs the stages in order
+// (solver/stages.hpp).
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace basalt::solver {
+
+struct StageSpec {
+  std::string name;
+  /// The stage's steps, or with a condition the most it may take.
+  std::int64_t steps = 0;
+
+  // The condition that ends it early (checked every `every` steps); none when until is false.
+  bool until = false;
+  std::int64_t every = 100;
+  double kinetic_energy_below = -1;  ///< the total kinetic energy falls below this (when >= 0)
+  std::string wall;                  ///< or: the force on this wall (summed over ranks) along `axis`
+  int axis = 2;
+  std::optional<double> force_above, force_below;
+
+  // The changes at its start.
+  std::vector<std::string> remove_walls;
+  std::vector<std::pair<std::string, std::array<double, 3>>> wall_velocity;
+  std::optional<std::vector<std::int64_t>> fixed_tags;
+  double dt = 0;  ///< a new time step (0: unchanged)
+};
+
+}  // namespace basalt::solver

@@ -1,0 +1,245 @@
+// The step's hooks and the steering calls between steps (Simulation::run with StepHook, set_dt,
+// set_wall_velocity, remove_wall, set_fixed_tags), and the time step a scene chooses by run.dt_fraction
+// reaching the velocity-dependent models (it did not: friction saw dt = 0). On 1 and 2 ranks.
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <mpi.h>
+
+#include <cmath>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "basalt/solver/core/errors.hpp"
+#include "basalt/solver/output/field_rows.hpp"
+#include "basalt/solver/simulation.hpp"
+#include "basalt/solver/stages.hpp"
+#include "solver_helpers.hpp"
+
+using namespace basalt::solver;
+
+namespace {
+
+/// A frictional pile on a floor under gravity: a 4 x 4 x 3 lattice of spheres (radius 0.45-0.5), tag 1
+/// for the bottom layer.
+basalt::io::Geometry pile() {
+  basalt::io::Geometry g;
+  std::int64_t id = 1;
+  for (int k = 0; k < 3; ++k)
+    for (int j = 0; j < 4; ++j)
+      for (int i = 0; i < 4; ++i, ++id) {
+        const auto u = static_cast<std::uint64_t>(id);
+        g.add_particle(id,
+                       {0.5 + i + 0.05 * basalt::test::hash_unit(3 * u + 1),
+                        0.5 + j + 0.05 * basalt::test::hash_unit(3 * u + 2), 0.48 + 0.98 * k},
+                       0.475 + 0.025 * basalt::test::hash_unit(u), k == 0 ? 1 : 0);
+      }
+  return g;
+}
+
+std::string pile_scene(const std::string& step) {
+  return R"(
+[particles]
+rotation = true
+[run]
+)" + step +
+         R"(
+steps = 0
+skin = 0.1
+[[interactions]]
+type = "rot_friction"
+K = 1000.0
+Ks = 500.0
+mu = 0.5
+mu_dynamic = 0.4
+[[walls]]
+name = "floor"
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
+interaction = "friction"
+K = 1000.0
+Ks = 500.0
+mu = 0.5
+[[walls]]
+name = "piston"
+point = [0.0, 0.0, 10.0]
+normal = [0.0, 0.0, -1.0]
+K = 1000.0
+[[body_forces]]
+type = "gravity"
+acceleration = [0.0, 0.0, -1.0]
+)";
+}
+
+Simulation<double> make(const std::string& step) {
+  RunOptions o;
+  o.quiet = true;
+  return Simulation<double>(basalt::test::scene_from(pile_scene(step)), pile(), MPI_COMM_WORLD, o);
+}
+
+/// id -> (x, y, z, vx, vy, vz) of every particle, gathered on every rank.
+std::map<std::int64_t, std::vector<double>> state(const Simulation<double>& sim) {
+  const auto& p = sim.particles();
+  std::vector<double> mine;
+  for (std::size_t i = 0; i < p.n_owned; ++i)
+    mine.insert(mine.end(), {double(p.id[i]), p.x[i], p.y[i], p.z[i], p.vx[i], p.vy[i], p.vz[i]});
+  const auto all = sim.comm().size() > 1 ? sim.comm().all_gather(mine) : mine;
+  std::map<std::int64_t, std::vector<double>> m;
+  for (std::size_t k = 0; k + 7 <= all.size(); k += 7)
+    m[std::int64_t(all[k])] =
+        std::vector<double>(all.begin() + std::ptrdiff_t(k) + 1, all.begin() + std::ptrdiff_t(k) + 7);
+  return m;
+}
+
+double lowest_z(const Simulation<double>& sim) {
+  double z = 1e300;
+  for (const auto& [id, s] : state(sim)) z = std::min(z, s[2]);
+  return z;
+}
+
+}  // namespace
+
+TEST(Steering, DtFractionReachesTheFrictionModels) {
+  // The same pile with run.dt_fraction and with run.dt = the step that fraction chose: the same bits. Before
+  // the fix the models kept the scene's dt (0) and friction's shear spring never loaded.
+  auto a = make("dt_fraction = 0.2");
+  const double dt = a.dt();
+  ASSERT_GT(dt, 0);
+  auto b = make(fmt::format("dt = {:.17g}", dt));
+  ASSERT_EQ(b.dt(), dt);
+  a.run(400);
+  b.run(400);
+  EXPECT_EQ(state(a), state(b));
+}
+
+TEST(Steering, HooksRunAtTheirStepsAndEndTheRunWithoutChangingIt) {
+  auto a = make("dt = 2e-3");
+  auto b = make("dt = 2e-3");
+  std::vector<std::int64_t> seen;
+  const StepHook hooks[] = {{10, [&](std::int64_t s) {
+                               seen.push_back(s);
+                               return s < 50;
+                             }}};
+  FieldRows rows(a.comm(), nullptr);
+  EXPECT_EQ(a.run(1000, rows, hooks), 50);
+  EXPECT_EQ(a.current_step(), 50);
+  EXPECT_EQ(seen, (std::vector<std::int64_t>{10, 20, 30, 40, 50}));
+  b.run(50);  // no hooks: deferred kicks throughout, the same bits
+  EXPECT_EQ(state(a), state(b));
+}
+
+TEST(Steering, SetDtChangesTheStepFromNowOn) {
+  auto sim = make("dt = 2e-3");
+  sim.run(10);
+  sim.set_dt(1e-3);
+  EXPECT_EQ(sim.dt(), 1e-3);
+  sim.run(10);
+  EXPECT_NEAR(sim.time(), 20 * 1e-3, 1e-15);  // time = step x dt: the clock follows the new step
+  EXPECT_THROW(sim.set_dt(0), InputError);
+  EXPECT_THROW(sim.set_dt(-1), InputError);
+}
+
+TEST(Steering, AWallMovesAtTheVelocityGivenFromWhereItIs) {
+  auto sim = make("dt = 2e-3");
+  sim.run(20);
+  const auto w = sim.wall_index("piston");
+  const auto before = sim.walls().point(w);
+  sim.set_wall_velocity("piston", {0, 0, -0.5});
+  sim.run(100);
+  const auto after = sim.walls().point(w);
+  EXPECT_NEAR(after[2] - before[2], -0.5 * 100 * 2e-3, 1e-12);
+  EXPECT_EQ(after[0], before[0]);
+  EXPECT_THROW(sim.set_wall_velocity("nope", {0, 0, 0}), InputError);
+}
+
+TEST(Steering, RemovingTheFloorLetsThePileFall) {
+  auto sim = make("dt = 2e-3");
+  sim.run(300);  // settles on the floor
+  const double z0 = lowest_z(sim);
+  EXPECT_GT(z0, 0.3);
+  sim.remove_wall("floor");
+  sim.run(500);  // 1 time unit under g = 1: a free fall of 0.5
+  EXPECT_LT(lowest_z(sim), z0 - 0.4);
+}
+
+TEST(Steering, FixedTagsHoldTheirParticlesFromNowOn) {
+  auto sim = make("dt = 2e-3");
+  sim.remove_wall("floor");
+  sim.set_fixed_tags({1});  // the bottom layer holds the pile up
+  const auto s0 = state(sim);
+  sim.run(300);
+  const auto s1 = state(sim);
+  for (const auto& [id, s] : s1)
+    if (id <= 16) {
+      EXPECT_EQ(s[2], s0.at(id)[2]) << id;
+    }
+  sim.set_fixed_tags({});
+  sim.run(300);
+  const auto s2 = state(sim);
+  EXPECT_LT(s2.at(1)[2], s0.at(1)[2] - 0.1);  // freed: it falls
+}
+
+TEST(Stages, SettleThenRemoveTheFloor) {
+  // [[stages]]: settle until the kinetic energy is small (well before the bound), then take the floor away
+  // and fall for a fixed number of steps.
+  const auto scene = basalt::test::scene_from(pile_scene("dt = 2e-3") + R"(
+[[body_forces]]
+type = "linear_damping"
+viscosity = 0.5
+[[body_forces]]
+type = "rotational_damping"
+viscosity = 0.5
+[[stages]]
+name = "settle"
+steps = 20000
+until = { kinetic_energy_below = 1e-3, every = 50 }
+[[stages]]
+name = "fall"
+remove_walls = ["floor"]
+wall_velocity = { piston = [0.0, 0.0, -1.0] }
+steps = 300
+)");
+  ASSERT_EQ(scene.stages.size(), 2u);
+  RunOptions o;
+  o.quiet = true;
+  Simulation<double> sim(scene, pile(), MPI_COMM_WORLD, o);
+  FieldRows rows(sim.comm(), nullptr);
+  std::vector<StageReport> reports;
+  std::vector<double> lowest;
+  const auto total = run_stages(sim, rows, scene.stages, [&](const StageSpec&, const StageReport& r) {
+    reports.push_back(r);
+    lowest.push_back(lowest_z(sim));  // the lowest particle at the stage's end
+  });
+  ASSERT_EQ(reports.size(), 2u);
+  EXPECT_TRUE(reports[0].condition_met);
+  EXPECT_LT(reports[0].steps, 20000);
+  EXPECT_EQ(reports[0].steps % 50, 0);
+  EXPECT_LT(reports[0].value, 1e-3);
+  EXPECT_EQ(reports[1].first_step, reports[0].steps);
+  EXPECT_EQ(reports[1].steps, 300);
+  EXPECT_EQ(total, reports[0].steps + 300);
+  EXPECT_EQ(sim.current_step(), total);
+  ASSERT_EQ(lowest.size(), 2u);
+  EXPECT_GT(lowest[0], 0.4);              // rested on the floor
+  EXPECT_LT(lowest[1], lowest[0] - 0.1);  // then fell through where it was
+  EXPECT_NEAR(sim.walls().point(sim.wall_index("piston"))[2], 10.0 - 300 * 2e-3, 1e-12);
+}
+
+TEST(Stages, BadStagesNameTheKey) {
+  const auto expect_error = [](const std::string& stages, const std::string& needle) {
+    try {
+      (void)basalt::test::scene_from(pile_scene("dt = 2e-3") + stages);
+      ADD_FAILURE() << "no error for " << stages;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+    }
+  };
+  expect_error("[[stages]]\nsteps = 10\nremove_walls = [\"gate\"]\n", "stages[0].remove_walls");
+  expect_error("[[stages]]\nsteps = 10\nremove_walls = [\"gate\"]\n", "floor, piston");
+  expect_error("[[stages]]\nuntil = { kinetic_energy_below = 1.0 }\n", "needs steps");
+  expect_error("[[stages]]\nsteps = 5\nuntil = { every = 3 }\n", "give one condition");
+  expect_error("[[stages]]\nsteps = 5\nuntil = { wall_force = \"piston\" }\n", "above = F or below");
+  expect_error("[[stages]]\nsteps = 5\nwall_velocity = { nope = [0.0, 0.0, 1.0] }\n",
+               "no planar wall named \"nope\"");
+  expect_error("[[stages]]\nsteps = 5\nspeed = 3\n", "speed");
+}
