@@ -25,3 +25,7 @@ class FormatError(ValueError):
 class PackError(ValueError):
     """An impossible packing request (bad radii, a volume too small, an unwritable output ...), with
     basalt-pack's message; options are named as on its command line (``--bond-tolerance must be >= 0``)."""
+
+
+# Shown as basalt.FormatError and basalt.PackError in tracebacks, where users catch them.
+FormatError.__module__ = PackError.__module__ = "basalt"

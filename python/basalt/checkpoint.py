@@ -193,6 +193,7 @@ def read_checkpoint(path):
     is read (the one ``basalt-run --restart <folder>`` continues from). Returns a Checkpoint. A file basalt-run
     would refuse (another schema, a newer version, not completely written, a damaged dataset) raises
     basalt.FormatError naming the file and the attribute or dataset."""
+    _h5py()  # says what is missing before anything else
     path = os.fspath(path)
     if os.path.isdir(path):
         latest = _core_loader.core().latest_complete_checkpoint(path)
@@ -206,6 +207,7 @@ def read_checkpoint(path):
 
 def iter_checkpoints(where):
     """read_checkpoints one at a time (a generator): for series larger than memory."""
+    _h5py()
     for f in checkpoint_files(where):
         yield _read_file(f)
 
