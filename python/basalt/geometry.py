@@ -107,12 +107,39 @@ class Geometry:
         name, then renamed). The geometry is checked first, with basalt-pack's checks: a FormatError names the
         file and the first bad particle or bond. Returns the path."""
         p = self.particles
+        mass = p.get("mass")
         _core_loader.core().write_geometry(
-            os.fspath(path), id=p["id"], position=p["position"], radius=p["radius"], tag=p["tag"],
-            mass=p.get("mass"), bonds=self.bonds["pairs"], bond_tag=self.bonds["tag"], box_min=self.box_min,
-            box_max=self.box_max, periodic=self.periodic, units=self.units, attributes=self.attrs,
-            statistics=self.statistics)
+            os.fspath(path), id=_column(p["id"], np.int64, 'particles["id"]'),
+            position=_column(p["position"], np.float64, 'particles["position"]'),
+            radius=_column(p["radius"], np.float64, 'particles["radius"]'),
+            tag=_column(p["tag"], np.int32, 'particles["tag"]'),
+            mass=None if mass is None else _column(mass, np.float64, 'particles["mass"]'),
+            bonds=_column(self.bonds["pairs"], np.int64, 'bonds["pairs"]'),
+            bond_tag=_column(self.bonds["tag"], np.int32, 'bonds["tag"]'),
+            box_min=_column(self.box_min, np.float64, "box_min"), box_max=_column(self.box_max, np.float64, "box_max"),
+            periodic=tuple(bool(v) for v in self.periodic), units=self.units,
+            attributes={str(k): str(v) for k, v in self.attrs.items()},
+            statistics={k: _column(v, np.float64, f'statistics["{k}"]').reshape(-1) for k, v in self.statistics.items()})
         return path
+
+
+def _column(values, dtype, name):
+    """An array as the file stores it (C order, of `dtype`): numbers that fit, whole numbers for integer types;
+    otherwise a ValueError naming it (a shape the schema does not have is the writer's error)."""
+    a = np.asarray(values)
+    if a.dtype == dtype:
+        return np.ascontiguousarray(a)
+    if np.issubdtype(dtype, np.integer) and a.size:
+        if not (np.issubdtype(a.dtype, np.integer) or np.issubdtype(a.dtype, np.bool_)):
+            if not np.issubdtype(a.dtype, np.number) or not np.all(np.isfinite(a)) or np.any(a != np.round(a)):
+                raise ValueError(f"{name}: whole numbers expected, got {a.dtype} values such as {a.ravel()[0]!r}")
+        info = np.iinfo(dtype)
+        if a.min() < info.min or a.max() > info.max:
+            raise ValueError(f"{name}: values from {a.min()} to {a.max()} do not fit {np.dtype(dtype).name}")
+    try:
+        return np.ascontiguousarray(a, dtype=dtype)
+    except (TypeError, ValueError) as e:
+        raise ValueError(f"{name}: not numbers ({e})") from e
 
 
 def read_geometry(path):

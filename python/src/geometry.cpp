@@ -63,13 +63,13 @@ io::Geometry geometry_from(const Ids& id, const Reals& position, const Reals& ra
                            const std::map<std::string, std::string>& attributes,
                            const std::map<std::string, Reals>& statistics) {
   const py::ssize_t n = id.ndim() == 1 ? id.shape(0) : -1;
-  check_shape(id, "id", -1, 0);
-  check_shape(position, "position", n, 3);
-  check_shape(radius, "radius", n, 0);
-  check_shape(tag, "tag", n, 0);
-  if (mass) check_shape(*mass, "mass", n, 0);
-  check_shape(pairs, "bonds", -1, 2);
-  check_shape(bond_tag, "bond_tag", pairs.shape(0), 0);
+  check_shape(id, "particles[\"id\"]", -1, 0);
+  check_shape(position, "particles[\"position\"]", n, 3);
+  check_shape(radius, "particles[\"radius\"]", n, 0);
+  check_shape(tag, "particles[\"tag\"]", n, 0);
+  if (mass) check_shape(*mass, "particles[\"mass\"]", n, 0);
+  check_shape(pairs, "bonds[\"pairs\"]", -1, 2);
+  check_shape(bond_tag, "bonds[\"tag\"]", pairs.shape(0), 0);
   io::Geometry g;
   const auto un = static_cast<std::size_t>(n);
   g.id.assign(id.data(), id.data() + un);

@@ -79,6 +79,22 @@ def test_geometry_write_errors(tmp_path):
         g.write(tmp_path / "x.txt")
     with pytest.raises(basalt.FormatError, match="folder '.*nowhere' does not exist"):
         basalt.read_geometry(CUBE).write(tmp_path / "nowhere" / "x.h5")
+    # arrays changed by hand: numpy's default integers are fine, values that do not fit are named
+    g = basalt.Geometry([[0, 0, 0], [2, 0, 0]], [1, 1])
+    g.particles["tag"] = np.array([1, 2])
+    g.write(tmp_path / "ok.h5")
+    assert basalt.read_geometry(tmp_path / "ok.h5").particles["tag"].tolist() == [1, 2]
+    g.particles["tag"] = np.array([1, 2 ** 40])
+    with pytest.raises(ValueError, match=r'particles\["tag"\]: values from 1 to 1099511627776 do not fit int32'):
+        g.write(tmp_path / "x.h5")
+    g.particles["tag"] = [1.5, 2]
+    with pytest.raises(ValueError, match=r'particles\["tag"\]: whole numbers expected'):
+        g.write(tmp_path / "x.h5")
+    g.particles["tag"] = [1, 2]
+    g.particles["position"] = g.positions[:, :2]
+    with pytest.raises(ValueError, match=r'particles\["position"\]: shape \(2, 2\), expected \(2, 3\)'):
+        g.write(tmp_path / "x.h5")
+    assert not (tmp_path / "x.h5").exists()
 
 
 def geo_text(particles, bonds=()):
