@@ -56,7 +56,13 @@ set(BASALT_HAS_VTK ${BASALT_WITH_VTK} CACHE INTERNAL "VTK is used by this build 
 # pytest) the package and its tests use, unless -DPython3_EXECUTABLE names another; pybind11 from pybind11-dev.
 # A pyenv python3 earlier on PATH has other packages (docs/python.md).
 set(BASALT_WITHOUT_PYTHON_REASON "configured with -DBASALT_WITH_PYTHON=OFF")
-if(BASALT_WITH_PYTHON)
+if(BASALT_WITH_PYTHON AND BASALT_SANITIZE)
+  # An instrumented module cannot be loaded into Debian's uninstrumented python3 (the sanitizer's runtime must
+  # come first), so its tests could only fail there.
+  set(BASALT_WITH_PYTHON OFF)
+  set(BASALT_WITHOUT_PYTHON_REASON "a sanitizer build (BASALT_SANITIZE=${BASALT_SANITIZE}): python3 cannot load an instrumented module")
+  message(STATUS "Basalt: no Python package (BASALT_WITH_PYTHON=OFF): ${BASALT_WITHOUT_PYTHON_REASON}")
+elseif(BASALT_WITH_PYTHON)
   if(NOT Python3_EXECUTABLE AND EXISTS /usr/bin/python3)
     set(Python3_EXECUTABLE /usr/bin/python3)
   endif()
@@ -77,7 +83,7 @@ if(BASALT_WITH_PYTHON)
   else()
     message(STATUS "Basalt: Python package for ${Python3_EXECUTABLE} ${Python3_VERSION}, pybind11 ${pybind11_VERSION}")
   endif()
-else()
+elseif(NOT BASALT_SANITIZE)
   message(STATUS "Basalt: BASALT_WITH_PYTHON=OFF: no Python package")
 endif()
 set(BASALT_HAS_PYTHON ${BASALT_WITH_PYTHON} CACHE INTERNAL "The Python package is built (BASALT_WITH_PYTHON, found)")
