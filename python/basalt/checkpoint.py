@@ -189,10 +189,11 @@ def checkpoint_files(where):
 
 
 def read_checkpoint(path):
-    """Reads one checkpoint: a ckpt_<step>.h5 file, or a run's output folder, whose latest complete checkpoint
-    is read (the one ``basalt-run --restart <folder>`` continues from). Returns a Checkpoint. A file basalt-run
-    would refuse (another schema, a newer version, not completely written, a damaged dataset) raises
-    basalt.FormatError naming the file and the attribute or dataset."""
+    """Reads one checkpoint: a ckpt_<step>.h5 file; a run's output folder, whose latest complete checkpoint is
+    read (the one ``basalt-run --restart <folder>`` continues from); or a glob pattern, whose match with the
+    highest step is read. Returns a Checkpoint. A file basalt-run would refuse (another schema, a newer version,
+    not completely written, a damaged dataset) raises basalt.FormatError naming the file and the attribute or
+    dataset."""
     _h5py()  # says what is missing before anything else
     path = os.fspath(path)
     if os.path.isdir(path):
@@ -201,7 +202,11 @@ def read_checkpoint(path):
             raise FormatError.at(path, "", "no complete checkpoint (ckpt_<step>.h5) in this folder")
         path = latest
     elif not os.path.exists(path):
-        raise FileNotFoundError(f"{path}: no such file or folder")
+        matches = checkpoint_files(path) if glob.has_magic(path) else []
+        if not matches:
+            raise FileNotFoundError(f"{path}: no such file or folder" if not glob.has_magic(path)
+                                    else f"{path}: no file matches")
+        path = matches[-1]
     return _read_file(path)
 
 

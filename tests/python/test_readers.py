@@ -207,6 +207,9 @@ def test_checkpoint_series_folder_and_glob(runs):
     assert [c.step for c in basalt.read_checkpoints(str(wave / "ckpt_00004*.h5"))] == [40]
     assert [c.step for c in basalt.read_checkpoints([wave / "ckpt_000060.h5", wave / "ckpt_000020.h5"])] == [20, 60]
     assert basalt.read_checkpoint(wave).step == 60  # a folder: its latest complete checkpoint
+    assert basalt.read_checkpoint(str(wave / "ckpt_0000[24]*.h5")).step == 40  # a glob: its highest step
+    with pytest.raises(FileNotFoundError, match="no file matches"):
+        basalt.read_checkpoint(str(wave / "ckpt_9*.h5"))
     # positions move between checkpoints, ids do not
     assert not np.array_equal(series[0].positions, series[2].positions)
     assert np.array_equal(series[0].particles["id"], series[2].particles["id"])
