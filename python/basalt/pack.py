@@ -15,6 +15,8 @@ interrupted with Ctrl-C.
 """
 
 import inspect
+import operator
+import os
 import time
 import warnings
 
@@ -79,21 +81,42 @@ def _tag_layers(value):
     return [one(t) for t in value]
 
 
+_FLOATS = ("rmin", "rmax", "target_fraction", "bond_tolerance", "overlap_tolerance", "seed_fraction", "max_spheres")
+_INTS = ("bond_tag", "bins")
+_BOOLS = ("fill", "no_bonds", "lattice", "allow_large", "allow_low_fraction")
+
+
+def _typed(name, value, kind):
+    """A keyword's value as the C++ request takes it; a TypeError naming the keyword otherwise."""
+    try:
+        if kind is int:
+            return operator.index(value)  # 16, not 16.0
+        return float(value)
+    except (TypeError, ValueError):
+        what = "a whole number" if kind is int else "a number"
+        raise TypeError(f"{name}={value!r}: {what} expected") from None
+
+
 def _pack(shape, call, volume, options):
     core = _core_loader.core()
     o = dict(options)
     output = o.pop("output")
     record_time = o.pop("record_time")
-    threads = o.pop("threads")
-    exponent = o.pop("exponent")
+    threads, exponent = o.pop("threads"), o.pop("exponent")
+    for name in _FLOATS:
+        o[name] = _typed(name, o[name], float)
+    for name in _INTS:
+        o[name] = _typed(name, o[name], int)
+    for name in _BOOLS:
+        o[name] = bool(o[name])
     o["seed"] = _seed(o["seed"])
     o["tag_layer"] = _tag_layers(o["tag_layer"])
     args = dict(size="", origin="0,0,0", centre="0,0,0", radius=0.0, height=0.0, mesh_file="")
     args.update(volume)
     start = time.perf_counter()
-    d, stats = core.pack(shape=shape, exponent=None if exponent is None else float(exponent),
-                         threads=0 if threads is None else int(threads),
-                         output="" if output is None else str(output), **args, **o)
+    d, stats = core.pack(shape=shape, exponent=None if exponent is None else _typed("exponent", exponent, float),
+                         threads=None if threads is None else _typed("threads", threads, int),
+                         output="" if output is None else os.fspath(output), **args, **o)
     seconds = time.perf_counter() - start
     g = Geometry._from_core(d)
     g.pack_stats = stats
@@ -135,7 +158,7 @@ def _shape(shape, volume_params, doc):
             elif name == "file":
                 volume["mesh_file"] = str(value)
             else:
-                volume[name] = float(value)
+                volume[name] = _typed(name, value, float)
         return _pack(shape, call, volume, options)
 
     pack.__name__ = pack.__qualname__ = shape

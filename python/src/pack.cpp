@@ -84,7 +84,7 @@ void bind_pack(py::module_& m) {
          const std::string& mesh_file, const std::string& seed, std::optional<double> exponent,
          double target_fraction, bool fill, double bond_tolerance, bool no_bonds, bool lattice,
          std::int32_t bond_tag, double overlap_tolerance, const std::vector<std::string>& tag_layer,
-         double seed_fraction, int bins, int threads, double max_spheres, bool allow_large,
+         double seed_fraction, int bins, std::optional<int> threads, double max_spheres, bool allow_large,
          bool allow_low_fraction, const std::string& output) {
         packer::Request r;
         r.shape = parse_shape(shape);
@@ -105,9 +105,9 @@ void bind_pack(py::module_& m) {
         r.assembly.bond_tolerance = bond_tolerance;
         r.assembly.bond_tag = bond_tag;
         r.assembly.histogram_bins = bins;
-        // 0: the machine's cores, as basalt-pack's default; the spheres do not depend on it.
+        // None: the machine's cores, as basalt-pack's default; the spheres do not depend on it.
         r.assembly.threads =
-            threads != 0 ? threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+            threads ? *threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
         r.tag_layers = tag_layer;
         r.no_bonds = no_bonds;
         r.lattice = lattice;
@@ -129,7 +129,7 @@ void bind_pack(py::module_& m) {
       py::arg("centre"), py::arg("radius"), py::arg("height"), py::arg("mesh_file"), py::arg("seed"),
       py::arg("exponent").none(true), py::arg("target_fraction"), py::arg("fill"), py::arg("bond_tolerance"),
       py::arg("no_bonds"), py::arg("lattice"), py::arg("bond_tag"), py::arg("overlap_tolerance"),
-      py::arg("tag_layer"), py::arg("seed_fraction"), py::arg("bins"), py::arg("threads"),
+      py::arg("tag_layer"), py::arg("seed_fraction"), py::arg("bins"), py::arg("threads").none(true),
       py::arg("max_spheres"), py::arg("allow_large"), py::arg("allow_low_fraction"), py::arg("output"),
       "basalt-pack's request (options as on its command line, vectors and the seed as text): returns "
       "(geometry "

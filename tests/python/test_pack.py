@@ -130,6 +130,9 @@ BAD = [
                                                             "--exponent", "25"]),
     (dict(size=(1e5, 1e5, 1e5), rmin=0.3, rmax=1), ["--size", "1e5,1e5,1e5", "--rmin", "0.3", "--rmax", "1"]),
     (dict(size=(1.2, 1.2, 1.2), rmin=0.5, rmax=0.5), ["--size", "1.2,1.2,1.2", "--rmin", "0.5", "--rmax", "0.5"]),
+    (dict(size=(5, 5, 5), rmin=0.3, rmax=1, threads=0), ["--size", "5,5,5", "--rmin", "0.3", "--rmax", "1",
+                                                          "--threads", "0"]),
+    (dict(size=(5, 5, 5), rmin=float("nan"), rmax=1), ["--size", "5,5,5", "--rmin", "nan", "--rmax", "1"]),
 ]
 
 
@@ -172,4 +175,8 @@ def test_arguments_are_checked_like_python_functions():
         basalt.pack.box(size=(5, 5, 5), rmin=0.3, rmax=1, bond_tolerence=1e-5)  # misspelt
     with pytest.raises(TypeError):
         basalt.pack.sphere(radius=1, rmin=0.3, rmax=0.5, centre=(0, 0, 0), center=(0, 0, 0))
+    with pytest.raises(TypeError, match=r"bins=16.5: a whole number expected"):
+        basalt.pack.box(size=(5, 5, 5), rmin=0.3, rmax=1, bins=16.5)
+    with pytest.raises(TypeError, match=r"rmin='small': a number expected"):
+        basalt.pack.box(size=(5, 5, 5), rmin="small", rmax=1)
     assert "bond_tolerance" in basalt.pack.box.__doc__ and basalt.pack.box.__name__ == "box"
