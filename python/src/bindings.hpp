@@ -8,6 +8,11 @@
 
 #include "basalt/io/geometry.hpp"
 
+//
+// Threads: the packer runs without the GIL (other Python threads go on); every call that may reach HDF5 keeps
+// it, since Debian's parallel HDF5 is built without thread safety: two Python threads reading at once would
+// enter it together. (h5py links a separate, serial HDF5 with its own lock.)
+
 namespace basalt::python {
 
 /// C++ errors as Python exceptions (basalt._errors): io::FormatError -> basalt.FormatError, packer::PackError

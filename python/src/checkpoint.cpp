@@ -18,12 +18,9 @@ void bind_checkpoint(py::module_& m) {
   m.def(
       "check_checkpoint",
       [](const std::string& path) {
-        io::CheckpointHeader h;
-        {
-          py::gil_scoped_release release;
-          const io::CheckpointFile file(path);  // schema, completion, every dataset's type and shape, clock
-          h = file.header();
-        }
+        // With the GIL held: Debian's parallel HDF5 is not thread-safe (bindings.hpp).
+        const io::CheckpointFile file(path);  // schema, completion, every dataset's type and shape, clock
+        const io::CheckpointHeader& h = file.header();
         py::dict d;
         d["particles"] = h.particles;
         d["bonds"] = h.bonds;
@@ -38,11 +35,7 @@ void bind_checkpoint(py::module_& m) {
       "Returns the row counts and the step.");
   m.def(
       "latest_complete_checkpoint",
-      [](const std::string& dir) {
-        py::gil_scoped_release release;
-        return io::latest_complete_checkpoint(dir).string();
-      },
-      py::arg("dir"),
+      [](const std::string& dir) { return io::latest_complete_checkpoint(dir).string(); }, py::arg("dir"),
       "The complete ckpt_<step>.h5 of `dir` with the highest step (as basalt-run --restart <dir> picks it), "
       "or '' when there is none.");
 }

@@ -145,12 +145,8 @@ void bind_geometry(py::module_& m) {
   m.def(
       "read_geometry",
       [](const std::string& path) {
-        io::Geometry g;
-        {
-          py::gil_scoped_release release;
-          g = io::read_geometry(path);
-        }
-        return geometry_to_dict(g);
+        // With the GIL held: Debian's parallel HDF5 is not thread-safe (bindings.hpp).
+        return geometry_to_dict(io::read_geometry(path));
       },
       py::arg("path"),
       "Reads a geometry (.h5/.hdf5: Basalt's schema; .geo: ESyS-Particle's) with basalt-run's reader: a dict "
@@ -165,8 +161,7 @@ void bind_geometry(py::module_& m) {
          const std::map<std::string, Reals>& statistics) {
         io::Geometry g = geometry_from(id, position, radius, tag, mass, bonds, bond_tag, box_min, box_max,
                                        periodic, units, attributes, statistics);
-        py::gil_scoped_release release;
-        io::write_geometry(g, path);
+        io::write_geometry(g, path);  // with the GIL held, as read_geometry
       },
       py::arg("path"), py::arg("id"), py::arg("position"), py::arg("radius"), py::arg("tag"), py::arg("mass"),
       py::arg("bonds"), py::arg("bond_tag"), py::arg("box_min"), py::arg("box_max"), py::arg("periodic"),

@@ -118,7 +118,7 @@ void bind_pack(py::module_& m) {
         packer::PackResult result;
         std::string volume;
         {
-          py::gil_scoped_release release;
+          py::gil_scoped_release release;  // the packer touches no HDF5 (bindings.hpp)
           auto prepared = packer::prepare(r);
           volume = prepared.volume->description();
           result = packer::run(prepared);
