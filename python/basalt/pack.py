@@ -10,8 +10,7 @@ the same spheres and bonds, bit for bit, and an impossible request raises basalt
 with basalt-pack's message, which names the command-line option (``--bond-tolerance must be >= 0, got -1``).
 Vectors (size, origin, centre) are three numbers or basalt-pack's text "15,15,15"; tag_layer is one or a list
 of "FACE:THICKNESS:TAG" texts or (face, thickness, tag) tuples; threads=None uses every core (the result does
-not depend on it). The pack holds the Python interpreter's other threads free while it runs, but cannot be
-interrupted with Ctrl-C.
+not depend on it). Other Python threads run while it packs; Ctrl-C does not stop a pack.
 """
 
 import inspect
@@ -69,11 +68,14 @@ def _seed(value):
 
 
 def _tag_layers(value):
+    def number(x):  # 2 -> "2", 0.3 -> "0.3", numpy's scalars alike; a text as given
+        return x if isinstance(x, str) else str(operator.index(x)) if hasattr(x, "__index__") else repr(float(x))
+
     def one(t):
         if isinstance(t, str):
             return t
         face, thickness, tag = t
-        return f"{face}:{thickness!r}:{tag}"
+        return f"{face}:{number(thickness)}:{number(tag)}"
 
     if isinstance(value, str) or (isinstance(value, tuple) and len(value) == 3 and isinstance(value[0], str)
                                   and not isinstance(value[1], str)):
