@@ -52,6 +52,42 @@ endif()
 # What this configuration chose, for scripts that read the cache (scripts/demo.sh).
 set(BASALT_HAS_VTK ${BASALT_WITH_VTK} CACHE INTERNAL "VTK is used by this build (BASALT_WITH_VTK, found)")
 
+# Python (optional, BASALT_WITH_PYTHON): Debian's interpreter /usr/bin/python3, whose packages (numpy, h5py,
+# pytest) the package and its tests use, unless -DPython3_EXECUTABLE names another; pybind11 from pybind11-dev.
+# A pyenv python3 earlier on PATH has other packages (docs/python.md).
+set(BASALT_WITHOUT_PYTHON_REASON "configured with -DBASALT_WITH_PYTHON=OFF")
+if(BASALT_WITH_PYTHON AND BASALT_SANITIZE)
+  # An instrumented module cannot be loaded into Debian's uninstrumented python3 (the sanitizer's runtime must
+  # come first), so its tests could only fail there.
+  set(BASALT_WITH_PYTHON OFF)
+  set(BASALT_WITHOUT_PYTHON_REASON "a sanitizer build (BASALT_SANITIZE=${BASALT_SANITIZE}): python3 cannot load an instrumented module")
+  message(STATUS "Basalt: no Python package (BASALT_WITH_PYTHON=OFF): ${BASALT_WITHOUT_PYTHON_REASON}")
+elseif(BASALT_WITH_PYTHON)
+  if(NOT Python3_EXECUTABLE AND EXISTS /usr/bin/python3)
+    set(Python3_EXECUTABLE /usr/bin/python3)
+  endif()
+  find_package(Python3 QUIET COMPONENTS Interpreter Development.Module)
+  if(Python3_FOUND)
+    # pybind11's config uses FindPython's targets once Python3 is found (its "new" mode).
+    find_package(pybind11 2.6 CONFIG QUIET)
+  endif()
+  if(NOT Python3_FOUND OR NOT pybind11_FOUND)
+    set(BASALT_WITH_PYTHON OFF)
+    if(NOT Python3_FOUND)
+      set(BASALT_WITHOUT_PYTHON_REASON "Python 3's development files (python3-dev) were not found")
+    else()
+      set(BASALT_WITHOUT_PYTHON_REASON "pybind11 (pybind11-dev) was not found")
+    endif()
+    message(STATUS "Basalt: no Python package (BASALT_WITH_PYTHON=OFF): ${BASALT_WITHOUT_PYTHON_REASON}; "
+                   "install pybind11-dev and python3-dev (scripts/install-deps.sh) and configure again")
+  else()
+    message(STATUS "Basalt: Python package for ${Python3_EXECUTABLE} ${Python3_VERSION}, pybind11 ${pybind11_VERSION}")
+  endif()
+elseif(NOT BASALT_SANITIZE)
+  message(STATUS "Basalt: BASALT_WITH_PYTHON=OFF: no Python package")
+endif()
+set(BASALT_HAS_PYTHON ${BASALT_WITH_PYTHON} CACHE INTERNAL "The Python package is built (BASALT_WITH_PYTHON, found)")
+
 if(BASALT_BUILD_TESTS)
   find_package(GTest REQUIRED)
 endif()

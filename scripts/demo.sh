@@ -14,7 +14,10 @@ build="${BASALT_BUILD_DIR:-$here/build}"
 out="${BASALT_DEMO_OUT:-$here/out}"
 steps="${BASALT_DEMO_STEPS:-10000}"
 cmake -S "$here" -B "$build" -DCMAKE_BUILD_TYPE=Release > /dev/null
-cmake --build "$build" -j "$(nproc)" --target basalt-pack basalt-run basalt-view
+cmake --build "$build" -j "$(nproc)" --target basalt-pack basalt-run basalt-view basalt-python
+# `import basalt` in any new shell (docs/python.md): basalt.pth in the user's site-packages; a failure here
+# leaves the demo going (PYTHONPATH=$build/python works too).
+"$here/scripts/python-path.sh" "$build" || echo "demo: the Python package is not on python3's path (above); PYTHONPATH=$build/python"
 bin="$build/bin"
 mkdir -p "$out"
 
@@ -61,3 +64,4 @@ echo "Done. Pictures:"
 echo "  $out/wave.png             vertical velocity at steps 200-800 on the cut face (like the paper's Figure 3)"
 echo "  $out/kinetic_energy.png   total kinetic energy against time"
 echo "Checkpoints: $out/wave/ckpt_*.h5   field series: $out/wave/fields.csv"
+echo "From Python (docs/python.md): /usr/bin/python3 -c 'import basalt; print(basalt.read_checkpoint(\"$out/wave\"))'"

@@ -13,6 +13,7 @@ PACKAGES=(
   libtomlplusplus-dev libcli11-dev libfmt-dev
   xvfb xauth
   python3-h5py python3-matplotlib python3-numpy
+  pybind11-dev python3-dev python3-pytest
 )
 
 installed() { dpkg-query -W -f='${Status}' "$1" 2>/dev/null | grep -q "install ok installed"; }

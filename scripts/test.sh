@@ -8,5 +8,7 @@ source "$here/scripts/mpi-env.sh"
 build="${BASALT_BUILD_DIR:-$here/build}"
 cmake -S "$here" -B "$build" -DCMAKE_BUILD_TYPE=Release -DBASALT_WERROR=ON
 cmake --build "$build" -j "$(nproc)"
+# `import basalt` in any new shell (docs/python.md); the tests themselves set PYTHONPATH.
+"$here/scripts/python-path.sh" "$build" || echo "test: the Python package is not on python3's path (above)"
 cd "$build"
 ctest --output-on-failure --timeout 600 -j "$(nproc)" "$@"

@@ -25,6 +25,7 @@
 #include "basalt/packer/assembly.hpp"
 #include "basalt/packer/error.hpp"
 #include "basalt/packer/pack.hpp"
+#include "basalt/packer/request.hpp"
 #include "basalt/packer/volume.hpp"
 #include "basalt/version.hpp"
 
@@ -33,61 +34,6 @@ using basalt::packer::PackError;
 using basalt::packer::Vec3;
 
 namespace {
-
-Vec3 parse_vec3(const std::string& text, const char* option) {
-  Vec3 v{};
-  std::size_t pos = 0;
-  for (int k = 0; k < 3; ++k) {
-    const auto end = text.find(',', pos);
-    if ((k < 2) == (end == std::string::npos))
-      throw PackError(
-          fmt::format("{} '{}': expected three comma-separated numbers, e.g. 15,15,15", option, text));
-    const std::string part = text.substr(pos, end == std::string::npos ? std::string::npos : end - pos);
-    try {
-      std::size_t used = 0;
-      v[k] = std::stod(part, &used);
-      if (used != part.size()) throw std::invalid_argument(part);
-    } catch (const std::exception&) {
-      throw PackError(fmt::format("{} '{}': '{}' is not a number", option, text, part));
-    }
-    pos = end + 1;
-  }
-  return v;
-}
-
-/// Fails early, before any packing, when the output cannot be written.
-void check_output(const fs::path& out) {
-  std::string ext = out.extension().string();
-  for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (ext != ".h5" && ext != ".hdf5" && ext != ".geo")
-    throw PackError(fmt::format("{}: unknown output format '{}' (use .h5 for Basalt, .geo for ESyS-Particle)",
-                                out.string(), ext));
-  const fs::path dir = out.parent_path().empty() ? fs::path(".") : out.parent_path();
-  if (!fs::is_directory(dir))
-    throw PackError(
-        fmt::format("{}: cannot write the output: folder '{}' does not exist", out.string(), dir.string()));
-  if (fs::is_directory(out))
-    throw PackError(fmt::format("{}: cannot write the output: it is a folder", out.string()));
-  if (access(dir.c_str(), W_OK) != 0)
-    throw PackError(
-        fmt::format("{}: cannot write the output: folder '{}' is not writable", out.string(), dir.string()));
-}
-
-/// --seed: a whole number in [0, 2^64). CLI11 would store -1 as 2^64 - 1 without a word.
-std::uint64_t parse_seed(const std::string& text) {
-  const auto bad = [&](const char* why) {
-    return PackError(fmt::format("--seed '{}': {}; give a whole number from 0 to {}", text, why,
-                                 std::numeric_limits<std::uint64_t>::max()));
-  };
-  if (text.empty()) throw bad("empty");
-  if (text[0] == '-') throw bad("a seed cannot be negative");
-  for (char ch : text)
-    if (ch < '0' || ch > '9') throw bad("not a whole number");
-  errno = 0;
-  const unsigned long long v = std::strtoull(text.c_str(), nullptr, 10);
-  if (errno == ERANGE) throw bad("too large");
-  return v;
-}
 
 const char* const kShapes[] = {"box", "cylinder", "sphere", "mesh"};
 
@@ -108,33 +54,6 @@ std::string check_shape(int argc, char** argv) {
   }
   return "no shape given: basalt-pack fills a box, cylinder, sphere or mesh, e.g. "
          "basalt-pack box --size 15,15,15 --rmin 0.2 --rmax 1.0 -o cube.h5";
-}
-
-std::string human_bytes(double bytes) {
-  const char* units[] = {"B", "KiB", "MiB", "GiB", "TiB", "PiB", "EiB"};
-  int u = 0;
-  while (bytes >= 1024 && u < 6) {
-    bytes /= 1024;
-    ++u;
-  }
-  return fmt::format("{:.3g} {}", bytes, units[u]);
-}
-
-/// Refuses, before any work, a pack whose expected sphere count is beyond `limit` (memory grows about
-/// 1 KiB per sphere): --size 1e6,1e6,1e6 ran until std::bad_alloc.
-void check_expected_count(const basalt::packer::Volume& volume, const basalt::packer::PackOptions& o,
-                          double limit, bool allowed) {
-  const double n = basalt::packer::expected_sphere_count(volume.measure(), o);
-  if (n <= limit || allowed) return;
-  const double bytes = n * basalt::packer::kBytesPerSphere;
-  const double ram =
-      static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGESIZE));
-  throw PackError(fmt::format(
-      "{} with radii {} .. {} would take about {:.3g} spheres and {} of memory{}, at about 1 KiB and "
-      "20 us of CPU per sphere; that is beyond the {:.3g} spheres basalt-pack packs without asking "
-      "(--max-spheres): pass --allow-large to pack it anyway, or give larger radii or a smaller volume",
-      volume.description(), o.rmin, o.rmax, n, human_bytes(bytes),
-      ram > 0 ? fmt::format(" (this machine has {})", human_bytes(ram)) : std::string(), limit));
 }
 
 /// Progress on stderr: a bar redrawn in place on a terminal; otherwise (a log file, a batch job) a plain
@@ -191,28 +110,24 @@ int main(int argc, char** argv) {
   }
   app.set_version_flag("--version", std::string(basalt::kVersion));
 
-  std::string size, origin = "0,0,0", centre = "0,0,0", mesh_file, output;
-  double radius = 0, height = 0;
-  basalt::packer::PackOptions popt;
-  basalt::packer::AssemblyOptions aopt;
-  std::optional<double> exponent;
-  std::vector<std::string> tag_texts;
-  bool no_bonds = false, record_time = false, quiet = false, allow_large = false, allow_low = false;
-  bool lattice = false;
-  std::string seed_text = "1";
-  double max_spheres = 1e7;
+  // The options land in the request basalt.pack (Python) fills too: its checks and messages are shared.
+  basalt::packer::Request req;
+  std::string mesh_file, output;
+  auto& popt = req.pack;
+  auto& aopt = req.assembly;
+  bool record_time = false, quiet = false;
   aopt.threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
 
   auto* box = app.add_subcommand("box", "an axis-aligned box from --origin to --origin + --size");
-  box->add_option("--size", size, "edge lengths X,Y,Z")->required();
-  box->add_option("--origin", origin, "lowest corner X,Y,Z")->capture_default_str();
+  box->add_option("--size", req.size, "edge lengths X,Y,Z")->required();
+  box->add_option("--origin", req.origin, "lowest corner X,Y,Z")->capture_default_str();
   auto* cyl = app.add_subcommand("cylinder", "a cylinder along z, base centre at --origin");
-  cyl->add_option("--radius", radius, "cylinder radius")->required();
-  cyl->add_option("--height", height, "cylinder height")->required();
-  cyl->add_option("--origin", origin, "centre of the base X,Y,Z")->capture_default_str();
+  cyl->add_option("--radius", req.radius, "cylinder radius")->required();
+  cyl->add_option("--height", req.height, "cylinder height")->required();
+  cyl->add_option("--origin", req.origin, "centre of the base X,Y,Z")->capture_default_str();
   auto* sph = app.add_subcommand("sphere", "a ball");
-  sph->add_option("--radius", radius, "ball radius")->required();
-  sph->add_option("--centre,--center", centre, "centre X,Y,Z")->capture_default_str();
+  sph->add_option("--radius", req.radius, "ball radius")->required();
+  sph->add_option("--centre,--center", req.centre, "centre X,Y,Z")->capture_default_str();
   auto* mesh = app.add_subcommand("mesh", "the inside of a closed triangle mesh (OFF, STL, OBJ, PLY)");
   mesh->add_option("file", mesh_file, "mesh file")->required();
 
@@ -221,16 +136,16 @@ int main(int argc, char** argv) {
     sub->add_option("--rmax", popt.rmax, "largest radius")->required();
     sub->add_option("-o,--output", output, "output geometry: .h5 (Basalt) or .geo (ESyS-Particle)")
         ->required();
-    sub->add_option("--seed", seed_text, "random seed, 0 .. 2^64-1 (same seed, same file)")
+    sub->add_option("--seed", req.seed, "random seed, 0 .. 2^64-1 (same seed, same file)")
         ->capture_default_str();
-    sub->add_flag("--allow-large", allow_large,
+    sub->add_flag("--allow-large", req.allow_large,
                   "pack even when more than --max-spheres spheres are expected (about 1 KiB of memory each)");
-    sub->add_option("--max-spheres", max_spheres,
+    sub->add_option("--max-spheres", req.max_spheres,
                     "expected sphere count above which basalt-pack refuses without --allow-large")
         ->capture_default_str();
-    sub->add_flag("--allow-low-fraction", allow_low,
+    sub->add_flag("--allow-low-fraction", req.allow_low_fraction,
                   "write the packing with a warning even when its solid fraction is far below the mode's");
-    sub->add_option("--exponent", exponent,
+    sub->add_option("--exponent", popt.exponent,
                     "follow the power law N(>r) ~ r^-EXPONENT instead of filling as densely as possible");
     sub->add_option("--target-fraction", popt.target_fraction,
                     "with --exponent: solid fraction whose worth of radii is drawn")
@@ -240,8 +155,8 @@ int main(int argc, char** argv) {
     sub->add_option("--bond-tolerance", aopt.bond_tolerance,
                     "bond every pair whose gap |ci-cj|-ri-rj is <= this (length units)")
         ->capture_default_str();
-    sub->add_flag("--no-bonds", no_bonds, "write no bonds");
-    sub->add_flag("--lattice", lattice,
+    sub->add_flag("--no-bonds", req.no_bonds, "write no bonds");
+    sub->add_flag("--lattice", req.lattice,
                   "a loose granular fill instead: a cubic lattice of spacing 2 rmax, radii uniform in [rmin, "
                   "rmax], each centre jittered by up to rmax - r (no overlaps; solid fraction ~0.3-0.5); "
                   "pack a column in a box this way for a pile with a free surface");
@@ -249,7 +164,7 @@ int main(int argc, char** argv) {
     sub->add_option("--overlap-tolerance", popt.overlap_tolerance,
                     "largest overlap allowed between spheres and with the boundary")
         ->capture_default_str();
-    sub->add_option("--tag-layer", tag_texts,
+    sub->add_option("--tag-layer", req.tag_layers,
                     "FACE:THICKNESS:TAG: particles within THICKNESS of FACE get TAG (repeatable; faces: "
                     "xmin..zmax for a box, side/bottom/top for a cylinder, surface for any volume)");
     sub->add_option("--seed-fraction", popt.seed_fraction,
@@ -267,48 +182,30 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
 
   try {
-    popt.exponent = exponent;
-    popt.seed = parse_seed(seed_text);
-    if (!(max_spheres >= 1)) throw PackError(fmt::format("--max-spheres must be >= 1, got {}", max_spheres));
-    aopt.bonds = !no_bonds;
-    if (!(aopt.bond_tolerance >= 0) || !std::isfinite(aopt.bond_tolerance))
-      throw PackError(fmt::format("--bond-tolerance must be >= 0, got {}", aopt.bond_tolerance));
-    if (aopt.histogram_bins < 1) throw PackError("--bins must be >= 1");
-    if (aopt.threads < 1) throw PackError(fmt::format("--threads must be >= 1, got {}", aopt.threads));
-    popt.threads = aopt.threads;
-    basalt::packer::check_options(popt);
-    for (const auto& t : tag_texts) aopt.tags.push_back(basalt::packer::parse_tag_layer(t));
-    check_output(output);
-
-    std::unique_ptr<basalt::packer::Volume> volume;
-    if (*box) {
-      const Vec3 lo = parse_vec3(origin, "--origin"), ext = parse_vec3(size, "--size");
-      volume = basalt::packer::make_box(lo, {lo[0] + ext[0], lo[1] + ext[1], lo[2] + ext[2]});
-    } else if (*cyl) {
-      volume = basalt::packer::make_cylinder(parse_vec3(origin, "--origin"), radius, height);
-    } else if (*sph) {
-      volume = basalt::packer::make_sphere(parse_vec3(centre, "--centre"), radius);
-    } else {
-      volume = basalt::packer::load_mesh(mesh_file);
-    }
-    // Unknown tag faces fail now, not after packing.
-    (void)basalt::packer::region_tags(*volume, {}, {}, aopt.tags);
-    check_expected_count(*volume, popt, max_spheres, allow_large);
+    if (*box)
+      req.shape = basalt::packer::Shape::box;
+    else if (*cyl)
+      req.shape = basalt::packer::Shape::cylinder;
+    else if (*sph)
+      req.shape = basalt::packer::Shape::sphere;
+    else
+      req.shape = basalt::packer::Shape::mesh;
+    req.mesh_file = mesh_file;
+    req.output = output;
+    auto prepared = basalt::packer::prepare(req);
+    const auto& volume = prepared.volume;
 
     ProgressBar bar(!quiet);
-    popt.progress = [&](double f) { bar.update(f); };
-    if (lattice && popt.exponent) throw PackError("--lattice and --exponent exclude each other");
-    auto packing =
-        lattice ? basalt::packer::lattice_packing(*volume, popt) : basalt::packer::pack(*volume, popt);
-    bar.finish();
-    const double pack_seconds = bar.seconds();
-    bar.step("packed; bonding");
-    basalt::packer::AssemblyStats st;
-    auto geometry = basalt::packer::assemble(*volume, packing, popt, aopt, st);
+    prepared.pack.progress = [&](double f) { bar.update(f); };
+    double pack_seconds = 0;
+    auto result = basalt::packer::run(prepared, [&] {
+      bar.finish();
+      pack_seconds = bar.seconds();
+      bar.step("packed; bonding");
+    });
+    auto& geometry = result.geometry;
+    const auto& st = result.stats;
     const double total_seconds = bar.seconds();
-    // The geometry holds the spheres now: free the packing's copy before writing (memory at 8.7 M spheres).
-    packing.centre = {};
-    packing.radius = {};
 
     // The command line without the output name (and -q, --threads), so that the same arguments give the same
     // bytes whatever the file is called.
@@ -328,10 +225,7 @@ int main(int argc, char** argv) {
       if (arg.rfind("--threads=", 0) == 0) continue;
       command += " " + arg;
     }
-    const auto low = basalt::packer::low_fraction_report(*volume, popt, packing, st.solid_fraction);
-    if (low.far_below && !allow_low && !lattice)
-      throw PackError(low.text + "; nothing written (--allow-low-fraction writes it anyway)");
-
+    const auto& low = result.low;
     geometry.attributes["creator"] = fmt::format("basalt-pack {}", basalt::kVersion);
     geometry.attributes["command_line"] = command;
     if (record_time) {
@@ -348,10 +242,10 @@ int main(int argc, char** argv) {
       fmt::print("basalt-pack {}: {}\n", basalt::kVersion, volume->description());
       fmt::print("  particles            {}\n", st.particles);
       if (popt.exponent)
-        fmt::print("  radii drawn/placed   {} / {} (power law, exponent {}){}\n", packing.requested,
-                   packing.requested - packing.not_placed, *popt.exponent,
+        fmt::print("  radii drawn/placed   {} / {} (power law, exponent {}){}\n", result.requested,
+                   result.requested - result.not_placed, *popt.exponent,
                    popt.fill_after ? fmt::format(", then {} filling voids",
-                                                 st.particles + packing.not_placed - packing.requested)
+                                                 st.particles + result.not_placed - result.requested)
                                    : "");
       fmt::print("  solid fraction       {:.4f}\n", st.solid_fraction);
       fmt::print("  radii                {:.4g} .. {:.4g}\n", st.min_radius, st.max_radius);
@@ -371,7 +265,7 @@ int main(int argc, char** argv) {
       fmt::print("  time                 {:.3f} s ({:.3f} s packing)\n", total_seconds, pack_seconds);
       fmt::print("  written              {}\n", output);
     }
-    if (!low.text.empty() && !lattice) {
+    if (!low.text.empty()) {
       if (low.far_below)
         std::fprintf(stderr, "basalt-pack: warning: %s (written as --allow-low-fraction asks)\n",
                      low.text.c_str());
