@@ -5,6 +5,8 @@
     g.write("cube.h5")
     c = basalt.read_checkpoint("out/wave/ckpt_000800.h5")                 # c.positions, c.particles["velocity"]
     f = basalt.read_fields("out/wave/fields.csv")                        # f["time"], f["kinetic_energy"]
+    sim = basalt.Simulation("scenes/wave.toml", geometry="cube.h5")      # a run: stages, callbacks, steering
+    sim.run(until=lambda s: s.kinetic_energy() < 1e-6, every=100, steps=10_000)
 
 docs/python.md documents the package. ``import basalt`` needs only the standard library: numpy, h5py and the
 compiled core (basalt._core) are loaded by the first function that needs them, so a missing h5py fails
@@ -13,7 +15,7 @@ read_checkpoint with a message saying so, never the import.
 
 import importlib
 
-from ._errors import FormatError, PackError
+from ._errors import FormatError, InputError, PackError, RunError
 from ._version import __version__
 
 # Public name -> the submodule defining it; loaded on first use (PEP 562).
@@ -24,10 +26,11 @@ _LAZY = {
     "read_checkpoint": "checkpoint",
     "read_checkpoints": "checkpoint",
     "read_fields": "fields",
+    "Simulation": "simulation",
 }
-_SUBMODULES = ("pack", "geometry", "checkpoint", "fields")
+_SUBMODULES = ("pack", "geometry", "checkpoint", "fields", "simulation")
 
-__all__ = ["__version__", "FormatError", "PackError", "pack", *_LAZY]
+__all__ = ["__version__", "FormatError", "PackError", "InputError", "RunError", "pack", *_LAZY]
 
 
 def __getattr__(name):

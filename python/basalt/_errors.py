@@ -27,5 +27,15 @@ class PackError(ValueError):
     basalt-pack's message; options are named as on its command line (``--bond-tolerance must be >= 0``)."""
 
 
-# Shown as basalt.FormatError and basalt.PackError in tracebacks, where users catch them.
-FormatError.__module__ = PackError.__module__ = "basalt"
+class InputError(ValueError):
+    """A bad scene, geometry or argument of basalt.Simulation, with basalt-run's message (naming the file, line
+    and key: ``<scene text>:12: run.dt: must be positive``)."""
+
+
+class RunError(RuntimeError):
+    """A run that stopped: a blow-up, an output error, a stop signal, or (on the other ranks) a callback's
+    exception on one rank. The rank whose callback raised gets its own exception back."""
+
+
+# Shown as basalt.FormatError ... in tracebacks, where users catch them.
+FormatError.__module__ = PackError.__module__ = InputError.__module__ = RunError.__module__ = "basalt"

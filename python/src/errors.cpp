@@ -1,4 +1,6 @@
 // Basalt's C++ errors as the Python exceptions of basalt._errors, messages unchanged.
+#include "basalt/solver/core/errors.hpp"
+
 #include <exception>
 
 #include "basalt/io/geometry.hpp"
@@ -34,6 +36,10 @@ void bind_errors(py::module_&) {
       raise("FormatError", e.what(), e.file().string(), e.where());
     } catch (const basalt::packer::PackError& e) {
       raise("PackError", e.what());
+    } catch (const basalt::solver::InputError& e) {
+      raise("InputError", e.what());
+    } catch (const basalt::solver::RunError& e) {
+      raise("RunError", e.what());
     }
   });
 }

@@ -12,4 +12,5 @@ PYBIND11_MODULE(_core, m) {
   basalt::python::bind_geometry(m);
   basalt::python::bind_checkpoint(m);
   basalt::python::bind_pack(m);
+  basalt::python::bind_simulation(m);
 }

@@ -1,0 +1,256 @@
+"""basalt.Simulation: a Basalt run driven from Python (docs/python.md).
+
+    import basalt
+    sim = basalt.Simulation("scenes/wave.toml", geometry="cube.h5", output="out/py")
+    sim.run(1000)                                          # as basalt-run, checkpoints and fields.csv included
+    sim.run(until=lambda s: s.kinetic_energy() < 1e-9, every=100, steps=50_000)   # a stage with a stop condition
+    sim.walls["gate"].remove()                             # then take the gate away
+    @sim.callback(every=100)
+    def watch(s): print(s.step, s.walls["top"].force)
+
+Run it as ``python3 script.py`` (one rank) or ``mpirun -np N python3 script.py``: every rank runs the same
+script; the solver's calls are collective and must be made alike on every compute rank (decide on collective
+values: kinetic_energy(), energies(), walls, sum()). With ``io_ranks=Q`` the last Q ranks write the output:
+on them the constructor returns when the compute ranks close the run, with ``is_io_rank`` True.
+"""
+
+import numbers
+import os
+
+from ._core_loader import core
+
+_ARRAYS = ("x", "y", "z", "vx", "vy", "vz", "fx", "fy", "fz", "radius", "inv_mass", "id", "tag", "wx", "wy", "wz")
+
+
+def _toml_value(v):
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, numbers.Integral):
+        return str(int(v))
+    if isinstance(v, numbers.Real):
+        return repr(float(v))
+    if isinstance(v, str):
+        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+    if isinstance(v, dict):
+        return "{" + ", ".join(f"{k} = {_toml_value(x)}" for k, x in v.items()) + "}"
+    raise TypeError(f"scene value {v!r}: not a TOML value (bool, number, string, list or dict)")
+
+
+def scene_text(scene):
+    """TOML text of a scene given as a dict: {"run": {...}, "walls": [{...}, ...], ...} (docs/scenes.md)."""
+    lines = []
+    for key, value in scene.items():
+        if isinstance(value, dict):
+            lines.append(f"[{key}]")
+            lines += [f"{k} = {_toml_value(v)}" for k, v in value.items()]
+        elif isinstance(value, (list, tuple)) and value and all(isinstance(t, dict) for t in value):
+            for table in value:
+                lines.append(f"[[{key}]]")
+                lines += [f"{k} = {_toml_value(v)}" for k, v in table.items()]
+        else:
+            raise TypeError(f"scene key {key!r}: a table (dict) or an array of tables (list of dicts) expected")
+        lines.append("")
+    return "\n".join(lines)
+
+
+class Particles:
+    """This rank's owned particles as numpy views (no copy): sim.particles.x, .vz, .radius, .id, ...
+
+    A view is valid until the next step (a rebuild reorders and reallocates the arrays): take it inside a
+    callback or between runs, not across them. Writing velocities between steps changes the run; after
+    writing positions call sim.state_changed().
+    """
+
+    def __init__(self, sim):
+        self._sim = sim
+
+    def __getattr__(self, name):
+        if name in _ARRAYS:
+            return self._sim._core.array(name)
+        raise AttributeError(f"no particle array {name!r} (one of {', '.join(_ARRAYS)})")
+
+    def __len__(self):
+        return self._sim._core.owned
+
+    @property
+    def positions(self):
+        """(N, 3) copy of the positions."""
+        import numpy as np
+
+        return np.column_stack([self.x, self.y, self.z])
+
+    @property
+    def velocities(self):
+        import numpy as np
+
+        return np.column_stack([self.vx, self.vy, self.vz])
+
+
+class Wall:
+    """A planar wall of the scene: position, normal and force (summed over the ranks), steering."""
+
+    def __init__(self, sim, name):
+        self._sim, self.name = sim, name
+
+    def _state(self):
+        return self._sim._core.walls()[self.name]
+
+    @property
+    def position(self):
+        return self._state()["position"]
+
+    @property
+    def force(self):
+        return self._state()["force"]
+
+    @property
+    def normal(self):
+        return self._state()["normal"]
+
+    def set_velocity(self, v):
+        """Move at velocity v (3 numbers) from now on, from where the wall is."""
+        self._sim._core.set_wall_velocity(self.name, [float(c) for c in v])
+
+    def stop(self):
+        self.set_velocity((0.0, 0.0, 0.0))
+
+    def remove(self):
+        """The wall touches no particle from now on (a gate taken away)."""
+        self._sim._core.remove_wall(self.name)
+
+    def __repr__(self):
+        s = self._state()
+        return f"Wall({self.name!r}, position={s['position']}, force={s['force']})"
+
+
+class Walls:
+    def __init__(self, sim):
+        self._sim = sim
+
+    def __getitem__(self, name):
+        if name not in self._sim._core.walls():
+            raise KeyError(f"no planar wall named {name!r} (the scene's walls: {', '.join(self) or 'none'})")
+        return Wall(self._sim, name)
+
+    def __iter__(self):
+        return iter(self._sim._core.walls())
+
+    def __len__(self):
+        return len(self._sim._core.walls())
+
+
+class Simulation:
+    """A run: the scene (a file, TOML text or a dict), its geometry, its output (checkpoints, fields.csv)."""
+
+    def __init__(self, scene, *, geometry=None, output=None, io_ranks=0, precision=None, checkpoint_every=None,
+                 quiet=True, force_dt=False):
+        if isinstance(scene, dict):
+            # run.steps is basalt-run's; a script says how long with run(): 0 unless given
+            scene = {**scene, "run": {"steps": 0, **scene.get("run", {})}} if "stages" not in scene else scene
+            text, source = True, scene_text(scene)
+        elif isinstance(scene, os.PathLike) or (isinstance(scene, str) and "\n" not in scene and "=" not in scene):
+            text, source = False, os.fspath(scene)
+        else:
+            text, source = True, str(scene)
+        self._core = core().Simulation(
+            source, text=text, geometry=os.fspath(geometry) if geometry else "",
+            output=os.fspath(output) if output else "", io_ranks=int(io_ranks), precision=precision or "",
+            checkpoint_every=-1 if checkpoint_every is None else int(checkpoint_every), quiet=bool(quiet),
+            force_dt=bool(force_dt))
+        self._callbacks = []  # (every, fn)
+        self.particles = Particles(self)
+        self.walls = Walls(self)
+
+    # -- running --------------------------------------------------------------------------------------------
+    def run(self, steps=None, *, until=None, every=1):
+        """Runs `steps` steps, or until `until(sim)` is true (checked every `every` steps; at most `steps`
+        steps when both are given). Returns the steps made. Callbacks registered with callback() run too."""
+        if steps is None and until is None:
+            raise ValueError("run(): give steps, until, or both")
+        if steps is None:
+            steps = 2**62
+        hooks = [(every_n, (lambda f: lambda step: f(self))(fn)) for every_n, fn in self._callbacks]
+        if until is not None:
+            hooks.append((int(every), lambda step: not until(self)))
+        return self._core.run(int(steps), hooks)
+
+    def run_stages(self):
+        """Runs the scene's [[stages]] in order (docs/scenes.md, "Stages"); returns one dict per stage: name,
+        first_step, steps, condition_met, value (the condition's quantity at its end) and line (basalt-run's
+        report line). Callbacks registered with callback() do not run during the stages."""
+        return self._core.run_stages()
+
+    def callback(self, fn=None, *, every=1):
+        """Registers fn(sim) to run after every `every`-th step of each run (a decorator too). fn returning
+        False ends the run. Returns fn."""
+        def register(f):
+            self._callbacks.append((int(every), f))
+            return f
+        return register(fn) if fn is not None else register
+
+    def remove_callback(self, fn):
+        self._callbacks = [(e, f) for e, f in self._callbacks if f is not fn]
+
+    # -- state ----------------------------------------------------------------------------------------------
+    is_io_rank = property(lambda self: self._core.is_io_rank)
+    rank = property(lambda self: self._core.rank, doc="this rank among the compute ranks (-1 on I/O ranks)")
+    ranks = property(lambda self: self._core.ranks, doc="the number of compute ranks")
+    step = property(lambda self: self._core.step)
+    time = property(lambda self: self._core.time)
+    total_particles = property(lambda self: self._core.total_particles)
+
+    @property
+    def dt(self):
+        return self._core.dt
+
+    @dt.setter
+    def dt(self, value):
+        self._core.set_dt(float(value))
+
+    def kinetic_energy(self):
+        """Collective: the total kinetic energy (translation and rotation)."""
+        return self._core.kinetic_energy()
+
+    def energies(self):
+        """Collective: the energy ledger's terms (kinetic, potentials, work, dissipated) summed over ranks."""
+        return self._core.energies()
+
+    def sum(self, value):
+        """Collective: value summed over the compute ranks."""
+        return self._core.allreduce(float(value), "sum")
+
+    def max(self, value):
+        return self._core.allreduce(float(value), "max")
+
+    def min(self, value):
+        return self._core.allreduce(float(value), "min")
+
+    # -- steering ---------------------------------------------------------------------------------------------
+    def fix(self, *tags):
+        """Particles of these tags are held from now on (replaces the scene's particles.fixed_tags)."""
+        self._core.set_fixed_tags([int(t) for t in tags])
+
+    def free(self):
+        """No particle is held from now on."""
+        self._core.set_fixed_tags([])
+
+    def state_changed(self):
+        """Collective: call after writing positions (recomputes forces and the energy the guard starts from)."""
+        self._core.state_changed()
+
+    def close(self):
+        """Ends the run's output (collective: the I/O ranks finish writing). Raises on an output error."""
+        error = self._core.close()
+        if error:
+            raise RuntimeError(f"output failed: {error}")
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        error = self._core.close()
+        if error and exc[0] is None:
+            raise RuntimeError(f"output failed: {error}")
+        return False

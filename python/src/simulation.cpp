@@ -1,0 +1,483 @@
+// basalt._core.Simulation: a run driven from Python (docs/python.md). The same start-up and output as
+// basalt-run (sliced geometry reading, dedicated I/O ranks or synchronous writing, checkpoints, field
+// series), with the run loop's hooks (Simulation::run, StepHook) calling Python, numpy views of the rank's
+// particle arrays and the steering calls of Simulation. basalt/simulation.py wraps it.
+//
+// SPMD: every MPI rank runs the same script. With io_ranks > 0 the last ranks of the world are I/O ranks:
+// their constructor serves the compute ranks' output until close() on the compute ranks, then returns an
+// object whose is_io_rank is True and whose run() does nothing.
+#include "basalt/solver/simulation.hpp"
+
+#include <fmt/format.h>
+#include <mpi.h>
+#include <pybind11/functional.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "basalt/io/io_ranks.hpp"
+#include "basalt/solver/core/errors.hpp"
+#include "basalt/solver/models/registry.hpp"
+#include "basalt/solver/parallel/communicator.hpp"
+#include "basalt/solver/scene/scene.hpp"
+#include "basalt/solver/stages.hpp"
+#include "basalt/version.hpp"
+#include "bindings.hpp"
+#include "client_sink.hpp"
+#include "geometry_input.hpp"
+#include "output_folder.hpp"
+#include "restart_support.hpp"
+#if BASALT_WITH_VTK
+#include "basalt/io/vtk_frame_writer.hpp"
+#endif
+
+namespace basalt::python {
+
+namespace py = pybind11;
+namespace fs = std::filesystem;
+using solver::InputError;
+using solver::RunError;
+using solver::Scene;
+
+namespace {
+
+class PySimulation;
+/// The simulations not closed yet: closed (collectively, in creation order) at exit, before MPI_Finalize.
+std::vector<PySimulation*>& live_simulations() {
+  static std::vector<PySimulation*> live;
+  return live;
+}
+void close_live_simulations();
+
+/// MPI for the whole interpreter: initialised at the first Simulation (FUNNELED, as basalt-run), finalised at
+/// exit (atexit) after closing the simulations still open, unless someone else (mpi4py) initialised it.
+void ensure_mpi() {
+  int up = 0;
+  MPI_Initialized(&up);
+  if (up) return;
+  int provided = 0;
+  MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided);
+  py::module_::import("atexit").attr("register")(py::cpp_function([] {
+    close_live_simulations();
+    int done = 0;
+    MPI_Finalized(&done);
+    if (!done) MPI_Finalize();
+  }));
+}
+
+bool mpi_finalized() {
+  int done = 0;
+  MPI_Finalized(&done);
+  return done != 0;
+}
+
+/// The start-up's choices, as the Python constructor takes them.
+struct Options {
+  std::string scene;  ///< a file, or TOML text when `text`
+  bool text = false;
+  std::string geometry, output, precision;
+  int io_ranks = 0;
+  std::int64_t checkpoint_every = -1;
+  bool quiet = true;
+  bool force_dt = false;
+};
+
+/// One compute rank's run of precision Real with its output client.
+class Run {
+ public:
+  virtual ~Run() = default;
+  virtual std::int64_t run(std::int64_t steps, const std::vector<solver::StepHook>& hooks) = 0;
+  virtual py::list run_stages() = 0;
+  virtual py::dict state() = 0;
+  virtual py::array array(const std::string& name, py::handle owner) = 0;
+  virtual const solver::Comm& comm() const = 0;
+  virtual std::int64_t step() const = 0;
+  virtual double time() const = 0;
+  virtual double dt() const = 0;
+  virtual std::int64_t total_particles() const = 0;
+  virtual std::size_t owned() const = 0;
+  virtual double kinetic_energy() = 0;
+  virtual py::dict energies() = 0;
+  virtual py::dict walls() = 0;
+  virtual void set_dt(double dt) = 0;
+  virtual void set_fixed_tags(std::vector<std::int64_t> tags) = 0;
+  virtual void set_wall_velocity(const std::string& name, const std::array<double, 3>& v) = 0;
+  virtual void remove_wall(const std::string& name) = 0;
+  virtual void state_changed() = 0;
+  virtual std::string close() = 0;
+};
+
+template <class Real>
+class RunOf final : public Run {
+ public:
+  RunOf(Scene scene, const io::RankLayout& layout, io::OutputConfig cfg, const io::VtkFrameWriter& vtk,
+        const Options& o)
+      : scene_(std::move(scene)), comm_(layout.compute) {
+    solver::RunOptions ro;
+    ro.quiet = o.quiet;
+    ro.force_dt = o.force_dt;
+    io::RunInfo info;
+    std::optional<std::string> error;
+    try {
+      const fs::path file = basalt::run::geometry_as_h5(scene_.geometry, cfg.dir, comm_, o.quiet);
+      std::optional<io::GeometryFile> rows;
+      std::optional<std::string> open_error;
+      try {
+        rows.emplace(file);
+      } catch (const std::exception& e) {
+        open_error = e.what();
+      }
+      if (auto e = comm_.agree_error(open_error)) throw InputError(*e);
+      const auto& h = rows->header();
+      info.box_min = h.box_min;
+      info.box_max = h.box_max;
+      info.periodic = h.periodic;
+      info.units = h.units;
+      sim_ = std::make_unique<solver::Simulation<Real>>(scene_, *rows, layout.compute, ro);
+      info.attributes = basalt::run::restart_attributes(sim_->restart_layout());
+      info.attributes["code_version"] = std::string(basalt::kVersion);
+      info.attributes["precision"] = scene_.precision;
+      info.scene_text = scene_.text;
+      scene_.dt = sim_->dt();
+      info.dt = scene_.dt;
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+    if (error) {  // release the I/O ranks (they wait for the run's information), then report
+      cfg.checkpoint_every = cfg.frames_every = cfg.fields_every = 0;
+      io::OutputClient client(layout, cfg, info, vtk);
+      client.finish();
+      throw InputError(*error);
+    }
+    client_ = std::make_unique<io::OutputClient>(layout, cfg, info, vtk);
+    sink_ = std::make_unique<basalt::run::ClientSink>(*client_, cfg.continue_on_error);
+  }
+
+  std::int64_t run(std::int64_t steps, const std::vector<solver::StepHook>& hooks) override {
+    return sim_->run(steps, *sink_, hooks);
+  }
+  py::list run_stages() override {
+    py::list out;
+    solver::run_stages(*sim_, *sink_, scene_.stages,
+                       [&](const solver::StageSpec& st, const solver::StageReport& r) {
+                         py::dict d;
+                         d["name"] = r.name;
+                         d["first_step"] = r.first_step;
+                         d["steps"] = r.steps;
+                         d["condition_met"] = r.condition_met;
+                         d["value"] = r.value;
+                         d["line"] = solver::describe(st, r);
+                         out.append(d);
+                       });
+    return out;
+  }
+  const solver::Comm& comm() const override { return comm_; }
+  std::int64_t step() const override { return sim_->current_step(); }
+  double time() const override { return sim_->time(); }
+  double dt() const override { return sim_->dt(); }
+  std::int64_t total_particles() const override { return sim_->total_particles(); }
+  std::size_t owned() const override { return sim_->particles().n_owned; }
+  double kinetic_energy() override { return sim_->kinetic_energy(); }
+  void set_dt(double dt) override { sim_->set_dt(dt); }
+  void set_fixed_tags(std::vector<std::int64_t> tags) override { sim_->set_fixed_tags(std::move(tags)); }
+  void set_wall_velocity(const std::string& name, const std::array<double, 3>& v) override {
+    sim_->set_wall_velocity(name, v);
+  }
+  void remove_wall(const std::string& name) override { sim_->remove_wall(name); }
+  void state_changed() override { sim_->state_changed(); }
+
+  py::dict energies() override {
+    const auto values = sim_->ledger_values();
+    py::dict d;
+    const auto& ledger = sim_->ledger();
+    for (std::size_t t = 0; t < ledger.size(); ++t) d[py::str(ledger[t].name)] = values[t];
+    return d;
+  }
+
+  py::dict walls() override {
+    // Forces are this rank's shares: summed over the compute ranks (collective), alike on every rank.
+    const auto& w = sim_->walls();
+    std::vector<double> f;
+    for (std::size_t k = 0; k < w.size(); ++k) f.insert(f.end(), w.force(k).begin(), w.force(k).end());
+    if (comm_.size() > 1) comm_.sum_all(f);
+    py::dict d;
+    const auto& o = sim_->origin();
+    for (std::size_t k = 0; k < w.size(); ++k) {
+      py::dict e;
+      const auto& x = w.point(k);
+      e["position"] = py::make_tuple(x[0] + o[0], x[1] + o[1], x[2] + o[2]);
+      e["normal"] = py::make_tuple(w.spec(k).normal[0], w.spec(k).normal[1], w.spec(k).normal[2]);
+      e["force"] = py::make_tuple(f[3 * k], f[3 * k + 1], f[3 * k + 2]);
+      e["removed"] = w.removed(k);
+      d[py::str(w.spec(k).name)] = e;
+    }
+    return d;
+  }
+
+  py::dict state() override {
+    py::dict d;
+    d["step"] = step();
+    d["time"] = time();
+    d["dt"] = dt();
+    return d;
+  }
+
+  py::array array(const std::string& name, py::handle owner) override {
+    // A view (no copy) of this rank's owned particles' values: valid until the next step, which may
+    // reorder and reallocate the arrays. Writing to it changes the run (velocities between steps).
+    auto& p = sim_->particles();  // drops the cached kinetic energy: the caller may write
+    const auto n = static_cast<py::ssize_t>(p.n_owned);
+    auto view = [&](auto& v) {
+      using T = typename std::decay_t<decltype(v)>::value_type;
+      return py::array_t<T>({n}, {py::ssize_t(sizeof(T))}, v.data(), owner);
+    };
+    if (name == "x") return view(p.x);
+    if (name == "y") return view(p.y);
+    if (name == "z") return view(p.z);
+    if (name == "vx") return view(p.vx);
+    if (name == "vy") return view(p.vy);
+    if (name == "vz") return view(p.vz);
+    if (name == "fx") return view(p.fx);
+    if (name == "fy") return view(p.fy);
+    if (name == "fz") return view(p.fz);
+    if (name == "radius") return view(p.radius);
+    if (name == "inv_mass") return view(p.inv_mass);
+    if (name == "id") return view(p.id);
+    if (name == "tag") return view(p.tag);
+    if (p.with_rotation) {
+      if (name == "wx") return view(p.wx);
+      if (name == "wy") return view(p.wy);
+      if (name == "wz") return view(p.wz);
+    }
+    throw py::key_error(
+        "no particle array \"" + name +
+        "\" (x, y, z, vx, vy, vz, fx, fy, fz, radius, inv_mass, id, tag; wx, wy, wz with rotation)");
+  }
+
+  std::string close() override {
+    if (!client_) return {};
+    const auto report = client_->finish();
+    client_.reset();
+    return report.error ? *report.error : std::string();
+  }
+
+ private:
+  Scene scene_;
+  solver::Comm comm_;
+  std::unique_ptr<solver::Simulation<Real>> sim_;
+  std::unique_ptr<io::OutputClient> client_;
+  std::unique_ptr<basalt::run::ClientSink> sink_;
+};
+
+/// The Python object: the world's layout, and a Run on compute ranks.
+class PySimulation {
+ public:
+  explicit PySimulation(const Options& o) {
+    ensure_mpi();
+    live_simulations().push_back(this);
+    try {
+      start(o);
+    } catch (...) {
+      forget();
+      throw;
+    }
+  }
+  ~PySimulation() {
+    forget();
+    if (mpi_finalized()) return;  // (closed at exit already, or MPI ended by someone else: nothing to do)
+    try {
+      close();
+    } catch (...) {
+    }
+  }
+  PySimulation(const PySimulation&) = delete;
+  PySimulation& operator=(const PySimulation&) = delete;
+
+  void start(const Options& o) {
+    Scene scene = o.text ? solver::parse_scene_text(o.scene, "<scene text>", fs::current_path())
+                         : solver::parse_scene(o.scene);
+    if (!o.geometry.empty()) scene.geometry = o.geometry;
+    if (!o.output.empty()) scene.output_dir = o.output;
+    if (o.checkpoint_every >= 0) scene.checkpoint_every = o.checkpoint_every;
+    if (!o.precision.empty()) scene.precision = o.precision;
+    if (scene.precision != "double" && scene.precision != "float" && scene.precision != "mixed")
+      throw InputError("precision = \"" + scene.precision + "\": double, float or mixed");
+    if (scene.precision != "double") solver::refuse_single_precision(scene);
+    if (scene.frames_every > 0 && !BASALT_WITH_VTK)
+      throw InputError("output.frames_every: VTK frames are not in this build (BASALT_WITH_VTK=OFF)");
+    if (scene.render_every > 0)
+      throw InputError(
+          "output.render_every: in-situ pictures are basalt-run's (--io-ranks); from Python, "
+          "write checkpoints and draw them with basalt-view render");
+    if (!fs::exists(scene.geometry))
+      throw InputError("geometry file " + scene.geometry.string() + " does not exist");
+    basalt::run::prepare_output_folder(scene.output_dir, MPI_COMM_WORLD);
+
+    io::OutputConfig cfg;
+    cfg.dir = scene.output_dir;
+    cfg.checkpoint_every = scene.checkpoint_every;
+    cfg.frames_every = scene.frames_every;
+    cfg.fields_every = scene.fields.empty() ? 0 : 1;
+    cfg.field_names = solver::field_columns(scene);
+    cfg.max_frames_in_flight = static_cast<int>(scene.frames_in_flight);
+    cfg.continue_on_error = scene.output_continue_on_error;
+#if BASALT_WITH_VTK
+    vtk_ = io::make_vtk_frame_writer(
+        io::Units{scene.units.length, scene.units.time, scene.units.force, io::Units{}.mass}, -1.0);
+#endif
+    try {
+      layout_ = io::split_ranks(MPI_COMM_WORLD, o.io_ranks);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(e.what());
+    }
+    split_ = true;
+    if (layout_.is_io) {
+      // Serve the compute ranks' output until they close; the script then goes on with an idle object.
+      io::IoServer server(layout_, cfg, vtk_);
+      const auto report = server.run();
+      if (report.error) io_error_ = *report.error;
+      return;
+    }
+    if (scene.precision == "double")
+      run_ = std::make_unique<RunOf<double>>(std::move(scene), layout_, cfg, vtk_, o);
+    else
+      run_ = std::make_unique<RunOf<float>>(std::move(scene), layout_, cfg, vtk_, o);
+  }
+  void forget() {
+    auto& live = live_simulations();
+    live.erase(std::remove(live.begin(), live.end(), this), live.end());
+  }
+
+  bool is_io_rank() const { return !run_ && split_; }
+  Run& run() {
+    if (!run_) throw RunError(closed_ ? "the simulation is closed" : "an I/O rank runs no steps");
+    return *run_;
+  }
+
+  /// Runs `steps` steps with the Python hooks [(every, callable(step) -> bool|None)]: False ends the run.
+  /// A Python exception on any compute rank ends the run on every rank, with its message.
+  std::int64_t run_steps(std::int64_t steps,
+                         const std::vector<std::pair<std::int64_t, py::function>>& hooks) {
+    if (!run_) return 0;
+    auto& r = *run_;
+    std::vector<solver::StepHook> calls;
+    std::optional<py::error_already_set>
+        raised;  // the Python exception of this rank, re-raised after the run
+    for (const auto& [every, fn] : hooks) {
+      if (every < 1) throw InputError("a callback's every must be >= 1");
+      calls.push_back({every, [&r, &raised, fn](std::int64_t step) {
+                         std::optional<std::string> error;
+                         bool go = true;
+                         try {
+                           const py::object result = fn(step);
+                           go = result.is_none() || py::bool_(result);
+                         } catch (py::error_already_set& e) {
+                           error = e.what();
+                           raised = std::move(e);
+                         }
+                         // One reduction: 2 = an error somewhere, 1 = a rank asks to stop.
+                         double flag = error ? 2 : go ? 0 : 1;
+                         if (r.comm().size() > 1) flag = r.comm().max(flag);
+                         if (flag >= 2) {
+                           const auto e = r.comm().size() > 1 ? r.comm().agree_error(error) : error;
+                           throw RunError(fmt::format("callback at step {}: {}", step, *e));
+                         }
+                         return flag == 0;
+                       }});
+    }
+    try {
+      return r.run(steps, calls);
+    } catch (const RunError&) {
+      if (raised) throw *raised;  // this rank's own Python exception, with its type and traceback
+      throw;
+    }
+  }
+
+  std::string close() {
+    if (closed_) return {};
+    closed_ = true;
+    std::string error = run_ ? run_->close() : io_error_;
+    run_.reset();
+    if (split_) io::free_layout(layout_);
+    split_ = false;
+    return error;
+  }
+
+ private:
+  io::RankLayout layout_;
+  bool split_ = false;
+  bool closed_ = false;
+  io::VtkFrameWriter vtk_;
+  std::unique_ptr<Run> run_;
+  std::string io_error_;
+};
+
+void close_live_simulations() {
+  const auto live = live_simulations();  // (a copy: close() does not change the list, forget() does)
+  for (auto* s : live) {
+    try {
+      s->close();
+    } catch (...) {
+    }
+  }
+}
+
+}  // namespace
+
+void bind_simulation(py::module_& m) {
+  py::class_<PySimulation>(m, "Simulation")
+      .def(py::init([](const std::string& scene, bool text, const std::string& geometry,
+                       const std::string& output, int io_ranks, const std::string& precision,
+                       std::int64_t checkpoint_every, bool quiet, bool force_dt) {
+             return std::make_unique<PySimulation>(Options{scene, text, geometry, output, precision, io_ranks,
+                                                           checkpoint_every, quiet, force_dt});
+           }),
+           py::arg("scene"), py::arg("text") = false, py::arg("geometry") = "", py::arg("output") = "",
+           py::arg("io_ranks") = 0, py::arg("precision") = "", py::arg("checkpoint_every") = -1,
+           py::arg("quiet") = true, py::arg("force_dt") = false)
+      .def_property_readonly("is_io_rank", &PySimulation::is_io_rank)
+      .def("run", &PySimulation::run_steps, py::arg("steps"), py::arg("hooks") = py::list())
+      .def("close", &PySimulation::close)
+      .def("run_stages", [](PySimulation& s) { return s.is_io_rank() ? py::list() : s.run().run_stages(); })
+      .def_property_readonly("rank",
+                             [](PySimulation& s) { return s.is_io_rank() ? -1 : s.run().comm().rank(); })
+      .def_property_readonly("ranks",
+                             [](PySimulation& s) { return s.is_io_rank() ? 0 : s.run().comm().size(); })
+      .def_property_readonly("step", [](PySimulation& s) { return s.run().step(); })
+      .def_property_readonly("time", [](PySimulation& s) { return s.run().time(); })
+      .def_property_readonly("dt", [](PySimulation& s) { return s.run().dt(); })
+      .def("set_dt", [](PySimulation& s, double dt) { s.run().set_dt(dt); })
+      .def_property_readonly("total_particles", [](PySimulation& s) { return s.run().total_particles(); })
+      .def_property_readonly("owned", [](PySimulation& s) { return s.run().owned(); })
+      .def("array",
+           [](py::object self, const std::string& name) {
+             return self.cast<PySimulation&>().run().array(name, self);
+           })
+      .def("kinetic_energy", [](PySimulation& s) { return s.run().kinetic_energy(); })
+      .def("energies", [](PySimulation& s) { return s.run().energies(); })
+      .def("walls", [](PySimulation& s) { return s.run().walls(); })
+      .def("set_fixed_tags",
+           [](PySimulation& s, std::vector<std::int64_t> t) { s.run().set_fixed_tags(std::move(t)); })
+      .def("set_wall_velocity", [](PySimulation& s, const std::string& name,
+                                   std::array<double, 3> v) { s.run().set_wall_velocity(name, v); })
+      .def("remove_wall", [](PySimulation& s, const std::string& name) { s.run().remove_wall(name); })
+      .def("state_changed", [](PySimulation& s) { s.run().state_changed(); })
+      .def("allreduce", [](PySimulation& s, double v, const std::string& op) {
+        const auto& c = s.run().comm();
+        if (c.size() == 1) return v;
+        if (op == "sum") return c.sum(v);
+        if (op == "max") return c.max(v);
+        if (op == "min") return -c.max(-v);
+        throw py::value_error("op: sum, max or min");
+      });
+}
+
+}  // namespace basalt::python
