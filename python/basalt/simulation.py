@@ -159,7 +159,7 @@ class Simulation:
             output=os.fspath(output) if output else "", io_ranks=int(io_ranks), precision=precision or "",
             checkpoint_every=-1 if checkpoint_every is None else int(checkpoint_every), quiet=bool(quiet),
             force_dt=bool(force_dt))
-        self._callbacks = []  # (every, fn)
+        self._callbacks = []  # (every, fn, reads velocities)
         self.particles = Particles(self)
         self.walls = Walls(self)
 
@@ -171,9 +171,10 @@ class Simulation:
             raise ValueError("run(): give steps, until, or both")
         if steps is None:
             steps = 2**62
-        hooks = [(every_n, (lambda f: lambda step: f(self))(fn)) for every_n, fn in self._callbacks]
+        hooks = [(every_n, (lambda f: lambda step: f(self))(fn), velocities)
+                 for every_n, fn, velocities in self._callbacks]
         if until is not None:
-            hooks.append((int(every), lambda step: not until(self)))
+            hooks.append((int(every), lambda step: not until(self), True))
         return self._core.run(int(steps), hooks)
 
     def run_stages(self):
@@ -182,16 +183,18 @@ class Simulation:
         report line). Callbacks registered with callback() do not run during the stages."""
         return self._core.run_stages()
 
-    def callback(self, fn=None, *, every=1):
+    def callback(self, fn=None, *, every=1, velocities=True):
         """Registers fn(sim) to run after every `every`-th step of each run (a decorator too). fn returning
-        False ends the run. Returns fn."""
+        False ends the run. Returns fn. velocities=False: fn reads no velocities (positions, forces, walls
+        only), so the step before it may leave its second half-kick to the next step (one pass over the
+        particles fewer; the velocities fn would see are half a kick behind)."""
         def register(f):
-            self._callbacks.append((int(every), f))
+            self._callbacks.append((int(every), f, bool(velocities)))
             return f
         return register(fn) if fn is not None else register
 
     def remove_callback(self, fn):
-        self._callbacks = [(e, f) for e, f in self._callbacks if f is not fn]
+        self._callbacks = [c for c in self._callbacks if c[1] is not fn]
 
     # -- state ----------------------------------------------------------------------------------------------
     is_io_rank = property(lambda self: self._core.is_io_rank)

@@ -362,18 +362,20 @@ class PySimulation {
     return *run_;
   }
 
-  /// Runs `steps` steps with the Python hooks [(every, callable(step) -> bool|None)]: False ends the run.
+  /// Runs `steps` steps with the Python hooks [(every, callable(step) -> bool|None, reads velocities)]: False
+  /// ends the run.
   /// A Python exception on any compute rank ends the run on every rank, with its message.
   std::int64_t run_steps(std::int64_t steps,
-                         const std::vector<std::pair<std::int64_t, py::function>>& hooks) {
+                         const std::vector<std::tuple<std::int64_t, py::function, bool>>& hooks) {
     if (!run_) return 0;
     auto& r = *run_;
     std::vector<solver::StepHook> calls;
     std::optional<py::error_already_set>
         raised;  // the Python exception of this rank, re-raised after the run
-    for (const auto& [every, fn] : hooks) {
+    for (const auto& [every, fn, velocities] : hooks) {
       if (every < 1) throw InputError("a callback's every must be >= 1");
-      calls.push_back({every, [&r, &raised, fn](std::int64_t step) {
+      calls.push_back({every,
+                       [&r, &raised, fn](std::int64_t step) {
                          std::optional<std::string> error;
                          bool go = true;
                          try {
@@ -391,7 +393,8 @@ class PySimulation {
                            throw RunError(fmt::format("callback at step {}: {}", step, *e));
                          }
                          return flag == 0;
-                       }});
+                       },
+                       velocities});
     }
     try {
       return r.run(steps, calls);

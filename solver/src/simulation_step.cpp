@@ -159,7 +159,8 @@ void Simulation<Real>::progress(std::int64_t done, std::int64_t total, double se
 
 template <class Real>
 bool Simulation<Real>::hooks_due(std::span<const StepHook> hooks, std::int64_t s) {
-  return std::any_of(hooks.begin(), hooks.end(), [s](const StepHook& h) { return s % h.every == 0; });
+  return std::any_of(hooks.begin(), hooks.end(),
+                     [s](const StepHook& h) { return h.reads_velocities && s % h.every == 0; });
 }
 
 template <class Real>

@@ -128,6 +128,30 @@ TEST(Steering, HooksRunAtTheirStepsAndEndTheRunWithoutChangingIt) {
   EXPECT_EQ(state(a), state(b));
 }
 
+TEST(Steering, AHookSeesTheStepsVelocitiesUnlessItSaysItReadsNone) {
+  // reads_velocities (the default): the step before the hook makes its second half-kick, so the hook sees
+  // the velocities a run of exactly that many steps ends with. Without, the kick stays deferred: half a kick
+  // of gravity behind.
+  auto exact = make("dt = 2e-3");
+  exact.run(10);
+  const double want = exact.particles().vz[0];
+  const auto seen = [](bool reads) {
+    auto sim = make("dt = 2e-3");
+    double vz = 0;
+    const StepHook hooks[] = {{5,
+                               [&](std::int64_t s) {
+                                 if (s == 10) vz = sim.particles().vz[0];
+                                 return true;
+                               },
+                               reads}};
+    FieldRows rows(sim.comm(), nullptr);
+    sim.run(20, rows, hooks);
+    return vz;
+  };
+  EXPECT_EQ(seen(true), want);
+  EXPECT_NE(seen(false), want);
+}
+
 TEST(Steering, SetDtChangesTheStepFromNowOn) {
   auto sim = make("dt = 2e-3");
   sim.run(10);

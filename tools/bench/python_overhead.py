@@ -1,7 +1,8 @@
 """What driving a run from Python costs (issue 44, docs/BENCHMARKS.md "Python"): the wave benchmark on the GenGeo
 cube (tests/data/cube1.geo, 8,948 particles) run by basalt-run and by basalt.Simulation, interleaved, at 1 and
 2 ranks; then the cost of a callback every step that reads numpy views of positions and velocities, and of one
-every 100 steps. The loop time only (basalt-run's "done: ... in X s"; Python's time around sim.run, the slowest
+every 100 steps (the views read in a callback that says it reads no velocities, velocities=False, measure the
+Python call alone: the other pays the pass that completes the velocities too). The loop time only (basalt-run's "done: ... in X s"; Python's time around sim.run, the slowest
 rank's), medians of --repeats interleaved runs.
 
     /usr/bin/python3 tools/bench/python_overhead.py [--steps 2000] [--repeats 3] [--ranks 1 2] [--json out.json]
@@ -27,7 +28,7 @@ if every > 0:
     def look(s):
         x, vx = s.particles.x, s.particles.vx
         return None
-    sim.callback(look, every=every)
+    sim.callback(look, every=abs(every), velocities=every > 0)
 t = time.perf_counter()
 sim.run(steps)
 dt = sim.max(time.perf_counter() - t)
@@ -78,23 +79,28 @@ def main():
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for ranks in args.ranks:
-            times = {"basalt-run": [], "python": [], "callback every step": [], "callback every 100": []}
+            times = {"basalt-run": [], "python": [], "callback every step": [], "callback every step, no velocities": [],
+                     "callback every 100": []}
             for r in range(args.repeats):
                 base = os.path.join(tmp, f"np{ranks}-{r}")
                 times["basalt-run"].append(basalt_run(ranks, args.steps, base + "-cli", args.bin))
                 times["python"].append(python_run(ranks, args.steps, base + "-py", 0, args.pythonpath))
                 times["callback every step"].append(python_run(ranks, args.steps, base + "-cb1", 1, args.pythonpath))
+                times["callback every step, no velocities"].append(
+                    python_run(ranks, args.steps, base + "-cb1p", -1, args.pythonpath))
                 times["callback every 100"].append(python_run(ranks, args.steps, base + "-cb100", 100,
                                                               args.pythonpath))
             med = {k: statistics.median(v) for k, v in times.items()}
             row = {"ranks": ranks, "steps": args.steps, "median_s": med, "all_s": times,
                    "python_over_basalt_run": med["python"] / med["basalt-run"],
                    "callback_us_per_call": 1e6 * (med["callback every step"] - med["python"]) / args.steps,
+                   "callback_no_velocities_us_per_call":
+                       1e6 * (med["callback every step, no velocities"] - med["python"]) / args.steps,
                    "callback_every_100_over_python": med["callback every 100"] / med["python"]}
             rows.append(row)
             print(f"np {ranks}: basalt-run {med['basalt-run']:.3f} s, Python {med['python']:.3f} s "
                   f"({row['python_over_basalt_run']:.3f}x); callback every step +{row['callback_us_per_call']:.1f} us "
-                  f"per call; every 100 steps {row['callback_every_100_over_python']:.3f}x "
+                  f"per call (+{row['callback_no_velocities_us_per_call']:.1f} us reading no velocities); every 100 steps {row['callback_every_100_over_python']:.3f}x "
                   f"({args.steps} steps, medians of {args.repeats}, interleaved)", flush=True)
     if args.json:
         with open(args.json, "w") as f:

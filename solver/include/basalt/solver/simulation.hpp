@@ -80,11 +80,14 @@ struct RestartLayout {
 };
 
 /// A caller's job between steps (Python callbacks, stop conditions): run() calls it after every step s with
-/// s % every == 0 (the step before it then makes its second half-kick: it may read velocities). It returns
-/// false to end the run after this step, and must decide alike on every rank (on collective values).
+/// s % every == 0. It returns false to end the run after this step, and must decide alike on every rank (on
+/// collective values). With reads_velocities the step before it makes its second half-kick (the velocities
+/// are the step's); without, the kick may stay deferred into the next step (velocities half a kick behind,
+/// one pass over memory fewer: for hooks that read positions, forces or walls only).
 struct StepHook {
   std::int64_t every = 1;
   std::function<bool(std::int64_t step)> call;
+  bool reads_velocities = true;
 };
 
 template <class Real>
@@ -334,7 +337,7 @@ class Simulation {
   void wall_work();
   /// Field savers due and the energy guard.
   void observe(const std::vector<double>& pe);
-  /// Whether any hook is due after step s.
+  /// Whether any hook that reads velocities is due after step s.
   static bool hooks_due(std::span<const StepHook> hooks, std::int64_t s);
   /// Collective: checks the state and hands this rank's share of a frame to `out`.
   void write_frame(OutputSink& out, std::uint32_t kinds, std::vector<double>& seconds);
