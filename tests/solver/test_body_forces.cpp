@@ -15,7 +15,8 @@
 #include "basalt/solver/core/errors.hpp"
 #include "basalt/solver/models/damping.hpp"
 #include "basalt/solver/simulation.hpp"
-#include "solver_helpers.hpp"
+#include "geometries.hpp"
+#include "scene_runs.hpp"
 #include "test_support.hpp"
 
 using namespace basalt::solver;

@@ -8,7 +8,7 @@
 
 #include "basalt/solver/core/errors.hpp"
 #include "basalt/solver/simulation.hpp"
-#include "solver_helpers.hpp"
+#include "scene_runs.hpp"
 #include "test_support.hpp"
 
 using namespace basalt::solver;
@@ -19,14 +19,7 @@ constexpr int kSteps = 400;  // past the first rebuild with migration (step ~323
 
 std::vector<double> ke_series(const Scene& scene, const basalt::io::Geometry& g, MPI_Comm comm,
                               std::array<int, 3> dims) {
-  RunOptions opt;
-  opt.dims = dims;
-  opt.quiet = true;
-  Simulation<double> sim(scene, g, comm, opt);
-  basalt::test::MemorySink sink;
-  sink.begin(field_columns(scene));
-  sim.run(kSteps, &sink);
-  return sink.column(0);
+  return basalt::test::run_fields(scene, g, comm, kSteps, dims).column(0);
 }
 
 }  // namespace

@@ -5,7 +5,8 @@
 #include <cmath>
 
 #include "basalt/solver/simulation.hpp"
-#include "solver_helpers.hpp"
+#include "geometries.hpp"
+#include "scene_runs.hpp"
 #include "test_support.hpp"
 
 using namespace basalt::solver;

@@ -15,7 +15,8 @@
 #include "basalt/solver/core/errors.hpp"
 #include "basalt/solver/simulation.hpp"
 #include "extremes_helpers.hpp"
-#include "solver_helpers.hpp"
+#include "geometries.hpp"
+#include "scene_runs.hpp"
 #include "test_support.hpp"
 
 using namespace basalt::solver;
@@ -142,8 +143,7 @@ class RadiusRatio : public ::testing::TestWithParam<double> {};
 TEST_P(RadiusRatio, CriticalStepSeesTheSmallestParticle) {
   const double ratio = GetParam();
   const auto pk = mixed_packing(ratio);
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   Simulation<double> sim(basalt::test::scene_from(ratio_scene(ratio, "dt_fraction = 0.5")), pk.g,
                          basalt::test::world(), opt);
   const auto& st = sim.stability();
@@ -164,8 +164,7 @@ TEST_P(RadiusRatio, CriticalStepSeesTheSmallestParticle) {
 TEST_P(RadiusRatio, ForcesEqualAllPairsSum) {
   const double ratio = GetParam();
   const auto pk = mixed_packing(ratio);
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   Simulation<double> sim(basalt::test::scene_from(ratio_scene(ratio, "dt_fraction = 0.2")), pk.g,
                          basalt::test::world(), opt);
   stir(sim, 0.05);
@@ -207,8 +206,7 @@ struct EnergyRecord {
 template <class Real>
 EnergyRecord ratio_energy(double ratio, double fraction, bool contacts) {
   const auto pk = mixed_packing(ratio);
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   Simulation<Real> sim(
       basalt::test::scene_from(ratio_scene(ratio, fmt::format("dt_fraction = {}", fraction), contacts)), pk.g,
       basalt::test::world(), opt);
@@ -277,8 +275,7 @@ TEST_P(RadiusRatio, StableAtTheEstimateFloat) { stable_at_estimate<float>(GetPar
 TEST_P(RadiusRatio, AboveTheEstimateIsRefusedOrStopped) {
   const double ratio = GetParam();
   const auto pk = mixed_packing(ratio);
-  RunOptions opt;
-  opt.quiet = true;
+  auto opt = basalt::test::quiet();
   std::string refused;
   try {
     Simulation<double> sim(basalt::test::scene_from(ratio_scene(ratio, "dt_fraction = 1.5")), pk.g,
@@ -345,8 +342,7 @@ type = "linear_elastic"
 K = {:.17g}
 )",
                                                           s_m, dt_line, 1000.0 * s_k, 1000.0 * s_k));
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   Simulation<Real> sim(scene, block, basalt::test::world(), opt);
   auto& p = sim.particles();
   const double v = 0.05 / time_scale;
@@ -448,8 +444,7 @@ template <class Real>
 void one_particle_free() {
   if (basalt::test::size() > 2)
     GTEST_SKIP() << "np 1, 2 here; 1 to 8 ranks: ExtremesDomain.OneParticleOnManyRanks";
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   const std::array<double, 3> x0{1, 2, 3}, v{0.3, -0.2, 0.1};
   Simulation<Real> sim(basalt::test::scene_from(kOneRun), one_particle(x0), basalt::test::world(), opt);
   set_velocity(sim, v);
@@ -470,8 +465,7 @@ TEST(OneParticle, FreeFlightKeepsItsKineticEnergy) { one_particle_free<double>()
 TEST(OneParticle, FreeFlightKeepsItsKineticEnergyFloat) { one_particle_free<float>(); }
 
 TEST(OneParticle, FallsAsTheClosedForm) {
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   const std::array<double, 3> x0{0, 0, 10}, v{0.1, 0, 0.5}, g{0, 0, -9.81e-3};
   Simulation<double> sim(
       basalt::test::scene_from(kOneRun +
@@ -494,8 +488,7 @@ template <class Real>
 void one_particle_bounces() {
   if (basalt::test::size() > 2)
     GTEST_SKIP() << "np 1, 2 here; 1 to 8 ranks: ExtremesDomain.OneParticleOnManyRanks";
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   std::string scene = kOneRun + R"([[body_forces]]
 type = "gravity"
 acceleration = [0.0, 0.0, -1.0]
@@ -548,8 +541,7 @@ TEST(OneParticle, BouncesOnAFloorKeepingItsEnergyFloat) { one_particle_bounces<f
 
 // Bonds only: one particle has no spring and can meet none, so run.dt_fraction is refused by name.
 TEST(OneParticle, DtFractionWithoutAnySpringIsRefused) {
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   std::string msg;
   try {
     Simulation<double> sim(
@@ -637,8 +629,7 @@ void short_drift(double bound) {
   const auto full = basalt::io::read_geometry(basalt::test::reference_dir() / "cube1.geo");
   const auto block = basalt::test::sub_cube(full, -1.0, 2.5);
   ASSERT_EQ(block.size(), 48u);
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   Simulation<Real> sim(basalt::test::scene_from(R"([run]
 dt = 1e-3
 steps = 0
@@ -687,8 +678,7 @@ TEST(EnergyDrift, ClosedBondedBlockOver1e5StepsFloat) { short_drift<float>(1e-2)
 TEST(FarFromOrigin, FloatWarnsWhenParticlesDriftFar) {
   const auto full = basalt::io::read_geometry(basalt::test::reference_dir() / "cube1.geo");
   const auto block = basalt::test::sub_cube(full, -1.0, 2.5);
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   const auto scene = basalt::test::scene_from(kOneRun);
   Simulation<float> sim(scene, block, basalt::test::world(), opt);
   auto& p = sim.particles();

@@ -12,7 +12,8 @@
 
 #include "basalt/solver/integrate/integrators.hpp"
 #include "basalt/solver/simulation.hpp"
-#include "solver_helpers.hpp"
+#include "geometries.hpp"
+#include "scene_runs.hpp"
 #include "test_support.hpp"
 
 using namespace basalt::solver;

@@ -10,7 +10,8 @@
 #include <string>
 
 #include "basalt/solver/simulation.hpp"
-#include "solver_helpers.hpp"
+#include "geometries.hpp"
+#include "scene_runs.hpp"
 #include "test_support.hpp"
 
 using namespace basalt::solver;
@@ -46,8 +47,7 @@ skin = 0.2
 type = "linear_bond"
 K = 100.0
 )");
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   testing::internal::CaptureStderr();
   Simulation<double> sim(scene, block(d), basalt::test::world(), opt);
   auto& p = sim.particles();
@@ -97,8 +97,7 @@ K = 100.0
       for (int k = 0; k < 4; ++k)
         g.add_particle(id++, {d + i * (1 - 1e-4), d + j * (1 - 1e-4), d + k * (1 - 1e-4)}, 0.5);
   g.sort_by_id();
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   testing::internal::CaptureStderr();
   Simulation<double> sim(scene, g, basalt::test::world(), opt);
   sim.run(20);

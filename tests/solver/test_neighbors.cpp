@@ -10,7 +10,8 @@
 #include <utility>
 
 #include "basalt/solver/simulation.hpp"
-#include "solver_helpers.hpp"
+#include "geometries.hpp"
+#include "scene_runs.hpp"
 #include "test_support.hpp"
 
 using namespace basalt::solver;

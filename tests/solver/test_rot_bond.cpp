@@ -18,7 +18,8 @@
 
 #include "basalt/solver/models/rot_bond.hpp"
 #include "basalt/solver/simulation.hpp"
-#include "solver_helpers.hpp"
+#include "geometries.hpp"
+#include "scene_runs.hpp"
 #include "test_support.hpp"
 
 using namespace basalt::solver;
@@ -657,8 +658,7 @@ type = "total_energy"
     p.wx[a] = c.w1.x, p.wy[a] = c.w1.y, p.wz[a] = c.w1.z;
     p.wx[b] = c.w2.x, p.wy[b] = c.w2.y, p.wz[b] = c.w2.z;
     sim.state_changed();
-    basalt::test::MemorySink sink;
-    sink.begin(field_columns(scene));
+    basalt::test::MemorySink sink(scene);
     for (int k = 0; k < 20000; ++k) sim.step(&sink);
     const auto e = sink.column(0);
     double lo = e[0], hi = e[0];
@@ -714,8 +714,7 @@ every = 10
                                                           angles));
   Simulation<double> sim(scene, g, MPI_COMM_SELF);
   EXPECT_EQ(sim.bonds().size(), 54u);
-  basalt::test::MemorySink sink;
-  sink.begin(field_columns(scene));
+  basalt::test::MemorySink sink(scene);
   for (int k = 0; k < 3000; ++k) sim.step(&sink);
   return sink.column(0);
 }

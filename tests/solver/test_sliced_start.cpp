@@ -13,7 +13,8 @@
 #include "basalt/solver/parallel/id_slices.hpp"
 #include "basalt/solver/scene/load_checks.hpp"
 #include "basalt/solver/simulation.hpp"
-#include "solver_helpers.hpp"
+#include "geometries.hpp"
+#include "scene_runs.hpp"
 #include "test_support.hpp"
 
 using namespace basalt::solver;
@@ -57,9 +58,7 @@ void compare_starts(const Scene& scene, const std::filesystem::path& h5) {
   io::GeometryFile file(h5);
   Simulation<double> sliced(scene, file, MPI_COMM_WORLD);
   expect_same_state(whole, sliced);
-  basalt::test::MemorySink sa, sb;
-  sa.begin(field_columns(scene));
-  sb.begin(field_columns(scene));
+  basalt::test::MemorySink sa(scene), sb(scene);
   whole.run(60, &sa);
   sliced.run(60, &sb);
   expect_same_state(whole, sliced);

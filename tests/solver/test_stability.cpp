@@ -14,7 +14,7 @@
 #include "basalt/solver/core/errors.hpp"
 #include "basalt/solver/simulation.hpp"
 #include "basalt/solver/stability/critical_step.hpp"
-#include "solver_helpers.hpp"
+#include "scene_runs.hpp"
 #include "test_support.hpp"
 
 using namespace basalt::solver;
@@ -165,8 +165,7 @@ K = 1000.0
 // cube1 with the wave scene (bonds, contacts, the base wall), on every rank count.
 TEST(CriticalStepCube1, MatchesConvergedEstimateAndMeasuredLimit) {
   Scene scene = wave_scene();
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   Simulation<double> sim(scene, cube1(), basalt::test::world(), opt);
   const auto& st = sim.stability();
   EXPECT_NEAR(st.dt_critical, kCube1Critical, 2e-3 * kCube1Critical) << st.iterations << " iterations";
@@ -238,24 +237,20 @@ TEST(DtFraction, SceneKeys) {
 template <class Real>
 void blowup_is_stopped(double factor = 1.1) {
   Scene scene = wave_scene();
-  RunOptions opt;
-  opt.quiet = true;
+  auto opt = basalt::test::quiet();
   opt.force_dt = true;
   double ke_stable = 0, dt_c = 0;
   {
     Simulation<Real> ref(scene, cube1(), basalt::test::world(), opt);
     dt_c = ref.stability().dt_critical;
     scene.dt = 0.5 * dt_c;
-    Simulation<Real> stable(scene, cube1(), basalt::test::world(), opt);
-    basalt::test::MemorySink sink;
-    sink.begin(field_columns(scene));
-    stable.run(400, &sink);
-    for (double k : sink.column(0)) ke_stable = std::max(ke_stable, k);
+    basalt::test::FieldRun<Real> stable(scene, cube1(), basalt::test::world(), opt);
+    stable.run(400);
+    for (double k : stable.sink.column(0)) ke_stable = std::max(ke_stable, k);
   }
   scene.dt = factor * dt_c;
   Simulation<Real> sim(scene, cube1(), basalt::test::world(), opt);
-  basalt::test::MemorySink sink;
-  sink.begin(field_columns(scene));
+  basalt::test::MemorySink sink(scene);
   std::string msg;
   try {
     sim.run(400, &sink);
@@ -295,16 +290,10 @@ TEST(Blowup, TwiceTheCriticalStepStopsFloat) { blowup_is_stopped<float>(2.0); }
 template <class Real>
 void ninety_percent_is_stable() {
   Scene scene = wave_scene();
-  RunOptions opt;
-  opt.quiet = true;
   auto peak = [&](double dt, std::int64_t steps) {
     scene.dt = dt;
-    Simulation<Real> sim(scene, cube1(), basalt::test::world(), opt);
-    basalt::test::MemorySink sink;
-    sink.begin(field_columns(scene));
-    sim.run(steps, &sink);
     double m = 0;
-    for (double k : sink.column(0)) {
+    for (double k : basalt::test::run_fields<Real>(scene, cube1(), basalt::test::world(), steps).column(0)) {
       EXPECT_TRUE(std::isfinite(k));
       m = std::max(m, k);
     }
@@ -324,13 +313,7 @@ TEST(Precision, FloatWaveAgreesWithDouble) {
   const Scene scene = wave_scene();
   auto series = [&](auto tag) {
     using Real = decltype(tag);
-    RunOptions opt;
-    opt.quiet = true;
-    Simulation<Real> sim(scene, cube1(), basalt::test::world(), opt);
-    basalt::test::MemorySink sink;
-    sink.begin(field_columns(scene));
-    sim.run(200, &sink);
-    return sink.column(0);
+    return basalt::test::run_fields<Real>(scene, cube1(), basalt::test::world(), 200).column(0);
   };
   const auto d = series(double{}), f = series(float{});
   if (basalt::test::rank() != 0) return;
@@ -375,14 +358,8 @@ Scene shifted_wave(double d) {
 
 TEST(Precision, OffsetGeometryRunsInDouble) {
   auto series = [&](double d) {
-    RunOptions opt;
-    opt.quiet = true;
-    const Scene scene = shifted_wave(d);
-    Simulation<double> sim(scene, shifted(cube1(), d), basalt::test::world(), opt);
-    basalt::test::MemorySink sink;
-    sink.begin(field_columns(scene));
-    sim.run(300, &sink);
-    return sink.column(0);
+    return basalt::test::run_fields(shifted_wave(d), shifted(cube1(), d), basalt::test::world(), 300)
+        .column(0);
   };
   const auto at0 = series(0), far = series(1e8);
   if (basalt::test::rank() != 0) return;
@@ -399,8 +376,7 @@ TEST(Precision, OffsetGeometryRunsInDouble) {
 }
 
 TEST(Precision, FloatFarFromOriginIsRefused) {
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   try {
     Simulation<float> sim(shifted_wave(1e3), shifted(cube1(), 1e3), basalt::test::world(), opt);
     ADD_FAILURE() << "float at an offset of 1e3 was accepted";
@@ -423,12 +399,9 @@ TEST(WaveArrival, MeanVzAboveIsTheMeanOverTheParticlesAboveZ) {
     f.z = z;
     scene.fields.push_back(f);
   }
-  RunOptions opt;
-  opt.quiet = true;
-  Simulation<double> sim(scene, cube1(), basalt::test::world(), opt);
-  basalt::test::MemorySink sink;
-  sink.begin(field_columns(scene));
-  sim.run(300, &sink);
+  basalt::test::FieldRun run(scene, cube1(), basalt::test::world());
+  const auto& sim = run.run(300).sim;
+  const auto& sink = run.sink;
   const auto& p = sim.particles();
   double sum = 0, count = 0;
   for (std::size_t i = 0; i < p.n_owned; ++i)

@@ -8,7 +8,7 @@
 
 #include "basalt/solver/core/errors.hpp"
 #include "basalt/solver/simulation.hpp"
-#include "solver_helpers.hpp"
+#include "scene_runs.hpp"
 #include "test_support.hpp"
 
 using namespace basalt::solver;
@@ -110,8 +110,7 @@ type = "bond_count"
   p.vx[index_of(p, 1)] = -1.0;
   p.vx[index_of(p, 2)] = 1.0;
   sim.state_changed();
-  basalt::test::MemorySink sink;
-  sink.begin(field_columns(scene));
+  basalt::test::MemorySink sink(scene);
   int broke_at = -1;
   double strain_before = 0;
   for (int k = 1; k <= 1500; ++k) {
@@ -217,8 +216,7 @@ wall = "floor"
     auto& p = sim.particles();
     p.vz[0] = -1.0;
     sim.state_changed();
-    basalt::test::MemorySink sink;
-    sink.begin(field_columns(scene));
+    basalt::test::MemorySink sink(scene);
     for (int k = 0; k < 20000 && !(p.z[0] > 0.52); ++k) sim.step(&sink);
     const double m = mass_of(r);
     EXPECT_NEAR(p.vz[0], 1.0, 1e-3) << mode;
