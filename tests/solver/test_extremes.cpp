@@ -344,15 +344,7 @@ K = {:.17g}
                                                           s_m, dt_line, 1000.0 * s_k, 1000.0 * s_k));
   const auto opt = basalt::test::quiet();
   Simulation<Real> sim(scene, block, basalt::test::world(), opt);
-  auto& p = sim.particles();
-  const double v = 0.05 / time_scale;
-  for (std::size_t i = 0; i < p.n_owned; ++i) {
-    const auto id = static_cast<std::uint64_t>(p.id[i]);
-    p.vx[i] = Real(v * basalt::test::hash_unit(3 * id));
-    p.vy[i] = Real(v * basalt::test::hash_unit(3 * id + 1));
-    p.vz[i] = Real(v * basalt::test::hash_unit(3 * id + 2));
-  }
-  sim.state_changed();
+  basalt::test::random_velocities(sim, 0.05 / time_scale);
   ScaledRun out;
   out.dt = sim.dt();
   out.dt_critical = sim.stability().dt_critical;
@@ -640,14 +632,7 @@ type = "linear_bond"
 K = 1000.0
 )"),
                        block, MPI_COMM_SELF, opt);
-  auto& p = sim.particles();
-  for (std::size_t i = 0; i < p.n_owned; ++i) {
-    const auto id = static_cast<std::uint64_t>(p.id[i]);
-    p.vx[i] = Real(0.05 * basalt::test::hash_unit(3 * id));
-    p.vy[i] = Real(0.05 * basalt::test::hash_unit(3 * id + 1));
-    p.vz[i] = Real(0.05 * basalt::test::hash_unit(3 * id + 2));
-  }
-  sim.state_changed();
+  basalt::test::random_velocities(sim, 0.05);
   const double e0 = basalt::test::total_energy(sim);
   std::vector<double> e;
   double worst = 0;

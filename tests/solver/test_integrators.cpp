@@ -152,14 +152,7 @@ K = 1000.0
 type = "kinetic_energy"
 )");
   Simulation<double> sim(scene, g, MPI_COMM_SELF);
-  auto& p = sim.particles();
-  for (std::size_t i = 0; i < p.n_owned; ++i) {
-    const auto id = static_cast<std::uint64_t>(p.id[i]);
-    p.vx[i] = 0.5 * basalt::test::hash_unit(3 * id);
-    p.vy[i] = 0.5 * basalt::test::hash_unit(3 * id + 1);
-    p.vz[i] = 0.5 * basalt::test::hash_unit(3 * id + 2);
-  }
-  sim.state_changed();
+  basalt::test::random_velocities(sim, 0.5);
   basalt::test::MemorySink sink;
   sink.begin({"kinetic_energy"});
   const auto& cp = std::as_const(sim).particles();

@@ -50,14 +50,7 @@ K = 100.0
   const auto opt = basalt::test::quiet();
   testing::internal::CaptureStderr();
   Simulation<double> sim(scene, block(d), basalt::test::world(), opt);
-  auto& p = sim.particles();
-  for (std::size_t i = 0; i < p.n_owned; ++i) {
-    const auto id = static_cast<std::uint64_t>(p.id[i]);
-    p.vx[i] = 1.0 + 1e-3 * basalt::test::hash_unit(3 * id);
-    p.vy[i] = 1e-3 * basalt::test::hash_unit(3 * id + 1);
-    p.vz[i] = 1e-3 * basalt::test::hash_unit(3 * id + 2);
-  }
-  sim.state_changed();
+  basalt::test::random_velocities(sim, 1e-3, {1.0, 0, 0});
   sim.run(200);
   return testing::internal::GetCapturedStderr();
 }

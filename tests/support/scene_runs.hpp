@@ -1,6 +1,7 @@
 #pragma once
 // Scenes the solver tests run: a scene from TOML text, run options without a progress line, a sink that keeps
-// every field row in memory, and a simulation built with its sink (the "build, sink, begin, run" of a test).
+// every field row in memory, a simulation built with its sink (the "build, sink, begin, run" of a test),
+// random starting velocities by id, and how far one run's series strays from another's.
 #include <mpi.h>
 
 #include <algorithm>
@@ -16,6 +17,7 @@
 #include "basalt/solver/output/field_sink.hpp"
 #include "basalt/solver/scene/scene.hpp"
 #include "basalt/solver/simulation.hpp"
+#include "geometries.hpp"
 
 namespace basalt::test {
 
@@ -76,6 +78,21 @@ template <class Real = double>
 MemorySink run_fields(const solver::Scene& scene, const io::Geometry& geometry, MPI_Comm comm,
                       std::int64_t steps, std::array<int, 3> dims = {0, 0, 0}) {
   return std::move(FieldRun<Real>(scene, geometry, comm, quiet(dims)).run(steps).sink);
+}
+
+/// Gives every owned particle of `sim` the velocity drift + scale (hash_unit(3 id), hash_unit(3 id + 1),
+/// hash_unit(3 id + 2)), random by id and so the same on any number of ranks, and tells `sim` its state
+/// changed.
+template <class Real>
+void random_velocities(solver::Simulation<Real>& sim, double scale, std::array<double, 3> drift = {0, 0, 0}) {
+  auto& p = sim.particles();
+  for (std::size_t i = 0; i < p.n_owned; ++i) {
+    const auto id = static_cast<std::uint64_t>(p.id[i]);
+    p.vx[i] = Real(drift[0] + scale * hash_unit(3 * id));
+    p.vy[i] = Real(drift[1] + scale * hash_unit(3 * id + 1));
+    p.vz[i] = Real(drift[2] + scale * hash_unit(3 * id + 2));
+  }
+  sim.state_changed();
 }
 
 /// The largest |a[s] - ref[s]| / ref[s] over the steps s of `a` where ref[s] > floor * ref.back(): how far a
