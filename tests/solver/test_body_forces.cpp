@@ -23,7 +23,7 @@ using namespace basalt::solver;
 
 namespace {
 
-double mass_of(double r) { return 4.0 / 3.0 * std::numbers::pi * r * r * r; }
+using basalt::test::mass_of;
 
 double term(const Simulation<double>& sim, const std::vector<double>& v, const std::string& name) {
   const int t = sim.ledger().find(name);

@@ -142,7 +142,7 @@ saturation = 20
   scene.contacts = with_age.contacts;
   scene.skin = 0.02;
   scene.walls[0].motion.amplitude = 0.5;
-  const auto g = basalt::io::read_geometry(basalt::test::reference_dir() / "cube1.geo");
+  const auto g = basalt::test::cube1();
   constexpr int kSteps = 400;
   const auto run = [&](MPI_Comm comm, std::array<int, 3> dims) {
     basalt::test::FieldRun r(scene, g, comm, basalt::test::quiet(dims));

@@ -8,6 +8,7 @@
 
 #include "basalt/solver/core/errors.hpp"
 #include "basalt/solver/simulation.hpp"
+#include "geometries.hpp"
 #include "scene_runs.hpp"
 #include "test_support.hpp"
 
@@ -26,7 +27,7 @@ std::vector<double> ke_series(const Scene& scene, const basalt::io::Geometry& g,
 
 TEST(DecompositionInvariance, WaveKineticEnergyMatchesSerialRun) {
   const auto scene = parse_scene(basalt::test::source_dir() / "scenes" / "wave.toml");
-  const auto g = basalt::io::read_geometry(basalt::test::reference_dir() / "cube1.geo");
+  const auto g = basalt::test::cube1();
   const int n = basalt::test::size();
   std::vector<double> ref(kSteps);
   if (basalt::test::rank() == 0) ref = ke_series(scene, g, MPI_COMM_SELF, {1, 1, 1});
@@ -61,7 +62,7 @@ TEST(DecompositionInvariance, WaveKineticEnergyMatchesSerialRun) {
 TEST(DecompositionInvariance, TooThinRegionsAreRefused) {
   if (basalt::test::size() < 8) GTEST_SKIP() << "needs 8 ranks";
   const auto scene = parse_scene(basalt::test::source_dir() / "scenes" / "wave.toml");
-  const auto g = basalt::io::read_geometry(basalt::test::reference_dir() / "cube1.geo");
+  const auto g = basalt::test::cube1();
   RunOptions opt;
   opt.dims = {1, 1, 8};  // 15 mm / 8 = 1.875 mm, thinner than the ghost width 2 rmax + skin = 2.1 mm
   try {

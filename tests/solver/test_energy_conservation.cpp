@@ -12,7 +12,7 @@
 using namespace basalt::solver;
 
 TEST(EnergyConservation, BondedBlockOver10000Steps) {
-  const auto full = basalt::io::read_geometry(basalt::test::reference_dir() / "cube1.geo");
+  const auto full = basalt::test::cube1();
   const auto g = basalt::test::sub_cube(full, 0.0, 5.0);
   ASSERT_GT(g.size(), 200u);
   const auto scene = basalt::test::scene_from(R"(

@@ -24,7 +24,7 @@ using basalt::io::Geometry;
 
 namespace {
 
-double mass_of(double r, double density = 1) { return density * 4.0 / 3.0 * std::numbers::pi * r * r * r; }
+using basalt::test::mass_of;
 
 // ---------------------------------------------------------------------------------------------------
 // Radius ratio: 8 big spheres (R = 1, a 2 x 2 x 2 block, centres 1.98 apart, bonded) and a patch of
@@ -321,7 +321,7 @@ struct ScaledRun {
 template <class Real>
 ScaledRun scaled_run(double s_k, double s_m, bool by_fraction) {
   static const Geometry block = [] {
-    const auto full = basalt::io::read_geometry(basalt::test::reference_dir() / "cube1.geo");
+    const auto full = basalt::test::cube1();
     return basalt::test::sub_cube(full, 0.0, 5.0);
   }();
   const double time_scale = std::sqrt(s_m / s_k);
@@ -618,7 +618,7 @@ TEST(Coincident, RefusedAtARestartFloat) { coincident_restart<float>(); }
 template <class Real>
 void short_drift(double bound) {
   if (basalt::test::rank() != 0) return;
-  const auto full = basalt::io::read_geometry(basalt::test::reference_dir() / "cube1.geo");
+  const auto full = basalt::test::cube1();
   const auto block = basalt::test::sub_cube(full, -1.0, 2.5);
   ASSERT_EQ(block.size(), 48u);
   const auto opt = basalt::test::quiet();
@@ -661,7 +661,7 @@ TEST(EnergyDrift, ClosedBondedBlockOver1e5StepsFloat) { short_drift<float>(1e-2)
 // float's strain resolution (eps |x| / 2 r_min = 1.2e-5) passes 1e-5: a warning names the step, |x|, the
 // resolution and the remedy, once. (This block heats 88-fold in 1e7 steps drifting, docs/stability.md.)
 TEST(FarFromOrigin, FloatWarnsWhenParticlesDriftFar) {
-  const auto full = basalt::io::read_geometry(basalt::test::reference_dir() / "cube1.geo");
+  const auto full = basalt::test::cube1();
   const auto block = basalt::test::sub_cube(full, -1.0, 2.5);
   const auto opt = basalt::test::quiet();
   const auto scene = basalt::test::scene_from(kOneRun);

@@ -101,7 +101,7 @@ K = 1000.0
 // to 1e-9 (rounding: forces are summed in another order on several ranks).
 TEST(ExtremesDomain, BlockDriftsIntoOneSubdomain) {
   static const Geometry block = [] {
-    const auto full = basalt::io::read_geometry(basalt::test::reference_dir() / "cube1.geo");
+    const auto full = basalt::test::cube1();
     return basalt::test::sub_cube(full, 0.0, 3.2);
   }();
   const auto scene = basalt::test::scene_from(kBlockScene);

@@ -134,7 +134,7 @@ TEST(Integrators, RotationWithoutOrientationGivesTheSameBitsFloat) {
 }
 
 TEST(Integrators, SavedKineticEnergyIsExactAcrossRebuilds) {
-  const auto full = basalt::io::read_geometry(basalt::test::reference_dir() / "cube1.geo");
+  const auto full = basalt::test::cube1();
   const auto g = basalt::test::sub_cube(full, 0.0, 4.0);
   ASSERT_GT(g.size(), 50u);
   // A thin skin and fast particles: the lists (and the particles' order in memory) are rebuilt often.

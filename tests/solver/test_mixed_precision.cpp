@@ -16,6 +16,7 @@
 #include "basalt/solver/integrate/integrators.hpp"
 #include "basalt/solver/output/simulation_frame.hpp"
 #include "basalt/solver/simulation.hpp"
+#include "geometries.hpp"
 #include "scene_runs.hpp"
 #include "test_support.hpp"
 
@@ -32,10 +33,7 @@ Scene wave_scene(double d = 0, const std::string& precision = "mixed") {
   return scene;
 }
 
-const Geometry& cube1() {
-  static const Geometry g = basalt::io::read_geometry(basalt::test::reference_dir() / "cube1.geo");
-  return g;
-}
+using basalt::test::cube1;
 
 Geometry shifted(const Geometry& g, double d) {
   Geometry s = g;

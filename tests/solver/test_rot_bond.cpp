@@ -531,13 +531,7 @@ Geometry bonded_pair(double r1, double r2, double d) {
   return g;
 }
 
-template <class Real>
-std::size_t index_of(const Particles<Real>& p, std::int64_t id) {
-  for (std::size_t i = 0; i < p.n_owned; ++i)
-    if (p.id[i] == id) return i;
-  ADD_FAILURE() << "no particle " << id;
-  return 0;
-}
+using basalt::test::index_of;
 
 /// The springs of the runs below (an [[interactions]] rot_bond table's lines).
 const std::string kSprings = R"(kn = 1000.0
@@ -554,7 +548,7 @@ skin = 0.05
 )";
 const std::string kStiff = kRun + "[[interactions]]\ntype = \"rot_bond\"\n" + kSprings;
 
-double mass_of(double r) { return 4.0 / 3.0 * kPi * r * r * r; }
+using basalt::test::mass_of;
 
 /// Period of the first up-crossing pair of a series sampled every dt.
 double period_of(const std::vector<double>& u, double dt) {

@@ -82,7 +82,7 @@ std::vector<std::vector<double>> series(const Scene& scene, const basalt::io::Ge
 }  // namespace
 
 TEST(RotBondParallel, CrushedSpecimenMatchesSerialRunThroughBreaks) {
-  const auto full = basalt::io::read_geometry(basalt::test::reference_dir() / "cube1.geo");
+  const auto full = basalt::test::cube1();
   const auto g = basalt::test::sub_cube(full, 0.0, 9.0);
   double top = 0;
   for (std::size_t i = 0; i < g.size(); ++i) top = std::max(top, g.position[i][2] + g.radius[i]);

@@ -14,6 +14,7 @@
 #include "basalt/solver/core/errors.hpp"
 #include "basalt/solver/simulation.hpp"
 #include "basalt/solver/stability/critical_step.hpp"
+#include "geometries.hpp"
 #include "scene_runs.hpp"
 #include "test_support.hpp"
 
@@ -22,7 +23,7 @@ using basalt::io::Geometry;
 
 namespace {
 
-double mass_of(double r) { return 4.0 / 3.0 * std::numbers::pi * r * r * r; }  // density 1
+using basalt::test::mass_of;
 
 /// n particles of radius r in a row along x, touching, bonded to their neighbours.
 Geometry chain(int n, double r) {
@@ -43,10 +44,7 @@ K = 1000.0
 )";
 
 Scene wave_scene() { return parse_scene(basalt::test::source_dir() / "scenes" / "wave.toml"); }
-const Geometry& cube1() {
-  static const Geometry g = basalt::io::read_geometry(basalt::test::reference_dir() / "cube1.geo");
-  return g;
-}
+using basalt::test::cube1;
 
 // 2 / omega_max of cube1's network at the start of the wave scene, from 1500 power iterations to a
 // relative change of 1e-9 (99 needed): the value the default iterations must reproduce.

@@ -8,6 +8,7 @@
 
 #include "basalt/solver/core/errors.hpp"
 #include "basalt/solver/simulation.hpp"
+#include "geometries.hpp"
 #include "scene_runs.hpp"
 #include "test_support.hpp"
 
@@ -16,15 +17,9 @@ using basalt::io::Geometry;
 
 namespace {
 
-double mass_of(double r) { return 4.0 / 3.0 * std::numbers::pi * r * r * r; }
+using basalt::test::mass_of;
 
-template <class Real>
-std::size_t index_of(const Particles<Real>& p, std::int64_t id) {
-  for (std::size_t i = 0; i < p.n_owned; ++i)
-    if (p.id[i] == id) return i;
-  ADD_FAILURE() << "no particle " << id;
-  return 0;
-}
+using basalt::test::index_of;
 
 template <class Real>
 double separation(const Particles<Real>& p) {

@@ -1,10 +1,13 @@
 #pragma once
-// Geometries the tests build in memory: a hash that jitters them alike on every rank and library, grains on a
-// jittered lattice, and a cube cut out of a geometry.
+// Geometries the tests build in memory or read: a hash that jitters them alike on every rank and library,
+// grains on a jittered lattice, a cube cut out of a geometry, GenGeo's cube1.geo read once, and a sphere's
+// mass.
 #include <array>
 #include <cstdint>
+#include <numbers>
 
 #include "basalt/io/geometry.hpp"
+#include "test_support.hpp"
 
 namespace basalt::test {
 
@@ -47,6 +50,17 @@ io::Geometry jittered_lattice(const Lattice& l, Radius radius, Tag tag) {
                        radius(u), tag(k));
       }
   return g;
+}
+
+/// GenGeo's cube1.geo (tests/data, 8,948 bonded particles), read once per process.
+inline const io::Geometry& cube1() {
+  static const io::Geometry g = io::read_geometry(reference_dir() / "cube1.geo");
+  return g;
+}
+
+/// The mass of a sphere of radius r and the given density (the solver's default density is 1).
+inline double mass_of(double r, double density = 1) {
+  return density * 4.0 / 3.0 * std::numbers::pi * r * r * r;
 }
 
 /// The particles of `g` inside [lo, hi)^3 and the bonds between them.

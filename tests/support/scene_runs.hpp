@@ -2,6 +2,7 @@
 // Scenes the solver tests run: a scene from TOML text, run options without a progress line, a sink that keeps
 // every field row in memory, a simulation built with its sink (the "build, sink, begin, run" of a test),
 // random starting velocities by id, and how far one run's series strays from another's.
+#include <gtest/gtest.h>
 #include <mpi.h>
 
 #include <algorithm>
@@ -78,6 +79,15 @@ template <class Real = double>
 MemorySink run_fields(const solver::Scene& scene, const io::Geometry& geometry, MPI_Comm comm,
                       std::int64_t steps, std::array<int, 3> dims = {0, 0, 0}) {
   return std::move(FieldRun<Real>(scene, geometry, comm, quiet(dims)).run(steps).sink);
+}
+
+/// The index of the owned particle with id `id` in `p` (a failure, and 0, when this rank owns none).
+template <class Real>
+std::size_t index_of(const solver::Particles<Real>& p, std::int64_t id) {
+  for (std::size_t i = 0; i < p.n_owned; ++i)
+    if (p.id[i] == id) return i;
+  ADD_FAILURE() << "no particle " << id;
+  return 0;
 }
 
 /// Gives every owned particle of `sim` the velocity drift + scale (hash_unit(3 id), hash_unit(3 id + 1),
