@@ -2,7 +2,7 @@
 // (docs/reliability.md, "ParaView's three XDMF readers"): every grid's Polyvertex topology has an
 // explicit connectivity (a HyperSlab of the shared vertex file, which holds 0..M-1 and grows only with
 // the particle count), a lone checkpoint's grid is inside a temporal collection (so the Xdmf3 readers see
-// its time), and the series upgrades grids written without connectivity. tests/tools/paraview_readers.py
+// its time), and the series upgrades grids written without connectivity. tests/paraview/xdmf_readers.py
 // opens the same files in ParaView itself.
 #include <gtest/gtest.h>
 #include <hdf5.h>

@@ -2,18 +2,17 @@
 # ParaView itself opens what basalt-run writes (docs/reliability.md, "ParaView's three XDMF readers"): a short
 # run's ckpt_series.xmf and single checkpoints' .xmf, each with XDMFReader, Xdmf3ReaderS and Xdmf3ReaderT
 # (tests/paraview/xdmf_readers.py checks time steps, points, cells, arrays and that particles are drawn).
-# pvpython comes from Debian's packages unpacked under the build tree (tools/paraview/fetch_pvpython.sh);
+# pvpython comes from Debian's packages unpacked under the build tree (tests/paraview/fetch_pvpython.sh);
 # exit 77 (CTest: SKIPPED) when that cannot be done here, or without xvfb-run.
 # Environment (tests/paraview/CMakeLists.txt): BASALT_RUN MPIEXEC SCENE GEOMETRY WORK PARAVIEW_DIR.
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
-src="$(cd "$here/../.." && pwd)"
 W="$WORK"
 rm -rf "$W"
 mkdir -p "$W"
 
 rc=0
-bash "$src/tools/paraview/fetch_pvpython.sh" "$PARAVIEW_DIR" || rc=$?
+bash "$here/fetch_pvpython.sh" "$PARAVIEW_DIR" || rc=$?
 if [ "$rc" -eq 77 ]; then
   echo "SKIPPED: no pvpython here (above)"
   exit 77

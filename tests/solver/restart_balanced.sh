@@ -8,6 +8,7 @@
 # work) a re-balance after the checkpoint must come at the same step in both runs.
 # Usage: restart_balanced.sh MPIEXEC BASALT_RUN SCENE GEO DIR N [MODE]
 set -e
+. "$(dirname "$0")/restart_checks.sh"
 mpi=$1 run=$2 scene=$3 geo=$4 dir=$5 n=$6 mode=${7:-count}
 rm -rf "$dir" && mkdir -p "$dir/a" "$dir/b"
 # The packing's particles plus one resting on the base at x = 60 (id 10000000).
@@ -16,8 +17,7 @@ awk 'NR == 7 { print $1 + 1; next } /^EndParticles/ { print "60 7.5 0.5 0.5 1000
   --fields-every 10 --output "$dir/a" --quiet > "$dir/a.log"
 grep -q "^balance: step 0: max/mean particles per rank" "$dir/a.log" || { cat "$dir/a.log"; echo "FAIL: no re-balance at start"; exit 1; }
 grep "^balance:" "$dir/a.log"
-cp "$dir/a/ckpt_$(printf %06d "$n").h5" "$dir/b/"
-head -n $((n / 10 + 1)) "$dir/a/fields.csv" > "$dir/b/fields.csv"
+seed_restart "$dir/a" "$dir/b" "$n"
 "$mpi" -n 2 "$run" "$scene" --geometry "$dir/uneven.geo" --balance "$mode" --steps "$n" --checkpoint-every "$n" \
   --fields-every 10 --output "$dir/b" --restart "$dir/b" --quiet > "$dir/b.log"
 grep "^balance:" "$dir/b.log"
@@ -28,10 +28,4 @@ if [ "$(after "$dir/a.log")" != "$(grep "^balance: step" "$dir/b.log" || true)" 
   echo "FAIL: the restart re-balanced where the uninterrupted run did not: the checkpoint's cuts were not taken"; exit 1
 fi
 grep -q "^balance: max/mean particles per rank 1.0[0-9]* at start" "$dir/b.log" || { echo "FAIL: the restart did not start balanced"; exit 1; }
-if cmp -s "$dir/a/fields.csv" "$dir/b/fields.csv"; then
-  echo "PASS: the restarted balanced run's $(wc -l < "$dir/b/fields.csv") rows equal the uninterrupted run's"
-else
-  diff "$dir/a/fields.csv" "$dir/b/fields.csv" | head -5
-  echo "FAIL: the restarted balanced run differs"
-  exit 1
-fi
+same_fields "$dir/a" "$dir/b" "the restarted balanced run"

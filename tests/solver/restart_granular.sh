@@ -3,12 +3,11 @@
 # with a checkpoint at N, and a run restarted from that checkpoint, must write identical fields.csv rows.
 # Usage: restart_granular.sh BASALT_RUN SCENE GEOMETRY DIR N
 set -e
+. "$(dirname "$0")/restart_checks.sh"
 run=$1 scene=$2 geo=$3 dir=$4 n=$5
 rm -rf "$dir" && mkdir -p "$dir"
 "$run" "$scene" --geometry "$geo" --steps $((2 * n)) --checkpoint-every "$n" --fields-every 10 --output "$dir/a" --quiet >/dev/null
-mkdir -p "$dir/b"
-cp "$dir/a/ckpt_$(printf %06d "$n").h5" "$dir/b/"
-head -n $((n / 10 + 1)) "$dir/a/fields.csv" > "$dir/b/fields.csv"
+seed_restart "$dir/a" "$dir/b" "$n"
 "$run" "$scene" --geometry "$geo" --steps "$n" --checkpoint-every "$n" --fields-every 10 --output "$dir/b" --restart "$dir/b" --quiet >/dev/null
 # Where the broken bonds broke (/bonds/break_position, for pictures of cracks) survives the restart: the
 # final checkpoints list the same broken bonds at the same positions, those restored from the checkpoint
@@ -23,10 +22,4 @@ if h5ls "$dir/a/$last/bonds/break_position" >/dev/null 2>&1; then
   done
   echo "PASS: $last's /bonds/broken and /bonds/break_position equal the uninterrupted run's"
 fi
-if cmp -s "$dir/a/fields.csv" "$dir/b/fields.csv"; then
-  echo "PASS: the restarted run's $(wc -l < "$dir/b/fields.csv") rows equal the uninterrupted run's"
-else
-  diff "$dir/a/fields.csv" "$dir/b/fields.csv" | head -5
-  echo "FAIL: the restarted run differs"
-  exit 1
-fi
+same_fields "$dir/a" "$dir/b"

@@ -6,6 +6,7 @@
 # remainders as particle fields; its precision attribute is "mixed", and a restart in float is refused.
 # Usage: restart_mixed.sh BASALT_RUN WAVE_SCENE CUBE_GEO DIR N OFFSET [MPIRUN NP]
 set -e
+. "$(dirname "$0")/restart_checks.sh"
 run=$1 scene=$2 geo=$3 dir=$4 n=$5 d=$6
 launch=""
 [ -n "$7" ] && launch="$7 -np $8"
@@ -38,10 +39,4 @@ grep -q "written by a run in mixed precision; restarting it in float is refused"
   cat "$dir/refused.txt"; echo "FAIL: the refusal does not name both precisions"; exit 1; }
 head -n $((n / 10 + 1)) "$dir/a/fields.csv" > "$dir/b/fields.csv"
 $launch "$run" "$dir/wave.toml" --geometry "$dir/cube.geo" --precision mixed --steps "$n" --checkpoint-every "$n" --fields-every 10 --output "$dir/b" --restart "$dir/b" --quiet >/dev/null
-if cmp -s "$dir/a/fields.csv" "$dir/b/fields.csv"; then
-  echo "PASS: the restarted run's $(wc -l < "$dir/b/fields.csv") rows equal the uninterrupted run's"
-else
-  diff "$dir/a/fields.csv" "$dir/b/fields.csv" | head -5
-  echo "FAIL: the restarted run differs"
-  exit 1
-fi
+same_fields "$dir/a" "$dir/b"

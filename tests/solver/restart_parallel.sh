@@ -6,14 +6,14 @@
 # Usage: restart_parallel.sh MPIEXEC BASALT_RUN SCENE GEOMETRY DIR N NP [basalt-run options...]
 #   NP = processes (compute ranks + --io-ranks); e.g. NP 3 with --io-ranks 1 for 2 compute ranks.
 set -e
+. "$(dirname "$0")/restart_checks.sh"
 mpi=$1 run=$2 scene=$3 geo=$4 dir=$5 n=$6 np=$7
 shift 7
 export HWLOC_COMPONENTS=-gl
 rm -rf "$dir" && mkdir -p "$dir/b"
 "$mpi" -n "$np" "$run" "$scene" --geometry "$geo" --steps $((2 * n)) --checkpoint-every "$n" --fields-every 10 \
   --output "$dir/a" --quiet "$@" > "$dir/a.log" 2>&1 || { cat "$dir/a.log"; echo "FAIL: the straight run failed"; exit 1; }
-cp "$dir/a/ckpt_$(printf %06d "$n").h5" "$dir/b/"
-head -n $((n / 10 + 1)) "$dir/a/fields.csv" > "$dir/b/fields.csv"
+seed_restart "$dir/a" "$dir/b" "$n"
 "$mpi" -n "$np" "$run" "$scene" --geometry "$geo" --steps "$n" --checkpoint-every "$n" --fields-every 10 \
   --output "$dir/b" --restart "$dir/b" --quiet "$@" > "$dir/b.log" 2>&1 || { cat "$dir/b.log"; echo "FAIL: the restart failed"; exit 1; }
 grep -q "continuing from step $n" "$dir/b.log" || { cat "$dir/b.log"; echo "FAIL: the restart did not continue from step $n"; exit 1; }

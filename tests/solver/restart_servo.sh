@@ -5,6 +5,7 @@
 # (radius 0.5, x and y jittered by up to 0.01) that servo_box.toml names.
 # Usage: restart_servo.sh BASALT_RUN SCENE DIR N [MPIRUN NP]
 set -e
+. "$(dirname "$0")/restart_checks.sh"
 run=$1 scene=$2 dir=$3 n=$4
 launch=""
 [ -n "$5" ] && launch="$5 -np $6"
@@ -19,17 +20,9 @@ awk 'BEGIN {
   }
   print "EndParticles"; print "BeginConnect"; print 0; print "EndConnect" }' > "$dir/servo_box.geo"
 $launch "$run" "$scene" --geometry "$dir/servo_box.geo" --steps $((2 * n)) --checkpoint-every "$n" --fields-every 10 --output "$dir/a" --quiet >/dev/null
-mkdir -p "$dir/b"
-cp "$dir/a/ckpt_$(printf %06d "$n").h5" "$dir/b/"
-head -n $((n / 10 + 1)) "$dir/a/fields.csv" > "$dir/b/fields.csv"
+seed_restart "$dir/a" "$dir/b" "$n"
 $launch "$run" "$scene" --geometry "$dir/servo_box.geo" --steps "$n" --checkpoint-every "$n" --fields-every 10 --output "$dir/b" --restart "$dir/b" --quiet >/dev/null
 z0=$(sed -n 2p "$dir/a/fields.csv" | cut -d, -f5) z1=$(tail -n 1 "$dir/a/fields.csv" | cut -d, -f5)
 echo "servo wall z: $z0 at step 10, $z1 at step $((2 * n))"
 if [ "$z0" = "$z1" ]; then echo "FAIL: the servo wall did not move"; exit 1; fi
-if cmp -s "$dir/a/fields.csv" "$dir/b/fields.csv"; then
-  echo "PASS: the restarted run's $(wc -l < "$dir/b/fields.csv") rows equal the uninterrupted run's"
-else
-  diff "$dir/a/fields.csv" "$dir/b/fields.csv" | head -5
-  echo "FAIL: the restarted run differs"
-  exit 1
-fi
+same_fields "$dir/a" "$dir/b"

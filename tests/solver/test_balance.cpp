@@ -21,7 +21,8 @@
 #include "basalt/solver/core/errors.hpp"
 #include "basalt/solver/parallel/balance.hpp"
 #include "basalt/solver/simulation.hpp"
-#include "solver_helpers.hpp"
+#include "geometries.hpp"
+#include "scene_runs.hpp"
 #include "test_support.hpp"
 
 using namespace basalt::solver;
@@ -198,21 +199,21 @@ std::vector<double> positions_by_id(const Simulation<Real>& sim, std::size_t n, 
   return xyz;
 }
 
+/// The largest difference of two runs' positions by id (positions_by_id), relative to the coordinate where it
+/// is larger than 1.
+double worst_position(const std::vector<double>& xyz, const std::vector<double>& ref) {
+  double worst = 0;
+  for (std::size_t k = 0; k < ref.size(); ++k)
+    worst = std::max(worst, std::abs(xyz[k] - ref[k]) / std::max(1.0, std::abs(ref[k])));
+  return worst;
+}
+
 /// A column of 12 x 2 x 10 grains (lattice, jittered radii 0.35-0.5) at x in [0, 12], and one grain resting
 /// on the floor at x = 40: the even grid cuts x at ~20, so one side holds every grain but one.
 basalt::io::Geometry blob_and_grain() {
-  basalt::io::Geometry g;
-  std::int64_t id = 1;
-  for (int k = 0; k < 10; ++k)
-    for (int j = 0; j < 2; ++j)
-      for (int i = 0; i < 12; ++i, ++id) {
-        const auto u = static_cast<std::uint64_t>(id);
-        g.add_particle(id,
-                       {0.5 + i + 0.04 * basalt::test::hash_unit(3 * u + 1),
-                        0.5 + j + 0.04 * basalt::test::hash_unit(3 * u + 2), 0.5 + k},
-                       0.425 + 0.075 * basalt::test::hash_unit(u));
-      }
-  g.add_particle(id, {40.0, 2.0, 0.45}, 0.45);
+  auto g = basalt::test::jittered_lattice({.n = {12, 2, 10}, .jitter = 0.04}, basalt::test::grain_radius,
+                                          [](int) { return 0; });
+  g.add_particle(12 * 2 * 10 + 1, {40.0, 2.0, 0.45}, 0.45);
   return g;
 }
 
@@ -228,17 +229,12 @@ Outcome run(const std::string& balance, MPI_Comm comm, std::array<int, 3> dims, 
   scene.balance = balance;
   scene.balance_threshold = 1.2;
   const auto g = blob_and_grain();
-  RunOptions opt;
-  opt.dims = dims;
-  opt.quiet = true;
-  Simulation<double> sim(scene, g, comm, opt);
+  basalt::test::FieldRun run(scene, g, comm, basalt::test::quiet(dims));
+  auto& sim = run.sim;
   Outcome o;
   o.start = sim.imbalance();
   o.before = sim.imbalance_before_last_rebalance();
-  basalt::test::MemorySink sink;
-  sink.begin(field_columns(scene));
-  sim.run(steps, &sink);
-  o.ke = sink.column(0);
+  o.ke = run.run(steps).sink.column(0);
   o.end = sim.imbalance();
   o.rebalances = sim.rebalances();
   o.xyz = positions_by_id(sim, g.size(), comm);
@@ -266,13 +262,8 @@ TEST(Balance, UnevenSceneIsBalancedAndDecompositionInvariant) {
     EXPECT_LT(balanced.start, 1.2) << grid;
     EXPECT_LT(balanced.end, 1.2) << grid;
     ASSERT_EQ(balanced.ke.size(), plain.ke.size());
-    double worst_ke = 0, worst_x = 0;
-    for (std::size_t s = 0; s < plain.ke.size(); ++s)
-      if (plain.ke[s] > 1e-6 * plain.ke.back())
-        worst_ke = std::max(worst_ke, std::abs(balanced.ke[s] - plain.ke[s]) / plain.ke[s]);
-    for (std::size_t k = 0; k < plain.xyz.size(); ++k)
-      worst_x =
-          std::max(worst_x, std::abs(balanced.xyz[k] - plain.xyz[k]) / std::max(1.0, std::abs(plain.xyz[k])));
+    const double worst_ke = basalt::test::worst_relative(balanced.ke, plain.ke, 1e-6);
+    const double worst_x = worst_position(balanced.xyz, plain.xyz);
     EXPECT_GT(plain.ke.back(), 0.0);
     EXPECT_LT(worst_ke, 1e-9) << grid;
     EXPECT_LT(worst_x, 1e-9) << grid;
@@ -297,15 +288,13 @@ TEST(Balance, TimeMovesWorkOffASlowRankAndResultsAgree) {
   scene.balance_threshold = 1.5;
   scene.balance_every = 100;
   const auto g = blob_and_grain();
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   Simulation<double> sim(scene, g, basalt::test::world(), opt);
   const auto counted = sim.rebalances();  // the first rebuild balances by count (no time measured yet)
   const double mean = double(g.size()) / 2;
   const auto owned = [&] { return double(sim.particles().n_owned); };
   if (basalt::test::rank() == 0) sim.add_rank_work(1.0);
-  basalt::test::MemorySink sink;
-  sink.begin(field_columns(scene));
+  basalt::test::MemorySink sink(scene);
   sim.run(101, &sink);  // the check at step 100 moves the cuts
   EXPECT_EQ(counted, 1) << "the blob scene starts uneven: the first rebuild balances it by count";
   EXPECT_EQ(sim.rebalances(), counted + 1);
@@ -319,12 +308,8 @@ TEST(Balance, TimeMovesWorkOffASlowRankAndResultsAgree) {
   const auto xyz = positions_by_id(sim, g.size(), basalt::test::world());
   const auto ke = sink.column(0);
   ASSERT_EQ(ke.size(), plain.ke.size());
-  double worst_ke = 0, worst_x = 0;
-  for (std::size_t s = 0; s < ke.size(); ++s)
-    if (plain.ke[s] > 1e-6 * plain.ke.back())
-      worst_ke = std::max(worst_ke, std::abs(ke[s] - plain.ke[s]) / plain.ke[s]);
-  for (std::size_t k = 0; k < xyz.size(); ++k)
-    worst_x = std::max(worst_x, std::abs(xyz[k] - plain.xyz[k]) / std::max(1.0, std::abs(plain.xyz[k])));
+  const double worst_ke = basalt::test::worst_relative(ke, plain.ke, 1e-6);
+  const double worst_x = worst_position(xyz, plain.xyz);
   EXPECT_LT(worst_ke, 1e-9);
   EXPECT_LT(worst_x, 1e-9);
   if (basalt::test::rank() == 0)
@@ -362,11 +347,9 @@ PairsOutcome run_pairs(const std::string& balance, int steps) {
   auto scene = basalt::test::scene_from(kGrains);
   scene.balance = balance;
   const auto g = dense_and_sparse();
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   Simulation<double> sim(scene, g, basalt::test::world(), opt);
-  basalt::test::MemorySink sink;
-  sink.begin(field_columns(scene));
+  basalt::test::MemorySink sink(scene);
   sim.run(1, &sink);
   sim.force_rebuild();  // the first rebuild with lists to weigh: "pairs" moves the cut here
   PairsOutcome o;
@@ -408,18 +391,12 @@ TEST(Balance, PairsWeighContactsAndRunBitForBitAlike) {
     EXPECT_GT(busiest_before, 1.5 * total_after / 2) << "and was not before";
   }
   EXPECT_EQ(weighed.xyz, again.xyz) << "pairs balancing must repeat bit for bit";
-  double worst_x = 0;
-  for (std::size_t k = 0; k < plain.xyz.size(); ++k)
-    worst_x =
-        std::max(worst_x, std::abs(weighed.xyz[k] - plain.xyz[k]) / std::max(1.0, std::abs(plain.xyz[k])));
+  const double worst_x = worst_position(weighed.xyz, plain.xyz);
   EXPECT_LT(worst_x, 1e-9);
   if (basalt::test::rank() != 0) return;  // (the field rows are rank 0's)
   ASSERT_EQ(weighed.ke.size(), plain.ke.size());
   ASSERT_FALSE(plain.ke.empty());
-  double worst_ke = 0;
-  for (std::size_t s = 0; s < plain.ke.size(); ++s)
-    if (plain.ke[s] > 1e-6 * plain.ke.back())
-      worst_ke = std::max(worst_ke, std::abs(weighed.ke[s] - plain.ke[s]) / plain.ke[s]);
+  const double worst_ke = basalt::test::worst_relative(weighed.ke, plain.ke, 1e-6);
   EXPECT_GT(plain.ke.back(), 0.0) << "the touching block must move";
   EXPECT_LT(worst_ke, 1e-9);
   EXPECT_EQ(weighed.ke, again.ke) << "pairs balancing must repeat bit for bit";
@@ -438,8 +415,7 @@ TEST(Halo, GhostsAndMigrantsDoNotDoubleTheParticleArrays) {
   if (basalt::test::size() == 1) GTEST_SKIP() << "no ghosts at np 1";
   auto scene = basalt::test::scene_from(kGrains);
   const auto g = dense_and_sparse();
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   Simulation<double> sim(scene, g, basalt::test::world(), opt);
   const auto& p = sim.particles();
   const auto fits = [&](const char* when) {
@@ -451,8 +427,7 @@ TEST(Halo, GhostsAndMigrantsDoNotDoubleTheParticleArrays) {
     EXPECT_LE(double(p.fx.capacity()), 1.125 * double(p.n_owned) + 1) << when << ": an owned-only array";
   };
   fits("after the first rebuild");
-  basalt::test::MemorySink sink;
-  sink.begin(field_columns(scene));
+  basalt::test::MemorySink sink(scene);
   sim.run(50, &sink);
   sim.force_rebuild();
   fits("after a later rebuild");

@@ -11,7 +11,7 @@
 #include "basalt/solver/core/errors.hpp"
 #include "basalt/solver/simulation.hpp"
 #include "extremes_helpers.hpp"
-#include "solver_helpers.hpp"
+#include "scene_runs.hpp"
 #include "test_support.hpp"
 
 using namespace basalt::solver;
@@ -56,8 +56,7 @@ K = 100.0
 /// error that stopped it, or "" when it ran to the end (then `end` holds every particle's state).
 std::string fly(const Scene& scene, const std::array<double, 3>& v, std::int64_t steps,
                 basalt::test::GlobalState* end = nullptr, const std::array<double, 3>& at = {5.0, 1.5, 1.5}) {
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   const auto g = block_and_projectile(at);
   Simulation<double> sim(scene, g, basalt::test::world(), opt);
   auto& p = sim.particles();

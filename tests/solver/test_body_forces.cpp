@@ -15,14 +15,15 @@
 #include "basalt/solver/core/errors.hpp"
 #include "basalt/solver/models/damping.hpp"
 #include "basalt/solver/simulation.hpp"
-#include "solver_helpers.hpp"
+#include "geometries.hpp"
+#include "scene_runs.hpp"
 #include "test_support.hpp"
 
 using namespace basalt::solver;
 
 namespace {
 
-double mass_of(double r) { return 4.0 / 3.0 * std::numbers::pi * r * r * r; }
+using basalt::test::mass_of;
 
 double term(const Simulation<double>& sim, const std::vector<double>& v, const std::string& name) {
   const int t = sim.ledger().find(name);

@@ -15,7 +15,8 @@
 #include <tuple>
 
 #include "basalt/solver/simulation.hpp"
-#include "solver_helpers.hpp"
+#include "geometries.hpp"
+#include "scene_runs.hpp"
 #include "test_support.hpp"
 
 using namespace basalt::solver;
@@ -86,9 +87,7 @@ saturation = 50
   basalt::io::Geometry g;
   g.add_particle(1, {-1.1, 0, 0}, 0.5);
   g.add_particle(2, {0.0, 0, 0}, 0.5);
-  RunOptions opt;
-  opt.quiet = true;
-  opt.dims = {n, 1, 1};
+  const auto opt = basalt::test::quiet({n, 1, 1});
   Simulation<double> sim(scene, g, basalt::test::world(), opt);
   auto& p = sim.particles();
   for (std::size_t i = 0; i < p.n_owned; ++i) p.vx[i] = p.id[i] == 1 ? 0.7 : 0.5;
@@ -143,17 +142,12 @@ saturation = 20
   scene.contacts = with_age.contacts;
   scene.skin = 0.02;
   scene.walls[0].motion.amplitude = 0.5;
-  const auto g = basalt::io::read_geometry(basalt::test::reference_dir() / "cube1.geo");
+  const auto g = basalt::test::cube1();
   constexpr int kSteps = 400;
   const auto run = [&](MPI_Comm comm, std::array<int, 3> dims) {
-    RunOptions opt;
-    opt.dims = dims;
-    opt.quiet = true;
-    Simulation<double> sim(scene, g, comm, opt);
-    basalt::test::MemorySink sink;
-    sink.begin(field_columns(scene));
-    sim.run(kSteps, &sink);
-    return std::make_tuple(sink.column(0), contact_ages(sim, comm), sim.rebuilds());
+    basalt::test::FieldRun r(scene, g, comm, basalt::test::quiet(dims));
+    r.run(kSteps);
+    return std::make_tuple(r.sink.column(0), contact_ages(r.sim, comm), r.sim.rebuilds());
   };
   const int n = basalt::test::size();
   std::vector<double> ref_ke(kSteps);
@@ -176,12 +170,7 @@ saturation = 20
   for (const auto& dims : grids) {
     const auto [ke, ages, rebuilds] = run(basalt::test::world(), dims);
     if (basalt::test::rank() != 0) continue;
-    double worst = 0;
-    for (std::size_t k = 0; k < ke.size(); ++k)
-      for (std::size_t s = 0; s < ke.size(); ++s) {
-        if (ref_ke[s] > 1e-9 * ref_ke.back())
-          worst = std::max(worst, std::abs(ke[s] - ref_ke[s]) / ref_ke[s]);
-      }
+    const double worst = basalt::test::worst_relative(ke, ref_ke, 1e-9);
     EXPECT_LT(worst, 1e-9) << "dims " << dims[0] << "," << dims[1] << "," << dims[2];
     EXPECT_EQ(ages, ref_ages) << "dims " << dims[0] << "," << dims[1] << "," << dims[2];
     std::printf("np %d dims %d,%d,%d: max relative KE difference %.3g, %zu aged contacts\n", n, dims[0],
@@ -220,8 +209,7 @@ K = 100.0
   g.add_particle(1, {0, 0, 0}, 0.5, 0);
   g.add_particle(2, {1.05, 0, 0}, 0.5, 0);
   g.add_particle(3, {2.1, 0.1, 0}, 0.5, 1);
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   Simulation<double> a(two_models, g, MPI_COMM_SELF, opt), b(one_model, g, MPI_COMM_SELF, opt);
   ASSERT_EQ(a.force_computes().size(), 2u);
   for (auto* sim : {&a, &b}) {

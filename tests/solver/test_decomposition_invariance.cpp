@@ -8,7 +8,8 @@
 
 #include "basalt/solver/core/errors.hpp"
 #include "basalt/solver/simulation.hpp"
-#include "solver_helpers.hpp"
+#include "geometries.hpp"
+#include "scene_runs.hpp"
 #include "test_support.hpp"
 
 using namespace basalt::solver;
@@ -19,21 +20,14 @@ constexpr int kSteps = 400;  // past the first rebuild with migration (step ~323
 
 std::vector<double> ke_series(const Scene& scene, const basalt::io::Geometry& g, MPI_Comm comm,
                               std::array<int, 3> dims) {
-  RunOptions opt;
-  opt.dims = dims;
-  opt.quiet = true;
-  Simulation<double> sim(scene, g, comm, opt);
-  basalt::test::MemorySink sink;
-  sink.begin(field_columns(scene));
-  sim.run(kSteps, &sink);
-  return sink.column(0);
+  return basalt::test::run_fields(scene, g, comm, kSteps, dims).column(0);
 }
 
 }  // namespace
 
 TEST(DecompositionInvariance, WaveKineticEnergyMatchesSerialRun) {
   const auto scene = parse_scene(basalt::test::source_dir() / "scenes" / "wave.toml");
-  const auto g = basalt::io::read_geometry(basalt::test::reference_dir() / "cube1.geo");
+  const auto g = basalt::test::cube1();
   const int n = basalt::test::size();
   std::vector<double> ref(kSteps);
   if (basalt::test::rank() == 0) ref = ke_series(scene, g, MPI_COMM_SELF, {1, 1, 1});
@@ -68,7 +62,7 @@ TEST(DecompositionInvariance, WaveKineticEnergyMatchesSerialRun) {
 TEST(DecompositionInvariance, TooThinRegionsAreRefused) {
   if (basalt::test::size() < 8) GTEST_SKIP() << "needs 8 ranks";
   const auto scene = parse_scene(basalt::test::source_dir() / "scenes" / "wave.toml");
-  const auto g = basalt::io::read_geometry(basalt::test::reference_dir() / "cube1.geo");
+  const auto g = basalt::test::cube1();
   RunOptions opt;
   opt.dims = {1, 1, 8};  // 15 mm / 8 = 1.875 mm, thinner than the ghost width 2 rmax + skin = 2.1 mm
   try {

@@ -5,13 +5,14 @@
 #include <cmath>
 
 #include "basalt/solver/simulation.hpp"
-#include "solver_helpers.hpp"
+#include "geometries.hpp"
+#include "scene_runs.hpp"
 #include "test_support.hpp"
 
 using namespace basalt::solver;
 
 TEST(EnergyConservation, BondedBlockOver10000Steps) {
-  const auto full = basalt::io::read_geometry(basalt::test::reference_dir() / "cube1.geo");
+  const auto full = basalt::test::cube1();
   const auto g = basalt::test::sub_cube(full, 0.0, 5.0);
   ASSERT_GT(g.size(), 200u);
   const auto scene = basalt::test::scene_from(R"(
@@ -28,14 +29,7 @@ type = "linear_elastic"
 K = 1000.0
 )");
   Simulation<double> sim(scene, g, MPI_COMM_SELF);
-  auto& p = sim.particles();
-  for (std::size_t i = 0; i < p.n_owned; ++i) {
-    const auto id = static_cast<std::uint64_t>(p.id[i]);
-    p.vx[i] = 0.05 * basalt::test::hash_unit(3 * id);
-    p.vy[i] = 0.05 * basalt::test::hash_unit(3 * id + 1);
-    p.vz[i] = 0.05 * basalt::test::hash_unit(3 * id + 2);
-  }
-  sim.state_changed();
+  basalt::test::random_velocities(sim, 0.05);
   auto total = [&] {
     const auto e = sim.energies();
     return e[0] + e[1] + e[2] + e[3];

@@ -15,7 +15,8 @@
 #include "basalt/solver/core/errors.hpp"
 #include "basalt/solver/simulation.hpp"
 #include "extremes_helpers.hpp"
-#include "solver_helpers.hpp"
+#include "geometries.hpp"
+#include "scene_runs.hpp"
 #include "test_support.hpp"
 
 using namespace basalt::solver;
@@ -23,7 +24,7 @@ using basalt::io::Geometry;
 
 namespace {
 
-double mass_of(double r, double density = 1) { return density * 4.0 / 3.0 * std::numbers::pi * r * r * r; }
+using basalt::test::mass_of;
 
 // ---------------------------------------------------------------------------------------------------
 // Radius ratio: 8 big spheres (R = 1, a 2 x 2 x 2 block, centres 1.98 apart, bonded) and a patch of
@@ -142,8 +143,7 @@ class RadiusRatio : public ::testing::TestWithParam<double> {};
 TEST_P(RadiusRatio, CriticalStepSeesTheSmallestParticle) {
   const double ratio = GetParam();
   const auto pk = mixed_packing(ratio);
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   Simulation<double> sim(basalt::test::scene_from(ratio_scene(ratio, "dt_fraction = 0.5")), pk.g,
                          basalt::test::world(), opt);
   const auto& st = sim.stability();
@@ -164,8 +164,7 @@ TEST_P(RadiusRatio, CriticalStepSeesTheSmallestParticle) {
 TEST_P(RadiusRatio, ForcesEqualAllPairsSum) {
   const double ratio = GetParam();
   const auto pk = mixed_packing(ratio);
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   Simulation<double> sim(basalt::test::scene_from(ratio_scene(ratio, "dt_fraction = 0.2")), pk.g,
                          basalt::test::world(), opt);
   stir(sim, 0.05);
@@ -207,8 +206,7 @@ struct EnergyRecord {
 template <class Real>
 EnergyRecord ratio_energy(double ratio, double fraction, bool contacts) {
   const auto pk = mixed_packing(ratio);
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   Simulation<Real> sim(
       basalt::test::scene_from(ratio_scene(ratio, fmt::format("dt_fraction = {}", fraction), contacts)), pk.g,
       basalt::test::world(), opt);
@@ -277,8 +275,7 @@ TEST_P(RadiusRatio, StableAtTheEstimateFloat) { stable_at_estimate<float>(GetPar
 TEST_P(RadiusRatio, AboveTheEstimateIsRefusedOrStopped) {
   const double ratio = GetParam();
   const auto pk = mixed_packing(ratio);
-  RunOptions opt;
-  opt.quiet = true;
+  auto opt = basalt::test::quiet();
   std::string refused;
   try {
     Simulation<double> sim(basalt::test::scene_from(ratio_scene(ratio, "dt_fraction = 1.5")), pk.g,
@@ -324,7 +321,7 @@ struct ScaledRun {
 template <class Real>
 ScaledRun scaled_run(double s_k, double s_m, bool by_fraction) {
   static const Geometry block = [] {
-    const auto full = basalt::io::read_geometry(basalt::test::reference_dir() / "cube1.geo");
+    const auto full = basalt::test::cube1();
     return basalt::test::sub_cube(full, 0.0, 5.0);
   }();
   const double time_scale = std::sqrt(s_m / s_k);
@@ -345,18 +342,9 @@ type = "linear_elastic"
 K = {:.17g}
 )",
                                                           s_m, dt_line, 1000.0 * s_k, 1000.0 * s_k));
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   Simulation<Real> sim(scene, block, basalt::test::world(), opt);
-  auto& p = sim.particles();
-  const double v = 0.05 / time_scale;
-  for (std::size_t i = 0; i < p.n_owned; ++i) {
-    const auto id = static_cast<std::uint64_t>(p.id[i]);
-    p.vx[i] = Real(v * basalt::test::hash_unit(3 * id));
-    p.vy[i] = Real(v * basalt::test::hash_unit(3 * id + 1));
-    p.vz[i] = Real(v * basalt::test::hash_unit(3 * id + 2));
-  }
-  sim.state_changed();
+  basalt::test::random_velocities(sim, 0.05 / time_scale);
   ScaledRun out;
   out.dt = sim.dt();
   out.dt_critical = sim.stability().dt_critical;
@@ -448,8 +436,7 @@ template <class Real>
 void one_particle_free() {
   if (basalt::test::size() > 2)
     GTEST_SKIP() << "np 1, 2 here; 1 to 8 ranks: ExtremesDomain.OneParticleOnManyRanks";
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   const std::array<double, 3> x0{1, 2, 3}, v{0.3, -0.2, 0.1};
   Simulation<Real> sim(basalt::test::scene_from(kOneRun), one_particle(x0), basalt::test::world(), opt);
   set_velocity(sim, v);
@@ -470,8 +457,7 @@ TEST(OneParticle, FreeFlightKeepsItsKineticEnergy) { one_particle_free<double>()
 TEST(OneParticle, FreeFlightKeepsItsKineticEnergyFloat) { one_particle_free<float>(); }
 
 TEST(OneParticle, FallsAsTheClosedForm) {
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   const std::array<double, 3> x0{0, 0, 10}, v{0.1, 0, 0.5}, g{0, 0, -9.81e-3};
   Simulation<double> sim(
       basalt::test::scene_from(kOneRun +
@@ -494,8 +480,7 @@ template <class Real>
 void one_particle_bounces() {
   if (basalt::test::size() > 2)
     GTEST_SKIP() << "np 1, 2 here; 1 to 8 ranks: ExtremesDomain.OneParticleOnManyRanks";
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   std::string scene = kOneRun + R"([[body_forces]]
 type = "gravity"
 acceleration = [0.0, 0.0, -1.0]
@@ -548,8 +533,7 @@ TEST(OneParticle, BouncesOnAFloorKeepingItsEnergyFloat) { one_particle_bounces<f
 
 // Bonds only: one particle has no spring and can meet none, so run.dt_fraction is refused by name.
 TEST(OneParticle, DtFractionWithoutAnySpringIsRefused) {
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   std::string msg;
   try {
     Simulation<double> sim(
@@ -634,11 +618,10 @@ TEST(Coincident, RefusedAtARestartFloat) { coincident_restart<float>(); }
 template <class Real>
 void short_drift(double bound) {
   if (basalt::test::rank() != 0) return;
-  const auto full = basalt::io::read_geometry(basalt::test::reference_dir() / "cube1.geo");
+  const auto full = basalt::test::cube1();
   const auto block = basalt::test::sub_cube(full, -1.0, 2.5);
   ASSERT_EQ(block.size(), 48u);
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   Simulation<Real> sim(basalt::test::scene_from(R"([run]
 dt = 1e-3
 steps = 0
@@ -649,14 +632,7 @@ type = "linear_bond"
 K = 1000.0
 )"),
                        block, MPI_COMM_SELF, opt);
-  auto& p = sim.particles();
-  for (std::size_t i = 0; i < p.n_owned; ++i) {
-    const auto id = static_cast<std::uint64_t>(p.id[i]);
-    p.vx[i] = Real(0.05 * basalt::test::hash_unit(3 * id));
-    p.vy[i] = Real(0.05 * basalt::test::hash_unit(3 * id + 1));
-    p.vz[i] = Real(0.05 * basalt::test::hash_unit(3 * id + 2));
-  }
-  sim.state_changed();
+  basalt::test::random_velocities(sim, 0.05);
   const double e0 = basalt::test::total_energy(sim);
   std::vector<double> e;
   double worst = 0;
@@ -685,10 +661,9 @@ TEST(EnergyDrift, ClosedBondedBlockOver1e5StepsFloat) { short_drift<float>(1e-2)
 // float's strain resolution (eps |x| / 2 r_min = 1.2e-5) passes 1e-5: a warning names the step, |x|, the
 // resolution and the remedy, once. (This block heats 88-fold in 1e7 steps drifting, docs/stability.md.)
 TEST(FarFromOrigin, FloatWarnsWhenParticlesDriftFar) {
-  const auto full = basalt::io::read_geometry(basalt::test::reference_dir() / "cube1.geo");
+  const auto full = basalt::test::cube1();
   const auto block = basalt::test::sub_cube(full, -1.0, 2.5);
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   const auto scene = basalt::test::scene_from(kOneRun);
   Simulation<float> sim(scene, block, basalt::test::world(), opt);
   auto& p = sim.particles();

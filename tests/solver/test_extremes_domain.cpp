@@ -13,7 +13,8 @@
 #include "basalt/solver/core/errors.hpp"
 #include "basalt/solver/simulation.hpp"
 #include "extremes_helpers.hpp"
-#include "solver_helpers.hpp"
+#include "geometries.hpp"
+#include "scene_runs.hpp"
 #include "test_support.hpp"
 
 using namespace basalt::solver;
@@ -32,8 +33,7 @@ template <class Real>
 Trace trace(const Scene& scene, const Geometry& g, MPI_Comm comm, std::array<double, 3> drift,
             std::int64_t first_id, std::size_t n_ids, int blocks, std::int64_t every, std::int64_t flyer = -1,
             std::array<double, 3> flyer_v = {0, 0, 0}) {
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   Simulation<Real> sim(scene, g, comm, opt);
   auto& p = sim.particles();
   for (std::size_t i = 0; i < p.n_owned; ++i) {
@@ -101,7 +101,7 @@ K = 1000.0
 // to 1e-9 (rounding: forces are summed in another order on several ranks).
 TEST(ExtremesDomain, BlockDriftsIntoOneSubdomain) {
   static const Geometry block = [] {
-    const auto full = basalt::io::read_geometry(basalt::test::reference_dir() / "cube1.geo");
+    const auto full = basalt::test::cube1();
     return basalt::test::sub_cube(full, 0.0, 3.2);
   }();
   const auto scene = basalt::test::scene_from(kBlockScene);
@@ -218,8 +218,7 @@ TEST(ExtremesDomain, ParticleFliesAMillionUnitsAwayFloat) {
 TEST(ExtremesDomain, OneParticleOnManyRanks) {
   Geometry g;
   g.add_particle(3, {1, 2, 3}, 0.5);
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   Simulation<double> sim(basalt::test::scene_from(kBlockScene), g, basalt::test::world(), opt);
   auto& p = sim.particles();
   for (std::size_t i = 0; i < p.n_owned; ++i) {
@@ -245,9 +244,7 @@ TEST(ExtremesDomain, RegionsThinnerThanTheGhostWidthAreRefused) {
   if (basalt::test::size() < 4) GTEST_SKIP() << "needs 3 or more ranks along an axis";
   Geometry g;
   g.add_particle(3, {1, 2, 3}, 0.5);
-  RunOptions opt;
-  opt.quiet = true;
-  opt.dims = {basalt::test::size(), 1, 1};
+  const auto opt = basalt::test::quiet({basalt::test::size(), 1, 1});
   std::string msg;
   try {
     Simulation<double> sim(basalt::test::scene_from(kBlockScene), g, basalt::test::world(), opt);

@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "basalt/solver/simulation.hpp"
-#include "solver_helpers.hpp"
+#include "scene_runs.hpp"
 #include "test_support.hpp"
 
 using namespace basalt::solver;
@@ -18,8 +18,7 @@ TEST(GeometryInput, GeoAndH5GiveTheSameRun) {
     Simulation<double> sim(scene, basalt::io::read_geometry(file), MPI_COMM_SELF);
     EXPECT_EQ(sim.total_particles(), 8948);
     EXPECT_EQ(sim.bond_count(), 30090);
-    basalt::test::MemorySink sink;
-    sink.begin(field_columns(scene));
+    basalt::test::MemorySink sink(scene);
     sim.run(100, &sink);
     series.push_back(sink.column(0));
   }

@@ -22,7 +22,8 @@
 #include "basalt/solver/models/hertz_mindlin.hpp"
 #include "basalt/solver/models/rolling_friction.hpp"
 #include "basalt/solver/simulation.hpp"
-#include "solver_helpers.hpp"
+#include "geometries.hpp"
+#include "scene_runs.hpp"
 #include "test_support.hpp"
 
 using namespace basalt::solver;
@@ -38,19 +39,8 @@ double term(const Simulation<double>& sim, const std::vector<double>& v, const s
 /// A column of spheres on a lattice with jittered radii (0.35-0.5, spacing 1), tags 1 for the bottom
 /// layer (fixed in some tests), 0 above; ids from 1.
 basalt::io::Geometry column(int nx, int ny, int nz) {
-  basalt::io::Geometry g;
-  std::int64_t id = 1;
-  for (int k = 0; k < nz; ++k)
-    for (int j = 0; j < ny; ++j)
-      for (int i = 0; i < nx; ++i, ++id) {
-        const auto u = static_cast<std::uint64_t>(id);
-        const double r = 0.425 + 0.075 * basalt::test::hash_unit(u);
-        g.add_particle(id,
-                       {0.5 + i + 0.04 * basalt::test::hash_unit(3 * u + 1),
-                        0.5 + j + 0.04 * basalt::test::hash_unit(3 * u + 2), 0.5 + k},
-                       r, k == 0 ? 1 : 0);
-      }
-  return g;
+  return basalt::test::jittered_lattice({.n = {nx, ny, nz}, .jitter = 0.04}, basalt::test::grain_radius,
+                                        [](int k) { return k == 0 ? 1 : 0; });
 }
 
 const std::string kColumnScene = R"(
@@ -143,8 +133,7 @@ acceleration = [0.0, 0.0, -1.0]
   const double m = 4.0 / 3.0 * std::numbers::pi;
   basalt::io::Geometry geo;
   geo.add_particle(1, {0, 0, R - m * g / K}, R);  // resting on the floor: no bounce
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   Simulation<double> sim(scene, geo, MPI_COMM_SELF, opt);
   auto& p = sim.particles();
   p.vx[0] = v0;
@@ -216,8 +205,7 @@ TEST(Granular, ColumnCollapseBalancesTheLedgerAndFixedParticlesStay) {
       std::string(kColumnScene)
           .replace(kColumnScene.find("rotation = true"), 15, "rotation = true\nfixed_tags = [1]"));
   const auto g = column(4, 4, 8);
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   Simulation<double> sim(s, g, MPI_COMM_SELF, opt);
   std::vector<std::array<double, 3>> fixed0;
   const auto& p = sim.particles();
@@ -226,8 +214,7 @@ TEST(Granular, ColumnCollapseBalancesTheLedgerAndFixedParticlesStay) {
   ASSERT_EQ(fixed0.size(), 16u);
   const auto v0 = sim.ledger_values();
   const double e0 = sim.ledger().mechanical(v0);
-  basalt::test::MemorySink sink;
-  sink.begin(field_columns(s));
+  basalt::test::MemorySink sink(s);
   sim.run(2000, &sink);
   const auto v = sim.ledger_values();
   const double e = sim.ledger().mechanical(v), d = sim.ledger().sum(v, Ledger::Kind::dissipated);
@@ -292,12 +279,9 @@ TEST(Granular, RunDefersTheSecondHalfKickToTheSameBitsAsSingleSteps) {
   const auto scene = basalt::test::scene_from(text);
   ASSERT_TRUE(scene.orientation);
   const auto g = column(4, 4, 8);
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   Simulation<double> run(scene, g, MPI_COMM_SELF, opt), single(scene, g, MPI_COMM_SELF, opt);
-  basalt::test::MemorySink run_rows, single_rows;
-  run_rows.begin(field_columns(scene));
-  single_rows.begin(field_columns(scene));
+  basalt::test::MemorySink run_rows(scene), single_rows(scene);
   constexpr int kSteps = 600;
   run.run(kSteps, &run_rows);
   for (int k = 0; k < kSteps; ++k) single.step(&single_rows);
@@ -332,8 +316,7 @@ TEST(Granular, OrientationsLeftOutChangeNoOtherBit) {
   ASSERT_TRUE(scene_with.orientation);
   ASSERT_FALSE(scene_without.orientation);
   const auto g = column(4, 4, 8);
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   Simulation<double> a_sim(scene_with, g, MPI_COMM_SELF, opt), b_sim(scene_without, g, MPI_COMM_SELF, opt);
   constexpr int kSteps = 600;
   a_sim.run(kSteps);
@@ -360,14 +343,9 @@ TEST_P(ColumnInvariance, FrictionalRotatingColumnIsDecompositionInvariant) {
   const auto g = column(6, 4, 10);
   constexpr int kSteps = 600;
   const auto run = [&](MPI_Comm comm, std::array<int, 3> dims) {
-    RunOptions opt;
-    opt.dims = dims;
-    opt.quiet = true;
-    Simulation<double> sim(scene, g, comm, opt);
-    basalt::test::MemorySink sink;
-    sink.begin(field_columns(scene));
-    sim.run(kSteps, &sink);
-    return std::make_pair(sink.column(0), sim.rebuilds());
+    basalt::test::FieldRun r(scene, g, comm, basalt::test::quiet(dims));
+    r.run(kSteps);
+    return std::make_pair(r.sink.column(0), r.sim.rebuilds());
   };
   const int n = basalt::test::size();
   std::vector<double> ref(kSteps);
@@ -384,9 +362,7 @@ TEST_P(ColumnInvariance, FrictionalRotatingColumnIsDecompositionInvariant) {
   for (const auto& dims : grids) {
     const auto [ke, rebuilds] = run(basalt::test::world(), dims);
     if (basalt::test::rank() != 0) continue;
-    double worst = 0;
-    for (std::size_t s = 0; s < ke.size(); ++s)
-      if (ref[s] > 1e-6 * ref.back()) worst = std::max(worst, std::abs(ke[s] - ref[s]) / ref[s]);
+    const double worst = basalt::test::worst_relative(ke, ref, 1e-6);
     std::printf("np %d dims %d,%d,%d: max relative KE difference %.3g (%lld rebuilds)\n", n, dims[0], dims[1],
                 dims[2], worst, static_cast<long long>(rebuilds));
     EXPECT_LT(worst, 1e-9) << "dims " << dims[0] << "," << dims[1] << "," << dims[2];
@@ -414,8 +390,7 @@ e = )" + std::to_string(e) + "\n");
   basalt::io::Geometry g;
   g.add_particle(1, {-0.5005, 0, 0}, 0.5);
   g.add_particle(2, {0.5005, 0, 0}, 0.5);
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   Simulation<double> sim(scene, g, MPI_COMM_SELF, opt);
   auto& p = sim.particles();
   for (std::size_t i = 0; i < p.n_owned; ++i) p.vx[i] = p.id[i] == 1 ? v / 2 : -v / 2;
@@ -734,8 +709,7 @@ e = 0.5
 )");
   basalt::io::Geometry g;
   for (int k = 0; k < 40; ++k) g.add_particle(k + 1, {1.5 * k, 0, 0.4995}, 0.5);
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   Simulation<double> sim(scene, g, MPI_COMM_SELF, opt), stay(scene, g, MPI_COMM_SELF, opt);
   for (auto* s : {&sim, &stay}) {
     auto& p = s->particles();
@@ -802,8 +776,7 @@ e = 0.5
   g.add_particle(2, {0.5005, 0, 0}, 0.5);
   g.add_particle(3, {-0.4999995, 0, 5}, 0.5);  // 3 and 4 touch from the start and meet slowly: they stay
   g.add_particle(4, {0.4999995, 0, 5}, 0.5);
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   Simulation<double> sim(scene, g, MPI_COMM_SELF, opt);
   auto& p = sim.particles();
   for (std::size_t i = 0; i < p.n_owned; ++i) {
@@ -871,8 +844,7 @@ TEST(HertzMindlin, LanesDriverMovesAClusterAsThePairByPairDriver) {
         g.add_particle(id, {a + 0.04 * u(k), b + 0.04 * u(k + 1), c + 0.04 * u(k + 2)}, 0.5 + 0.04 * u(k + 3),
                        static_cast<std::int32_t>(1 + id % 2));
       }
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   Simulation<double> lanes(one, g, MPI_COMM_SELF, opt), rows(three, g, MPI_COMM_SELF, opt);
   for (auto* sim : {&lanes, &rows}) {
     auto& p = sim->particles();
@@ -923,8 +895,7 @@ TEST(HertzMindlin, APairTakesItsOwnGroupsMaterial) {
   basalt::io::Geometry g;
   g.add_particle(1, {0, 0, 0}, 1.0, 1);
   g.add_particle(2, {2 - d, 0, 0}, 1.0, 2);
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   Simulation<double> sim(basalt::test::scene_from(scene), g, MPI_COMM_SELF, opt);
   sim.step();
   const auto& p = sim.particles();
@@ -990,8 +961,7 @@ mu = 0.092
   for (const double theta : {10.0, 20.0, 45.0, 60.0, 80.0}) {
     basalt::io::Geometry geo;
     geo.add_particle(1, {0, 0, R + 1e-7}, R);
-    RunOptions opt;
-    opt.quiet = true;
+    auto opt = basalt::test::quiet();
     opt.force_dt = true;
     Simulation<double> sim(scene, geo, MPI_COMM_SELF, opt);
     auto& p = sim.particles();
@@ -1062,12 +1032,10 @@ TEST(RollingFriction, ResistsTheSpreadingOfAColumnAndKeepsTheLedger) {
   double front[2] = {0, 0};
   for (int variant = 0; variant < 2; ++variant) {
     const auto s = basalt::test::scene_from(variant == 0 ? plain : with_roll);
-    RunOptions opt;
-    opt.quiet = true;
+    const auto opt = basalt::test::quiet();
     Simulation<double> sim(s, column(4, 4, 8), MPI_COMM_SELF, opt);
     const double e0 = sim.ledger().mechanical(sim.ledger_values());
-    basalt::test::MemorySink sink;
-    sink.begin(field_columns(s));
+    basalt::test::MemorySink sink(s);
     sim.run(3000, &sink);
     const auto v = sim.ledger_values();
     const double e = sim.ledger().mechanical(v), d = sim.ledger().sum(v, Ledger::Kind::dissipated);

@@ -12,7 +12,8 @@
 
 #include "basalt/solver/integrate/integrators.hpp"
 #include "basalt/solver/simulation.hpp"
-#include "solver_helpers.hpp"
+#include "geometries.hpp"
+#include "scene_runs.hpp"
 #include "test_support.hpp"
 
 using namespace basalt::solver;
@@ -133,7 +134,7 @@ TEST(Integrators, RotationWithoutOrientationGivesTheSameBitsFloat) {
 }
 
 TEST(Integrators, SavedKineticEnergyIsExactAcrossRebuilds) {
-  const auto full = basalt::io::read_geometry(basalt::test::reference_dir() / "cube1.geo");
+  const auto full = basalt::test::cube1();
   const auto g = basalt::test::sub_cube(full, 0.0, 4.0);
   ASSERT_GT(g.size(), 50u);
   // A thin skin and fast particles: the lists (and the particles' order in memory) are rebuilt often.
@@ -151,14 +152,7 @@ K = 1000.0
 type = "kinetic_energy"
 )");
   Simulation<double> sim(scene, g, MPI_COMM_SELF);
-  auto& p = sim.particles();
-  for (std::size_t i = 0; i < p.n_owned; ++i) {
-    const auto id = static_cast<std::uint64_t>(p.id[i]);
-    p.vx[i] = 0.5 * basalt::test::hash_unit(3 * id);
-    p.vy[i] = 0.5 * basalt::test::hash_unit(3 * id + 1);
-    p.vz[i] = 0.5 * basalt::test::hash_unit(3 * id + 2);
-  }
-  sim.state_changed();
+  basalt::test::random_velocities(sim, 0.5);
   basalt::test::MemorySink sink;
   sink.begin({"kinetic_energy"});
   const auto& cp = std::as_const(sim).particles();

@@ -12,7 +12,7 @@
 
 #include "basalt/solver/models/jkr.hpp"
 #include "basalt/solver/simulation.hpp"
-#include "solver_helpers.hpp"
+#include "scene_runs.hpp"
 #include "test_support.hpp"
 
 using namespace basalt::solver;
@@ -149,8 +149,7 @@ work_of_adhesion = 1.0
   const double gap0 = 1e-3;
   g.add_particle(1, {-0.5 - gap0 / 2, 0, 0}, 0.5);
   g.add_particle(2, {0.5 + gap0 / 2, 0, 0}, 0.5);
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   Simulation<double> sim(scene, g, MPI_COMM_SELF, opt);
   auto& p = sim.particles();
   for (std::size_t i = 0; i < p.n_owned; ++i) p.vx[i] = p.id[i] == 1 ? v / 2 : -v / 2;

@@ -10,7 +10,7 @@
 #include "basalt/solver/core/errors.hpp"
 #include "basalt/solver/scene/load_checks.hpp"
 #include "basalt/solver/simulation.hpp"
-#include "solver_helpers.hpp"
+#include "scene_runs.hpp"
 #include "test_support.hpp"
 
 using namespace basalt::solver;
@@ -135,8 +135,7 @@ TEST(LoadChecks, WallsThatJumpOverParticlesNameTheMotionKey) {
 }
 
 TEST(LoadChecks, TheSimulationRefusesBeforeItStarts) {
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   const auto scene = scene_from("[material]\ndensity = 1e308\n" + kRun + kBonds);
   try {
     Simulation<double> sim(scene, pair_geometry(), MPI_COMM_SELF, opt);

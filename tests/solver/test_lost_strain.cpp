@@ -10,7 +10,8 @@
 #include <string>
 
 #include "basalt/solver/simulation.hpp"
-#include "solver_helpers.hpp"
+#include "geometries.hpp"
+#include "scene_runs.hpp"
 #include "test_support.hpp"
 
 using namespace basalt::solver;
@@ -46,18 +47,10 @@ skin = 0.2
 type = "linear_bond"
 K = 100.0
 )");
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   testing::internal::CaptureStderr();
   Simulation<double> sim(scene, block(d), basalt::test::world(), opt);
-  auto& p = sim.particles();
-  for (std::size_t i = 0; i < p.n_owned; ++i) {
-    const auto id = static_cast<std::uint64_t>(p.id[i]);
-    p.vx[i] = 1.0 + 1e-3 * basalt::test::hash_unit(3 * id);
-    p.vy[i] = 1e-3 * basalt::test::hash_unit(3 * id + 1);
-    p.vz[i] = 1e-3 * basalt::test::hash_unit(3 * id + 2);
-  }
-  sim.state_changed();
+  basalt::test::random_velocities(sim, 1e-3, {1.0, 0, 0});
   sim.run(200);
   return testing::internal::GetCapturedStderr();
 }
@@ -97,8 +90,7 @@ K = 100.0
       for (int k = 0; k < 4; ++k)
         g.add_particle(id++, {d + i * (1 - 1e-4), d + j * (1 - 1e-4), d + k * (1 - 1e-4)}, 0.5);
   g.sort_by_id();
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   testing::internal::CaptureStderr();
   Simulation<double> sim(scene, g, basalt::test::world(), opt);
   sim.run(20);

@@ -25,7 +25,8 @@
 
 #include "basalt/solver/core/errors.hpp"
 #include "basalt/solver/simulation.hpp"
-#include "solver_helpers.hpp"
+#include "geometries.hpp"
+#include "scene_runs.hpp"
 #include "test_support.hpp"
 
 using namespace basalt::solver;
@@ -79,12 +80,6 @@ void write_box(const fs::path& file, double L) {
   write_obj(file, v, t);
 }
 
-RunOptions quiet() {
-  RunOptions o;
-  o.quiet = true;
-  return o;
-}
-
 const std::string kFloorRun = R"(
 [particles]
 rotation = true
@@ -123,8 +118,8 @@ std::pair<double, double> floor_difference(const fs::path& mesh, bool friction, 
   const double R = 0.5, m = 4.0 / 3.0 * std::numbers::pi * R * R * R;
   basalt::io::Geometry geo;
   geo.add_particle(1, {l.x[0], l.x[1], R - m / 1e4}, R);  // resting: overlap m g / K
-  Simulation<double> a(planar_scene, geo, MPI_COMM_SELF, quiet());
-  Simulation<double> b(mesh_scene, geo, MPI_COMM_SELF, quiet());
+  Simulation<double> a(planar_scene, geo, MPI_COMM_SELF, basalt::test::quiet());
+  Simulation<double> b(mesh_scene, geo, MPI_COMM_SELF, basalt::test::quiet());
   for (auto* s : {&a, &b}) {
     auto& p = s->particles();
     p.vx[0] = l.v[0], p.vy[0] = l.v[1], p.vz[0] = l.v[2];
@@ -206,12 +201,11 @@ wall = "box"
 )");
   basalt::io::Geometry geo;
   geo.add_particle(1, {2, 2, 3}, 0.5);
-  Simulation<double> sim(scene, geo, MPI_COMM_SELF, quiet());
+  Simulation<double> sim(scene, geo, MPI_COMM_SELF, basalt::test::quiet());
   auto& p = sim.particles();
   p.vx[0] = 3, p.vy[0] = 2.2, p.vz[0] = -1;
   sim.state_changed();
-  basalt::test::MemorySink sink;
-  sink.begin(field_columns(scene));
+  basalt::test::MemorySink sink(scene);
   double lo = 1e9, hi = -1e9;
   int bounces = 0;
   double last_vx = p.vx[0];
@@ -256,9 +250,8 @@ type = "wall_work_in"
 )");
   basalt::io::Geometry geo;
   geo.add_particle(1, {2.0, 1.2, 0.0}, 0.5);
-  Simulation<double> sim(scene, geo, MPI_COMM_SELF, quiet());
-  basalt::test::MemorySink sink;
-  sink.begin(field_columns(scene));
+  Simulation<double> sim(scene, geo, MPI_COMM_SELF, basalt::test::quiet());
+  basalt::test::MemorySink sink(scene);
   const auto& p = sim.particles();
   double tally = 0;  // largest |mesh force + sphere force|
   bool touched = false;
@@ -303,7 +296,7 @@ velocity = [1.0, 0.0, 0.0]
   const double R = 0.5, m = 4.0 / 3.0 * std::numbers::pi * R * R * R;
   basalt::io::Geometry geo;
   geo.add_particle(1, {0.0, 0.0, R - m / 1e4}, R);
-  Simulation<double> sim(scene, geo, MPI_COMM_SELF, quiet());
+  Simulation<double> sim(scene, geo, MPI_COMM_SELF, basalt::test::quiet());
   for (int k = 0; k < 8000; ++k) sim.step();
   const auto& p = sim.particles();
   std::printf("sphere v = %.6f (2/7 = %.6f), w R = %.6f\n", p.vx[0], 2.0 / 7.0, -p.wy[0] * R);
@@ -345,26 +338,16 @@ z = 0.0
 type = "wall_force"
 wall = "silo"
 )");
-  basalt::io::Geometry g;
-  std::int64_t id = 1;
-  for (int k = 0; k < 5; ++k)
-    for (int j = 0; j < 8; ++j)
-      for (int i = 0; i < 8; ++i, ++id) {
-        const auto u = static_cast<std::uint64_t>(id);
-        g.add_particle(id,
-                       {-7.0 + 2 * i + 0.05 * basalt::test::hash_unit(3 * u),
-                        -7.0 + 2 * j + 0.05 * basalt::test::hash_unit(3 * u + 1), 2.0 + 2 * k},
-                       0.85 + 0.1 * basalt::test::hash_unit(3 * u + 2));
-      }
+  // 8 x 8 x 5 grains 2 apart, jittered along x and y by hash_unit(3 id) and (3 id + 1), radii from (3 id +
+  // 2).
+  const auto g = basalt::test::jittered_lattice(
+      {.n = {8, 8, 5}, .origin = {-7.0, -7.0, 2.0}, .spacing = 2.0, .jitter = 0.05, .key = 0},
+      [](std::uint64_t u) { return 0.85 + 0.1 * basalt::test::hash_unit(3 * u + 2); }, [](int) { return 0; });
   constexpr int kSteps = 700;
   const auto run = [&](MPI_Comm comm, std::array<int, 3> dims) {
-    RunOptions opt = quiet();
-    opt.dims = dims;
-    Simulation<double> sim(scene, g, comm, opt);
-    basalt::test::MemorySink sink;
-    sink.begin(field_columns(scene));
-    sim.run(kSteps, &sink);
-    return std::make_tuple(sink.column(0), sink.column(1), sink.column(4), sim.rebuilds());
+    basalt::test::FieldRun r(scene, g, comm, basalt::test::quiet(dims));
+    r.run(kSteps);
+    return std::make_tuple(r.sink.column(0), r.sink.column(1), r.sink.column(4), r.sim.rebuilds());
   };
   const int n = basalt::test::size();
   std::vector<double> ref(kSteps);
@@ -381,9 +364,7 @@ wall = "silo"
   if (n == 1) return;
   const auto [ke, below, fz, rebuilds] = run(basalt::test::world(), {n, 1, 1});
   if (basalt::test::rank() != 0) return;
-  double worst = 0;
-  for (std::size_t s = 0; s < ke.size(); ++s)
-    if (ref[s] > 1e-6 * ref.back()) worst = std::max(worst, std::abs(ke[s] - ref[s]) / ref[s]);
+  const double worst = basalt::test::worst_relative(ke, ref, 1e-6);
   std::printf("np %d: max relative KE difference %.3g (%lld rebuilds)\n", n, worst,
               static_cast<long long>(rebuilds));
   EXPECT_LT(worst, 1e-9);

@@ -16,7 +16,8 @@
 #include "basalt/solver/integrate/integrators.hpp"
 #include "basalt/solver/output/simulation_frame.hpp"
 #include "basalt/solver/simulation.hpp"
-#include "solver_helpers.hpp"
+#include "geometries.hpp"
+#include "scene_runs.hpp"
 #include "test_support.hpp"
 
 using namespace basalt::solver;
@@ -32,10 +33,7 @@ Scene wave_scene(double d = 0, const std::string& precision = "mixed") {
   return scene;
 }
 
-const Geometry& cube1() {
-  static const Geometry g = basalt::io::read_geometry(basalt::test::reference_dir() / "cube1.geo");
-  return g;
-}
+using basalt::test::cube1;
 
 Geometry shifted(const Geometry& g, double d) {
   Geometry s = g;
@@ -47,14 +45,7 @@ Geometry shifted(const Geometry& g, double d) {
 template <class Real>
 std::vector<double> ke_series(const Scene& scene, const Geometry& g, MPI_Comm comm, int steps,
                               std::array<int, 3> dims = {0, 0, 0}) {
-  RunOptions opt;
-  opt.quiet = true;
-  opt.dims = dims;
-  Simulation<Real> sim(scene, g, comm, opt);
-  basalt::test::MemorySink sink;
-  sink.begin(field_columns(scene));
-  sim.run(steps, &sink);
-  return sink.column(0);
+  return basalt::test::run_fields<Real>(scene, g, comm, steps, dims).column(0);
 }
 
 /// max |a - b| / max |b|
@@ -74,8 +65,7 @@ double max_rel(const std::vector<double>& a, const std::vector<double>& b) {
 // float offset of up to 8 mm: a few 1e-7), where plain float would round them to 0.06.
 TEST(MixedPrecision, PositionsAreOffsetsFromTheCentre) {
   constexpr double d = 1e6;
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   const Geometry g = shifted(cube1(), d);
   Simulation<float> sim(wave_scene(d), g, basalt::test::world(), opt);
   const auto& o = sim.origin();
@@ -153,8 +143,7 @@ TEST(MixedPrecision, WaveKineticEnergyMatchesSerialRun) {
 // The load check looks at the extent in mixed, not the offset: a geometry at 1e9 starts without a warning
 // about rounded strains, while float is refused there.
 TEST(MixedPrecision, FarGeometryIsNotRefused) {
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   EXPECT_NO_THROW(Simulation<float>(wave_scene(1e9), shifted(cube1(), 1e9), basalt::test::world(), opt));
   EXPECT_THROW(Simulation<float>(wave_scene(1e9, "float"), shifted(cube1(), 1e9), basalt::test::world(), opt),
                InputError);
@@ -165,8 +154,7 @@ TEST(MixedPrecision, FarGeometryIsNotRefused) {
 // remainders as particle fields, which a restart reads back.
 TEST(MixedPrecision, FramesAreAbsoluteAndCarryTheExactOffsets) {
   constexpr double d = 1e6;
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   Scene scene = wave_scene(d);
   scene.checkpoint_every = 100;  // positions at the rebuild are kept for checkpoints only
   Simulation<float> sim(scene, shifted(cube1(), d), basalt::test::world(), opt);

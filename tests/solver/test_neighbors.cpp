@@ -10,7 +10,8 @@
 #include <utility>
 
 #include "basalt/solver/simulation.hpp"
-#include "solver_helpers.hpp"
+#include "geometries.hpp"
+#include "scene_runs.hpp"
 #include "test_support.hpp"
 
 using namespace basalt::solver;
@@ -155,7 +156,7 @@ K = 1000.0
 }  // namespace
 
 TEST(Neighbors, BondedCubeMatchesBruteForce) {
-  const auto g = basalt::io::read_geometry(basalt::test::reference_dir() / "cube1.geo");
+  const auto g = basalt::test::cube1();
   const auto scene = basalt::test::scene_from(std::string(kScene) +
                                               "[[interactions]]\ntype = \"linear_bond\"\nK = 1000.0\n");
   Simulation<double> sim(scene, g, basalt::test::world());
@@ -166,8 +167,7 @@ TEST(Neighbors, BondedCubeMatchesBruteForce) {
 
 TEST(Neighbors, AfterMigrationMatchesBruteForce) {
   // Unbonded particles flying apart (an expanding cloud): they cross rank boundaries and the box.
-  const auto g = basalt::test::sub_cube(
-      basalt::io::read_geometry(basalt::test::reference_dir() / "cube1.geo"), 0.0, 9.0);
+  const auto g = basalt::test::sub_cube(basalt::test::cube1(), 0.0, 9.0);
   Simulation<double> sim(basalt::test::scene_from(kScene), g, basalt::test::world());
   auto& p = sim.particles();
   for (std::size_t i = 0; i < p.n_owned; ++i) {

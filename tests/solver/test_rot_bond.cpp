@@ -18,7 +18,8 @@
 
 #include "basalt/solver/models/rot_bond.hpp"
 #include "basalt/solver/simulation.hpp"
-#include "solver_helpers.hpp"
+#include "geometries.hpp"
+#include "scene_runs.hpp"
 #include "test_support.hpp"
 
 using namespace basalt::solver;
@@ -530,13 +531,7 @@ Geometry bonded_pair(double r1, double r2, double d) {
   return g;
 }
 
-template <class Real>
-std::size_t index_of(const Particles<Real>& p, std::int64_t id) {
-  for (std::size_t i = 0; i < p.n_owned; ++i)
-    if (p.id[i] == id) return i;
-  ADD_FAILURE() << "no particle " << id;
-  return 0;
-}
+using basalt::test::index_of;
 
 /// The springs of the runs below (an [[interactions]] rot_bond table's lines).
 const std::string kSprings = R"(kn = 1000.0
@@ -553,7 +548,7 @@ skin = 0.05
 )";
 const std::string kStiff = kRun + "[[interactions]]\ntype = \"rot_bond\"\n" + kSprings;
 
-double mass_of(double r) { return 4.0 / 3.0 * kPi * r * r * r; }
+using basalt::test::mass_of;
 
 /// Period of the first up-crossing pair of a series sampled every dt.
 double period_of(const std::vector<double>& u, double dt) {
@@ -657,8 +652,7 @@ type = "total_energy"
     p.wx[a] = c.w1.x, p.wy[a] = c.w1.y, p.wz[a] = c.w1.z;
     p.wx[b] = c.w2.x, p.wy[b] = c.w2.y, p.wz[b] = c.w2.z;
     sim.state_changed();
-    basalt::test::MemorySink sink;
-    sink.begin(field_columns(scene));
+    basalt::test::MemorySink sink(scene);
     for (int k = 0; k < 20000; ++k) sim.step(&sink);
     const auto e = sink.column(0);
     double lo = e[0], hi = e[0];
@@ -714,8 +708,7 @@ every = 10
                                                           angles));
   Simulation<double> sim(scene, g, MPI_COMM_SELF);
   EXPECT_EQ(sim.bonds().size(), 54u);
-  basalt::test::MemorySink sink;
-  sink.begin(field_columns(scene));
+  basalt::test::MemorySink sink(scene);
   for (int k = 0; k < 3000; ++k) sim.step(&sink);
   return sink.column(0);
 }

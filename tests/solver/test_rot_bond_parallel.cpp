@@ -10,7 +10,8 @@
 #include <cmath>
 
 #include "basalt/solver/simulation.hpp"
-#include "solver_helpers.hpp"
+#include "geometries.hpp"
+#include "scene_runs.hpp"
 #include "test_support.hpp"
 
 using namespace basalt::solver;
@@ -72,13 +73,7 @@ every = 10
 
 std::vector<std::vector<double>> series(const Scene& scene, const basalt::io::Geometry& g, MPI_Comm comm,
                                         std::array<int, 3> dims) {
-  RunOptions opt;
-  opt.dims = dims;
-  opt.quiet = true;
-  Simulation<double> sim(scene, g, comm, opt);
-  basalt::test::MemorySink sink;
-  sink.begin(field_columns(scene));
-  sim.run(kSteps, &sink);
+  const auto sink = basalt::test::run_fields(scene, g, comm, kSteps, dims);
   std::vector<std::vector<double>> cols;
   for (std::size_t c = 0; c < sink.columns.size(); ++c) cols.push_back(sink.column(c));
   return cols;
@@ -87,7 +82,7 @@ std::vector<std::vector<double>> series(const Scene& scene, const basalt::io::Ge
 }  // namespace
 
 TEST(RotBondParallel, CrushedSpecimenMatchesSerialRunThroughBreaks) {
-  const auto full = basalt::io::read_geometry(basalt::test::reference_dir() / "cube1.geo");
+  const auto full = basalt::test::cube1();
   const auto g = basalt::test::sub_cube(full, 0.0, 9.0);
   double top = 0;
   for (std::size_t i = 0; i < g.size(); ++i) top = std::max(top, g.position[i][2] + g.radius[i]);

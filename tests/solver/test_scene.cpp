@@ -7,7 +7,7 @@
 #include "basalt/solver/models/elastic_wall.hpp"
 #include "basalt/solver/models/linear_bond.hpp"
 #include "basalt/solver/scene/scene.hpp"
-#include "solver_helpers.hpp"
+#include "scene_runs.hpp"
 #include "test_support.hpp"
 
 using namespace basalt::solver;

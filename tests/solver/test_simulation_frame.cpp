@@ -16,6 +16,8 @@
 #include "basalt/io/frame.hpp"
 #include "basalt/solver/output/simulation_frame.hpp"
 #include "basalt/solver/simulation.hpp"
+#include "geometries.hpp"
+#include "scene_runs.hpp"
 #include "test_support.hpp"
 
 using namespace basalt;
@@ -55,9 +57,8 @@ std::vector<std::int64_t> gather(const std::vector<std::int64_t>& mine) {
 template <class Real>
 void check_frame_equals_state() {
   const auto scene = breakable_wave_scene();
-  const auto g = io::read_geometry(test::reference_dir() / "cube1.geo");
-  RunOptions opt;
-  opt.quiet = true;
+  const auto g = test::cube1();
+  auto opt = test::quiet();
   opt.force_dt = true;
   Simulation<Real> sim(scene, g, test::world(), opt);
   // Kick the particle with the lowest id hard: its bonds break within a few steps.

@@ -13,7 +13,8 @@
 #include "basalt/solver/parallel/id_slices.hpp"
 #include "basalt/solver/scene/load_checks.hpp"
 #include "basalt/solver/simulation.hpp"
-#include "solver_helpers.hpp"
+#include "geometries.hpp"
+#include "scene_runs.hpp"
 #include "test_support.hpp"
 
 using namespace basalt::solver;
@@ -57,9 +58,7 @@ void compare_starts(const Scene& scene, const std::filesystem::path& h5) {
   io::GeometryFile file(h5);
   Simulation<double> sliced(scene, file, MPI_COMM_WORLD);
   expect_same_state(whole, sliced);
-  basalt::test::MemorySink sa, sb;
-  sa.begin(field_columns(scene));
-  sb.begin(field_columns(scene));
+  basalt::test::MemorySink sa(scene), sb(scene);
   whole.run(60, &sa);
   sliced.run(60, &sb);
   expect_same_state(whole, sliced);
@@ -87,8 +86,7 @@ void compare_starts(const Scene& scene, const std::filesystem::path& h5) {
 TEST(SlicedStart, WaveCubeSameAsWholeFile) {
   const auto dir = basalt::test::scratch_dir("sliced-start");
   const auto h5 = dir / "cube1.h5";
-  if (basalt::test::rank() == 0)
-    io::write_geometry(io::read_geometry(basalt::test::reference_dir() / "cube1.geo"), h5);
+  if (basalt::test::rank() == 0) io::write_geometry(basalt::test::cube1(), h5);
   MPI_Barrier(MPI_COMM_WORLD);
   auto scene = parse_scene(basalt::test::source_dir() / "scenes" / "wave.toml");
   compare_starts(scene, h5);
@@ -100,7 +98,7 @@ TEST(SlicedStart, TagsMassesGroupsAndBreakingSameAsWholeFile) {
   const auto dir = basalt::test::scratch_dir("sliced-start-tags");
   const auto h5 = dir / "tagged.h5";
   if (basalt::test::rank() == 0) {
-    auto g = io::read_geometry(basalt::test::reference_dir() / "cube1.geo");
+    auto g = basalt::test::cube1();
     g.mass.resize(g.size());
     for (std::size_t i = 0; i < g.size(); ++i) {
       g.tag[i] = static_cast<std::int32_t>(g.id[i] % 3);
@@ -149,7 +147,7 @@ TEST(SlicedStart, LoadChecksSeeTheBondTagsOfTheSlices) {
   // did: the slices it summarised held particles only); a tag no bond has is still reported.
   const auto dir = basalt::test::scratch_dir("sliced-start-bond-tags");
   const auto h5 = dir / "cube1.h5";
-  const auto whole = io::read_geometry(basalt::test::reference_dir() / "cube1.geo");
+  const auto whole = basalt::test::cube1();
   ASSERT_FALSE(whole.bonds.empty());
   for (const auto& b : whole.bonds) ASSERT_EQ(b.tag, 0);
   if (basalt::test::rank() == 0) io::write_geometry(whole, h5);

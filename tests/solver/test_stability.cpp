@@ -14,7 +14,8 @@
 #include "basalt/solver/core/errors.hpp"
 #include "basalt/solver/simulation.hpp"
 #include "basalt/solver/stability/critical_step.hpp"
-#include "solver_helpers.hpp"
+#include "geometries.hpp"
+#include "scene_runs.hpp"
 #include "test_support.hpp"
 
 using namespace basalt::solver;
@@ -22,7 +23,7 @@ using basalt::io::Geometry;
 
 namespace {
 
-double mass_of(double r) { return 4.0 / 3.0 * std::numbers::pi * r * r * r; }  // density 1
+using basalt::test::mass_of;
 
 /// n particles of radius r in a row along x, touching, bonded to their neighbours.
 Geometry chain(int n, double r) {
@@ -43,10 +44,7 @@ K = 1000.0
 )";
 
 Scene wave_scene() { return parse_scene(basalt::test::source_dir() / "scenes" / "wave.toml"); }
-const Geometry& cube1() {
-  static const Geometry g = basalt::io::read_geometry(basalt::test::reference_dir() / "cube1.geo");
-  return g;
-}
+using basalt::test::cube1;
 
 // 2 / omega_max of cube1's network at the start of the wave scene, from 1500 power iterations to a
 // relative change of 1e-9 (99 needed): the value the default iterations must reproduce.
@@ -165,8 +163,7 @@ K = 1000.0
 // cube1 with the wave scene (bonds, contacts, the base wall), on every rank count.
 TEST(CriticalStepCube1, MatchesConvergedEstimateAndMeasuredLimit) {
   Scene scene = wave_scene();
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   Simulation<double> sim(scene, cube1(), basalt::test::world(), opt);
   const auto& st = sim.stability();
   EXPECT_NEAR(st.dt_critical, kCube1Critical, 2e-3 * kCube1Critical) << st.iterations << " iterations";
@@ -238,24 +235,20 @@ TEST(DtFraction, SceneKeys) {
 template <class Real>
 void blowup_is_stopped(double factor = 1.1) {
   Scene scene = wave_scene();
-  RunOptions opt;
-  opt.quiet = true;
+  auto opt = basalt::test::quiet();
   opt.force_dt = true;
   double ke_stable = 0, dt_c = 0;
   {
     Simulation<Real> ref(scene, cube1(), basalt::test::world(), opt);
     dt_c = ref.stability().dt_critical;
     scene.dt = 0.5 * dt_c;
-    Simulation<Real> stable(scene, cube1(), basalt::test::world(), opt);
-    basalt::test::MemorySink sink;
-    sink.begin(field_columns(scene));
-    stable.run(400, &sink);
-    for (double k : sink.column(0)) ke_stable = std::max(ke_stable, k);
+    basalt::test::FieldRun<Real> stable(scene, cube1(), basalt::test::world(), opt);
+    stable.run(400);
+    for (double k : stable.sink.column(0)) ke_stable = std::max(ke_stable, k);
   }
   scene.dt = factor * dt_c;
   Simulation<Real> sim(scene, cube1(), basalt::test::world(), opt);
-  basalt::test::MemorySink sink;
-  sink.begin(field_columns(scene));
+  basalt::test::MemorySink sink(scene);
   std::string msg;
   try {
     sim.run(400, &sink);
@@ -295,16 +288,10 @@ TEST(Blowup, TwiceTheCriticalStepStopsFloat) { blowup_is_stopped<float>(2.0); }
 template <class Real>
 void ninety_percent_is_stable() {
   Scene scene = wave_scene();
-  RunOptions opt;
-  opt.quiet = true;
   auto peak = [&](double dt, std::int64_t steps) {
     scene.dt = dt;
-    Simulation<Real> sim(scene, cube1(), basalt::test::world(), opt);
-    basalt::test::MemorySink sink;
-    sink.begin(field_columns(scene));
-    sim.run(steps, &sink);
     double m = 0;
-    for (double k : sink.column(0)) {
+    for (double k : basalt::test::run_fields<Real>(scene, cube1(), basalt::test::world(), steps).column(0)) {
       EXPECT_TRUE(std::isfinite(k));
       m = std::max(m, k);
     }
@@ -324,13 +311,7 @@ TEST(Precision, FloatWaveAgreesWithDouble) {
   const Scene scene = wave_scene();
   auto series = [&](auto tag) {
     using Real = decltype(tag);
-    RunOptions opt;
-    opt.quiet = true;
-    Simulation<Real> sim(scene, cube1(), basalt::test::world(), opt);
-    basalt::test::MemorySink sink;
-    sink.begin(field_columns(scene));
-    sim.run(200, &sink);
-    return sink.column(0);
+    return basalt::test::run_fields<Real>(scene, cube1(), basalt::test::world(), 200).column(0);
   };
   const auto d = series(double{}), f = series(float{});
   if (basalt::test::rank() != 0) return;
@@ -375,14 +356,8 @@ Scene shifted_wave(double d) {
 
 TEST(Precision, OffsetGeometryRunsInDouble) {
   auto series = [&](double d) {
-    RunOptions opt;
-    opt.quiet = true;
-    const Scene scene = shifted_wave(d);
-    Simulation<double> sim(scene, shifted(cube1(), d), basalt::test::world(), opt);
-    basalt::test::MemorySink sink;
-    sink.begin(field_columns(scene));
-    sim.run(300, &sink);
-    return sink.column(0);
+    return basalt::test::run_fields(shifted_wave(d), shifted(cube1(), d), basalt::test::world(), 300)
+        .column(0);
   };
   const auto at0 = series(0), far = series(1e8);
   if (basalt::test::rank() != 0) return;
@@ -399,8 +374,7 @@ TEST(Precision, OffsetGeometryRunsInDouble) {
 }
 
 TEST(Precision, FloatFarFromOriginIsRefused) {
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   try {
     Simulation<float> sim(shifted_wave(1e3), shifted(cube1(), 1e3), basalt::test::world(), opt);
     ADD_FAILURE() << "float at an offset of 1e3 was accepted";
@@ -423,12 +397,9 @@ TEST(WaveArrival, MeanVzAboveIsTheMeanOverTheParticlesAboveZ) {
     f.z = z;
     scene.fields.push_back(f);
   }
-  RunOptions opt;
-  opt.quiet = true;
-  Simulation<double> sim(scene, cube1(), basalt::test::world(), opt);
-  basalt::test::MemorySink sink;
-  sink.begin(field_columns(scene));
-  sim.run(300, &sink);
+  basalt::test::FieldRun run(scene, cube1(), basalt::test::world());
+  const auto& sim = run.run(300).sim;
+  const auto& sink = run.sink;
   const auto& p = sim.particles();
   double sum = 0, count = 0;
   for (std::size_t i = 0; i < p.n_owned; ++i)

@@ -8,7 +8,7 @@
 
 #include "basalt/solver/core/errors.hpp"
 #include "basalt/solver/simulation.hpp"
-#include "solver_helpers.hpp"
+#include "scene_runs.hpp"
 #include "test_support.hpp"
 
 using namespace basalt::solver;
@@ -34,8 +34,7 @@ basalt::io::Geometry two(double distance, bool bonded = false) {
 }
 
 std::string error_of(const std::string& scene, const basalt::io::Geometry& g, bool force = false) {
-  RunOptions opt;
-  opt.quiet = true;
+  auto opt = basalt::test::quiet();
   opt.force_overlap = force;
   try {
     Simulation<double> sim(basalt::test::scene_from(scene), g, MPI_COMM_SELF, opt);

@@ -8,7 +8,8 @@
 
 #include "basalt/solver/core/errors.hpp"
 #include "basalt/solver/simulation.hpp"
-#include "solver_helpers.hpp"
+#include "geometries.hpp"
+#include "scene_runs.hpp"
 #include "test_support.hpp"
 
 using namespace basalt::solver;
@@ -16,15 +17,9 @@ using basalt::io::Geometry;
 
 namespace {
 
-double mass_of(double r) { return 4.0 / 3.0 * std::numbers::pi * r * r * r; }
+using basalt::test::mass_of;
 
-template <class Real>
-std::size_t index_of(const Particles<Real>& p, std::int64_t id) {
-  for (std::size_t i = 0; i < p.n_owned; ++i)
-    if (p.id[i] == id) return i;
-  ADD_FAILURE() << "no particle " << id;
-  return 0;
-}
+using basalt::test::index_of;
 
 template <class Real>
 double separation(const Particles<Real>& p) {
@@ -110,8 +105,7 @@ type = "bond_count"
   p.vx[index_of(p, 1)] = -1.0;
   p.vx[index_of(p, 2)] = 1.0;
   sim.state_changed();
-  basalt::test::MemorySink sink;
-  sink.begin(field_columns(scene));
+  basalt::test::MemorySink sink(scene);
   int broke_at = -1;
   double strain_before = 0;
   for (int k = 1; k <= 1500; ++k) {
@@ -217,8 +211,7 @@ wall = "floor"
     auto& p = sim.particles();
     p.vz[0] = -1.0;
     sim.state_changed();
-    basalt::test::MemorySink sink;
-    sink.begin(field_columns(scene));
+    basalt::test::MemorySink sink(scene);
     for (int k = 0; k < 20000 && !(p.z[0] > 0.52); ++k) sim.step(&sink);
     const double m = mass_of(r);
     EXPECT_NEAR(p.vz[0], 1.0, 1e-3) << mode;

@@ -21,7 +21,8 @@
 #include "basalt/solver/core/errors.hpp"
 #include "basalt/solver/models/bonded_wall.hpp"
 #include "basalt/solver/simulation.hpp"
-#include "solver_helpers.hpp"
+#include "geometries.hpp"
+#include "scene_runs.hpp"
 #include "test_support.hpp"
 
 using namespace basalt::solver;
@@ -31,18 +32,9 @@ namespace {
 /// A box of touching spheres (radius 0.5, spacing 1, jitter 0.01 in x and y), nx x ny x nz, in
 /// [0, nx] x [0, ny] x [0, nz]; the top layer tagged 2, the others 0; ids from 1.
 basalt::io::Geometry box(int nx, int ny, int nz) {
-  basalt::io::Geometry g;
-  std::int64_t id = 1;
-  for (int k = 0; k < nz; ++k)
-    for (int j = 0; j < ny; ++j)
-      for (int i = 0; i < nx; ++i, ++id) {
-        const auto u = static_cast<std::uint64_t>(id);
-        g.add_particle(id,
-                       {0.5 + i + 0.01 * basalt::test::hash_unit(3 * u + 1),
-                        0.5 + j + 0.01 * basalt::test::hash_unit(3 * u + 2), 0.5 + k},
-                       0.5, k == nz - 1 ? 2 : 0);
-      }
-  return g;
+  return basalt::test::jittered_lattice(
+      {.n = {nx, ny, nz}, .jitter = 0.01}, [](std::uint64_t) { return 0.5; },
+      [nz](int k) { return k == nz - 1 ? 2 : 0; });
 }
 
 std::size_t column_of(const basalt::test::MemorySink& s, const std::string& name) {
@@ -122,11 +114,9 @@ fields = [{type = "wall_position", wall = "platen"}, {type = "wall_force", wall 
 )");
   basalt::io::Geometry g;
   g.add_particle(1, {0.5, 0.5, 0.5}, 0.5, 0);
-  RunOptions opt;
-  opt.quiet = true;
+  const auto opt = basalt::test::quiet();
   Simulation<double> sim(scene, g, MPI_COMM_SELF, opt);
-  basalt::test::MemorySink sink;
-  sink.begin(field_columns(scene));
+  basalt::test::MemorySink sink(scene);
   ASSERT_EQ(sink.columns[0], "wall_position_platen_x");
   ASSERT_EQ(sink.columns[2], "wall_position_platen_z");
   ASSERT_EQ(sink.columns[3], "wall_force_platen_x");
@@ -199,14 +189,7 @@ TEST(ServoWall, HoldsTheTargetForceOnAConfinedBoxOnAnyNumberOfRanks) {
   const auto g = box(4, 4, 6);
   constexpr int kSteps = 6000;
   const auto run = [&](MPI_Comm comm, std::array<int, 3> dims) {
-    RunOptions opt;
-    opt.dims = dims;
-    opt.quiet = true;
-    Simulation<double> sim(scene, g, comm, opt);
-    basalt::test::MemorySink sink;
-    sink.begin(field_columns(scene));
-    sim.run(kSteps, &sink);
-    return sink;
+    return basalt::test::run_fields(scene, g, comm, kSteps, dims);
   };
   const int n = basalt::test::size();
   std::vector<double> ref_z(kSteps), ref_f(kSteps);
@@ -304,14 +287,12 @@ TEST(BondedWall, ForceOnATiedParticleFollowsTheClosedFormAndTheLedgerBalances) {
     const auto scene = basalt::test::scene_from(bonded_one(stiffness));
     basalt::io::Geometry g;
     g.add_particle(1, {0.3, -0.2, 0.25}, 0.5, 2);  // overlapping the wall: tied, not repelled
-    RunOptions opt;
-    opt.quiet = true;
+    const auto opt = basalt::test::quiet();
     Simulation<double> sim(scene, g, MPI_COMM_SELF, opt);
     const double m = 4.0 / 3.0 * std::numbers::pi * 0.125;
     const double k = stiffness == "plain" ? 100.0 : BondedWall::kEsysBondPi * 0.5 * 100.0;
     const double w = std::sqrt(k / m);
-    basalt::test::MemorySink sink;
-    sink.begin(field_columns(scene));
+    basalt::test::MemorySink sink(scene);
     const int steps = static_cast<int>(3 * 2 * std::numbers::pi / w / 1e-4);  // three periods
     sim.run(steps, &sink);
     // Relative coordinate u = x - x0 - V t: m u'' = -k u, u(0) = 0, u'(0) = -V, so the particle feels
@@ -376,22 +357,17 @@ fields = [{type = "wall_force", wall = "grip"}, {type = "kinetic_energy"}]
   const auto g = box(6, 2, 3);
   constexpr int kSteps = 3000;  // the layer travels 1.25, more than a rank's width at np 4 along x
   const auto run = [&](MPI_Comm comm, std::array<int, 3> dims) {
-    RunOptions opt;
-    opt.dims = dims;
-    opt.quiet = true;
-    Simulation<double> sim(scene, g, comm, opt);
-    basalt::test::MemorySink sink;
-    sink.begin(field_columns(scene));
-    sim.run(kSteps, &sink);
+    basalt::test::FieldRun r(scene, g, comm, basalt::test::quiet(dims));
+    r.run(kSteps);
     double dx = 0;  // the tied layer's mean displacement along x (this rank's particles)
     int tied = 0;
-    const auto& p = sim.particles();
+    const auto& p = r.sim.particles();
     for (std::size_t i = 0; i < p.n_owned; ++i)
       if (p.tag[i] == 2) {
         dx += p.x[i] - g.position[static_cast<std::size_t>(g.index_of(p.id[i]))][0];
         ++tied;
       }
-    return std::make_tuple(sink, sim.rebuilds(), tied ? dx / tied : 0.0);
+    return std::make_tuple(r.sink, r.sim.rebuilds(), tied ? dx / tied : 0.0);
   };
   const int n = basalt::test::size();
   std::vector<double> ref(3 * kSteps);

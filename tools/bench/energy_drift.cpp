@@ -27,7 +27,7 @@ namespace {
 using basalt::io::Geometry;
 using namespace basalt::solver;
 
-/// The same hash as the tests' (tests/solver/solver_helpers.hpp): a value in [-1, 1) from an integer.
+/// The same hash as the tests' (tests/support/geometries.hpp): a value in [-1, 1) from an integer.
 double hash_unit(std::uint64_t k) {
   k += 0x9E3779B97F4A7C15ull;
   k = (k ^ (k >> 30)) * 0xBF58476D1CE4E5B9ull;

@@ -4,7 +4,7 @@
 # `apt-get download` and unpacked with `dpkg -x` into DIR/root. (python3-paraview cannot be installed beside
 # libvtk9-dev: it conflicts with python3-vtk9. Never `apt-get install` it here: that removes libvtk9-dev.)
 #
-# Usage: tools/paraview/fetch_pvpython.sh DIR
+# Usage: tests/paraview/fetch_pvpython.sh DIR
 #   then: source DIR/env.sh && pvpython --force-offscreen-rendering script.py   (under xvfb-run to draw)
 # Idempotent: when DIR/ready names the same version and pvpython starts, nothing is fetched again; two
 # callers at once wait for each other (flock). Costs, once: ~73 MB downloaded, ~530 MB unpacked, ~20-40 s.
@@ -35,7 +35,7 @@ fi
 
 write_env() {
   cat >"$dest/env.sh" <<ENV
-# pvpython unpacked by tools/paraview/fetch_pvpython.sh (Debian's paraview $1, not installed)
+# pvpython unpacked by tests/paraview/fetch_pvpython.sh (Debian's paraview $1, not installed)
 export PATH="$root/usr/bin:\$PATH"
 export LD_LIBRARY_PATH="$lib:$lib/paraview-5.11\${LD_LIBRARY_PATH:+:\$LD_LIBRARY_PATH}"
 export PYTHONPATH="$root/usr/lib/python3/dist-packages\${PYTHONPATH:+:\$PYTHONPATH}"
