@@ -14,7 +14,8 @@
 #include "basalt/solver/output/field_rows.hpp"
 #include "basalt/solver/simulation.hpp"
 #include "basalt/solver/stages.hpp"
-#include "solver_helpers.hpp"
+#include "geometries.hpp"
+#include "scene_runs.hpp"
 
 using namespace basalt::solver;
 
@@ -72,9 +73,8 @@ acceleration = [0.0, 0.0, -1.0]
 }
 
 Simulation<double> make(const std::string& step) {
-  RunOptions o;
-  o.quiet = true;
-  return Simulation<double>(basalt::test::scene_from(pile_scene(step)), pile(), MPI_COMM_WORLD, o);
+  return Simulation<double>(basalt::test::scene_from(pile_scene(step)), pile(), MPI_COMM_WORLD,
+                            basalt::test::quiet());
 }
 
 /// id -> (x, y, z, vx, vy, vz) of every particle, gathered on every rank.
@@ -224,9 +224,7 @@ wall_velocity = { piston = [0.0, 0.0, -1.0] }
 steps = 300
 )");
   ASSERT_EQ(scene.stages.size(), 2u);
-  RunOptions o;
-  o.quiet = true;
-  Simulation<double> sim(scene, pile(), MPI_COMM_WORLD, o);
+  Simulation<double> sim(scene, pile(), MPI_COMM_WORLD, basalt::test::quiet());
   FieldRows rows(sim.comm(), nullptr);
   std::vector<StageReport> reports;
   std::vector<double> lowest;
