@@ -154,6 +154,10 @@ class Simulation:
             text, source = False, os.fspath(scene)
         else:
             text, source = True, str(scene)
+        # numpy now, not at the first view a callback takes: imported in the middle of a run it left the run
+        # 10-15 % slower for the rest of it (measured on the wave, tools/bench/python_overhead.py)
+        import numpy  # noqa: F401
+
         self._core = core().Simulation(
             source, text=text, geometry=os.fspath(geometry) if geometry else "",
             output=os.fspath(output) if output else "", io_ranks=int(io_ranks), precision=precision or "",

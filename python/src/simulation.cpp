@@ -34,6 +34,7 @@
 #include "client_sink.hpp"
 #include "geometry_input.hpp"
 #include "output_folder.hpp"
+#include "process_setup.hpp"
 #include "restart_support.hpp"
 #if BASALT_WITH_VTK
 #include "basalt/io/vtk_frame_writer.hpp"
@@ -63,6 +64,8 @@ void ensure_mpi() {
   int up = 0;
   MPI_Initialized(&up);
   if (up) return;
+  basalt::run::bound_heap_growth();  // as basalt-run does (solver/app/process_setup.hpp)
+  basalt::run::prefer_eager_shared_memory_messages();
   int provided = 0;
   MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided);
   py::module_::import("atexit").attr("register")(py::cpp_function([] {

@@ -10,9 +10,6 @@
 #include <fmt/format.h>
 #include <mpi.h>
 #include <sys/resource.h>
-#if defined(__GLIBC__)
-#include <malloc.h>
-#endif
 
 #include <CLI/CLI.hpp>
 #include <chrono>
@@ -48,6 +45,7 @@
 #include "geometry_input.hpp"
 #include "output_folder.hpp"
 #include "picture_module.hpp"
+#include "process_setup.hpp"
 #include "rank_spread.hpp"
 #include "restart_support.hpp"
 
@@ -93,32 +91,6 @@ void refuse_without_vtk(const Scene& scene, const Cli& cli) {
            "basalt-view built with VTK");
 }
 #endif
-
-/// glibc keeps freed memory in the heap and raises its mmap threshold to the largest block freed (up to
-/// 32 MB), so the arrays rebuilt at every neighbour-list rebuild come back from a heap that only grows: the
-/// 60 mm wave cube's two ranks went from 274 to 401 MB of RSS in 2,000 steps (25 rebuilds), the 9.47 M cube
-/// from 2.77 to 3.00 GB. A fixed threshold of 1 MB (blocks above it mmapped, returned to the system when
-/// freed) and trimming above 1 MB keep them at 220 MB and flat (docs/BENCHMARKS.md, "Memory over a run").
-/// MALLOC_MMAP_THRESHOLD_ / MALLOC_TRIM_THRESHOLD_ in the environment still win.
-void bound_heap_growth() {
-#if defined(__GLIBC__)
-  constexpr int kBytes = 1 << 20;
-  if (!std::getenv("MALLOC_MMAP_THRESHOLD_")) mallopt(M_MMAP_THRESHOLD, kBytes);
-  if (!std::getenv("MALLOC_TRIM_THRESHOLD_")) mallopt(M_TRIM_THRESHOLD, kBytes);
-#endif
-}
-
-/// Open MPI's shared-memory transport (btl vader) sends a message above 4 KiB by rendezvous: the
-/// receiver reads the rest from the sender's memory once both have met in an MPI call. The per-step
-/// ghost refresh is 10-60 kB each way in the benchmark scenes (e.g. 600 ghosts x 9 values for a granular
-/// pile cut in two), so every step paid that meeting. Sent eagerly (copied into shared memory at the
-/// send, taken at the wait), 2-rank runs took 0.90x the time on the wave cube and 0.98x on the granular
-/// piles (docs/BENCHMARKS.md, "Ghost messages sent eagerly"). Set only where the user has not (mpirun
-/// --mca, the environment, which win); other MPI libraries and other transports ignore these names.
-void prefer_eager_shared_memory_messages() {
-  setenv("OMPI_MCA_btl_vader_eager_limit", "65536", 0);
-  setenv("OMPI_MCA_btl_vader_max_send_size", "65536", 0);
-}
 
 /// User + system CPU seconds of this process.
 double cpu_seconds() {
@@ -697,8 +669,8 @@ int run_world(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  bound_heap_growth();
-  prefer_eager_shared_memory_messages();  // before MPI_Init, which reads them
+  basalt::run::bound_heap_growth();
+  basalt::run::prefer_eager_shared_memory_messages();  // before MPI_Init, which reads them
   // A file-size limit (ulimit -f) must make the write fail with EFBIG, named, not kill the rank.
   std::signal(SIGXFSZ, SIG_IGN);
   // FUNNELED: I/O rank 0's picture thread (in-situ pictures) makes no MPI call, only the main thread does.
