@@ -216,6 +216,11 @@ class Simulation:
     def dt(self, value):
         self._core.set_dt(float(value))
 
+    def gather(self, name):
+        """Collective: one particle array (a name of sim.particles) of every rank, on rank 0 as (ids, values)
+        sorted by id (float64 values); None on the other ranks."""
+        return self._core.gather(name)
+
     def kinetic_energy(self):
         """Collective: the total kinetic energy (translation and rotation)."""
         return self._core.kinetic_energy()
@@ -242,6 +247,24 @@ class Simulation:
     def free(self):
         """No particle is held from now on."""
         self._core.set_fixed_tags([])
+
+    @property
+    def body_forces(self):
+        """The scene's [[body_forces]] groups: {name: model} (name: the group's name, e.g. "gravity0")."""
+        return dict(self._core.body_forces())
+
+    def set_body_force(self, name, **keys):
+        """New keys for a body-force group from now on, checked as the scene's (docs/scenes.md):
+        set_body_force("gravity0", acceleration=(0, 0, -2.0)). Keys not given take their defaults."""
+        self._core.set_body_force(name, "\n".join(f"{k} = {_toml_value(v)}" for k, v in keys.items()))
+
+    def set_gravity(self, acceleration):
+        """The scene's gravity (its one gravity group) from now on: set_gravity((0, 0, -9.81e-3))."""
+        names = [n for n, m in self.body_forces.items() if m == "gravity"]
+        if len(names) != 1:
+            raise ValueError(f"set_gravity: the scene has {len(names)} gravity groups "
+                             f"({', '.join(names) or 'none'}): use set_body_force(name, acceleration=...)")
+        self.set_body_force(names[0], acceleration=[float(c) for c in acceleration])
 
     def state_changed(self):
         """Collective: call after writing positions (recomputes forces and the energy the guard starts from)."""

@@ -101,6 +101,7 @@ class Run {
   virtual py::list run_stages() = 0;
   virtual py::dict state() = 0;
   virtual py::array array(const std::string& name, py::handle owner) = 0;
+  virtual py::object gather(const std::string& name, py::handle owner) = 0;
   virtual const solver::Comm& comm() const = 0;
   virtual std::int64_t step() const = 0;
   virtual double time() const = 0;
@@ -114,6 +115,8 @@ class Run {
   virtual void set_fixed_tags(std::vector<std::int64_t> tags) = 0;
   virtual void set_wall_velocity(const std::string& name, const std::array<double, 3>& v) = 0;
   virtual void remove_wall(const std::string& name) = 0;
+  virtual void set_body_force(const std::string& name, const std::string& keys) = 0;
+  virtual py::list body_forces() const = 0;
   virtual void state_changed() = 0;
   virtual std::string close() = 0;
 };
@@ -195,6 +198,14 @@ class RunOf final : public Run {
     sim_->set_wall_velocity(name, v);
   }
   void remove_wall(const std::string& name) override { sim_->remove_wall(name); }
+  void set_body_force(const std::string& name, const std::string& keys) override {
+    sim_->set_body_force(name, keys);
+  }
+  py::list body_forces() const override {
+    py::list l;
+    for (const auto& b : scene_.body_forces) l.append(py::make_tuple(b.name, b.model));
+    return l;
+  }
   void state_changed() override { sim_->state_changed(); }
 
   py::dict energies() override {
@@ -263,6 +274,36 @@ class RunOf final : public Run {
     throw py::key_error(
         "no particle array \"" + name +
         "\" (x, y, z, vx, vy, vz, fx, fy, fz, radius, inv_mass, id, tag; wx, wy, wz with rotation)");
+  }
+
+  py::object gather(const std::string& name, py::handle owner) override {
+    // Collective: (id, value) of every owned particle, all ranks', to rank 0 sorted by id (as float64).
+    const py::array local = array(name, owner);  // validates the name
+    const auto& p = sim_->particles();
+    std::vector<double> mine;
+    mine.reserve(2 * p.n_owned);
+    const py::array_t<double> values = local.attr("astype")("float64");
+    const auto v = values.unchecked<1>();
+    for (std::size_t i = 0; i < p.n_owned; ++i) {
+      mine.push_back(double(p.id[i]));
+      mine.push_back(v(static_cast<py::ssize_t>(i)));
+    }
+    const std::vector<double> all = comm_.size() > 1 ? comm_.all_gather(mine) : mine;
+    if (comm_.rank() != 0) return py::none();
+    const std::size_t n = all.size() / 2;
+    std::vector<std::size_t> order(n);
+    for (std::size_t k = 0; k < n; ++k) order[k] = k;
+    std::sort(order.begin(), order.end(),
+              [&](std::size_t a, std::size_t b) { return all[2 * a] < all[2 * b]; });
+    py::array_t<std::int64_t> ids(static_cast<py::ssize_t>(n));
+    py::array_t<double> out(static_cast<py::ssize_t>(n));
+    auto wi = ids.mutable_unchecked<1>();
+    auto wo = out.mutable_unchecked<1>();
+    for (std::size_t k = 0; k < n; ++k) {
+      wi(static_cast<py::ssize_t>(k)) = static_cast<std::int64_t>(all[2 * order[k]]);
+      wo(static_cast<py::ssize_t>(k)) = all[2 * order[k] + 1];
+    }
+    return py::make_tuple(ids, out);
   }
 
   std::string close() override {
@@ -467,6 +508,10 @@ void bind_simulation(py::module_& m) {
            [](py::object self, const std::string& name) {
              return self.cast<PySimulation&>().run().array(name, self);
            })
+      .def("gather",
+           [](py::object self, const std::string& name) {
+             return self.cast<PySimulation&>().run().gather(name, self);
+           })
       .def("kinetic_energy", [](PySimulation& s) { return s.run().kinetic_energy(); })
       .def("energies", [](PySimulation& s) { return s.run().energies(); })
       .def("walls", [](PySimulation& s) { return s.run().walls(); })
@@ -476,6 +521,9 @@ void bind_simulation(py::module_& m) {
                                    std::array<double, 3> v) { s.run().set_wall_velocity(name, v); })
       .def("remove_wall", [](PySimulation& s, const std::string& name) { s.run().remove_wall(name); })
       .def("state_changed", [](PySimulation& s) { s.run().state_changed(); })
+      .def("set_body_force", [](PySimulation& s, const std::string& name,
+                                const std::string& keys) { s.run().set_body_force(name, keys); })
+      .def("body_forces", [](PySimulation& s) { return s.run().body_forces(); })
       .def("allreduce", [](PySimulation& s, double v, const std::string& op) {
         const auto& c = s.run().comm();
         if (c.size() == 1) return v;

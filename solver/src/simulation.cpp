@@ -12,6 +12,7 @@
 #include "basalt/solver/integrate/integrators.hpp"
 #include "basalt/solver/models/registry.hpp"
 #include "basalt/solver/scene/load_checks.hpp"
+#include "basalt/solver/scene/table_reader.hpp"
 
 namespace basalt::solver {
 
@@ -371,6 +372,37 @@ template <class Real>
 void Simulation<Real>::remove_wall(std::string_view name) {
   forces_.walls().remove(wall_index(name));
   force_rebuild();
+}
+
+template <class Real>
+void Simulation<Real>::set_body_force(std::string_view name, const std::string& keys) {
+  auto it = std::find_if(scene_.body_forces.begin(), scene_.body_forces.end(),
+                         [&](const InteractionSpec& b) { return b.name == name; });
+  if (it == scene_.body_forces.end()) {
+    std::string names;
+    for (const auto& b : scene_.body_forces) names += (names.empty() ? "" : ", ") + b.name;
+    throw InputError(
+        fmt::format("no body force named \"{}\" (the scene's: {})", name, names.empty() ? "none" : names));
+  }
+  InteractionSpec spec = *it;
+  const std::string label = fmt::format("body_forces \"{}\"", name);
+  toml::table table;
+  try {
+    table = toml::parse(keys, label);
+  } catch (const toml::parse_error& e) {
+    throw InputError(fmt::format("{}: {}", label, e.description()));
+  }
+  TableReader t(table, label, std::string(name));
+  spec.params = find_model(spec.model, ModelKind::body)->parse(t);
+  spec.tags = t.integers_or("tags", {});
+  t.finish();
+  for (const auto& c : forces_.computes())
+    if (c->reconfigure(spec)) {
+      *it = spec;
+      state_changed();
+      return;
+    }
+  throw InputError(fmt::format("{}: no force compute took it (a bug)", label));
 }
 
 template <class Real>

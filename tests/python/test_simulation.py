@@ -144,6 +144,13 @@ def test_views_and_steering(tmp_path):
     assert sim.dt == 1e-3
     with pytest.raises(ValueError, match="positive"):
         sim.dt = -1
+    # body forces: the scene's groups by name; gravity changed from now on; bad keys named
+    assert sim.body_forces["gravity0"] == "gravity"
+    sim.set_gravity((0.0, 0.0, -2.0))
+    with pytest.raises(basalt.InputError, match="speed"):
+        sim.set_body_force("gravity0", acceleration=(0, 0, -1), speed=3)
+    with pytest.raises(basalt.InputError, match="no body force named"):
+        sim.set_body_force("nope", acceleration=(0, 0, -1))
     vz = sim.particles.vz
     vz[:] = 0.0
     vz[0] = 5.0
@@ -178,6 +185,12 @@ def test_mpi_two_compute_ranks_and_an_io_rank(tmp_path):
             sim.run(200)
             ke = sim.kinetic_energy()
             assert steps == [50, 100, 150, 200], steps
+            g = sim.gather("z")
+            if sim.rank == 0:
+                ids, z = g
+                assert len(ids) == 8948 and (ids[1:] > ids[:-1]).all(), len(ids)
+            else:
+                assert g is None
             if sim.rank == 0:
                 print("ranks", sim.ranks, "ke", repr(ke))
         sim.close()

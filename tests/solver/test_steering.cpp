@@ -265,3 +265,41 @@ TEST(Stages, BadStagesNameTheKey) {
                "no planar wall named \"nope\"");
   expect_error("[[stages]]\nsteps = 5\nspeed = 3\n", "speed");
 }
+
+TEST(Steering, GravityChangedMidRunMovesTheCentreOfMassByTheNewAcceleration) {
+  // In free fall (the floor taken away) the contacts cancel in the momentum: the centre of mass's vertical
+  // velocity changes by g t, with the new g from the step it is set.
+  auto sim = make("dt = 2e-3");
+  sim.run(50);
+  sim.remove_wall("floor");
+  sim.set_body_force("gravity0", "acceleration = [0.0, 0.0, -3.0]");
+  const auto momentum = [&] {
+    const auto& p = sim.particles();
+    double m = 0, mv = 0;
+    for (std::size_t i = 0; i < p.n_owned; ++i) {
+      m += p.mass(i);
+      mv += p.mass(i) * p.vz[i];
+    }
+    if (sim.comm().size() > 1) {
+      m = sim.comm().sum(m);
+      mv = sim.comm().sum(mv);
+    }
+    return mv / m;
+  };
+  const double v0 = momentum();
+  sim.run(100);
+  EXPECT_NEAR(momentum() - v0, -3.0 * 100 * 2e-3, 1e-9);
+  EXPECT_THROW(sim.set_body_force("nope", "acceleration = [0.0, 0.0, -1.0]"), InputError);
+  try {
+    sim.set_body_force("gravity0", "acceleration = [0.0, 0.0]");
+    ADD_FAILURE() << "no error for a 2-vector";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("acceleration"), std::string::npos) << e.what();
+  }
+  try {
+    sim.set_body_force("gravity0", "acceleration = [0.0, 0.0, -1.0]\nspeed = 2");
+    ADD_FAILURE() << "no error for an unknown key";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("speed"), std::string::npos) << e.what();
+  }
+}

@@ -193,6 +193,10 @@ class Simulation {
   void set_wall_velocity(std::string_view name, const std::array<double, 3>& v);
   /// The wall stops touching particles (a gate taken away): the lists are rebuilt at once.
   void remove_wall(std::string_view name);
+  /// New keys for the [[body_forces]] group `name` (TOML text of its table's keys, e.g. "acceleration = [0.0,
+  /// 0.0, -2.0]"), checked as the scene's are; keys not given take their defaults, tags included. Recomputes
+  /// the forces and the energy guard's reference (a changed potential is not a change of energy).
+  void set_body_force(std::string_view name, const std::string& keys);
   /// Collective: the busiest rank's owned particles over the mean (1 = perfectly balanced).
   double imbalance() const;
   /// run.balance = "pairs"'s estimate of each owned particle's work in a step, a whole number (units of

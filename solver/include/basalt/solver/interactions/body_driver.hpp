@@ -4,6 +4,7 @@
 // particles. Body forces run last, in the ghost part of the step, so that a model that reads the
 // force (local damping) sees every other model's share.
 #include <algorithm>
+#include <string>
 #include <string_view>
 #include <type_traits>
 #include <vector>
@@ -23,7 +24,18 @@ class BodyDriver final : public ForceCompute<Real> {
       if (g.model != Model::name) continue;
       coeffs_.push_back(Model::template coeffs<Real>(g.template params_of<Model>()));
       tags_.push_back(g.tags);
+      names_.push_back(g.name);
     }
+  }
+
+  bool reconfigure(const InteractionSpec& g) override {
+    for (std::size_t k = 0; k < names_.size(); ++k)
+      if (names_[k] == g.name && g.model == Model::name) {
+        coeffs_[k] = Model::template coeffs<Real>(g.template params_of<Model>());
+        tags_[k] = g.tags;
+        return true;
+      }
+    return false;
   }
 
   std::string_view model() const override { return Model::name; }
@@ -133,6 +145,7 @@ class BodyDriver final : public ForceCompute<Real> {
   std::vector<std::uint8_t> flags_;  ///< apply_all's scratch
   std::vector<Coeffs> coeffs_;
   std::vector<TagFilter> tags_;
+  std::vector<std::string> names_;  ///< each group's name (reconfigure)
   double dissipated_ = 0;
   Real dt_ = 0;
 };
