@@ -384,6 +384,7 @@ class PySimulation {
     }
     split_ = true;
     if (layout_.is_io) {
+      io_ = true;
       // Serve the compute ranks' output until they close; the script then goes on with an idle object.
       io::IoServer server(layout_, cfg, vtk_);
       const auto report = server.run();
@@ -400,7 +401,7 @@ class PySimulation {
     live.erase(std::remove(live.begin(), live.end(), this), live.end());
   }
 
-  bool is_io_rank() const { return !run_ && split_; }
+  bool is_io_rank() const { return io_; }
   Run& run() {
     if (!run_) throw RunError(closed_ ? "the simulation is closed" : "an I/O rank runs no steps");
     return *run_;
@@ -411,8 +412,8 @@ class PySimulation {
   /// A Python exception on any compute rank ends the run on every rank, with its message.
   std::int64_t run_steps(std::int64_t steps,
                          const std::vector<std::tuple<std::int64_t, py::function, bool>>& hooks) {
-    if (!run_) return 0;
-    auto& r = *run_;
+    if (is_io_rank()) return 0;
+    auto& r = run();  // (a closed simulation: RunError)
     std::vector<solver::StepHook> calls;
     std::optional<py::error_already_set>
         raised;  // the Python exception of this rank, re-raised after the run
@@ -461,6 +462,7 @@ class PySimulation {
  private:
   io::RankLayout layout_;
   bool split_ = false;
+  bool io_ = false;  ///< an I/O rank (its run() does nothing)
   bool closed_ = false;
   io::VtkFrameWriter vtk_;
   std::unique_ptr<Run> run_;

@@ -114,6 +114,8 @@ def test_callbacks_until_and_exceptions(tmp_path):
     with pytest.raises(ValueError, match="boom at 154"):  # 154 = 22 x 7
         sim.run(100)
     sim.close()
+    with pytest.raises(basalt.RunError, match="closed"):
+        sim.run(10)
 
 
 def test_views_and_steering(tmp_path):
