@@ -104,7 +104,8 @@ void Simulation<Real>::rebuild() {
   const bool parallel = comm().size() > 1;
   if (parallel) error = comm().agree_error(error);
   if (error) stop(*error);
-  if (parallel && scene_.balance == "pairs" && !balance_paused_ && rebuilds_ > 0) weigh_pairs();
+  if (parallel && scene_.balance == "pairs" && !balancer_.paused() && rebuilds_ > 0)
+    balancer_.weigh_pairs(balance_run());
   times_.communication += sw.lap();
   forces_.save_history(p_);  // before the ghosts (and the pairs' ids) go
   p_.drop_ghosts();
@@ -118,7 +119,8 @@ void Simulation<Real>::rebuild() {
     if (total != n_global_)
       stop(fmt::format("step {}: {} particles on the ranks, {} expected: particles were lost", step_, total,
                        n_global_));
-    if (scene_.balance != "none" && !balance_paused_) balance_at_rebuild();
+    if (scene_.balance != "none" && !balancer_.paused())
+      if (auto balance_error = balancer_.at_rebuild(balance_run())) stop(*balance_error);
   }
   times_.communication += sw.lap();
   spatial_sort();

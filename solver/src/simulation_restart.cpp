@@ -105,7 +105,7 @@ void Simulation<Real>::finish_restart(const io::Checkpoint& c, bool replay) {
     if (!forces_.walls().empty()) forces_.walls().move_to(double(step_) * scene_.dt);
     rebuild();
   }
-  balance_paused_ = false;
+  balancer_.set_paused(false);
   check_start(false);
   estimate_critical_step(false);  // simulation_stability.cpp
   start_ledger(compute_forces<true>());
@@ -146,7 +146,7 @@ template <class Real>
 void Simulation<Real>::restore_decomposition(const RestartLayout& layout, MPI_Comm comm) {
   dec_ = std::make_unique<Decomposition>(Comm(comm), options_.dims, layout.box_min, layout.box_max);
   // The checkpoint's cuts when they fit this rank grid (the same ranks along each axis): the replayed
-  // rebuild then finds every particle where the run had it and must not move them (balance_paused_).
+  // rebuild then finds every particle where the run had it and must not move them (the balancer paused).
   // On another grid the cuts start even and a balanced run re-balances at that rebuild.
   bool fits = true;
   for (int d = 0; d < 3; ++d)
@@ -154,7 +154,7 @@ void Simulation<Real>::restore_decomposition(const RestartLayout& layout, MPI_Co
            layout.cuts[static_cast<std::size_t>(d)].size() == static_cast<std::size_t>(dec_->dims()[d] - 1);
   if (fits && !(layout.cuts[0].empty() && layout.cuts[1].empty() && layout.cuts[2].empty())) {
     dec_->set_cuts(layout.cuts);
-    balance_paused_ = true;
+    balancer_.set_paused(true);
   }
   halo_ = std::make_unique<Halo<Real>>(*dec_);
   ghost_width_ = layout.ghost_width;

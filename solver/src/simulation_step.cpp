@@ -57,7 +57,8 @@ bool Simulation<Real>::refresh_neighbours(double moved2) {
   const bool parallel = comm().size() > 1;
   // (the scene's string is compared once per balance_every steps, not at every step)
   const bool balance_due = parallel && step_ > 0 && step_ % scene_.balance_every == 0 &&
-                           scene_.balance == "time" && !balance_paused_ && time_balance_due();
+                           scene_.balance == "time" && !balancer_.paused() &&
+                           balancer_.time_balance_due(balance_run());
   double need =
       bond_broke_ || balance_due
           ? std::numeric_limits<double>::infinity()

@@ -32,6 +32,7 @@
 #include "basalt/solver/parallel/decomposition.hpp"
 #include "basalt/solver/parallel/geometry_loader.hpp"
 #include "basalt/solver/parallel/halo.hpp"
+#include "basalt/solver/parallel/load_balancer.hpp"
 #include "basalt/solver/scene/frame_origin.hpp"
 #include "basalt/solver/scene/load_checks.hpp"
 #include "basalt/solver/scene/scene.hpp"
@@ -198,20 +199,20 @@ class Simulation {
   /// the forces and the energy guard's reference (a changed potential is not a change of energy).
   void set_body_force(std::string_view name, const std::string& keys);
   /// Collective: the busiest rank's owned particles over the mean (1 = perfectly balanced).
-  double imbalance() const;
+  double imbalance() const { return LoadBalancer<Real>::imbalance(p_, comm(), n_global_); }
   /// run.balance = "pairs"'s estimate of each owned particle's work in a step, a whole number (units of
   /// about 50 instructions): 2 for the particle; per end of a listed pair 1, 4 while the pair touches; per
   /// end of a bond 3; 4 per wall or mesh the particle is a candidate of. A pair or bond with a ghost puts
   /// both ends' share on the owned end (this rank evaluates all of it). From the lists and bonds of the last
   /// rebuild, at the current positions (2 each before the first).
-  std::vector<double> pair_work() const;
+  std::vector<double> pair_work() const { return LoadBalancer<Real>::pair_work(p_, forces_, bonds_); }
   /// run.balance = "time": adds seconds to this rank's measured compute time, as if its steps had taken
   /// them (the balancer then moves work off this rank; tests stand in for a slower core with it).
-  void add_rank_work(double seconds) { extra_work_ += seconds; }
+  void add_rank_work(double seconds) { balancer_.add_rank_work(seconds); }
   /// Times the cuts moved (run.balance = "count" or "time"), and the imbalance (of particles, or of
   /// compute time for "time") before the last move.
-  std::int64_t rebalances() const { return rebalances_; }
-  double imbalance_before_last_rebalance() const { return imbalance_before_; }
+  std::int64_t rebalances() const { return balancer_.rebalances(); }
+  double imbalance_before_last_rebalance() const { return balancer_.imbalance_before_last_rebalance(); }
   /// Rows this rank read and records it received at start-up (zeros when given a whole geometry).
   const LoadStats& load_stats() const { return load_stats_; }
   /// Bytes held by the solver's arrays on this rank (capacity, not RSS).
@@ -287,21 +288,10 @@ class Simulation {
   void warn_lost_strain();
   /// The fraction of the scene's largest bond strain that rounding may take before warn_lost_strain warns.
   static constexpr double kStrainLossWarn = 1e-3;
-  /// Collective, in a rebuild after migration (simulation_balance.cpp): with run.balance = "count" (and
-  /// "time" at its first rebuild), moves the cuts when the busiest rank exceeds the mean particles by
-  /// run.balance_threshold, and migrates to them; with "time" after a time_balance_due() that said yes,
-  /// moves them by the particles' time weights (parallel/balance.hpp, time_weight).
-  void balance_at_rebuild();
-  /// Collective, with run.balance = "pairs", in a rebuild before its migration (the lists still index the
-  /// particles): each rank's work (pair_work) against the mean, and when that exceeds the threshold the
-  /// weighted marginals balance_at_rebuild then cuts by.
-  void weigh_pairs();
-  /// Collective, every run.balance_every steps with run.balance = "time": whether the busiest rank's compute
-  /// time since the last check exceeds the mean by the threshold (then the step rebuilds and re-balances);
-  /// otherwise starts a new measuring window.
-  bool time_balance_due();
-  /// This rank's compute time so far (forces and integration, and add_rank_work's).
-  double work_total() const { return times_.forces + times_.integration + extra_work_; }
+  /// What the balancer reads and moves at this point of the run (LoadBalancer::Run).
+  typename LoadBalancer<Real>::Run balance_run() {
+    return {scene_, *dec_, *halo_, p_, bonds_, forces_, times_, n_global_, step_, rebuilds_, ghost_width_};
+  }
   /// x0 = the owned positions relative to skin_origin (of the decomposition box), as float: the skin
   /// criterion's reference, set at every rebuild (and restored after the critical-step estimate).
   void set_skin_reference();
@@ -430,23 +420,12 @@ class Simulation {
   OutputSink* output_ = nullptr;   ///< the output of the step being made (run(), step())
   std::int64_t rebuild_step_ = 0;  ///< step of the last rebuild (checkpoints store it with p_.xr, yr, zr)
   bool far_moves_ = false;  ///< check_blowup let fast particles go on: the next migration goes any distance
-  bool strain_warned_ = false;  ///< warn_lost_strain() has warned
-  double strain_max_ = 0;       ///< the largest bond or contact strain warn_lost_strain has seen (all ranks)
-  bool far_warned_ = false;     ///< warn_far_positions() has warned (or the load check did at the start)
-  std::int64_t rebalances_ = 0;
-  double imbalance_before_ = 1;
-  bool balance_paused_ = false;         ///< a restart replaying a rebuild with the checkpoint's own cuts
-  double extra_work_ = 0;               ///< add_rank_work's seconds
-  double work_mark_ = 0;                ///< work_total() when the time balancer's window began
-  std::int64_t work_window_start_ = 0;  ///< the step it began
-  bool balance_by_time_ = false;        ///< set by time_balance_due(): the next rebuild moves the cuts
-  double time_weight_ = 1024;           ///< this rank's particles' weight for that move
-  double time_imbalance_ = 1;           ///< max/mean compute time per rank at that check
-  bool pairs_weighed_ = false;          ///< weigh_pairs() ran in this rebuild
-  double pairs_imbalance_ = 1;          ///< max/mean pair_work per rank it found
-  BalanceMarginals pairs_marginals_;    ///< its weighted marginals (when above the threshold)
-  bool mixed_ = false;                  ///< run.precision = "mixed" (set by configure_particles())
-  Origin origin_{};                     ///< the frame's origin (mixed; zero otherwise)
+  bool strain_warned_ = false;   ///< warn_lost_strain() has warned
+  double strain_max_ = 0;        ///< the largest bond or contact strain warn_lost_strain has seen (all ranks)
+  bool far_warned_ = false;      ///< warn_far_positions() has warned (or the load check did at the start)
+  LoadBalancer<Real> balancer_;  ///< run.balance: its state between rebuilds (parallel/load_balancer.hpp)
+  bool mixed_ = false;           ///< run.precision = "mixed" (set by configure_particles())
+  Origin origin_{};              ///< the frame's origin (mixed; zero otherwise)
 };
 
 /// The last step's force and (with rotation) torque in checkpoints, /particles/<name> float64 (N): what a
