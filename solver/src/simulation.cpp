@@ -326,6 +326,10 @@ template <class Real>
 void Simulation<Real>::set_dt(double dt) {
   if (!(dt > 0) || !std::isfinite(dt))
     throw InputError(fmt::format("dt = {}: must be positive and finite", dt));
+  // The clock goes on from now at the new step (a step x dt clock would jump, and the walls' motions with
+  // it).
+  time_base_ = time_;
+  step_base_ = step_;
   apply_dt(dt);
 }
 

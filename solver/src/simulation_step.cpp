@@ -27,7 +27,7 @@ void Simulation<Real>::advance(bool may_defer) {
   move_walls(step_ + 1);
   const bool in_flight = refresh_neighbours(moved2);
   ++step_;
-  time_ = double(step_) * scene_.dt;
+  time_ = time_at(step_);
   const auto& pe = step_forces(in_flight);
   second_kick(may_defer && !observed(step_));
   wall_work();
@@ -47,7 +47,7 @@ void Simulation<Real>::move_walls(std::int64_t step) {
   if (forces_.walls().empty()) return;
   Stopwatch sw;
   forces_.walls().advance_servos(scene_.dt);
-  forces_.walls().move_to(double(step) * scene_.dt);
+  forces_.walls().move_to(time_at(step));
   times_.communication += sw.lap();
 }
 

@@ -247,6 +247,9 @@ class Simulation {
   void find_fixed();
   /// The run's time step: the integrator's kicks and the models' time step (set_time_step).
   void apply_dt(double dt);
+  /// The time of `step`: step x dt, counted from the last set_dt() (time_base_ at step_base_; both zero
+  /// otherwise, which gives step x dt to the bit).
+  double time_at(std::int64_t step) const { return time_base_ + double(step - step_base_) * scene_.dt; }
   double kinetic_energy_local() const;
   /// Bonds of this rank counted once across ranks (a bond to a ghost by the rank owning the lower id).
   std::int64_t local_bond_count() const;
@@ -409,6 +412,8 @@ class Simulation {
   std::int64_t n_global_ = 0;
   std::int64_t step_ = 0;
   double time_ = 0;
+  double time_base_ = 0;        ///< time_ at the last set_dt() (time_at)
+  std::int64_t step_base_ = 0;  ///< step_ at the last set_dt()
   std::int64_t rebuilds_ = 0;
   double energy0_ = 0;
   std::vector<double> ledger0_;  ///< the ledger's global values at the start (the guard's reference)
