@@ -73,6 +73,17 @@ std::vector<std::int64_t> Comm::all_gather(std::int64_t v) const {
   return all;
 }
 
+std::vector<std::int64_t> Comm::all_gather_ids(const std::vector<std::int64_t>& v) const {
+  if (size_ == 1) return v;
+  const int n = static_cast<int>(v.size());
+  std::vector<int> counts(static_cast<std::size_t>(size_)), displs(static_cast<std::size_t>(size_), 0);
+  MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, comm_);
+  for (std::size_t r = 1; r < counts.size(); ++r) displs[r] = displs[r - 1] + counts[r - 1];
+  std::vector<std::int64_t> all(static_cast<std::size_t>(displs.back() + counts.back()));
+  MPI_Allgatherv(v.data(), n, MPI_INT64_T, all.data(), counts.data(), displs.data(), MPI_INT64_T, comm_);
+  return all;
+}
+
 std::string Comm::broadcast(const std::string& s, int root) const {
   if (size_ == 1) return s;
   int n = static_cast<int>(s.size());

@@ -24,6 +24,8 @@ void scene_to_frame(Scene& scene, const Origin& o) {
     for (auto& v : m.vertices) shift(v);
     shift(m.axis_point);
   }
+  for (auto& i : scene.inserts) i.region.shift(o);
+  for (auto& d : scene.deletes) d.region.shift(o);
   for (auto& f : scene.fields) {
     if (f.type == FieldSpec::Type::runout) shift(f.origin);
     if (f.type == FieldSpec::Type::mass_below || f.type == FieldSpec::Type::mean_vz_above) f.z -= o[2];

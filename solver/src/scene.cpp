@@ -218,7 +218,8 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
     s.steps = top.has("stages") ? t.integer_or("steps", 0) : t.integer("steps");
     if (s.steps < 0) t.fail("steps", fmt::format("must be >= 0, got {}", s.steps));
     if (s.steps > 0 && top.has("stages"))
-      t.fail("steps", "the scene has [[stages]], whose steps = N say how long each runs: leave run.steps out");
+      t.fail("steps",
+             "the scene has [[stages]], whose steps = N say how long each runs: leave run.steps out");
     s.skin = t.positive("skin");
     s.integrator = t.choice_or("integrator", {"velocity_verlet", "symplectic_euler"}, "velocity_verlet") ==
                            "symplectic_euler"
@@ -469,6 +470,16 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
     }
     t.finish();
   }
+  if (const auto* arr = top.table_array("insert"))
+    for (std::size_t k = 0; k < arr->size(); ++k) {
+      TableReader t(*(*arr)[k].as_table(), label, fmt::format("insert[{}]", k));
+      s.inserts.push_back(parse_insert(t, s.density));
+    }
+  if (const auto* arr = top.table_array("delete"))
+    for (std::size_t k = 0; k < arr->size(); ++k) {
+      TableReader t(*(*arr)[k].as_table(), label, fmt::format("delete[{}]", k));
+      s.deletes.push_back(parse_delete(t));
+    }
   if (const auto* arr = top.table_array("stages")) {
     for (std::size_t k = 0; k < arr->size(); ++k) {
       TableReader t(*(*arr)[k].as_table(), label, fmt::format("stages[{}]", k));

@@ -54,8 +54,9 @@ Simulation<Real>::Simulation(const Scene& scene, io::Geometry g, MPI_Comm comm, 
   }
   const auto summary = summarize_geometry(scene_, g, scene.geometry.string());
   run_load_checks(scene_, summary, scene.geometry.string(), comm, kEpsilon, precision_name());
+  GeometryExtent extent = extent_of(g);
+  include_flow(extent);
   check_stability(summary);
-  const GeometryExtent extent = extent_of(g);
   decompose(extent, comm);
   distribute(g, extent);
   rebuild();
@@ -82,11 +83,13 @@ Simulation<Real>::Simulation(const Scene& scene, const io::GeometryFile& file, M
   const auto summary =
       merge_summaries(summarize_geometry(scene_, loader.slice(), scene.geometry.string()), comm);
   run_load_checks(scene_, summary, scene.geometry.string(), comm, kEpsilon, precision_name());
+  GeometryExtent extent = loader.extent();
+  include_flow(extent);
   check_stability(summary);
-  decompose(loader.extent(), comm);
+  decompose(extent, comm);
   io::Geometry part = loader.local_part(*dec_);
   load_stats_ = loader.stats();
-  distribute(part, loader.extent());
+  distribute(part, extent);
   rebuild();
   check_start(true);
   estimate_critical_step(true);

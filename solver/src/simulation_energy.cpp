@@ -33,6 +33,15 @@ void Simulation<Real>::start_ledger(const std::vector<double>& pe) {
 }
 
 template <class Real>
+void Simulation<Real>::rebase_ledger(const std::vector<double>& pe) {
+  ledger0_ = ledger_totals(pe);
+  const auto& l = forces_.ledger();
+  energy0_ = l.mechanical(ledger0_) + l.sum(ledger0_, Ledger::Kind::dissipated) -
+             l.sum(ledger0_, Ledger::Kind::work);
+  flow_changed_ = false;
+}
+
+template <class Real>
 std::vector<double> Simulation<Real>::ledger_values() {
   return ledger_totals(compute_forces<true>());
 }
@@ -96,6 +105,7 @@ void Simulation<Real>::guard_energy(const std::vector<double>& pe) {
   template double Simulation<R>::term_value(std::size_t, const std::vector<double>&) const;    \
   template std::vector<double> Simulation<R>::ledger_totals(const std::vector<double>&) const; \
   template void Simulation<R>::start_ledger(const std::vector<double>&);                       \
+  template void Simulation<R>::rebase_ledger(const std::vector<double>&);                      \
   template std::vector<double> Simulation<R>::ledger_values();                                 \
   template std::array<double, 4> Simulation<R>::energies();                                    \
   template void Simulation<R>::guard_energy(const std::vector<double>&);

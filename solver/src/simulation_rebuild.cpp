@@ -108,7 +108,10 @@ void Simulation<Real>::rebuild() {
     balancer_.weigh_pairs(balance_run());
   times_.communication += sw.lap();
   forces_.save_history(p_);  // before the ghosts (and the pairs' ids) go
+  const bool flow = !flow_.inserts.empty() || !flow_.deletes.empty();
+  if (flow) plan_arrivals();  // (simulation_flow.cpp: reads the ghosts)
   p_.drop_ghosts();
+  if (flow) exchange_flow();
   times_.neighbor += sw.lap();
   if (parallel) {
     error = halo_->migrate(p_, bonds_, forces_.pending_history(), far_moves_);

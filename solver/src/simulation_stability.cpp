@@ -17,10 +17,12 @@
 namespace basalt::solver {
 
 template <class Real>
-void Simulation<Real>::check_stability(const GeometrySummary& s) {
+void Simulation<Real>::check_stability(const GeometrySummary& given) {
   // What the geometry alone tells: the smallest mass and radius, and the former one-spring estimate
   // 2 sqrt(m_min / k_max) (printed for comparison). The network's estimate needs the lists:
-  // estimate_critical_step(), after the first rebuild.
+  // estimate_critical_step(), after the first rebuild. The particles the scene inserts later count.
+  GeometrySummary s = given;
+  include_flow(s);
   const double m_min = s.m_min_pow, rmax = s.rmax, rmin = s.rmin;
   stability_.m_min = m_min;
   stability_.k_max = forces_.max_stiffness(rmax);

@@ -29,7 +29,7 @@ void Simulation<Real>::advance(bool may_defer) {
   ++step_;
   time_ = time_at(step_);
   const auto& pe = step_forces(in_flight);
-  second_kick(may_defer && !observed(step_));
+  second_kick(may_defer && !observed(step_) && !flow_changed_);
   wall_work();
   observe(pe);
 }
@@ -59,8 +59,10 @@ bool Simulation<Real>::refresh_neighbours(double moved2) {
   const bool balance_due = parallel && step_ > 0 && step_ % scene_.balance_every == 0 &&
                            scene_.balance == "time" && !balancer_.paused() &&
                            balancer_.time_balance_due(balance_run());
+  // Particles entering or leaving as this step begins (the scene's [[insert]], [[delete]]): at a rebuild.
+  const bool flow = (!scene_.inserts.empty() || !scene_.deletes.empty()) && queue_flow(step_);
   double need =
-      bond_broke_ || balance_due
+      bond_broke_ || balance_due || flow
           ? std::numeric_limits<double>::infinity()
           : std::max(moved2, forces_.walls().empty() ? 0.0 : forces_.walls().moved2_since_rebuild());
   if (parallel) need = comm().max(need);
@@ -81,8 +83,8 @@ template <class Real>
 const std::vector<double>& Simulation<Real>::step_forces(bool in_flight) {
   Stopwatch sw;
   ghost_wait_ = 0;
-  const auto& pe =
-      energy_due(step_) ? compute_forces<true>(in_flight, true) : compute_forces<false>(in_flight, true);
+  const auto& pe = energy_due(step_) || flow_changed_ ? compute_forces<true>(in_flight, true)
+                                                      : compute_forces<false>(in_flight, true);
   times_.forces += sw.lap() - ghost_wait_;
   times_.communication += ghost_wait_;
   return pe;
@@ -109,6 +111,7 @@ void Simulation<Real>::observe(const std::vector<double>& pe) {
   Stopwatch sw;
   output_fields(pe);
   times_.output += sw.lap();
+  if (flow_changed_) rebase_ledger(pe);  // particles came or went: the ledger balances from here
   if (scene_.energy_check_every > 0 && step_ % scene_.energy_check_every == 0) guard_energy(pe);
 }
 

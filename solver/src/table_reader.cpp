@@ -91,6 +91,27 @@ std::array<double, 3> TableReader::vec3(const std::string& key) {
   return out;
 }
 
+std::vector<double> TableReader::number_list(const std::string& key) {
+  const auto& n = node(key);
+  const auto value = [&](const toml::node& e) {
+    double v = 0;
+    if (auto d = e.value_exact<double>())
+      v = *d;
+    else if (auto i = e.value_exact<std::int64_t>())
+      v = static_cast<double>(*i);
+    else
+      fail(key, "must be a number or an array of numbers");
+    if (!std::isfinite(v)) fail(key, "must be finite");
+    return v;
+  };
+  std::vector<double> out;
+  if (const auto* arr = n.as_array())
+    for (const auto& e : *arr) out.push_back(value(e));
+  else
+    out.push_back(value(n));
+  return out;
+}
+
 std::optional<std::array<double, 3>> TableReader::vec3_opt(const std::string& key) {
   if (!has(key)) return std::nullopt;
   return vec3(key);

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <map>
 #include <memory>
 #include <optional>
 #include <span>
@@ -21,6 +22,7 @@
 #include "basalt/solver/core/bonds.hpp"
 #include "basalt/solver/core/id_map.hpp"
 #include "basalt/solver/core/ledger.hpp"
+#include "basalt/solver/core/particle_source.hpp"
 #include "basalt/solver/core/particles.hpp"
 #include "basalt/solver/integrate/verlet.hpp"
 #include "basalt/solver/interactions/force_field.hpp"
@@ -198,6 +200,23 @@ class Simulation {
   /// 0.0, -2.0]"), checked as the scene's are; keys not given take their defaults, tags included. Recomputes
   /// the forces and the energy guard's reference (a changed potential is not a change of energy).
   void set_body_force(std::string_view name, const std::string& keys);
+  // Particles entering and leaving (simulation_flow.cpp; the scene's [[insert]] and [[delete]] events happen
+  // as a step begins): collective, called alike on every rank.
+  /// Inserts up to spec.count particles now where they overlap nothing (candidates keyed by spec.seed and
+  /// the current step); returns how many went in. InputError when a radius exceeds the run's largest (the
+  /// lists' reach) or the particles are too light for dt.
+  std::int64_t insert_particles(InsertSpec spec);
+  /// Removes the particles of spec's tags (all when empty) whose centre lies in spec.region now, with their
+  /// bonds; returns how many.
+  std::int64_t remove_particles(DeleteSpec spec);
+  /// Particles inserted and removed since the start of this process's run (restarts count from there).
+  const std::array<std::int64_t, 2>& flow_totals() const { return flow_totals_; }
+  /// The id the next inserted particle gets (checkpoints keep it: attribute next_particle_id).
+  std::int64_t next_particle_id() const { return next_id_; }
+  /// Whether checkpoints store next_particle_id (a scene with [[insert]], or ids were issued).
+  bool keeps_next_id() const { return ids_issued_ || !scene_.inserts.empty(); }
+  /// The largest radius the lists reach (the geometry's and the scene's [[insert]]s').
+  double largest_radius() const { return rmax_run_; }
   /// Collective: the busiest rank's owned particles over the mean (1 = perfectly balanced).
   double imbalance() const { return LoadBalancer<Real>::imbalance(p_, comm(), n_global_); }
   /// run.balance = "pairs"'s estimate of each owned particle's work in a step, a whole number (units of
@@ -357,6 +376,28 @@ class Simulation {
   void output_fields(const std::vector<double>& pe);
   /// Collective: the runout saver's value (FieldSpec::percentile of the distances along its direction).
   double runout(const FieldSpec& f) const;
+  /// The scene's [[insert]] regions and radii into the decomposition's box and the lists' reach; sets
+  /// rmax_run_ and next_id_ (fresh starts).
+  void include_flow(GeometryExtent& e) const;
+  /// The scene's [[insert]] radii and masses into the stability estimate's (future contacts).
+  void include_flow(GeometrySummary& s) const;
+  /// Queues the scene's insert and delete events of step s (the one about to be made); whether any is.
+  bool queue_flow(std::int64_t s);
+  /// InputError when spec's particles do not fit the run (radius beyond the lists' reach, too light for dt).
+  void check_insert(const InsertSpec& spec) const;
+  /// At a rebuild, before the ghosts go: the queued inserts' chosen particles (flow_.arriving), agreed.
+  void plan_arrivals();
+  /// At a rebuild, after the ghosts went: removes the queued deletions' particles and bonds, appends the
+  /// arrivals this rank owns, counts.
+  void exchange_flow();
+  /// The queued flow now, between steps: a rebuild, the forces, the ledger's new reference.
+  void flow_now();
+  /// The energy guard's reference after particles came or went: the ledger now balances (mechanical +
+  /// dissipated - work in is the new reference).
+  void rebase_ledger(const std::vector<double>& pe);
+  /// Restart: next_id_ from the checkpoint's attribute next_particle_id (else the largest id + 1) and the
+  /// lists' reach from the largest radius.
+  void restore_flow(const std::map<std::string, std::string>& attributes, std::int64_t last_id, double rmax);
   /// Restart: what both restart constructors check first (particles, bond groups, dt) and set.
   void begin_restart(std::size_t particles, double dt, const RestartLayout& layout);
   /// Restart: the checkpoint's bonds belong to the scene's bond groups, its contact histories to its
@@ -431,6 +472,20 @@ class Simulation {
   LoadBalancer<Real> balancer_;  ///< run.balance: its state between rebuilds (parallel/load_balancer.hpp)
   bool mixed_ = false;           ///< run.precision = "mixed" (set by configure_particles())
   Origin origin_{};              ///< the frame's origin (mixed; zero otherwise)
+  /// Particles to insert and remove at the next rebuild (the scene's events due, or a caller's), and the
+  /// inserts' chosen particles.
+  struct FlowQueue {
+    std::vector<InsertSpec> inserts;
+    std::vector<DeleteSpec> deletes;
+    std::vector<NewParticle> arriving;
+  } flow_;
+  mutable std::int64_t next_id_ = 0;  ///< the id of the next inserted particle (alike on every rank)
+  mutable double rmax_run_ = 0;       ///< the largest radius the lists reach
+  std::array<std::int64_t, 2> last_flow_{0, 0};    ///< inserted, removed by the last event
+  std::array<std::int64_t, 2> flow_totals_{0, 0};  ///< inserted, removed in all
+  bool flow_changed_ = false;  ///< particles came or went at this step's rebuild: the guard rebases
+  /// Inserted ids were issued (or the checkpoint kept the counter): checkpoints keep next_id_.
+  bool ids_issued_ = false;
 };
 
 /// The last step's force and (with rotation) torque in checkpoints, /particles/<name> float64 (N): what a

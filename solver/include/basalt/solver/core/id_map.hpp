@@ -18,6 +18,9 @@ class IdMap {
     if (dense_) table_.assign(range, -1);
   }
 
+  /// The same lowest id, a new highest id and count (particles inserted with new ids).
+  void grow(std::int64_t max_id, std::size_t n_global) { configure(min_, max_id, n_global); }
+
   /// Maps ids[0..n) -> 0..n). Valid while `ids` is unchanged.
   void assign(const std::vector<std::int64_t>& ids, std::size_t n) {
     ids_ = &ids;

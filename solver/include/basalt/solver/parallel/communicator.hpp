@@ -36,6 +36,8 @@ class Comm {
   std::vector<double> all_gather(const std::vector<double>& v) const;
   /// Every rank's value, in rank order, on every rank.
   std::vector<std::int64_t> all_gather(std::int64_t v) const;
+  /// Every rank's values, concatenated in rank order.
+  std::vector<std::int64_t> all_gather_ids(const std::vector<std::int64_t>& v) const;
   /// Broadcasts a string from `root`.
   std::string broadcast(const std::string& s, int root) const;
   /// Collective: if any rank has an error, every rank gets the message of the lowest such rank.

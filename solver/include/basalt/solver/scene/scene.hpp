@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "basalt/solver/models/model.hpp"
+#include "basalt/solver/scene/flow_spec.hpp"
 #include "basalt/solver/scene/stage_spec.hpp"
 #include "basalt/solver/scene/wall_motion.hpp"
 
@@ -228,7 +229,9 @@ struct Scene {
   std::vector<InteractionSpec> body_forces;  ///< [[body_forces]]: tags = the particle tags it acts on
   std::filesystem::path output_dir = "out";
   std::vector<FieldSpec> fields;
-  std::vector<StageSpec> stages;  ///< [[stages]]: run in order instead of run.steps (stages.hpp)
+  std::vector<StageSpec> stages;    ///< [[stages]]: run in order instead of run.steps (stages.hpp)
+  std::vector<InsertSpec> inserts;  ///< [[insert]]: particles poured in (scene/flow_spec.hpp)
+  std::vector<DeleteSpec> deletes;  ///< [[delete]]: particles taken out (outlets)
   // [output] frames and checkpoints (written by the I/O layer; docs/io-ranks.md)
   std::int64_t checkpoint_every = 0;      ///< HDF5 checkpoint every N steps (0 = off)
   std::int64_t frames_every = 0;          ///< VTK frame every N steps (0 = off)

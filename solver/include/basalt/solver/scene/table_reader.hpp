@@ -40,6 +40,8 @@ class TableReader {
                         const std::string& fallback);
   std::array<double, 3> vec3(const std::string& key);
   std::optional<std::array<double, 3>> vec3_opt(const std::string& key);
+  /// A number or an array of numbers, as a list (finite values only).
+  std::vector<double> number_list(const std::string& key);
   std::vector<std::int64_t> integers_or(const std::string& key, std::vector<std::int64_t> fallback);
   std::vector<std::string> strings_or(const std::string& key, std::vector<std::string> fallback);
   /// A sub-table (must be a table); marks the key used.
