@@ -266,6 +266,65 @@ class Simulation:
                              f"({', '.join(names) or 'none'}): use set_body_force(name, acceleration=...)")
         self.set_body_force(names[0], acceleration=[float(c) for c in acceleration])
 
+    # -- particles in and out -----------------------------------------------------------------------------------
+    def insert(self, *, count, radius, box=None, cylinder=None, velocity=None, tag=0, density=None, seed=1,
+               attempts=20):
+        """Collective: up to `count` new spheres now, where they overlap nothing, in a box ((x0, y0, z0), (x1, y1,
+        z1)) or a cylinder dict(base=(x, y, z), axis=(0, 0, 1), radius=R, length=L); radius R or (rmin, rmax)
+        (uniform). Returns how many went in (fewer when the region is full). The same keys as the scene's
+        [[insert]] (docs/scenes.md); the same seed at the same step gives the same candidates."""
+        keys = self._region_keys(box, cylinder)
+        keys["radius"] = list(radius) if isinstance(radius, (list, tuple)) else float(radius)
+        keys["count"] = int(count)
+        if velocity is not None:
+            keys["velocity"] = [float(c) for c in velocity]
+        keys["tag"] = int(tag)
+        if density is not None:
+            keys["density"] = float(density)
+        keys["seed"] = int(seed)
+        keys["attempts"] = int(attempts)
+        return self._core.insert(self._keys_text(keys))
+
+    def delete(self, *, box=None, cylinder=None, tags=None):
+        """Collective: removes the particles (of `tags`, or all) whose centre lies in the box or cylinder now,
+        with their bonds; returns how many."""
+        keys = self._region_keys(box, cylinder)
+        if tags is not None:
+            keys["tags"] = [int(t) for t in tags]
+        return self._core.delete(self._keys_text(keys))
+
+    @property
+    def inserted(self):
+        """Particles inserted so far in this process's run (the scene's [[insert]] and insert() calls)."""
+        return self._core.flow_totals()[0]
+
+    @property
+    def deleted(self):
+        """Particles removed so far in this process's run (the scene's [[delete]] and delete() calls)."""
+        return self._core.flow_totals()[1]
+
+    def bond_count(self):
+        """Collective: the bonds now."""
+        return self._core.bond_count()
+
+    def broken_bonds(self):
+        """Collective: the bonds broken so far."""
+        return self._core.broken_bonds()
+
+    @staticmethod
+    def _region_keys(box, cylinder):
+        if (box is None) == (cylinder is None):
+            raise ValueError("give the region as box=((x0, y0, z0), (x1, y1, z1)) or "
+                             "cylinder=dict(base=..., axis=..., radius=..., length=...)")
+        if box is not None:
+            lo, hi = box
+            return {"box": {"min": [float(c) for c in lo], "max": [float(c) for c in hi]}}
+        return {"cylinder": dict(cylinder)}
+
+    @staticmethod
+    def _keys_text(keys):
+        return "\n".join(f"{k} = {_toml_value(v)}" for k, v in keys.items())
+
     def state_changed(self):
         """Collective: call after writing positions (recomputes forces and the energy the guard starts from)."""
         self._core.state_changed()

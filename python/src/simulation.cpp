@@ -118,8 +118,30 @@ class Run {
   virtual void set_body_force(const std::string& name, const std::string& keys) = 0;
   virtual py::list body_forces() const = 0;
   virtual void state_changed() = 0;
+  /// Particles in and out now (keys: the TOML of an [[insert]] / [[delete]] table); how many.
+  virtual std::int64_t insert(const std::string& keys) = 0;
+  virtual std::int64_t remove(const std::string& keys) = 0;
+  /// Collective: bonds now, bonds broken so far (every rank's), particles inserted and removed so far.
+  virtual std::int64_t bond_count() = 0;
+  virtual std::int64_t broken_bonds() = 0;
+  virtual std::array<std::int64_t, 2> flow_totals() const = 0;
   virtual std::string close() = 0;
 };
+
+/// The table of TOML `keys` read by `parse` as the scene's `label` table would be (its messages name
+/// "Simulation.<label>").
+template <class Parse>
+auto parse_keys(const std::string& keys, const std::string& label, Parse parse) {
+  toml::table table;
+  const std::string source = "Simulation." + label;
+  try {
+    table = toml::parse(keys, source);
+  } catch (const toml::parse_error& e) {
+    throw InputError(fmt::format("{}: {}", source, e.description()));
+  }
+  solver::TableReader t(table, source, label);
+  return parse(t);
+}
 
 template <class Real>
 class RunOf final : public Run {
@@ -207,6 +229,19 @@ class RunOf final : public Run {
     return l;
   }
   void state_changed() override { sim_->state_changed(); }
+  std::int64_t insert(const std::string& keys) override {
+    return sim_->insert_particles(parse_keys(
+        keys, "insert", [&](solver::TableReader& t) { return solver::parse_insert(t, scene_.density); }));
+  }
+  std::int64_t remove(const std::string& keys) override {
+    return sim_->remove_particles(
+        parse_keys(keys, "delete", [](solver::TableReader& t) { return solver::parse_delete(t); }));
+  }
+  std::int64_t bond_count() override { return sim_->bond_count(); }
+  std::int64_t broken_bonds() override {
+    return comm_.sum(static_cast<long long>(sim_->broken_bonds().size()));
+  }
+  std::array<std::int64_t, 2> flow_totals() const override { return sim_->flow_totals(); }
 
   py::dict energies() override {
     const auto values = sim_->ledger_values();
@@ -526,6 +561,11 @@ void bind_simulation(py::module_& m) {
       .def("set_body_force", [](PySimulation& s, const std::string& name,
                                 const std::string& keys) { s.run().set_body_force(name, keys); })
       .def("body_forces", [](PySimulation& s) { return s.run().body_forces(); })
+      .def("insert", [](PySimulation& s, const std::string& keys) { return s.run().insert(keys); })
+      .def("delete", [](PySimulation& s, const std::string& keys) { return s.run().remove(keys); })
+      .def("bond_count", [](PySimulation& s) { return s.run().bond_count(); })
+      .def("broken_bonds", [](PySimulation& s) { return s.run().broken_bonds(); })
+      .def("flow_totals", [](PySimulation& s) { return s.run().flow_totals(); })
       .def("allreduce", [](PySimulation& s, double v, const std::string& op) {
         const auto& c = s.run().comm();
         if (c.size() == 1) return v;
