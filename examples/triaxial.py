@@ -90,12 +90,12 @@ def triaxial(geometry, folder, size, pressure, rate):
     # Servo gain: the wall moves at gain x (force error). The loop is stable while gain x k x dt << 1, k the
     # stiffness the wall sees (the specimen's, E A / L ~ 1e6 N/mm here: 0.05 at gain 5e-4), and fast enough for
     # the lateral walls to follow the specimen's bulging in stage 2 (gain 1e-5 let the lateral stress climb 30 %
-    # above the target, 5e-4 holds it within 2 %). max_speed bounds the approach from a gap.
+    # above the target before the peak, 5e-4 holds it within 3 %). max_speed bounds the approach from a gap.
     s = scene(geometry, folder, size, p, gain=5.0e-4, max_speed=0.05)
     rows = []  # (step, time, axial strain, volumetric strain, axial stress, lateral stress)
     with basalt.Simulation(s) as sim:
         # Stage 1: every wall servoes to the confining pressure; stop once all six faces have been within 2 % of
-        # it at 5 checks in a row (250 steps, about 8 times the time a wave takes to cross the specimen).
+        # it at 5 checks in a row (250 steps, 0.025 ms: a wave crosses about 9 mm of the specimen in that time).
         tol, held = 0.02, [0]
 
         def confined(s):
@@ -110,9 +110,10 @@ def triaxial(geometry, folder, size, pressure, rate):
               + ", ".join(f"{k} {v:.2f}" for k, v in face.items()) + " N/mm^2")
 
         # Stage 2: the platens close at a constant strain rate (each moves at half of rate x height), the lateral
-        # walls go on servoing. The speed is ramped up over 0.25 ms (set_velocity from a callback, every 10 steps):
-        # a sudden start sends a stress wave bouncing between the platens, which then load the specimen in a
-        # staircase (steps every wave transit, ~0.06 ms here, barely damped); the ramp spans several transits.
+        # walls go on servoing (a platen given a velocity stops being a servo). The speed is ramped up over 0.25 ms
+        # (set_velocity from a callback, every 10 steps), several times the ~0.06 ms a wave takes to cross the
+        # specimen: a sudden start would send a stress wave between the platens (the small steps left in the curve
+        # are not from the start: docs/python.md).
         speed, ramp_time, t0 = 0.5 * rate * h0, 0.25, sim.time
 
         def ramp(s):
@@ -130,8 +131,8 @@ def triaxial(geometry, folder, size, pressure, rate):
                 peak[:] = axial - lateral, rows[-1][2]
 
         def past_peak(s):
-            # The deviatoric stress fell below 80 % of a peak reached past 0.05 % of axial strain (the stress
-            # waves of the start make the first points wobble), or a strain limit.
+            # The deviatoric stress fell below 80 % of a peak reached past 0.05 % of axial strain (the first points
+            # wobble about the small stresses of the start), or a strain limit.
             strain, axial, lateral = rows[-1][2], rows[-1][4], rows[-1][5]
             return (peak[1] > 5e-4 and axial - lateral < 0.8 * peak[0]) or strain > 0.02
 
