@@ -97,59 +97,58 @@ void Simulation<Real>::check_insert(const InsertSpec& s) const {
 template <class Real>
 void Simulation<Real>::plan_arrivals() {
   // Before the ghosts go: the owner of each candidate's place checks it against its owned particles and
-  // ghosts (every particle within reach of its region), which are where they were at the last step.
+  // ghosts (every particle within reach of its region), which are where they were at the last step. The
+  // candidates go in batches of twice the particles still asked for, so that a region with room checks
+  // few more than it takes (each batch: one small reduction).
   const std::size_t n = p_.size();
   CellGrid grid;
   if (n > 0) grid.build(p_.x, p_.y, p_.z, n, 2 * rmax_run_);
   const auto& start = grid.start();
   const auto& order = grid.order();
+  const auto& dims = grid.dims();
+  const auto blocked_here = [&](const NewParticle& c) {
+    if (n == 0 || !dec_->owns(c.x[0], c.x[1], c.x[2])) return false;
+    const double reach = c.radius + rmax_run_;
+    std::array<std::int64_t, 3> lo{}, hi{};
+    for (int d = 0; d < 3; ++d) {
+      lo[d] = grid.coord(d, c.x[static_cast<std::size_t>(d)] - reach);
+      hi[d] = grid.coord(d, c.x[static_cast<std::size_t>(d)] + reach);
+    }
+    for (auto cz = lo[2]; cz <= hi[2]; ++cz)
+      for (auto cy = lo[1]; cy <= hi[1]; ++cy)
+        for (auto cx = lo[0]; cx <= hi[0]; ++cx) {
+          const auto cell = static_cast<std::size_t>((cz * dims[1] + cy) * dims[0] + cx);
+          for (auto e = start[cell]; e < start[cell + 1]; ++e) {
+            const auto j = order[e];
+            const double dx = c.x[0] - double(p_.x[j]), dy = c.x[1] - double(p_.y[j]),
+                         dz = c.x[2] - double(p_.z[j]), rs = c.radius + double(p_.radius[j]);
+            if (dx * dx + dy * dy + dz * dz < rs * rs) return true;
+          }
+        }
+    return false;
+  };
   const bool parallel = comm().size() > 1;
+  CandidatePicker picker(2 * rmax_run_);
+  for (const auto& a : flow_.arriving) picker.add(a);
   for (const auto& s : flow_.inserts) {
     const auto cands = insertion_candidates(s, step_);
-    std::vector<double> blocked(cands.size(), 0.0);
-    for (std::size_t k = 0; k < cands.size() && n > 0; ++k) {
-      const auto& c = cands[k];
-      if (!dec_->owns(c.x[0], c.x[1], c.x[2])) continue;
-      const double reach = c.radius + rmax_run_;
-      std::array<std::int64_t, 3> lo{}, hi{};
-      for (int d = 0; d < 3; ++d) {
-        lo[d] = grid.coord(d, c.x[d] - reach);
-        hi[d] = grid.coord(d, c.x[d] + reach);
+    std::int64_t taken = 0;
+    std::vector<double> blocked;
+    for (std::size_t b0 = 0; b0 < cands.size() && taken < s.count;) {
+      const std::size_t b1 =
+          std::min(cands.size(), b0 + static_cast<std::size_t>(std::max<std::int64_t>(64, 2 * (s.count - taken))));
+      blocked.assign(b1 - b0, 0.0);
+      for (std::size_t k = b0; k < b1; ++k) blocked[k - b0] = blocked_here(cands[k]) ? 1 : 0;
+      if (parallel) comm().sum_all(blocked);
+      for (std::size_t k = b0; k < b1 && taken < s.count; ++k) {
+        if (blocked[k - b0] != 0 || !picker.try_take(cands[k])) continue;
+        auto c = cands[k];
+        c.id = next_id_++;
+        ids_issued_ = true;
+        flow_.arriving.push_back(c);
+        ++taken;
       }
-      const auto& dims = grid.dims();
-      bool hit = false;
-      for (auto cz = lo[2]; cz <= hi[2] && !hit; ++cz)
-        for (auto cy = lo[1]; cy <= hi[1] && !hit; ++cy)
-          for (auto cx = lo[0]; cx <= hi[0] && !hit; ++cx) {
-            const auto cell = static_cast<std::size_t>((cz * dims[1] + cy) * dims[0] + cx);
-            for (auto e = start[cell]; e < start[cell + 1]; ++e) {
-              const auto j = order[e];
-              const double dx = c.x[0] - double(p_.x[j]), dy = c.x[1] - double(p_.y[j]),
-                           dz = c.x[2] - double(p_.z[j]), rs = c.radius + double(p_.radius[j]);
-              if (dx * dx + dy * dy + dz * dz < rs * rs) {
-                hit = true;
-                break;
-              }
-            }
-          }
-      blocked[k] = hit ? 1 : 0;
-    }
-    if (parallel) comm().sum_all(blocked);
-    // The newcomers of an earlier insert of this event block like particles (every rank knows them).
-    for (std::size_t k = 0; k < cands.size(); ++k)
-      for (const auto& a : flow_.arriving) {
-        const double dx = cands[k].x[0] - a.x[0], dy = cands[k].x[1] - a.x[1], dz = cands[k].x[2] - a.x[2],
-                     rs = cands[k].radius + a.radius;
-        if (dx * dx + dy * dy + dz * dz < rs * rs) {
-          blocked[k] = 1;
-          break;
-        }
-      }
-    for (const auto k : choose_candidates(cands, blocked, s.count)) {
-      auto c = cands[k];
-      c.id = next_id_++;
-      ids_issued_ = true;
-      flow_.arriving.push_back(c);
+      b0 = b1;
     }
   }
 }

@@ -50,46 +50,41 @@ inline std::vector<NewParticle> insertion_candidates(const InsertSpec& s, std::i
   return out;
 }
 
-/// The candidates taken, in order: each one not blocked (by an existing particle) and clear of every
-/// candidate taken before it, until `count` are taken. Deterministic: the same on every rank.
-inline std::vector<std::size_t> choose_candidates(const std::vector<NewParticle>& c,
-                                                  const std::vector<double>& blocked, std::int64_t count) {
-  std::vector<std::size_t> taken;
-  if (c.empty()) return taken;
-  double rmax = 0;
-  for (const auto& p : c) rmax = std::max(rmax, p.radius);
-  const double cell = 2 * rmax;
-  const auto key = [&](std::int64_t i, std::int64_t j, std::int64_t k) {
-    return (static_cast<std::uint64_t>(i) * 73856093ull) ^ (static_cast<std::uint64_t>(j) * 19349663ull) ^
-           (static_cast<std::uint64_t>(k) * 83492791ull);
-  };
-  const auto cell_of = [&](double v) { return static_cast<std::int64_t>(std::floor(v / cell)); };
-  std::unordered_map<std::uint64_t, std::vector<std::size_t>> grid;
-  for (std::size_t k = 0; k < c.size() && static_cast<std::int64_t>(taken.size()) < count; ++k) {
-    if (blocked[k] != 0) continue;
-    const auto& p = c[k];
+/// The greedy choice among candidates: each one offered is taken when it overlaps none taken before (nor any
+/// particle add()ed: newcomers of an earlier insert of the same event). A hash grid of cells `cell` wide (at
+/// least the largest diameter) keeps each check to the 27 cells around. Deterministic: the same on every rank.
+class CandidatePicker {
+ public:
+  explicit CandidatePicker(double cell) : cell_(cell) {}
+  /// Takes p when it overlaps nothing taken so far.
+  bool try_take(const NewParticle& p) {
     const std::int64_t ci = cell_of(p.x[0]), cj = cell_of(p.x[1]), ck = cell_of(p.x[2]);
-    bool clear = true;
-    for (std::int64_t i = ci - 1; i <= ci + 1 && clear; ++i)
-      for (std::int64_t j = cj - 1; j <= cj + 1 && clear; ++j)
-        for (std::int64_t l = ck - 1; l <= ck + 1 && clear; ++l) {
-          const auto it = grid.find(key(i, j, l));
-          if (it == grid.end()) continue;
-          for (const auto t : it->second) {
-            const auto& q = c[t];
-            const double dx = p.x[0] - q.x[0], dy = p.x[1] - q.x[1], dz = p.x[2] - q.x[2];
-            const double rs = p.radius + q.radius;
-            if (dx * dx + dy * dy + dz * dz < rs * rs) {
-              clear = false;
-              break;
-            }
+    for (std::int64_t i = ci - 1; i <= ci + 1; ++i)
+      for (std::int64_t j = cj - 1; j <= cj + 1; ++j)
+        for (std::int64_t l = ck - 1; l <= ck + 1; ++l) {
+          const auto it = grid_.find(key(i, j, l));
+          if (it == grid_.end()) continue;
+          for (const auto& q : it->second) {
+            const double dx = p.x[0] - q[0], dy = p.x[1] - q[1], dz = p.x[2] - q[2], rs = p.radius + q[3];
+            if (dx * dx + dy * dy + dz * dz < rs * rs) return false;
           }
         }
-    if (!clear) continue;
-    taken.push_back(k);
-    grid[key(ci, cj, ck)].push_back(k);
+    add(p);
+    return true;
   }
-  return taken;
-}
+  /// Takes p whatever it overlaps.
+  void add(const NewParticle& p) {
+    grid_[key(cell_of(p.x[0]), cell_of(p.x[1]), cell_of(p.x[2]))].push_back({p.x[0], p.x[1], p.x[2], p.radius});
+  }
+
+ private:
+  static std::uint64_t key(std::int64_t i, std::int64_t j, std::int64_t k) {
+    return (static_cast<std::uint64_t>(i) * 73856093ull) ^ (static_cast<std::uint64_t>(j) * 19349663ull) ^
+           (static_cast<std::uint64_t>(k) * 83492791ull);
+  }
+  std::int64_t cell_of(double v) const { return static_cast<std::int64_t>(std::floor(v / cell_)); }
+  double cell_;
+  std::unordered_map<std::uint64_t, std::vector<std::array<double, 4>>> grid_;
+};
 
 }  // namespace basalt::solver
