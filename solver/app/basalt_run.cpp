@@ -191,7 +191,7 @@ template <class Real>
 int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::OutputConfig cfg,
                 const io::VtkFrameWriter& vtk, const io::CheckpointHeader* header,
                 const io::Checkpoint* whole, std::optional<io::CheckpointFile>* rows_file,
-                const fs::path& ckpt_file) {
+                const fs::path& ckpt_file, const basalt::solver::StageProgress* stage_progress) {
   const Comm comm(layout.compute);
   const bool root = comm.rank() == 0;
   RunOptions options;
@@ -271,8 +271,9 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
     info.attributes["code_version"] = std::string(basalt::kVersion);
     info.attributes["precision"] = scene.precision;  // a restart in the other precision is refused
     info.scene_text = scene.text;
-    scene.dt = sim->dt();  // run.dt, or run.dt_fraction x the critical step
-    info.dt = scene.dt;    // constant for the run: sent once to the I/O ranks, stored in every checkpoint
+    // run.dt, or run.dt_fraction x the critical step (a staged restart runs a stage's dt: the run's first stays)
+    if (scene.clock_base.dt == 0) scene.dt = sim->dt();
+    info.dt = scene.dt;  // constant for the run: sent once to the I/O ranks, stored in every checkpoint
   } catch (const std::exception& e) {
     setup_error = e.what();
   }
@@ -355,9 +356,12 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
       if (scene.stages.empty()) {
         sim->run(steps, sink);
       } else {
-        steps = basalt::solver::run_stages(*sim, sink, scene.stages, [&](const auto& stage, const auto& r) {
-          if (root) fmt::print("{}\n", basalt::solver::describe(stage, r));
-        });
+        steps = basalt::solver::run_stages(
+            *sim, sink, scene.stages,
+            [&](const auto& stage, const auto& r) {
+              if (root) fmt::print("{}\n", basalt::solver::describe(stage, r));
+            },
+            stage_progress);
       }
     } catch (const std::exception& e) {
       run_error = e.what();  // raised alike on every compute rank
@@ -544,11 +548,6 @@ int run_world(int argc, char** argv) {
   if (!scene.stages.empty() && cli.steps >= 0)
     throw InputError(fmt::format(
         "{}: --steps: the scene runs [[stages]], whose steps = N say how long each runs", cli.scene_file));
-  if (!scene.stages.empty() && !cli.restart.empty())
-    throw InputError(
-        fmt::format("{}: --restart: a run of [[stages]] cannot continue from a checkpoint yet (the "
-                    "checkpoint does not store which stage it was in); start the run again",
-                    cli.scene_file));
   if (!cli.preset.empty()) {  // docs/stability.md, "Presets": the error and speed measured for each
     scene.precision = cli.preset == "fast" ? "float" : "double";
     scene.dt = 0;
@@ -570,6 +569,7 @@ int run_world(int argc, char** argv) {
   std::optional<io::Checkpoint> ckpt;
   std::optional<io::CheckpointFile> ckpt_rows;
   std::optional<io::CheckpointHeader> header;
+  std::optional<basalt::solver::StageProgress> stage_progress;  ///< a staged run's restart
   fs::path ckpt_file;
   if (!cli.restart.empty()) {
     ckpt_file = basalt::run::resolve_restart(cli.restart, world_root);
@@ -587,6 +587,30 @@ int run_world(int argc, char** argv) {
     basalt::run::check_same_scene(*header, ckpt_file, scene);
     basalt::run::check_same_precision(*header, ckpt_file, scene.precision);
     if (scene.dt_fraction > 0) scene.dt = header->run.dt;  // the run's step, chosen at its start
+    if (!scene.stages.empty()) {
+      // A staged run goes on in the stage it was in, with the changes of the stages begun replayed into the
+      // scene (the walls taken away or set moving, fixed tags, dt and the clock): stages.hpp.
+      const auto& attrs = header->run.geometry.attributes;
+      const auto it = attrs.find("stage_first_steps");
+      if (it == attrs.end())
+        throw InputError(
+            fmt::format("--restart: {} has no attribute stage_first_steps: it was not written by a run "
+                        "of [[stages]] (by an older basalt-run, or by a scene without stages)",
+                        ckpt_file.string()));
+      try {
+        stage_progress = basalt::solver::StageProgress::parse(it->second, scene.stages.size());
+        if (scene.dt_fraction > 0)
+          for (std::size_t k = 0; k < stage_progress->first_steps.size(); ++k)
+            if (scene.stages[k].dt > 0)
+              throw InputError(
+                  fmt::format("stage {} changed dt in a run whose dt was run.dt_fraction x the critical "
+                              "step: its clock cannot be replayed; give run.dt",
+                              scene.stages[k].name));
+        basalt::solver::replay_stages(scene, *stage_progress);
+      } catch (const InputError& e) {
+        throw InputError(fmt::format("--restart: {}: {}", ckpt_file.string(), e.what()));
+      }
+    }
     (void)basalt::run::restart_layout_of(*header, ckpt_file);
   } else if (cli.whole_checkpoint) {
     throw InputError("--whole-checkpoint: no --restart to read whole");
@@ -661,9 +685,10 @@ int run_world(int argc, char** argv) {
   }
   const io::CheckpointHeader* h = header ? &*header : nullptr;
   const io::Checkpoint* whole = ckpt ? &*ckpt : nullptr;
+  const basalt::solver::StageProgress* progress = stage_progress ? &*stage_progress : nullptr;
   if (scene.precision == "float" || scene.precision == "mixed")
-    return run_compute<float>(cli, scene, layout, cfg, vtk, h, whole, &ckpt_rows, ckpt_file);
-  return run_compute<double>(cli, scene, layout, cfg, vtk, h, whole, &ckpt_rows, ckpt_file);
+    return run_compute<float>(cli, scene, layout, cfg, vtk, h, whole, &ckpt_rows, ckpt_file, progress);
+  return run_compute<double>(cli, scene, layout, cfg, vtk, h, whole, &ckpt_rows, ckpt_file, progress);
 }
 
 }  // namespace

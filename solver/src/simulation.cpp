@@ -38,6 +38,8 @@ void Simulation<Real>::start(const Scene& scene) {
   configure_particles();
   if (scene.bonds.size() > 254) throw InputError("interactions: at most 254 bond groups");
   apply_dt(scene_.dt);
+  time_base_ = scene_.clock_base.time;
+  step_base_ = scene_.clock_base.step;
   rebuild_limit2_ = 0.25 * scene.skin * scene.skin;
 }
 

@@ -135,8 +135,8 @@ void Simulation<Real>::plan_arrivals() {
     std::int64_t taken = 0;
     std::vector<double> blocked;
     for (std::size_t b0 = 0; b0 < cands.size() && taken < s.count;) {
-      const std::size_t b1 =
-          std::min(cands.size(), b0 + static_cast<std::size_t>(std::max<std::int64_t>(64, 2 * (s.count - taken))));
+      const std::size_t b1 = std::min(
+          cands.size(), b0 + static_cast<std::size_t>(std::max<std::int64_t>(64, 2 * (s.count - taken))));
       blocked.assign(b1 - b0, 0.0);
       for (std::size_t k = b0; k < b1; ++k) blocked[k - b0] = blocked_here(cands[k]) ? 1 : 0;
       if (parallel) comm().sum_all(blocked);

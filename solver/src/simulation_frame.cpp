@@ -29,6 +29,8 @@ SimulationFrame<Real>::SimulationFrame(const Simulation<Real>& sim, std::uint32_
   // The cuts in force since the last rebuild: a restart on as many ranks rebuilds this decomposition.
   if ((kinds & io::kFrameCheckpoint) && sim.comm().rank() == 0)
     attributes_["decomposition_cuts"] = cuts_text(sim.dec_->cuts(0), sim.dec_->cuts(1), sim.dec_->cuts(2));
+  if ((kinds & io::kFrameCheckpoint) && sim.comm().rank() == 0)
+    for (const auto& [key, value] : sim.checkpoint_attributes_) attributes_[key] = value;
   // Inserted particles' ids go on from this counter after a restart (simulation_flow.cpp).
   if ((kinds & io::kFrameCheckpoint) && sim.comm().rank() == 0 && sim.keeps_next_id())
     attributes_["next_particle_id"] = std::to_string(sim.next_particle_id());

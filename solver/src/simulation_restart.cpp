@@ -32,7 +32,9 @@ void Simulation<Real>::begin_restart(std::size_t particles, double dt, const Res
   if (dt != scene_.dt)
     throw InputError(
         fmt::format("the checkpoint was written with dt = {}, the scene has run.dt = {}", dt, scene_dt));
-  apply_dt(scene_.dt);
+  apply_dt(scene_.clock_base.dt > 0 ? scene_.clock_base.dt : scene_.dt);
+  time_base_ = scene_.clock_base.time;  // (a staged run's dt change, replayed: stages.hpp)
+  step_base_ = scene_.clock_base.step;
   rebuild_limit2_ = 0.25 * scene_.skin * scene_.skin;
 }
 
@@ -104,7 +106,7 @@ void Simulation<Real>::finish_restart(const io::Checkpoint& c, bool replay) {
                  "older basalt-run): the lists are rebuilt at step {}, so the continuation agrees with the "
                  "uninterrupted run to rounding only\n",
                  step_);
-    if (!forces_.walls().empty()) forces_.walls().move_to(double(step_) * scene_.dt);
+    if (!forces_.walls().empty()) forces_.walls().move_to(time_at(step_));
     rebuild();
   }
   balancer_.set_paused(false);
@@ -299,7 +301,7 @@ void Simulation<Real>::replay_rebuild(const io::Checkpoint& c) {
   const auto& g = c.geometry;
   const std::int64_t now = step_;
   step_ = c.rebuild_step;
-  if (!forces_.walls().empty()) forces_.walls().move_to(double(c.rebuild_step) * scene_.dt);
+  if (!forces_.walls().empty()) forces_.walls().move_to(time_at(c.rebuild_step));
   rebuild();
   step_ = now;
   restore_servos(c, false);  // from where the rebuild saw them to where the checkpoint has them

@@ -86,15 +86,105 @@ std::string describe(const StageSpec& stage, const StageReport& r) {
                             stage.force_above ? *stage.force_above : *stage.force_below);
 }
 
+StageProgress StageProgress::parse(const std::string& text, std::size_t stages) {
+  StageProgress p;
+  std::size_t at = 0;
+  while (at <= text.size()) {
+    const auto end = std::min(text.find(';', at), text.size());
+    try {
+      std::size_t used = 0;
+      const std::string item = text.substr(at, end - at);
+      p.first_steps.push_back(std::stoll(item, &used));
+      if (used != item.size()) throw std::invalid_argument(item);
+    } catch (const std::exception&) {
+      throw InputError(
+          fmt::format("the checkpoint's attribute stage_first_steps = \"{}\" is not a list of steps "
+                      "separated by ';'",
+                      text));
+    }
+    at = end + 1;
+  }
+  for (std::size_t k = 1; k < p.first_steps.size(); ++k)
+    if (p.first_steps[k] < p.first_steps[k - 1])
+      throw InputError(
+          fmt::format("the checkpoint's attribute stage_first_steps = \"{}\": steps out of order", text));
+  if (p.first_steps.empty() || p.first_steps.size() > stages)
+    throw InputError(
+        fmt::format("the checkpoint's attribute stage_first_steps = \"{}\" names {} stages; the "
+                    "scene has {}: not the scene of this checkpoint",
+                    text, p.first_steps.size(), stages));
+  return p;
+}
+
+std::string StageProgress::text() const {
+  std::string t;
+  for (std::size_t k = 0; k < first_steps.size(); ++k) {
+    if (k > 0) t.push_back(';');
+    t.append(std::to_string(first_steps[k]));
+  }
+  return t;
+}
+
+void replay_stages(Scene& scene, const StageProgress& progress) {
+  // The same arithmetic as the run's: time_at(step) = base time + (step - base step) x dt; a wall set moving
+  // starts from spec.point + its motion's displacement at that time (Walls::move_to, Walls::set_velocity).
+  for (std::size_t k = 0; k < progress.first_steps.size(); ++k) {
+    const auto& st = scene.stages[k];
+    const std::int64_t s = progress.first_steps[k];
+    const double dt = scene.clock_base.dt > 0 ? scene.clock_base.dt : scene.dt;
+    const double t = scene.clock_base.time + double(s - scene.clock_base.step) * dt;
+    for (const auto& name : st.remove_walls)
+      for (auto& w : scene.walls)
+        if (w.name == name) w.removed = true;
+    for (const auto& [name, v] : st.wall_velocity)
+      for (auto& w : scene.walls) {
+        if (w.name != name) continue;
+        if (w.motion.type == WallMotion::Type::servo)
+          throw InputError(
+              fmt::format("stage {} sets the servo wall \"{}\" moving: a restart cannot know where "
+                          "the servo had it; start the run again",
+                          st.name, name));
+        const auto u = w.motion.displacement_at(t);
+        for (int d = 0; d < 3; ++d) w.point[d] = w.point[d] + u[d];
+        WallMotion m;
+        m.type = WallMotion::Type::ramp;
+        m.velocity = v;
+        m.start_time = t;
+        w.motion = m;
+      }
+    if (st.fixed_tags) scene.fixed_tags = *st.fixed_tags;
+    if (st.dt > 0) {
+      scene.clock_base.time = t;
+      scene.clock_base.step = s;
+      scene.clock_base.dt = st.dt;
+    }
+  }
+}
+
 template <class Real>
 std::int64_t run_stages(Simulation<Real>& sim, OutputSink& out, const std::vector<StageSpec>& stages,
-                        const std::function<void(const StageSpec&, const StageReport&)>& report) {
+                        const std::function<void(const StageSpec&, const StageReport&)>& report,
+                        const StageProgress* resume) {
   std::int64_t total = 0;
-  for (const auto& st : stages) {
-    for (const auto& name : st.remove_walls) sim.remove_wall(name);
-    for (const auto& [name, v] : st.wall_velocity) sim.set_wall_velocity(name, v);
-    if (st.fixed_tags) sim.set_fixed_tags(*st.fixed_tags);
-    if (st.dt > 0) sim.set_dt(st.dt);
+  StageProgress progress;
+  if (resume) progress = *resume;
+  for (std::size_t k = resume ? progress.first_steps.size() - 1 : 0; k < stages.size(); ++k) {
+    const auto& st = stages[k];
+    std::int64_t steps = st.steps;
+    if (resume &&
+        k + 1 == progress.first_steps.size()) {  // the stage in progress: its changes are in the scene
+      steps = std::max<std::int64_t>(0, st.steps - (sim.current_step() - progress.first_steps[k]));
+    } else {
+      progress.first_steps.push_back(sim.current_step());
+      for (const auto& name : st.remove_walls) sim.remove_wall(name);
+      for (const auto& [name, v] : st.wall_velocity) sim.set_wall_velocity(name, v);
+      if (st.fixed_tags) sim.set_fixed_tags(*st.fixed_tags);
+      if (st.dt > 0) {
+        sim.set_dt(st.dt);
+        sim.force_rebuild();
+      }
+    }
+    sim.set_checkpoint_attribute("stage_first_steps", progress.text());
     StageReport r{st.name, sim.current_step(), 0, false, 0};
     std::vector<StepHook> hooks;
     if (st.until)
@@ -112,7 +202,7 @@ std::int64_t run_stages(Simulation<Real>& sim, OutputSink& out, const std::vecto
                          }
                          return !r.condition_met;
                        }});
-    r.steps = sim.run(st.steps, out, hooks);
+    r.steps = sim.run(steps, out, hooks);
     total += r.steps;
     if (report) report(st, r);
   }
@@ -120,8 +210,10 @@ std::int64_t run_stages(Simulation<Real>& sim, OutputSink& out, const std::vecto
 }
 
 template std::int64_t run_stages(Simulation<double>&, OutputSink&, const std::vector<StageSpec>&,
-                                 const std::function<void(const StageSpec&, const StageReport&)>&);
+                                 const std::function<void(const StageSpec&, const StageReport&)>&,
+                                 const StageProgress*);
 template std::int64_t run_stages(Simulation<float>&, OutputSink&, const std::vector<StageSpec>&,
-                                 const std::function<void(const StageSpec&, const StageReport&)>&);
+                                 const std::function<void(const StageSpec&, const StageReport&)>&,
+                                 const StageProgress*);
 
 }  // namespace basalt::solver

@@ -213,6 +213,10 @@ class Simulation {
   const std::array<std::int64_t, 2>& flow_totals() const { return flow_totals_; }
   /// The id the next inserted particle gets (checkpoints keep it: attribute next_particle_id).
   std::int64_t next_particle_id() const { return next_id_; }
+  /// Every checkpoint from now on carries this root attribute (text), e.g. the stages' progress (stages.hpp).
+  void set_checkpoint_attribute(const std::string& key, const std::string& value) {
+    checkpoint_attributes_[key] = value;
+  }
   /// Whether checkpoints store next_particle_id (a scene with [[insert]], or ids were issued).
   bool keeps_next_id() const { return ids_issued_ || !scene_.inserts.empty(); }
   /// The largest radius the lists reach (the geometry's and the scene's [[insert]]s').
@@ -484,6 +488,7 @@ class Simulation {
   std::array<std::int64_t, 2> last_flow_{0, 0};    ///< inserted, removed by the last event
   std::array<std::int64_t, 2> flow_totals_{0, 0};  ///< inserted, removed in all
   bool flow_changed_ = false;  ///< particles came or went at this step's rebuild: the guard rebases
+  std::map<std::string, std::string> checkpoint_attributes_;  ///< set_checkpoint_attribute()
   /// Inserted ids were issued (or the checkpoint kept the counter): checkpoints keep next_id_.
   bool ids_issued_ = false;
 };

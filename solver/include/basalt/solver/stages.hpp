@@ -25,10 +25,29 @@ struct StageReport {
   double value = 0;  ///< the condition's quantity at the stage's end (kinetic energy or wall force)
 };
 
+/// Where a staged run stood at a checkpoint: the first step of each stage begun (the last is the one in
+/// progress). Checkpoints keep it as the root attribute stage_first_steps ("0;300;712").
+struct StageProgress {
+  std::vector<std::int64_t> first_steps;
+  std::string text() const;
+  /// From the attribute's text; InputError naming it when it is not steps in order, at most `stages` of them.
+  static StageProgress parse(const std::string& text, std::size_t stages);
+};
+
+/// A restart's scene: the changes of every stage begun (walls taken away, walls set moving from where their
+/// motion had them, fixed tags, dt and the clock's base) applied to the scene itself, so that the run
+/// continues with the uninterrupted run's walls and clock to the bit. InputError when a stage set a servo
+/// wall moving (its place has no closed form).
+void replay_stages(Scene& scene, const StageProgress& progress);
+
 /// Runs the stages in order through `out`; calls `report` after each (every rank). Returns the steps made.
+/// With `resume` (a restart, its scene replayed by replay_stages): continues the stage in progress with the
+/// steps it has left, without making its changes again, then the rest. A stage that changes dt rebuilds the
+/// lists as it begins (a restart's replayed rebuild then never straddles two clocks).
 template <class Real>
 std::int64_t run_stages(Simulation<Real>& sim, OutputSink& out, const std::vector<StageSpec>& stages,
-                        const std::function<void(const StageSpec&, const StageReport&)>& report = {});
+                        const std::function<void(const StageSpec&, const StageReport&)>& report = {},
+                        const StageProgress* resume = nullptr);
 
 /// "stage settle: steps 1-4200 (kinetic energy 9.1e-07 < 1e-06 at step 4200)" and the like.
 std::string describe(const StageSpec& stage, const StageReport& r);

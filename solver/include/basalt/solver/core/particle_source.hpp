@@ -52,7 +52,8 @@ inline std::vector<NewParticle> insertion_candidates(const InsertSpec& s, std::i
 
 /// The greedy choice among candidates: each one offered is taken when it overlaps none taken before (nor any
 /// particle add()ed: newcomers of an earlier insert of the same event). A hash grid of cells `cell` wide (at
-/// least the largest diameter) keeps each check to the 27 cells around. Deterministic: the same on every rank.
+/// least the largest diameter) keeps each check to the 27 cells around. Deterministic: the same on every
+/// rank.
 class CandidatePicker {
  public:
   explicit CandidatePicker(double cell) : cell_(cell) {}
@@ -74,7 +75,8 @@ class CandidatePicker {
   }
   /// Takes p whatever it overlaps.
   void add(const NewParticle& p) {
-    grid_[key(cell_of(p.x[0]), cell_of(p.x[1]), cell_of(p.x[2]))].push_back({p.x[0], p.x[1], p.x[2], p.radius});
+    grid_[key(cell_of(p.x[0]), cell_of(p.x[1]), cell_of(p.x[2]))].push_back(
+        {p.x[0], p.x[1], p.x[2], p.radius});
   }
 
  private:

@@ -26,7 +26,10 @@ class Walls {
  public:
   explicit Walls(const std::vector<WallSpec>& walls, const std::vector<MeshWallSpec>& meshes = {})
       : walls_(walls), point_(walls.size()), force_(walls.size()), velocity_(walls.size()) {
-    for (std::size_t w = 0; w < walls.size(); ++w) point_[w] = walls[w].point;
+    for (std::size_t w = 0; w < walls.size(); ++w) {
+      point_[w] = walls[w].point;
+      if (walls[w].removed) remove(w);
+    }
     for (const auto& m : meshes) {
       ContactMesh::Options opt;
       opt.sides = m.one_sided ? ContactMesh::Sides::one : ContactMesh::Sides::two;

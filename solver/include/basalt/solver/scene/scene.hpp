@@ -48,6 +48,8 @@ struct WallSpec {
   /// interaction = "bonded": tags of the particles tied to the wall (candidates wherever they are).
   TagFilter bond_tags;
   WallMotion motion;
+  /// Taken away (a stage's remove_walls, replayed by a restart: stages.hpp): touches no particle.
+  bool removed = false;
 
   bool bonds(std::int64_t tag) const {
     for (const auto t : bond_tags)
@@ -229,7 +231,15 @@ struct Scene {
   std::vector<InteractionSpec> body_forces;  ///< [[body_forces]]: tags = the particle tags it acts on
   std::filesystem::path output_dir = "out";
   std::vector<FieldSpec> fields;
-  std::vector<StageSpec> stages;    ///< [[stages]]: run in order instead of run.steps (stages.hpp)
+  std::vector<StageSpec> stages;  ///< [[stages]]: run in order instead of run.steps (stages.hpp)
+  /// The clock's base: time = time + (step - step) x dt from this step on, with dt the step in force then (0:
+  /// run.dt). Zero, unless a restart of a staged run replays a stage's dt change (stages.hpp, replay_stages);
+  /// run.dt stays the run's first step (the checkpoints' dt).
+  struct {
+    double time = 0;
+    std::int64_t step = 0;
+    double dt = 0;
+  } clock_base;
   std::vector<InsertSpec> inserts;  ///< [[insert]]: particles poured in (scene/flow_spec.hpp)
   std::vector<DeleteSpec> deletes;  ///< [[delete]]: particles taken out (outlets)
   // [output] frames and checkpoints (written by the I/O layer; docs/io-ranks.md)
