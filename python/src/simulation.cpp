@@ -29,13 +29,12 @@
 #include "basalt/solver/parallel/communicator.hpp"
 #include "basalt/solver/scene/scene.hpp"
 #include "basalt/solver/stages.hpp"
-#include "basalt/version.hpp"
 #include "bindings.hpp"
 #include "client_sink.hpp"
 #include "geometry_input.hpp"
 #include "output_folder.hpp"
 #include "process_setup.hpp"
-#include "restart_support.hpp"
+#include "run_start.hpp"
 #if BASALT_WITH_VTK
 #include "basalt/io/vtk_frame_writer.hpp"
 #endif
@@ -131,38 +130,10 @@ class RunOf final : public Run {
     ro.quiet = o.quiet;
     ro.force_dt = o.force_dt;
     io::RunInfo info;
-    std::optional<std::string> error;
-    try {
-      const fs::path file = basalt::run::geometry_as_h5(scene_.geometry, cfg.dir, comm_, o.quiet);
-      std::optional<io::GeometryFile> rows;
-      std::optional<std::string> open_error;
-      try {
-        rows.emplace(file);
-      } catch (const std::exception& e) {
-        open_error = e.what();
-      }
-      if (auto e = comm_.agree_error(open_error)) throw InputError(*e);
-      const auto& h = rows->header();
-      info.box_min = h.box_min;
-      info.box_max = h.box_max;
-      info.periodic = h.periodic;
-      info.units = h.units;
-      sim_ = std::make_unique<solver::Simulation<Real>>(scene_, *rows, layout.compute, ro);
-      info.attributes = basalt::run::restart_attributes(sim_->restart_layout());
-      info.attributes["code_version"] = std::string(basalt::kVersion);
-      info.attributes["precision"] = scene_.precision;
-      info.scene_text = scene_.text;
-      scene_.dt = sim_->dt();
-      info.dt = scene_.dt;
-    } catch (const std::exception& e) {
-      error = e.what();
-    }
-    if (error) {  // release the I/O ranks (they wait for the run's information), then report
-      cfg.checkpoint_every = cfg.frames_every = cfg.fields_every = 0;
-      io::OutputClient client(layout, cfg, info, vtk);
-      client.finish();
-      throw InputError(*error);
-    }
+    sim_ = basalt::run::start_simulation<Real>(scene_, layout, cfg, vtk, info, [&](io::RunInfo& run_info) {
+      const auto rows = basalt::run::open_geometry(scene_, cfg.dir, comm_, o.quiet, run_info);
+      return std::make_unique<solver::Simulation<Real>>(scene_, *rows, layout.compute, ro);
+    });
     client_ = std::make_unique<io::OutputClient>(layout, cfg, info, vtk);
     sink_ = std::make_unique<basalt::run::ClientSink>(*client_, cfg.continue_on_error);
   }
