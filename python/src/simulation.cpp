@@ -16,6 +16,7 @@
 #include <pybind11/stl.h>
 
 #include <algorithm>
+#include <exception>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -25,17 +26,17 @@
 
 #include "basalt/io/io_ranks.hpp"
 #include "basalt/solver/core/errors.hpp"
+#include "basalt/solver/core/stop_request.hpp"
 #include "basalt/solver/models/registry.hpp"
 #include "basalt/solver/parallel/communicator.hpp"
 #include "basalt/solver/scene/scene.hpp"
 #include "basalt/solver/stages.hpp"
-#include "basalt/version.hpp"
 #include "bindings.hpp"
 #include "client_sink.hpp"
 #include "geometry_input.hpp"
 #include "output_folder.hpp"
 #include "process_setup.hpp"
-#include "restart_support.hpp"
+#include "run_start.hpp"
 #if BASALT_WITH_VTK
 #include "basalt/io/vtk_frame_writer.hpp"
 #endif
@@ -153,38 +154,10 @@ class RunOf final : public Run {
     ro.quiet = o.quiet;
     ro.force_dt = o.force_dt;
     io::RunInfo info;
-    std::optional<std::string> error;
-    try {
-      const fs::path file = basalt::run::geometry_as_h5(scene_.geometry, cfg.dir, comm_, o.quiet);
-      std::optional<io::GeometryFile> rows;
-      std::optional<std::string> open_error;
-      try {
-        rows.emplace(file);
-      } catch (const std::exception& e) {
-        open_error = e.what();
-      }
-      if (auto e = comm_.agree_error(open_error)) throw InputError(*e);
-      const auto& h = rows->header();
-      info.box_min = h.box_min;
-      info.box_max = h.box_max;
-      info.periodic = h.periodic;
-      info.units = h.units;
-      sim_ = std::make_unique<solver::Simulation<Real>>(scene_, *rows, layout.compute, ro);
-      info.attributes = basalt::run::restart_attributes(sim_->restart_layout());
-      info.attributes["code_version"] = std::string(basalt::kVersion);
-      info.attributes["precision"] = scene_.precision;
-      info.scene_text = scene_.text;
-      scene_.dt = sim_->dt();
-      info.dt = scene_.dt;
-    } catch (const std::exception& e) {
-      error = e.what();
-    }
-    if (error) {  // release the I/O ranks (they wait for the run's information), then report
-      cfg.checkpoint_every = cfg.frames_every = cfg.fields_every = 0;
-      io::OutputClient client(layout, cfg, info, vtk);
-      client.finish();
-      throw InputError(*error);
-    }
+    sim_ = basalt::run::start_simulation<Real>(scene_, layout, cfg, vtk, info, [&](io::RunInfo& run_info) {
+      const auto rows = basalt::run::open_geometry(scene_, cfg.dir, comm_, o.quiet, run_info);
+      return std::make_unique<solver::Simulation<Real>>(scene_, *rows, layout.compute, ro);
+    });
     client_ = std::make_unique<io::OutputClient>(layout, cfg, info, vtk);
     sink_ = std::make_unique<basalt::run::ClientSink>(*client_, cfg.continue_on_error);
   }
@@ -476,12 +449,50 @@ class PySimulation {
                        },
                        velocities});
     }
+    const std::int64_t first = r.step();
     try {
-      return r.run(steps, calls);
+      return interruptible([&] { return r.run(steps, calls); });
+    } catch (const solver::StopRequested&) {
+      return r.step() - first;  // stopped by Ctrl-C, and Python's SIGINT handler did not raise
     } catch (const RunError&) {
       if (raised) throw *raised;  // this rank's own Python exception, with its type and traceback
       throw;
     }
+  }
+
+  py::list run_stages() {
+    if (is_io_rank()) return py::list();
+    auto& r = run();
+    return interruptible([&] { return r.run_stages(); });
+  }
+
+  /// Runs body() with Ctrl-C asking the run to stop (solver::InterruptStopsRun): every compute rank stops at
+  /// the same whole step, the next one where they agree on output errors (every 32 steps), with the
+  /// deferred half-kick made. The SIGINT is then handed to Python's own handler, put back first (on every
+  /// rank, whichever got it), which raises KeyboardInterrupt unless the script set another. A SIGINT after
+  /// the ranks' last agreement is handed on at the end of the run, on its rank only, as Python would.
+  /// Without a Python handler (SIG_IGN, SIG_DFL) SIGINT is left alone. Throws StopRequested when the run
+  /// stopped and the handler did not raise.
+  template <class Body>
+  static auto interruptible(Body&& body) -> decltype(body()) {
+    std::exception_ptr stopped;
+    {
+      solver::InterruptStopsRun interrupt;
+      try {
+        auto result = body();
+        if (interrupt.restore() != 0) signal_python();
+        return result;
+      } catch (const solver::StopRequested&) {
+        stopped = std::current_exception();
+      }
+    }
+    signal_python();
+    std::rethrow_exception(stopped);
+  }
+  /// A SIGINT for Python's own handler, run now (on the main thread; elsewhere Python runs it later).
+  static void signal_python() {
+    PyErr_SetInterrupt();
+    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
   }
 
   std::string close() {
@@ -530,7 +541,7 @@ void bind_simulation(py::module_& m) {
       .def_property_readonly("is_io_rank", &PySimulation::is_io_rank)
       .def("run", &PySimulation::run_steps, py::arg("steps"), py::arg("hooks") = py::list())
       .def("close", &PySimulation::close)
-      .def("run_stages", [](PySimulation& s) { return s.is_io_rank() ? py::list() : s.run().run_stages(); })
+      .def("run_stages", &PySimulation::run_stages)
       .def_property_readonly("rank",
                              [](PySimulation& s) { return s.is_io_rank() ? -1 : s.run().comm().rank(); })
       .def_property_readonly("ranks",

@@ -48,6 +48,7 @@
 #include "process_setup.hpp"
 #include "rank_spread.hpp"
 #include "restart_support.hpp"
+#include "run_start.hpp"
 
 namespace fs = std::filesystem;
 using namespace basalt::solver;
@@ -201,27 +202,28 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
   options.force_overlap = cli.force_overlap;
 
   const auto t0 = std::chrono::steady_clock::now();
-  std::unique_ptr<Simulation<Real>> sim;
   io::RunInfo info;
-  std::optional<std::string> setup_error;
-  try {
+  const auto sim = basalt::run::start_simulation<
+      Real>(scene, layout, cfg, vtk, info, [&](io::RunInfo& run_info) -> std::unique_ptr<Simulation<Real>> {
+    std::unique_ptr<Simulation<Real>> built;
     if (header) {
       const auto restart_layout = basalt::run::restart_layout_of(*header, ckpt_file);
       if (whole) {  // --whole-checkpoint: the former restart, kept as the check of the one below
-        sim = std::make_unique<Simulation<Real>>(scene, *whole, restart_layout, layout.compute, options);
+        built = std::make_unique<Simulation<Real>>(scene, *whole, restart_layout, layout.compute, options);
       } else {
-        // Each compute rank reads a slice of the checkpoint's rows and the ranks route them to their owners
-        // (docs/solver.md, "Restart"); the file is closed once they have.
-        sim = std::make_unique<Simulation<Real>>(scene, **rows_file, restart_layout, layout.compute, options);
+        // Each compute rank reads a slice of the checkpoint's rows and the ranks route them to their
+        // owners (docs/solver.md, "Restart"); the file is closed once they have.
+        built =
+            std::make_unique<Simulation<Real>>(scene, **rows_file, restart_layout, layout.compute, options);
         rows_file->reset();
       }
       const auto& g = header->run.geometry;
-      info.box_min = g.box_min;
-      info.box_max = g.box_max;
-      info.periodic = g.periodic;
-      info.units = g.units;
+      run_info.box_min = g.box_min;
+      run_info.box_max = g.box_max;
+      run_info.periodic = g.periodic;
+      run_info.units = g.units;
       if (std::getenv("BASALT_DEBUG_LOAD")) {
-        const auto& ls = sim->load_stats();
+        const auto& ls = built->load_stats();
         fmt::print(
             "restart: compute rank {} read {} particle rows and {} bond rows of {} and {}; holds {} owned "
             "particles, {} bonds\n",
@@ -229,61 +231,28 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
             ls.bonds);
         std::fflush(stdout);
       }
-    } else {
-      // Each compute rank reads a slice of the file's rows and the ranks route them to their owners; a
-      // .geo is first converted to HDF5 once, by compute rank 0 (docs/formats.md, "Start-up").
-      const fs::path file = basalt::run::geometry_as_h5(scene.geometry, cfg.dir, comm, cli.quiet);
-      std::optional<io::GeometryFile> rows;
-      std::optional<std::string> open_error;
-      try {
-        rows.emplace(file);
-      } catch (const std::exception& e) {
-        open_error = e.what();
-      }
-      if (auto e = comm.agree_error(open_error)) throw InputError(*e);
-      const auto& h = rows->header();
-      if (root && (h.units.length != scene.units.length || h.units.time != scene.units.time ||
-                   h.units.force != scene.units.force))
-        fmt::print(stderr, "warning: the geometry declares units {}, {}, {}; the scene {}, {}, {}\n",
-                   h.units.length, h.units.time, h.units.force, scene.units.length, scene.units.time,
-                   scene.units.force);
-      info.box_min = h.box_min;
-      info.box_max = h.box_max;
-      info.periodic = h.periodic;
-      info.units = h.units;
-      if (cli.whole_geometry) {  // the former start-up, kept as the check of the one above
-        rows.reset();
-        sim = std::make_unique<Simulation<Real>>(scene, io::read_geometry(file), layout.compute, options);
-      } else {
-        sim = std::make_unique<Simulation<Real>>(scene, *rows, layout.compute, options);
-      }
-      if (std::getenv("BASALT_DEBUG_LOAD")) {
-        const auto& ls = sim->load_stats();
-        fmt::print(
-            "load: compute rank {} read {} particle rows and {} bond rows of {} and {}; holds {} owned "
-            "particles, {} far bond ends, {} bonds\n",
-            comm.rank(), ls.particle_rows, ls.bond_rows, h.particles, h.bonds, ls.owned, ls.ghost_ends,
-            ls.bonds);
-        std::fflush(stdout);
-      }
+      return built;
     }
-    info.attributes = basalt::run::restart_attributes(sim->restart_layout());
-    info.attributes["code_version"] = std::string(basalt::kVersion);
-    info.attributes["precision"] = scene.precision;  // a restart in the other precision is refused
-    info.scene_text = scene.text;
-    // run.dt, or run.dt_fraction x the critical step (a staged restart runs a stage's dt: the run's first stays)
-    if (scene.clock_base.dt == 0) scene.dt = sim->dt();
-    info.dt = scene.dt;  // constant for the run: sent once to the I/O ranks, stored in every checkpoint
-  } catch (const std::exception& e) {
-    setup_error = e.what();
-  }
-  if (setup_error) {
-    // Release the I/O ranks (they wait for the run's information), then report.
-    cfg.checkpoint_every = cfg.frames_every = cfg.fields_every = 0;
-    io::OutputClient client(layout, cfg, info, vtk);
-    client.finish();
-    throw InputError(*setup_error);
-  }
+    auto rows = basalt::run::open_geometry(scene, cfg.dir, comm, cli.quiet, run_info);
+    const io::GeometryHeader h = rows->header();
+    if (cli.whole_geometry) {  // the former start-up, kept as the check of the sliced one
+      const fs::path file = rows->path();
+      rows.reset();
+      built = std::make_unique<Simulation<Real>>(scene, io::read_geometry(file), layout.compute, options);
+    } else {
+      built = std::make_unique<Simulation<Real>>(scene, *rows, layout.compute, options);
+    }
+    if (std::getenv("BASALT_DEBUG_LOAD")) {
+      const auto& ls = built->load_stats();
+      fmt::print(
+          "load: compute rank {} read {} particle rows and {} bond rows of {} and {}; holds {} owned "
+          "particles, {} far bond ends, {} bonds\n",
+          comm.rank(), ls.particle_rows, ls.bond_rows, h.particles, h.bonds, ls.owned, ls.ghost_ends,
+          ls.bonds);
+      std::fflush(stdout);
+    }
+    return built;
+  });
 
   std::int64_t steps = scene.steps;
   for (std::size_t k = 0; k < scene.stages.size(); ++k)

@@ -189,10 +189,10 @@ bool Simulation<Real>::agree_on_output(OutputSink& out, bool& reported) {
   int sig = stop_signal;
   if (parallel) sig = static_cast<int>(comm().max(static_cast<double>(sig)));
   if (sig != 0)
-    throw RunError(
-        fmt::format("stopped by {} at step {}: the output due up to this step is written; "
-                    "--restart from the last checkpoint continues the run",
-                    signal_name(sig), step_));
+    throw StopRequested(fmt::format("stopped by {} at step {}: the output due up to this step is written; "
+                                    "--restart from the last checkpoint continues the run",
+                                    signal_name(sig), step_),
+                        sig, step_);
   auto error = out.poll();
   if (parallel) error = comm().agree_error(error);
   if (!error || reported) return true;

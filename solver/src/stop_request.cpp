@@ -21,6 +21,27 @@ void install_stop_handlers() {
   std::signal(SIGINT, record_stop_signal);
 }
 
+InterruptStopsRun::InterruptStopsRun() {
+  stop_signal = 0;
+  if (sigaction(SIGINT, nullptr, &former_) != 0) return;
+  if (!(former_.sa_flags & SA_SIGINFO) && (former_.sa_handler == SIG_IGN || former_.sa_handler == SIG_DFL))
+    return;
+  struct sigaction record {};
+  record.sa_handler = record_stop_signal;
+  sigemptyset(&record.sa_mask);
+  installed_ = sigaction(SIGINT, &record, nullptr) == 0;
+}
+
+InterruptStopsRun::~InterruptStopsRun() { restore(); }
+
+int InterruptStopsRun::restore() {
+  if (installed_) sigaction(SIGINT, &former_, nullptr);
+  installed_ = false;
+  const int sig = stop_signal;
+  stop_signal = 0;
+  return sig;
+}
+
 const char* signal_name(int sig) {
   switch (sig) {
     case SIGTERM:

@@ -170,6 +170,15 @@ def test_bad_scene_is_a_python_exception(tmp_path):
         basalt.Simulation(wave_scene(tmp_path / "bad"), geometry=tmp_path / "missing.h5")
 
 
+def test_units_other_than_the_geometrys_are_warned_of(tmp_path, capfd):
+    """The start-up is basalt-run's (solver/app/run_start.hpp): the same warning, on stderr."""
+    scene = wave_scene(tmp_path / "units", checkpoint_every=0)
+    scene["units"]["length"] = "m"
+    with basalt.Simulation(scene):
+        pass
+    assert "warning: the geometry declares units mm, ms, N; the scene m, ms, N" in capfd.readouterr().err
+
+
 @pytest.mark.skipif(not (BIN / "basalt-run").exists(), reason="needs the build's basalt-run")
 def test_mpi_two_compute_ranks_and_an_io_rank(tmp_path):
     """mpirun -np 3 python3 script.py with io_ranks=1: the I/O rank writes the checkpoint; the two compute
