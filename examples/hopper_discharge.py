@@ -6,7 +6,7 @@ The discharge rate W (mass per time) is the slope of the discharged mass against
 Beverloo: W = C rho_b sqrt(g) (D0 - k d)^(5/2), rho_b the settled fill's measured bulk density. Units: mm, ms, N
 (g for masses). One rank.
 
-    python3 examples/hopper_discharge.py            # three orifices in a 25 mm silo (~2,000 grains each)
+    python3 examples/hopper_discharge.py            # three orifices in a 28 mm silo (~2,500 grains each)
     python3 examples/hopper_discharge.py --quick    # the test: one orifice in a smaller silo (< 1 min)
 
 Writes out/examples/hopper_discharge/discharge.csv (per orifice and every 50 steps of the discharge: time after
@@ -115,7 +115,7 @@ def hopper(folder, diameter, orifice, fill_height, discharge_fraction, seed=1):
     # Target: the grains that fill the silo to fill_height at a solid fraction of 0.6.
     mean_volume = 4.0 / 3.0 * np.pi * (RMAX**4 - RMIN**4) / (4 * (RMAX - RMIN))
     target = int(0.6 * np.pi * R**2 * fill_height / mean_volume)
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     with basalt.Simulation(scene(geometry, mesh, folder / f"run_d{diameter:g}_o{orifice:g}", R - 0.2, height)) as sim:
         initial = sim.total_particles
         # Stage 1: pour handfuls at the top until the target count is in.
@@ -159,27 +159,37 @@ def hopper(folder, diameter, orifice, fill_height, discharge_fraction, seed=1):
         sim.callback(record, every=FIELD_EVERY, velocities=False)
         discharge_steps = sim.run(2_000_000)
         balance = sim.total_particles == initial + sim.inserted - sim.deleted
-        elapsed = time.perf_counter() - t0
+        elapsed, cpu = time.perf_counter() - t0, time.process_time() - c0
     t, count, mass = (np.array(c, dtype=float) for c in zip(*rows))
-    # The steady part: from 15 % of the mass discharged in the end to 90 % of it.
+    # The steady part: from 15 % of the mass discharged in the end to 90 % of it (none when the orifice jammed
+    # before 50 grains were out: an arch across it, likely below D0 ~ 4-5 d).
     steady = (mass >= 0.15 * mass[-1]) & (mass <= 0.9 * mass[-1])
-    W, _, r2_mass = fit_line(t[steady], mass[steady])
-    rate, _, r2_count = fit_line(t[steady], count[steady])
+    jammed = count[-1] < 50
+    if jammed:
+        steady[:] = False
+        W = rate = r2_mass = r2_count = float("nan")
+    else:
+        W, _, r2_mass = fit_line(t[steady], mass[steady])
+        rate, _, r2_count = fit_line(t[steady], count[steady])
     return {"diameter": diameter, "orifice": orifice, "initial": initial, "target": target, "filled": filled,
             "unique_ids": unique, "handfuls": k, "fill_steps": fill_steps, "settle_steps": settle, "phi": phi,
             "rho_b": rho_b, "fill_top": top, "fill_mass": m0, "discharge_steps": discharge_steps,
             "discharged": int(count[-1]), "discharged_mass": float(mass[-1]), "balance": balance,
-            "W": W, "grains_per_ms": rate, "r2": min(r2_mass, r2_count), "window": (t[steady][0], t[steady][-1]),
-            "t": t, "count": count, "mass": mass, "seconds": elapsed, "discharge_fraction": discharge_fraction,
+            "W": W, "grains_per_ms": rate, "r2": min(r2_mass, r2_count), "jammed": jammed,
+            "window": (t[steady][0], t[steady][-1]) if steady.any() else (float("nan"),) * 2,
+            "t": t, "count": count, "mass": mass, "seconds": elapsed, "cpu_seconds": cpu, "discharge_fraction": discharge_fraction,
             "beverloo": float(beverloo(orifice, rho_b))}
 
 
 def fit_beverloo(results):
     """C with k = 1.5 (one parameter, any number of orifices), and C, k together from W^(2/5) linear in D0 (three
     or more orifices): W^(2/5) = (C rho_b sqrt g)^(2/5) (D0 - k d)."""
+    rho_b = float(np.mean([r["rho_b"] for r in results]))
+    results = [r for r in results if not r["jammed"]]
+    if not results:
+        return rho_b, float("nan"), None, None
     d0 = np.array([r["orifice"] for r in results])
     w = np.array([r["W"] for r in results])
-    rho_b = float(np.mean([r["rho_b"] for r in results]))
     shape = (d0 - K_LIT * D) ** 2.5
     c_fixed = float(np.sum(w * shape) / np.sum(shape**2)) / (rho_b * np.sqrt(G))
     c_fit = k_fit = None
@@ -199,6 +209,8 @@ def plot(results, fit, path):
     rho_b, c_fixed, c_fit, k_fit = fit
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(9, 3.6))
     for r in results:
+        if r["jammed"]:
+            continue
         line, = a1.plot(r["t"], r["mass"], lw=1.2, label=f"D0 = {r['orifice']:g} mm ({r['orifice'] / D:.2g} d)")
         t0, t1 = r["window"]
         tt = np.array([t0, t1])
@@ -208,7 +220,7 @@ def plot(results, fit, path):
     a1.set_ylabel("discharged mass (g)")
     a1.legend(fontsize=8)
     d0 = np.array([r["orifice"] for r in results])
-    a2.plot(d0, [r["W"] * 1e3 for r in results], "o", label="measured")
+    a2.plot(d0, [r["W"] * 1e3 for r in results], "o", label="measured (steady part)")
     x = np.linspace(min(d0.min(), K_LIT * D + 0.5) - 0.5, d0.max() + 1.0, 100)
     a2.plot(x, beverloo(x, rho_b) * 1e3, "-", label=f"Beverloo C = {C_LIT}, k = {K_LIT}")
     a2.plot(x, beverloo(x, rho_b, c=c_fixed) * 1e3, "--", label=f"fit, k = {K_LIT}: C = {c_fixed:.2f}")
@@ -230,8 +242,13 @@ def main():
     if args.quick:
         cases = [dict(diameter=18.0, orifice=9.0, fill_height=14.0, discharge_fraction=0.5)]
     else:
-        cases = [dict(diameter=25.0, orifice=o, fill_height=26.0, discharge_fraction=0.35) for o in (7.0, 8.5, 10.0)]
-    results = [hopper(args.out, **c) for c in cases]
+        cases = [dict(diameter=28.0, orifice=o, fill_height=29.0, discharge_fraction=0.3) for o in (8.0, 9.5, 11.0)]
+    results = []
+    for c in cases:
+        results.append(hopper(args.out, **c))
+        print(f"D0 = {c['orifice']:g} mm: {results[-1]['discharged']} grains out, "
+              f"W = {results[-1]['W'] * 1e3:.3f} mg/ms, {results[-1]['seconds']:.0f} s "
+              f"({results[-1]['cpu_seconds']:.0f} s of CPU)", flush=True)
     fit = fit_beverloo(results)
     with open(args.out / "discharge.csv", "w", newline="") as f:
         w = csv.writer(f)
@@ -249,7 +266,7 @@ def main():
               f"({r['discharged_mass']:.3f} g) out in {r['discharge_steps']} steps; "
               f"W = {r['W'] * 1e3:.3f} mg/ms ({r['grains_per_ms']:.3f} grains/ms, R^2 {r['r2']:.4f}, "
               f"t = {r['window'][0]:.0f}-{r['window'][1]:.0f} ms), Beverloo {r['beverloo'] * 1e3:.3f} mg/ms, "
-              f"ratio {ratio:.2f}; {r['seconds']:.1f} s")
+              f"ratio {ratio:.2f}; {r['seconds']:.1f} s ({r['cpu_seconds']:.1f} s of CPU)" + (" (JAMMED: an arch closed the orifice)" if r["jammed"] else ""))
         checks = {"fill reached its target with unique ids": r["filled"] == r["target"] and r["unique_ids"],
                   "initial + inserted - deleted == total": r["balance"],
                   "grains discharged (no jam)": r["discharged_mass"] >= r["discharge_fraction"] * r["fill_mass"],
