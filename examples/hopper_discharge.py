@@ -177,7 +177,8 @@ def hopper(folder, diameter, orifice, fill_height, discharge_fraction, seed=1):
             "discharged": int(count[-1]), "discharged_mass": float(mass[-1]), "balance": balance,
             "W": W, "grains_per_ms": rate, "r2": min(r2_mass, r2_count), "jammed": jammed,
             "window": (t[steady][0], t[steady][-1]) if steady.any() else (float("nan"),) * 2,
-            "t": t, "count": count, "mass": mass, "seconds": elapsed, "cpu_seconds": cpu, "discharge_fraction": discharge_fraction,
+            "t": t, "count": count, "mass": mass, "seconds": elapsed, "cpu_seconds": cpu,
+            "discharge_fraction": discharge_fraction,
             "beverloo": float(beverloo(orifice, rho_b))}
 
 
@@ -211,7 +212,7 @@ def plot(results, fit, path):
     for r in results:
         if r["jammed"]:
             continue
-        line, = a1.plot(r["t"], r["mass"], lw=1.2, label=f"D0 = {r['orifice']:g} mm ({r['orifice'] / D:.2g} d)")
+        a1.plot(r["t"], r["mass"], lw=1.2, label=f"D0 = {r['orifice']:g} mm ({r['orifice'] / D:.2g} d)")
         t0, t1 = r["window"]
         tt = np.array([t0, t1])
         b = np.polyfit(r["t"][(r["t"] >= t0) & (r["t"] <= t1)], r["mass"][(r["t"] >= t0) & (r["t"] <= t1)], 1)
@@ -266,7 +267,8 @@ def main():
               f"({r['discharged_mass']:.3f} g) out in {r['discharge_steps']} steps; "
               f"W = {r['W'] * 1e3:.3f} mg/ms ({r['grains_per_ms']:.3f} grains/ms, R^2 {r['r2']:.4f}, "
               f"t = {r['window'][0]:.0f}-{r['window'][1]:.0f} ms), Beverloo {r['beverloo'] * 1e3:.3f} mg/ms, "
-              f"ratio {ratio:.2f}; {r['seconds']:.1f} s ({r['cpu_seconds']:.1f} s of CPU)" + (" (JAMMED: an arch closed the orifice)" if r["jammed"] else ""))
+              f"ratio {ratio:.2f}; {r['seconds']:.1f} s ({r['cpu_seconds']:.1f} s of CPU)"
+              + (" (JAMMED: an arch closed the orifice)" if r["jammed"] else ""))
         checks = {"fill reached its target with unique ids": r["filled"] == r["target"] and r["unique_ids"],
                   "initial + inserted - deleted == total": r["balance"],
                   "grains discharged (no jam)": r["discharged_mass"] >= r["discharge_fraction"] * r["fill_mass"],
