@@ -19,7 +19,7 @@
 namespace basalt::solver {
 
 template <class Real>
-void Simulation<Real>::include_flow(GeometryExtent& e) const {
+void Simulation<Real>::include_flow(GeometryExtent& e) {
   // The lists' reach and the decomposition's box cover the particles to come.
   for (const auto& s : scene_.inserts) {
     e.rmax = std::max(e.rmax, s.rmax);
@@ -219,7 +219,7 @@ void Simulation<Real>::flow_now() {
 }
 
 #define BASALT_INSTANTIATE(R)                                                                        \
-  template void Simulation<R>::include_flow(GeometryExtent&) const;                                  \
+  template void Simulation<R>::include_flow(GeometryExtent&);                                  \
   template void Simulation<R>::include_flow(GeometrySummary&) const;                                 \
   template bool Simulation<R>::queue_flow(std::int64_t);                                             \
   template void Simulation<R>::restore_flow(const std::map<std::string, std::string>&, std::int64_t, \

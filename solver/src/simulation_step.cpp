@@ -1,7 +1,8 @@
 // The step and the run loop, in one place. A step is, in this order:
 //   1. drift       first half-kick (and a deferred second one), zeroed forces, drift    (VelocityVerlet)
 //   2. walls       prescribed and servo walls to the step's end time
-//   3. neighbours  a rebuild (skin exceeded, a bond broke, the balancer asks) or the ghosts' new positions
+//   3. neighbours  a rebuild (skin exceeded, a bond broke, the balancer asks, particles enter or leave:
+//                  simulation_flow.cpp) or the ghosts' new positions
 //   4. forces      bonds, contacts, walls, body forces; fixed particles held; bond breaks recorded
 //   5. kick        second half-kick, now or deferred to the next step's drift when nothing reads velocities
 //   6. wall work   work done by the walls (energy ledger), servo walls steered by the summed force

@@ -382,7 +382,7 @@ class Simulation {
   double runout(const FieldSpec& f) const;
   /// The scene's [[insert]] regions and radii into the decomposition's box and the lists' reach; sets
   /// rmax_run_ and next_id_ (fresh starts).
-  void include_flow(GeometryExtent& e) const;
+  void include_flow(GeometryExtent& e);
   /// The scene's [[insert]] radii and masses into the stability estimate's (future contacts).
   void include_flow(GeometrySummary& s) const;
   /// Queues the scene's insert and delete events of step s (the one about to be made); whether any is.
@@ -483,8 +483,8 @@ class Simulation {
     std::vector<DeleteSpec> deletes;
     std::vector<NewParticle> arriving;
   } flow_;
-  mutable std::int64_t next_id_ = 0;  ///< the id of the next inserted particle (alike on every rank)
-  mutable double rmax_run_ = 0;       ///< the largest radius the lists reach
+  std::int64_t next_id_ = 0;  ///< the id of the next inserted particle (alike on every rank)
+  double rmax_run_ = 0;       ///< the largest radius the lists reach
   std::array<std::int64_t, 2> last_flow_{0, 0};    ///< inserted, removed by the last event
   std::array<std::int64_t, 2> flow_totals_{0, 0};  ///< inserted, removed in all
   bool flow_changed_ = false;  ///< particles came or went at this step's rebuild: the guard rebases
