@@ -216,6 +216,18 @@ class Simulation:
     def dt(self, value):
         self._core.set_dt(float(value))
 
+    def checkpoint(self):
+        """Collective: writes a checkpoint of the current step now (out/ckpt_<step>.h5, as the scheduled ones; none
+        when one of this step is written already). A restart from it is bit for bit when the scene writes
+        checkpoints (output.checkpoint_every > 0: the run then keeps the positions of its last rebuild)."""
+        self._core.checkpoint()
+
+    @property
+    def critical_dt(self):
+        """The critical time step estimated at the start (docs/stability.md): sim.dt = 0.2 * sim.critical_dt sets
+        dt as a fraction of it, as run.dt_fraction does."""
+        return self._core.critical_dt
+
     def gather(self, name):
         """Collective: one particle array (a name of sim.particles) of every rank, on rank 0 as (ids, values)
         sorted by id (float64 values); None on the other ranks."""

@@ -126,6 +126,10 @@ class Run {
   virtual std::int64_t bond_count() = 0;
   virtual std::int64_t broken_bonds() = 0;
   virtual std::array<std::int64_t, 2> flow_totals() const = 0;
+  /// Collective: a checkpoint of the current step now.
+  virtual void checkpoint() = 0;
+  /// The critical time step the run estimated at its start (docs/stability.md).
+  virtual double critical_dt() const = 0;
   virtual std::string close() = 0;
 };
 
@@ -215,6 +219,8 @@ class RunOf final : public Run {
     return comm_.sum(static_cast<long long>(sim_->broken_bonds().size()));
   }
   std::array<std::int64_t, 2> flow_totals() const override { return sim_->flow_totals(); }
+  double critical_dt() const override { return sim_->stability().dt_critical; }
+  void checkpoint() override { sim_->checkpoint_now(*sink_); }
 
   py::dict energies() override {
     const auto values = sim_->ledger_values();
@@ -577,6 +583,8 @@ void bind_simulation(py::module_& m) {
       .def("bond_count", [](PySimulation& s) { return s.run().bond_count(); })
       .def("broken_bonds", [](PySimulation& s) { return s.run().broken_bonds(); })
       .def("flow_totals", [](PySimulation& s) { return s.run().flow_totals(); })
+      .def_property_readonly("critical_dt", [](PySimulation& s) { return s.run().critical_dt(); })
+      .def("checkpoint", [](PySimulation& s) { s.run().checkpoint(); })
       .def("allreduce", [](PySimulation& s, double v, const std::string& op) {
         const auto& c = s.run().comm();
         if (c.size() == 1) return v;

@@ -180,6 +180,17 @@ void Simulation<Real>::write_frame(OutputSink& out, std::uint32_t kinds, std::ve
   Stopwatch frame_clock;
   out.frame(SimulationFrame<Real>(*this, kinds));
   seconds.push_back(frame_clock.lap());
+  if (kinds & io::kFrameCheckpoint) checkpoint_step_ = step_;
+}
+
+template <class Real>
+void Simulation<Real>::checkpoint_now(OutputSink& out) {
+  if (checkpoint_step_ == step_) return;
+  settle_kick();
+  std::vector<double> seconds;
+  write_frame(out, io::kFrameCheckpoint, seconds);
+  bool reported = false;
+  agree_on_output(out, reported);
 }
 
 template <class Real>
@@ -299,6 +310,7 @@ void Simulation<Real>::stop(const std::string& message) {
   template void Simulation<R>::progress(std::int64_t, std::int64_t, double) const;                \
   template bool Simulation<R>::hooks_due(std::span<const StepHook>, std::int64_t);                \
   template void Simulation<R>::write_frame(OutputSink&, std::uint32_t, std::vector<double>&);     \
+  template void Simulation<R>::checkpoint_now(OutputSink&);                                       \
   template bool Simulation<R>::agree_on_output(OutputSink&, bool&);                               \
   template std::int64_t Simulation<R>::run(std::int64_t, OutputSink&, std::span<const StepHook>); \
   template FieldRows& Simulation<R>::field_rows(FieldSink*);                                      \

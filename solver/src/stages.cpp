@@ -30,12 +30,14 @@ StageSpec parse_stage(TableReader& t, const std::vector<WallSpec>& walls) {
     s.until = true;
     s.every = c.integer_or("every", 100);
     if (s.every < 1) c.fail("every", "must be >= 1");
-    const bool ke = c.has("kinetic_energy_below"), wall = c.has("wall_force");
-    if (ke == wall)
+    const bool ke = c.has("kinetic_energy_below"), wall = c.has("wall_force"), time = c.has("time_above");
+    if (int(ke) + int(wall) + int(time) != 1)
       c.fail_here(
-          "give one condition: kinetic_energy_below = E, or wall_force = \"name\" with axis and above or "
-          "below");
+          "give one condition: kinetic_energy_below = E, time_above = T, or wall_force = \"name\" with axis "
+          "and "
+          "above or below");
     if (ke) s.kinetic_energy_below = c.non_negative("kinetic_energy_below");
+    if (time) s.time_above = c.number("time_above");
     if (wall) {
       s.wall = c.string("wall_force");
       (void)find_wall(c, "wall_force", walls, s.wall);
@@ -81,6 +83,7 @@ std::string describe(const StageSpec& stage, const StageReport& r) {
     return line + fmt::format(" (its condition never held: it ran its {} steps)", stage.steps);
   if (stage.kinetic_energy_below >= 0)
     return line + fmt::format(" (kinetic energy {:.4g} < {:.4g})", r.value, stage.kinetic_energy_below);
+  if (stage.time_above) return line + fmt::format(" (time {:.6g} >= {:.6g})", r.value, *stage.time_above);
   return line + fmt::format(" (force on {} along {} {:.4g} {} {:.4g})", stage.wall, char('x' + stage.axis),
                             r.value, stage.force_above ? ">" : "<",
                             stage.force_above ? *stage.force_above : *stage.force_below);
@@ -193,6 +196,9 @@ std::int64_t run_stages(Simulation<Real>& sim, OutputSink& out, const std::vecto
                          if (st.kinetic_energy_below >= 0) {
                            r.value = sim.kinetic_energy();
                            r.condition_met = r.value < st.kinetic_energy_below;
+                         } else if (st.time_above) {  // (the same clock on every rank)
+                           r.value = sim.time();
+                           r.condition_met = r.value >= *st.time_above;
                          } else {
                            const std::size_t w = sim.wall_index(st.wall);
                            double f = sim.walls().force(w)[static_cast<std::size_t>(st.axis)];

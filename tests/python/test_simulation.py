@@ -142,6 +142,7 @@ def test_views_and_steering(tmp_path):
     sim.run(100)
     assert floor.position[2] - z0 == pytest.approx(0.01 * 100 * sim.dt)
     floor.stop()
+    assert 2e-3 < sim.critical_dt < 1.0  # the scene's dt = 2e-3 runs below its critical step
     sim.dt = 1e-3
     assert sim.dt == 1e-3
     with pytest.raises(ValueError, match="positive"):
@@ -218,3 +219,31 @@ def test_mpi_two_compute_ranks_and_an_io_rank(tmp_path):
     b = h5(tmp_path / "one" / "ckpt_000200.h5")
     ia, ib = np.argsort(a["id"]), np.argsort(b["id"])
     np.testing.assert_allclose(a["position"][ia], b["position"][ib], rtol=0, atol=1e-9)
+
+
+@pytest.mark.skipif(not (BIN / "basalt-run").exists(), reason="needs the build's basalt-run")
+def test_checkpoint_now_is_a_restart_point(tmp_path):
+    """sim.checkpoint() between runs writes the current step's checkpoint; basalt-run restarted from it reaches
+    the scheduled checkpoint 50 steps on with the particles of the Python run, to the bit."""
+    scene = wave_scene(tmp_path / "py", steps=100, checkpoint_every=100)
+    with basalt.Simulation(scene) as sim:
+        sim.run(50)
+        sim.checkpoint()
+        sim.checkpoint()  # the same step again: nothing more
+        sim.run(50)
+    assert (tmp_path / "py" / "ckpt_000050.h5").exists()
+    import h5py
+
+    with h5py.File(tmp_path / "py" / "ckpt_000050.h5", "r") as f:  # the scene as the run read it
+        stored = f.attrs["scene_text"]
+    text = tmp_path / "wave.toml"
+    text.write_text(stored.decode() if isinstance(stored, bytes) else str(stored))
+    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    r = subprocess.run([str(BIN / "basalt-run"), str(text), "--restart", str(tmp_path / "py" / "ckpt_000050.h5"),
+                        "--steps", "50", "--output", str(tmp_path / "cli"), "--quiet"], env=env,
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stdout + r.stderr
+    a, b = h5(tmp_path / "py" / "ckpt_000100.h5"), h5(tmp_path / "cli" / "ckpt_000100.h5")
+    np.testing.assert_array_equal(a["id"], b["id"])
+    np.testing.assert_array_equal(a["position"], b["position"])
+    np.testing.assert_array_equal(a["velocity"], b["velocity"])

@@ -251,6 +251,35 @@ steps = 300
   EXPECT_NEAR(sim.walls().point(sim.wall_index("piston"))[2], 10.0 - 300 * 2e-3, 1e-12);
 }
 
+TEST(Stages, ATimeConditionEndsTheStageAtTheFirstCheckPastIt) {
+  // until = { time_above = T }: with dt = 2e-3 and checks every 10 steps, T = 0.105 is passed at step 60
+  // (time 0.12; the check at step 50 sees 0.1). A second stage with a new dt goes on from there.
+  const auto scene = basalt::test::scene_from(pile_scene("dt = 2e-3") + R"(
+[[stages]]
+name = "until_time"
+steps = 1000
+until = { time_above = 0.105, every = 10 }
+[[stages]]
+name = "finer"
+dt = 1e-3
+steps = 20
+)");
+  Simulation<double> sim(scene, pile(), MPI_COMM_WORLD, basalt::test::quiet());
+  FieldRows rows(sim.comm(), nullptr);
+  std::vector<StageReport> reports;
+  run_stages(sim, rows, scene.stages, [&](const StageSpec& st, const StageReport& r) {
+    reports.push_back(r);
+    if (reports.size() == 1) {
+      EXPECT_NE(describe(st, r).find("time 0.12 >= 0.105"), std::string::npos) << describe(st, r);
+    }
+  });
+  ASSERT_EQ(reports.size(), 2u);
+  EXPECT_TRUE(reports[0].condition_met);
+  EXPECT_EQ(reports[0].steps, 60);
+  EXPECT_EQ(sim.current_step(), 80);
+  EXPECT_NEAR(sim.time(), 0.12 + 20 * 1e-3, 1e-12);
+}
+
 TEST(Stages, BadStagesNameTheKey) {
   const auto expect_error = [](const std::string& stages, const std::string& needle) {
     try {
@@ -264,6 +293,8 @@ TEST(Stages, BadStagesNameTheKey) {
   expect_error("[[stages]]\nsteps = 10\nremove_walls = [\"gate\"]\n", "floor, piston");
   expect_error("[[stages]]\nuntil = { kinetic_energy_below = 1.0 }\n", "needs steps");
   expect_error("[[stages]]\nsteps = 5\nuntil = { every = 3 }\n", "give one condition");
+  expect_error("[[stages]]\nsteps = 5\nuntil = { time_above = 1.0, kinetic_energy_below = 1.0 }\n",
+               "give one condition");
   expect_error("[[stages]]\nsteps = 5\nuntil = { wall_force = \"piston\" }\n", "above = F or below");
   expect_error("[[stages]]\nsteps = 5\nwall_velocity = { nope = [0.0, 0.0, 1.0] }\n",
                "no planar wall named \"nope\"");

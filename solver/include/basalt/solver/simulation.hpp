@@ -127,6 +127,9 @@ class Simulation {
   /// An output error stops the run on every rank at the same step (RunError naming it) unless
   /// out.continue_on_error(). Returns the steps made (fewer when a hook ended the run).
   std::int64_t run(std::int64_t steps, OutputSink& out, std::span<const StepHook> hooks = {});
+  /// Collective, between runs: writes a checkpoint of the current step through `out` now (none when one of
+  /// this step is written already); the output errors so far stop it as in run() (RunError).
+  void checkpoint_now(OutputSink& out);
   /// The decomposition's box, ghost width and contact cut-off (stored in checkpoints).
   RestartLayout restart_layout() const;
 
@@ -489,6 +492,7 @@ class Simulation {
   std::array<std::int64_t, 2> flow_totals_{0, 0};  ///< inserted, removed in all
   bool flow_changed_ = false;  ///< particles came or went at this step's rebuild: the guard rebases
   std::map<std::string, std::string> checkpoint_attributes_;  ///< set_checkpoint_attribute()
+  std::int64_t checkpoint_step_ = -1;                         ///< the step of the last checkpoint written
   /// Inserted ids were issued (or the checkpoint kept the counter): checkpoints keep next_id_.
   bool ids_issued_ = false;
 };

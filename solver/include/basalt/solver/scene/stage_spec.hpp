@@ -20,6 +20,7 @@ struct StageSpec {
   bool until = false;
   std::int64_t every = 100;
   double kinetic_energy_below = -1;  ///< the total kinetic energy falls below this (when >= 0)
+  std::optional<double> time_above;  ///< or: the run's time reaches this (the time since the run began)
   std::string wall;                  ///< or: the force on this wall (summed over ranks) along `axis`
   int axis = 2;
   std::optional<double> force_above, force_below;
