@@ -219,7 +219,7 @@ void Simulation<Real>::flow_now() {
 }
 
 #define BASALT_INSTANTIATE(R)                                                                        \
-  template void Simulation<R>::include_flow(GeometryExtent&);                                  \
+  template void Simulation<R>::include_flow(GeometryExtent&);                                        \
   template void Simulation<R>::include_flow(GeometrySummary&) const;                                 \
   template bool Simulation<R>::queue_flow(std::int64_t);                                             \
   template void Simulation<R>::restore_flow(const std::map<std::string, std::string>&, std::int64_t, \
