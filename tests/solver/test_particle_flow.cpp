@@ -55,17 +55,9 @@ basalt::io::Geometry pile() {
 
 /// id -> (x, y, z, radius, tag, vz) of every particle, gathered on every rank.
 std::map<std::int64_t, std::vector<double>> state(const Simulation<double>& sim) {
-  const auto& p = sim.particles();
-  std::vector<double> mine;
-  for (std::size_t i = 0; i < p.n_owned; ++i)
-    mine.insert(mine.end(),
-                {double(p.id[i]), p.x[i], p.y[i], p.z[i], p.radius[i], double(p.tag[i]), p.vz[i]});
-  const auto all = sim.comm().size() > 1 ? sim.comm().all_gather(mine) : mine;
-  std::map<std::int64_t, std::vector<double>> m;
-  for (std::size_t k = 0; k + 7 <= all.size(); k += 7)
-    m[std::int64_t(all[k])] =
-        std::vector<double>(all.begin() + std::ptrdiff_t(k) + 1, all.begin() + std::ptrdiff_t(k) + 7);
-  return m;
+  return basalt::test::gather_by_id(sim, [](const Particles<double>& p, std::size_t i) {
+    return std::vector<double>{p.x[i], p.y[i], p.z[i], p.radius[i], double(p.tag[i]), p.vz[i]};
+  });
 }
 
 /// The deepest overlap of a particle with an id above `first` (an inserted one) with any other in `s`,

@@ -9,6 +9,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <utility>
@@ -88,6 +89,28 @@ std::size_t index_of(const solver::Particles<Real>& p, std::int64_t id) {
     if (p.id[i] == id) return i;
   ADD_FAILURE() << "no particle " << id;
   return 0;
+}
+
+/// id -> values(p, i) (a std::vector<double> of the same length for every particle) of every rank's owned
+/// particles, gathered on every rank: a run's state to compare across runs and rank counts.
+template <class Real, class Values>
+std::map<std::int64_t, std::vector<double>> gather_by_id(const solver::Simulation<Real>& sim, Values values) {
+  const auto& p = sim.particles();
+  std::vector<double> mine;
+  std::size_t width = 0;
+  for (std::size_t i = 0; i < p.n_owned; ++i) {
+    const std::vector<double> v = values(p, i);
+    width = v.size();
+    mine.push_back(double(p.id[i]));
+    mine.insert(mine.end(), v.begin(), v.end());
+  }
+  if (sim.comm().size() > 1) width = static_cast<std::size_t>(sim.comm().max(double(width)));
+  const auto all = sim.comm().size() > 1 ? sim.comm().all_gather(mine) : mine;
+  std::map<std::int64_t, std::vector<double>> m;
+  for (std::size_t k = 0; k + width + 1 <= all.size(); k += width + 1)
+    m[std::int64_t(all[k])] =
+        std::vector<double>(all.begin() + std::ptrdiff_t(k) + 1, all.begin() + std::ptrdiff_t(k + width) + 1);
+  return m;
 }
 
 /// Gives every owned particle of `sim` the velocity drift + scale (hash_unit(3 id), hash_unit(3 id + 1),

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -52,7 +53,7 @@ struct Region {
     for (auto& c : e1) c /= n1;
     const std::array<double, 3> e2{a[1] * e1[2] - a[2] * e1[1], a[2] * e1[0] - a[0] * e1[2],
                                    a[0] * e1[1] - a[1] * e1[0]};
-    const double rho = (radius - r) * std::sqrt(u0), phi = 2 * 3.14159265358979323846 * u1;
+    const double rho = (radius - r) * std::sqrt(u0), phi = 2 * std::numbers::pi * u1;
     const double h = r + u2 * (length - 2 * r), c1 = rho * std::cos(phi), c2 = rho * std::sin(phi);
     return {base[0] + h * a[0] + c1 * e1[0] + c2 * e2[0], base[1] + h * a[1] + c1 * e1[1] + c2 * e2[1],
             base[2] + h * a[2] + c1 * e1[2] + c2 * e2[2]};
