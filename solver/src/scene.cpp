@@ -483,7 +483,7 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
   if (const auto* arr = top.table_array("stages")) {
     for (std::size_t k = 0; k < arr->size(); ++k) {
       TableReader t(*(*arr)[k].as_table(), label, fmt::format("stages[{}]", k));
-      s.stages.push_back(parse_stage(t, s.walls));
+      s.stages.push_back(parse_stage(t, s.walls, s.fields));
     }
   }
   top.finish();
@@ -503,20 +503,23 @@ Scene parse_scene(const fs::path& file) {
   return s;
 }
 
-std::vector<std::string> field_columns(const Scene& scene) {
+std::vector<std::string> field_columns(const FieldSpec& f) {
   std::vector<std::string> cols;
-  for (const auto& f : scene.fields) {
-    if (f.type == FieldSpec::Type::broken_bonds) {
-      for (const char* m : {"tension", "shear", "bending", "torsion"})
-        cols.push_back(fmt::format("broken_bonds_{}", m));
-      continue;
-    }
-    if (!f.per_wall()) {
-      cols.push_back(f.name());
-      continue;
-    }
+  if (f.type == FieldSpec::Type::broken_bonds) {
+    for (const char* m : {"tension", "shear", "bending", "torsion"})
+      cols.push_back(fmt::format("broken_bonds_{}", m));
+  } else if (!f.per_wall()) {
+    cols.push_back(f.name());
+  } else {
     for (const char* c : {"x", "y", "z"}) cols.push_back(fmt::format("{}_{}_{}", f.name(), f.wall, c));
   }
+  return cols;
+}
+
+std::vector<std::string> field_columns(const Scene& scene) {
+  std::vector<std::string> cols;
+  for (const auto& f : scene.fields)
+    for (auto& c : field_columns(f)) cols.push_back(std::move(c));
   return cols;
 }
 

@@ -22,20 +22,20 @@ std::size_t find_wall(const TableReader& t, const std::string& key, const std::v
 
 }  // namespace
 
-StageSpec parse_stage(TableReader& t, const std::vector<WallSpec>& walls) {
+StageSpec parse_stage(TableReader& t, const std::vector<WallSpec>& walls,
+                      const std::vector<FieldSpec>& fields) {
   StageSpec s;
   s.name = t.string_or("name", t.path());
   if (const auto* u = t.subtable("until")) {
     TableReader c(*u, t.file(), t.path() + ".until");
     s.until = true;
-    s.every = c.integer_or("every", 100);
-    if (s.every < 1) c.fail("every", "must be >= 1");
-    const bool ke = c.has("kinetic_energy_below"), wall = c.has("wall_force"), time = c.has("time_above");
-    if (int(ke) + int(wall) + int(time) != 1)
+    const bool ke = c.has("kinetic_energy_below"), wall = c.has("wall_force"), time = c.has("time_above"),
+               saver = c.has("saver");
+    if (int(ke) + int(wall) + int(time) + int(saver) != 1)
       c.fail_here(
-          "give one condition: kinetic_energy_below = E, time_above = T, or wall_force = \"name\" with axis "
-          "and "
-          "above or below");
+          "give one condition: kinetic_energy_below = E, time_above = T, wall_force = \"name\" with axis "
+          "and above or below, or saver = \"column\" (of fields.csv) with above or below");
+    std::int64_t saver_every = 0;
     if (ke) s.kinetic_energy_below = c.non_negative("kinetic_energy_below");
     if (time) s.time_above = c.number("time_above");
     if (wall) {
@@ -43,11 +43,40 @@ StageSpec parse_stage(TableReader& t, const std::vector<WallSpec>& walls) {
       (void)find_wall(c, "wall_force", walls, s.wall);
       const auto axis = c.choice_or("axis", {"x", "y", "z"}, "z");
       s.axis = axis[0] - 'x';
-      if (c.has("above")) s.force_above = c.number("above");
-      if (c.has("below")) s.force_below = c.number("below");
-      if (s.force_above.has_value() == s.force_below.has_value())
-        c.fail_here("wall_force: give one of above = F or below = F");
     }
+    if (saver) {
+      s.saver = c.string("saver");
+      std::vector<std::string> names;
+      for (const auto& f : fields) {
+        const auto first = names.size();
+        for (const auto& col : field_columns(f)) names.push_back(col);
+        for (auto k = first; k < names.size(); ++k)
+          if (names[k] == s.saver) {
+            s.saver_column = k;
+            saver_every = f.every;
+          }
+      }
+      if (saver_every == 0) {
+        std::string list;
+        for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
+        c.fail("saver", fmt::format("no field saver writes a column \"{}\" (the scene's columns: {}); add "
+                                    "it to [[output.fields]]",
+                                    s.saver, list.empty() ? "none" : list));
+      }
+    }
+    if (wall || saver) {
+      if (c.has("above")) s.above = c.number("above");
+      if (c.has("below")) s.below = c.number("below");
+      if (s.above.has_value() == s.below.has_value())
+        c.fail_here(fmt::format("{}: give one of above = X or below = X", wall ? "wall_force" : "saver"));
+    }
+    // A saver's value exists at its own steps: checked there, or at a multiple of them.
+    s.every = c.integer_or("every", saver ? saver_every : 100);
+    if (s.every < 1) c.fail("every", "must be >= 1");
+    if (saver && s.every % saver_every != 0)
+      c.fail("every", fmt::format("must be a multiple of the saver's every = {}: the column \"{}\" has a "
+                                  "value only at those steps",
+                                  saver_every, s.saver));
     c.finish();
     if (!t.has("steps"))
       t.fail("until",
@@ -84,9 +113,10 @@ std::string describe(const StageSpec& stage, const StageReport& r) {
   if (stage.kinetic_energy_below >= 0)
     return line + fmt::format(" (kinetic energy {:.4g} < {:.4g})", r.value, stage.kinetic_energy_below);
   if (stage.time_above) return line + fmt::format(" (time {:.6g} >= {:.6g})", r.value, *stage.time_above);
-  return line + fmt::format(" (force on {} along {} {:.4g} {} {:.4g})", stage.wall, char('x' + stage.axis),
-                            r.value, stage.force_above ? ">" : "<",
-                            stage.force_above ? *stage.force_above : *stage.force_below);
+  const auto passed = fmt::format("{:.4g} {} {:.4g}", r.value, stage.above ? ">" : "<",
+                                  stage.above ? *stage.above : *stage.below);
+  if (!stage.saver.empty()) return line + fmt::format(" ({} {})", stage.saver, passed);
+  return line + fmt::format(" (force on {} along {} {})", stage.wall, char('x' + stage.axis), passed);
 }
 
 StageProgress StageProgress::parse(const std::string& text, std::size_t stages) {
@@ -200,11 +230,19 @@ std::int64_t run_stages(Simulation<Real>& sim, OutputSink& out, const std::vecto
                            r.value = sim.time();
                            r.condition_met = r.value >= *st.time_above;
                          } else {
-                           const std::size_t w = sim.wall_index(st.wall);
-                           double f = sim.walls().force(w)[static_cast<std::size_t>(st.axis)];
-                           if (sim.comm().size() > 1) f = sim.comm().sum(f);
+                           double f = 0;
+                           if (!st.saver.empty()) {
+                             // Checked at the saver's steps only (parse_stage): its value is there.
+                             const auto v = sim.saved_field(st.saver_column);
+                             if (!v) return true;
+                             f = *v;
+                           } else {
+                             const std::size_t w = sim.wall_index(st.wall);
+                             f = sim.walls().force(w)[static_cast<std::size_t>(st.axis)];
+                             if (sim.comm().size() > 1) f = sim.comm().sum(f);
+                           }
                            r.value = f;
-                           r.condition_met = st.force_above ? f > *st.force_above : f < *st.force_below;
+                           r.condition_met = st.above ? f > *st.above : f < *st.below;
                          }
                          return !r.condition_met;
                        }});

@@ -273,6 +273,55 @@ steps = 20
   EXPECT_NEAR(sim.time(), 0.12 + 20 * 1e-3, 1e-12);
 }
 
+TEST(Stages, ASaverConditionEndsTheStageWhereItsColumnFirstPassesTheLimit) {
+  // until = { saver = "mass_below", above = M }: the floor taken away, the pile falls through z = -0.5; the
+  // stage ends at the first of the saver's rows (every 10 steps) whose value passes M, with the value the
+  // row has. The kinetic energy saver beside it (every 1) moves mass_below to column 1.
+  const auto scene = basalt::test::scene_from(pile_scene("dt = 2e-3") + R"(
+[[output.fields]]
+type = "kinetic_energy"
+[[output.fields]]
+type = "mass_below"
+z = -0.5
+every = 10
+[[stages]]
+name = "fall"
+remove_walls = ["floor"]
+steps = 5000
+until = { saver = "mass_below", above = 6.0 }
+)");
+  ASSERT_EQ(scene.stages[0].every, 10);  // the saver's every, by default
+  ASSERT_EQ(scene.stages[0].saver_column, 1u);
+  Simulation<double> sim(scene, pile(), MPI_COMM_WORLD, basalt::test::quiet());
+  basalt::test::MemorySink sink(scene);
+  FieldRows rows(sim.comm(), &sink);
+  StageReport report;
+  std::string line;
+  run_stages(sim, rows, scene.stages, [&](const StageSpec& st, const StageReport& r) {
+    report = r;
+    line = describe(st, r);
+  });
+  rows.finish();
+  ASSERT_TRUE(report.condition_met) << line;
+  EXPECT_EQ(report.steps % 10, 0);
+  EXPECT_LT(report.steps, 5000);
+  EXPECT_GT(report.value, 6.0);
+  EXPECT_NE(line.find("mass_below"), std::string::npos) << line;
+  if (sim.comm().rank() != 0) return;
+  // The rows of fields.csv: the last one is the stage's last step with the value the stage saw; every
+  // earlier row of the saver stays at or below the limit.
+  const auto mass = sink.column(1);
+  ASSERT_EQ(sink.steps.back(), report.steps);
+  EXPECT_EQ(mass.back(), report.value);
+  int rows_checked = 0;
+  for (std::size_t k = 0; k + 1 < mass.size(); ++k)
+    if (!std::isnan(mass[k])) {
+      EXPECT_LE(mass[k], 6.0) << "step " << sink.steps[k];
+      ++rows_checked;
+    }
+  EXPECT_GT(rows_checked, 10);
+}
+
 TEST(Stages, BadStagesNameTheKey) {
   const auto expect_error = [](const std::string& stages, const std::string& needle) {
     try {
@@ -288,10 +337,16 @@ TEST(Stages, BadStagesNameTheKey) {
   expect_error("[[stages]]\nsteps = 5\nuntil = { every = 3 }\n", "give one condition");
   expect_error("[[stages]]\nsteps = 5\nuntil = { time_above = 1.0, kinetic_energy_below = 1.0 }\n",
                "give one condition");
-  expect_error("[[stages]]\nsteps = 5\nuntil = { wall_force = \"piston\" }\n", "above = F or below");
+  expect_error("[[stages]]\nsteps = 5\nuntil = { wall_force = \"piston\" }\n", "above = X or below");
   expect_error("[[stages]]\nsteps = 5\nwall_velocity = { nope = [0.0, 0.0, 1.0] }\n",
                "no planar wall named \"nope\"");
   expect_error("[[stages]]\nsteps = 5\nspeed = 3\n", "speed");
+  expect_error("[[stages]]\nsteps = 5\nuntil = { saver = \"mass_below\", above = 1.0 }\n",
+               "no field saver writes a column \"mass_below\"");
+  const std::string saver = "[[output.fields]]\ntype = \"mass_below\"\nz = 0.0\nevery = 10\n";
+  expect_error(saver + "[[stages]]\nsteps = 5\nuntil = { saver = \"mass_below\" }\n", "above = X or below");
+  expect_error(saver + "[[stages]]\nsteps = 5\nuntil = { saver = \"mass_below\", below = 1.0, every = 15 }\n",
+               "multiple of the saver's every = 10");
 }
 
 TEST(Steering, GravityChangedMidRunMovesTheCentreOfMassByTheNewAcceleration) {

@@ -172,6 +172,9 @@ class Simulation {
   /// Geometry bonds that no bond group takes (they exert no force).
   std::size_t unassigned_bonds() const { return unassigned_bonds_; }
   const std::vector<BrokenBond>& broken_bonds() const { return broken_; }
+  /// Collective: column `column` of fields.csv (field_columns(scene) order) as the savers computed it at this
+  /// step, summed over the compute ranks; nullopt when that column's saver was not due at this step.
+  std::optional<double> saved_field(std::size_t column) const;
   /// Collective: total kinetic energy.
   double kinetic_energy() const;
   /// Collective: {kinetic, bond, contact, wall} energies (recomputes forces' energies; forces unchanged).
@@ -449,6 +452,10 @@ class Simulation {
   IdMap ids_;
   ForceField<Real> forces_;  ///< the models, their lists and the energy ledger
   std::vector<BrokenBond> broken_;
+  /// This rank's field-saver partials and due mask at step fields_step_ (output_fields; saved_field).
+  std::vector<double> fields_local_;
+  std::vector<char> fields_due_;
+  std::int64_t fields_step_ = -1;
   std::vector<std::uint32_t> fixed_;  ///< owned particles of a fixed tag (from the last rebuild)
   bool bond_broke_ = false;
 

@@ -14,8 +14,10 @@
 
 namespace basalt::solver {
 
-/// Parses one [[stages]] table (its keys checked; wall names against the scene's planar walls).
-StageSpec parse_stage(TableReader& t, const std::vector<WallSpec>& walls);
+/// Parses one [[stages]] table (its keys checked; wall names against the scene's planar walls, a saver's
+/// column against the scene's field savers).
+StageSpec parse_stage(TableReader& t, const std::vector<WallSpec>& walls,
+                      const std::vector<FieldSpec>& fields);
 
 /// What happened in a stage (for the report line).
 struct StageReport {

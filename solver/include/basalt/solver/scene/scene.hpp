@@ -262,5 +262,7 @@ Scene parse_scene_text(const std::string& text, const std::string& label,
 
 /// Column names of fields.csv for these savers (after "step" and "time").
 std::vector<std::string> field_columns(const Scene& scene);
+/// The columns one saver writes (wall_force x, y, z; broken_bonds one per failure mode; else one).
+std::vector<std::string> field_columns(const FieldSpec& f);
 
 }  // namespace basalt::solver

@@ -3,6 +3,7 @@
 // or steps until a condition holds. basalt-run (and basalt.Simulation.run_stages) runs the stages in order
 // (solver/stages.hpp).
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -23,7 +24,9 @@ struct StageSpec {
   std::optional<double> time_above;  ///< or: the run's time reaches this (the time since the run began)
   std::string wall;                  ///< or: the force on this wall (summed over ranks) along `axis`
   int axis = 2;
-  std::optional<double> force_above, force_below;
+  std::string saver;                   ///< or: this column of fields.csv, as its saver computes it
+  std::size_t saver_column = 0;        ///< its index in field_columns(scene)
+  std::optional<double> above, below;  ///< wall_force and saver: the value passes above or below this
 
   // The changes at its start.
   std::vector<std::string> remove_walls;
