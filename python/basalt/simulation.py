@@ -270,6 +270,19 @@ class Simulation:
         set_body_force("gravity0", acceleration=(0, 0, -2.0)). Keys not given take their defaults."""
         self._core.set_body_force(name, "\n".join(f"{k} = {_toml_value(v)}" for k, v in keys.items()))
 
+    @property
+    def contacts(self):
+        """The scene's contact groups ([[interactions]] of a pair model): {name: model}, e.g. {"grains": "rot_friction"}
+        (an unnamed group is "contacts<k>", k its index in [[interactions]])."""
+        return dict(self._core.contacts())
+
+    def set_contact(self, name, **keys):
+        """Collective: new parameters for a contact group from now on, checked as the scene's (docs/scenes.md):
+        set_contact("grains", K=1000.0, Ks=500.0, mu=0.2). Keys not given take their defaults; the group's tags
+        and its contacts' history stay. Refused (nothing changed) when the new parameters make dt unstable or
+        reach further than the lists were built for."""
+        self._core.set_contact(name, self._keys_text(keys))
+
     def set_gravity(self, acceleration):
         """The scene's gravity (its one gravity group) from now on: set_gravity((0, 0, -9.81e-3))."""
         names = [n for n, m in self.body_forces.items() if m == "gravity"]

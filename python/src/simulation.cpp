@@ -118,6 +118,8 @@ class Run {
   virtual void remove_wall(const std::string& name) = 0;
   virtual void set_body_force(const std::string& name, const std::string& keys) = 0;
   virtual py::list body_forces() const = 0;
+  virtual void set_contact(const std::string& name, const std::string& keys) = 0;
+  virtual py::list contacts() const = 0;
   virtual void state_changed() = 0;
   /// Particles in and out now (keys: the TOML of an [[insert]] / [[delete]] table); how many.
   virtual std::int64_t insert(const std::string& keys) = 0;
@@ -199,6 +201,14 @@ class RunOf final : public Run {
   void remove_wall(const std::string& name) override { sim_->remove_wall(name); }
   void set_body_force(const std::string& name, const std::string& keys) override {
     sim_->set_body_force(name, keys);
+  }
+  void set_contact(const std::string& name, const std::string& keys) override {
+    sim_->set_contact(name, keys);
+  }
+  py::list contacts() const override {
+    py::list l;
+    for (const auto& g : scene_.contacts) l.append(py::make_tuple(g.name, g.model));
+    return l;
   }
   py::list body_forces() const override {
     py::list l;
@@ -578,6 +588,9 @@ void bind_simulation(py::module_& m) {
       .def("set_body_force", [](PySimulation& s, const std::string& name,
                                 const std::string& keys) { s.run().set_body_force(name, keys); })
       .def("body_forces", [](PySimulation& s) { return s.run().body_forces(); })
+      .def("set_contact", [](PySimulation& s, const std::string& name,
+                             const std::string& keys) { s.run().set_contact(name, keys); })
+      .def("contacts", [](PySimulation& s) { return s.run().contacts(); })
       .def("insert", [](PySimulation& s, const std::string& keys) { return s.run().insert(keys); })
       .def("delete", [](PySimulation& s, const std::string& keys) { return s.run().remove(keys); })
       .def("bond_count", [](PySimulation& s) { return s.run().bond_count(); })

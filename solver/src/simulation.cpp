@@ -383,6 +383,20 @@ void Simulation<Real>::remove_wall(std::string_view name) {
   force_rebuild();
 }
 
+namespace {
+
+/// The TOML text of a group's keys given from a script (set_body_force, set_contact); InputError naming the
+/// group when it does not parse.
+toml::table parse_group_keys(const std::string& keys, const std::string& label) {
+  try {
+    return toml::parse(keys, label);
+  } catch (const toml::parse_error& e) {
+    throw InputError(fmt::format("{}: {}", label, e.description()));
+  }
+}
+
+}  // namespace
+
 template <class Real>
 void Simulation<Real>::set_body_force(std::string_view name, const std::string& keys) {
   auto it = std::find_if(scene_.body_forces.begin(), scene_.body_forces.end(),
@@ -395,12 +409,7 @@ void Simulation<Real>::set_body_force(std::string_view name, const std::string& 
   }
   InteractionSpec spec = *it;
   const std::string label = fmt::format("body_forces \"{}\"", name);
-  toml::table table;
-  try {
-    table = toml::parse(keys, label);
-  } catch (const toml::parse_error& e) {
-    throw InputError(fmt::format("{}: {}", label, e.description()));
-  }
+  const toml::table table = parse_group_keys(keys, label);
   TableReader t(table, label, std::string(name));
   spec.params = find_model(spec.model, ModelKind::body)->parse(t);
   spec.tags = t.integers_or("tags", {});
@@ -412,6 +421,59 @@ void Simulation<Real>::set_body_force(std::string_view name, const std::string& 
       return;
     }
   throw InputError(fmt::format("{}: no force compute took it (a bug)", label));
+}
+
+template <class Real>
+void Simulation<Real>::set_contact(std::string_view name, const std::string& keys) {
+  auto it = std::find_if(scene_.contacts.begin(), scene_.contacts.end(),
+                         [&](const InteractionSpec& g) { return g.name == name; });
+  if (it == scene_.contacts.end()) {
+    const bool bond = std::any_of(scene_.bonds.begin(), scene_.bonds.end(),
+                                  [&](const InteractionSpec& g) { return g.name == name; });
+    std::string names;
+    for (const auto& g : scene_.contacts) names += (names.empty() ? "" : ", ") + g.name;
+    throw InputError(
+        fmt::format("no contact group named \"{}\"{} (the scene's contact groups: {})", name,
+                    bond ? ": it is a bond group, and bonds keep the parameters they were made with" : "",
+                    names.empty() ? "none" : names));
+  }
+  const std::string label = fmt::format("interactions \"{}\"", name);
+  const toml::table table = parse_group_keys(keys, label);
+  TableReader t(table, label, std::string(name));
+  InteractionSpec spec = *it;
+  spec.params = find_model(spec.model, ModelKind::pair)->parse(t);
+  t.finish();  // (no tags key: which pairs a group takes is fixed at the start)
+  const InteractionSpec before = *it;
+  const StabilityReport stability = stability_;
+  const auto take = [&](const InteractionSpec& g) {
+    for (const auto& c : forces_.computes())
+      if (c->reconfigure(g)) return;
+    throw InputError(fmt::format("{}: no force compute took it (a bug)", label));
+  };
+  take(spec);
+  // The lists were built for the reach the scene's models had at the start (contact_cutoff_).
+  const double reach = forces_.pair_reach(rmax_run_);
+  if (2 * rmax_run_ + reach + scene_.skin > contact_cutoff_ * (1 + 1e-12)) {
+    take(before);
+    throw InputError(
+        fmt::format("{}: the new parameters reach {:.6g} beyond touching, further than the lists were built "
+                    "for ({:.6g}): "
+                    "give the scene the far-reaching parameters from the start and weaken them here instead",
+                    label, reach, contact_cutoff_ - 2 * rmax_run_ - scene_.skin));
+  }
+  // A stiffer contact shortens the critical step: the network's estimate again, refused as at the start.
+  try {
+    stability_.dt_contact = contact_critical_step(stability_.m_min, rmax_run_);
+    stability_.k_max = forces_.max_stiffness(rmax_run_);
+    estimate_critical_step(false);
+  } catch (const InputError& e) {
+    take(before);
+    stability_ = stability;
+    compute_forces<false>();  // (the estimate used the force arrays as scratch)
+    throw InputError(fmt::format("{}: {}", label, e.what()));
+  }
+  *it = spec;
+  state_changed();
 }
 
 template <class Real>

@@ -28,6 +28,11 @@ void Simulation<Real>::check_stability(const GeometrySummary& given) {
   stability_.k_max = forces_.max_stiffness(rmax);
   stability_.rmin = rmin;
   stability_.dt_pair = stability::critical_step(stability_.k_max / m_min);
+  stability_.dt_contact = contact_critical_step(m_min, rmax);
+}
+
+template <class Real>
+double Simulation<Real>::contact_critical_step(double m_min, double rmax) const {
   // A contact that forms later, between two of the lightest particles (omega^2 = 2 k / m_min) or one
   // and a wall (k / m_min): the network at the start does not have it.
   double future2 = 0;
@@ -35,7 +40,7 @@ void Simulation<Real>::check_stability(const GeometrySummary& given) {
     if (c->kind() == ModelKind::pair) future2 = std::max(future2, 2 * c->max_stiffness(rmax) / m_min);
     if (c->kind() == ModelKind::wall) future2 = std::max(future2, c->max_stiffness(rmax) / m_min);
   }
-  stability_.dt_contact = stability::critical_step(future2);
+  return stability::critical_step(future2);
 }
 
 template <class Real>
@@ -567,6 +572,7 @@ std::optional<std::string> Simulation<Real>::check_frame_state() const {
   template std::optional<std::string> Simulation<R>::check_frame_state() const; \
   template void Simulation<R>::check_stability(const GeometrySummary&);         \
   template void Simulation<R>::estimate_critical_step(bool);                    \
+  template double Simulation<R>::contact_critical_step(double, double) const;   \
   template void Simulation<R>::check_blowup();                                  \
   template std::optional<std::string> Simulation<R>::blocked_path(std::vector<double>&, bool) const;
 BASALT_INSTANTIATE(double)

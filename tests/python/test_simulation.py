@@ -154,6 +154,15 @@ def test_views_and_steering(tmp_path):
         sim.set_body_force("gravity0", acceleration=(0, 0, -1), speed=3)
     with pytest.raises(basalt.InputError, match="no body force named"):
         sim.set_body_force("nope", acceleration=(0, 0, -1))
+    # contact groups: new parameters from now on; an unstable stiffness refused, naming the group
+    assert sim.contacts == {"contacts0": "rot_friction"}
+    e = sim.energies()["contact_potential_energy"]
+    sim.set_contact("contacts0", K=1000.0, Ks=500.0, mu=0.1, mu_dynamic=0.1)
+    with pytest.raises(basalt.InputError, match='interactions "contacts0".*critical time step'):
+        sim.set_contact("contacts0", K=1e12, Ks=500.0, mu=0.1)
+    with pytest.raises(basalt.InputError, match="contact groups: contacts0"):
+        sim.set_contact("grains", K=1.0)
+    assert sim.energies()["contact_potential_energy"] == e  # normal energy: K unchanged
     vz = sim.particles.vz
     vz[:] = 0.0
     vz[0] = 5.0

@@ -349,6 +349,45 @@ TEST(Stages, BadStagesNameTheKey) {
                "multiple of the saver's every = 10");
 }
 
+TEST(Steering, AContactGroupTakesNewParametersAndRefusesAnUnstableOne) {
+  // set_contact: a linear elastic pile (E = K overlap^2 / 2 per contact) settles for a while; tripling K at
+  // fixed positions triples the contact energy at once; a K that makes dt unstable is refused and leaves
+  // the old K in place.
+  std::string text = pile_scene("dt = 2e-3");
+  const auto from = text.find("[[interactions]]"), to = text.find("[[walls]]");
+  text.replace(from, to - from,
+               "[[interactions]]\nname = \"grains\"\ntype = \"linear_elastic\"\nK = 1000.0\n");
+  Simulation<double> sim(basalt::test::scene_from(text), pile(), MPI_COMM_WORLD, basalt::test::quiet());
+  FieldRows rows(sim.comm(), nullptr);
+  sim.run(300, rows);
+  const double e1 = sim.energies()[2];
+  ASSERT_GT(e1, 0.0);
+  sim.set_contact("grains", "K = 3000.0");
+  const double e3 = sim.energies()[2];
+  EXPECT_NEAR(e3, 3 * e1, 1e-12 * e3);
+  try {
+    sim.set_contact("grains", "K = 1e9");
+    ADD_FAILURE() << "an unstable K was taken";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("interactions \"grains\""), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("critical time step"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(sim.energies()[2], e3);  // the K of before
+  const auto expect_error = [&](const std::string& name, const std::string& keys, const std::string& needle) {
+    try {
+      sim.set_contact(name, keys);
+      ADD_FAILURE() << "no error for " << name << ": " << keys;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+    }
+  };
+  expect_error("sand", "K = 1.0", "contact groups: grains");
+  expect_error("grains", "K = 1.0\nQ = 2.0", "Q");
+  expect_error("grains", "K = -1.0", "K");
+  sim.run(100, rows);  // and the run goes on with K = 3000
+  EXPECT_TRUE(std::isfinite(sim.kinetic_energy()));
+}
+
 TEST(Steering, GravityChangedMidRunMovesTheCentreOfMassByTheNewAcceleration) {
   // In free fall (the floor taken away) the contacts cancel in the momentum: the centre of mass's vertical
   // velocity changes by g t, with the new g from the step it is set.

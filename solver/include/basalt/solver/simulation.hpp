@@ -206,6 +206,12 @@ class Simulation {
   /// 0.0, -2.0]"), checked as the scene's are; keys not given take their defaults, tags included. Recomputes
   /// the forces and the energy guard's reference (a changed potential is not a change of energy).
   void set_body_force(std::string_view name, const std::string& keys);
+  /// New parameters for the contact group `name` (a pair model of [[interactions]]; TOML text of its keys,
+  /// e.g. "mu = 0.2"), checked as the scene's are; keys not given take their defaults; its tags stay. The
+  /// contacts keep their history. Refused (InputError, nothing changed) when the new parameters reach further
+  /// than the lists were built for, or make dt exceed the network's new critical step (unless forced).
+  /// Recomputes the forces and the energy guard's reference.
+  void set_contact(std::string_view name, const std::string& keys);
   // Particles entering and leaving (simulation_flow.cpp; the scene's [[insert]] and [[delete]] events happen
   // as a step begins): collective, called alike on every rank.
   /// Inserts up to spec.count particles now where they overlap nothing (candidates keyed by spec.seed and
@@ -288,6 +294,9 @@ class Simulation {
   double term_value(std::size_t t, const std::vector<double>& pe) const;
   void progress(std::int64_t done, std::int64_t total, double seconds) const;
   void check_stability(const GeometrySummary& s);
+  /// The critical step of one new contact of the lightest particle (mass m_min, radius up to rmax) with
+  /// another or with a wall, by the models' stiffness now.
+  double contact_critical_step(double m_min, double rmax) const;
   /// Collective, after the first rebuild (simulation_stability.cpp): the network's critical step, dt
   /// from run.dt_fraction (fresh starts), and the refusal above it unless forced.
   void estimate_critical_step(bool fresh);

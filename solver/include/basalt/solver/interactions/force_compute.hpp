@@ -79,8 +79,9 @@ class ForceCompute {
   virtual std::size_t sliding_contacts() const { return 0; }
   /// The run's time step (models that integrate over a step: tangential springs, damping).
   virtual void set_time_step(double) {}
-  /// Takes new parameters and tags for its group named g.name (between steps: a body force changed by a
-  /// script); false when it has no group of that name. Body forces only so far.
+  /// Takes new parameters for its group named g.name (between steps: a body force or a contact model changed
+  /// by a script; a body force takes its tags too); false when it has no group of that name. Body and pair
+  /// models.
   virtual bool reconfigure(const InteractionSpec& /*g*/) { return false; }
   /// Largest spring constant for particles up to radius rmax (critical time step).
   virtual double max_stiffness(double rmax) const = 0;

@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <cstring>
 #include <initializer_list>
+#include <string>
 #include <string_view>
 #include <type_traits>
 #include <vector>
@@ -69,9 +70,22 @@ class PairDriver final : public ForceCompute<Real> {
       params_.push_back(g.template params_of<Model>());
       coeffs_.push_back(Model::template coeffs<Real>(params_.back()));
       tags_.push_back(g.tags);
+      names_.push_back(g.name);
     }
     uniform_ = tags_.size() == 1 && tags_[0].empty();
     pending_.width = history_width<Model>();
+  }
+
+  /// New parameters for the group g.name (its tags stay: the lists' split among models is the rebuild's).
+  /// Contact histories stay as they are: the model reads them with the new parameters from the next step.
+  bool reconfigure(const InteractionSpec& g) override {
+    for (std::size_t k = 0; k < names_.size(); ++k)
+      if (names_[k] == g.name && g.model == Model::name) {
+        params_[k] = g.template params_of<Model>();
+        coeffs_[k] = Model::template coeffs<Real>(params_[k]);
+        return true;
+      }
+    return false;
   }
 
   std::string_view model() const override { return Model::name; }
@@ -768,6 +782,7 @@ class PairDriver final : public ForceCompute<Real> {
   std::vector<typename Model::Params> params_;
   std::vector<Coeffs> coeffs_;
   std::vector<TagFilter> tags_;
+  std::vector<std::string> names_;  ///< each group's name (reconfigure)
   bool uniform_ = false;
   const PairList* own_ = nullptr;
   const PairList* ghost_ = nullptr;
