@@ -79,6 +79,7 @@ def parse_args(argv):
     p.add_argument("-o", "--out", help="the study's folder (default study-<scene name>)")
     p.add_argument("--np", type=int, default=1, help="compute ranks per run (default 1)")
     p.add_argument("--rows", type=int, default=1000, help="field rows saved over the window (default 1000)")
+    p.add_argument("--no-plot", action="store_true", help="no study.png (matplotlib is not imported)")
     p.add_argument("--bin", help="folder of basalt-run (default build/bin of the checkout)")
     return p.parse_args(argv)
 
@@ -169,8 +170,11 @@ class Study:
         return path
 
     def probe(self, folder, scene_file, precision):
-        """basalt-run for one step: the dt, critical step and particles of a setting, the fields' columns."""
-        out = os.path.join(folder, "probe")
+        """basalt-run for one step: the dt, critical step and particles of a setting, the fields' columns.
+        Kept in FOLDER/probe.json (the study's plan.json vouches for the scene and geometry)."""
+        out, kept = os.path.join(folder, "probe"), os.path.join(folder, "probe.json")
+        if os.path.exists(kept):
+            return load_json(kept), None
         p = bt.run(self.command(scene_file, out, precision, 1, 1), check=False, env=self.env)
         info = bt.parse_run(p.stdout)
         if p.returncode != 0 or "dt" not in info:
@@ -178,6 +182,7 @@ class Study:
         with open(os.path.join(out, "fields.csv")) as f:
             info["columns"] = f.readline().strip().split(",")
         info["checkpoint"] = bt.last_checkpoint(out)
+        rep.write_json(kept, info)
         return info, None
 
     def run(self, run, k, total):
@@ -188,9 +193,12 @@ class Study:
             return load_json(done)
         geometry = self.members[run.get("member", 0)]
         scene_file = self.write_scene(folder, run["setting"], geometry, run.get("fixed_dt"))
-        info, err = self.probe(folder, scene_file, run["setting"]["precision"])
-        if info is None:
-            return self.finish(done, run, status="failed", message=err)
+        if run.get("fixed_dt"):  # an ensemble member: the reference's dt and particles, no probe needed
+            info = {"dt": run["fixed_dt"], "particles": run["particles"]}
+        else:
+            info, err = self.probe(folder, scene_file, run["setting"]["precision"])
+            if info is None:
+                return self.finish(done, run, status="failed", message=err)
         dt = info["dt"]
         every = max(1, round(self.t_end / (dt * self.a.rows)))
         steps = every * math.ceil(self.t_end / (dt * every) - 1e-9)
@@ -316,7 +324,8 @@ class Study:
         for k, run in enumerate(runs, 1):
             before = self.work_done
             if run["kind"] == "ensemble":
-                run["fixed_dt"] = finished[0]["dt"]  # the reference's step: members differ by the nudge alone
+                # the reference's step: members differ by the nudge alone
+                run.update(fixed_dt=finished[0]["dt"], particles=finished[0]["particles"])
             finished.append(self.run(run, k, len(runs)))
             self.runs_timed += self.work_done > before
             if run["kind"] == "reference" and finished[-1]["status"] != "ok":
@@ -340,7 +349,8 @@ class Study:
                        {"scene": os.path.abspath(self.scene_path), "window": [self.a.window_start, self.t_end],
                         "quantities": specs, "spread": spreads, "host": cpu_name(), "budget": self.a.budget,
                         "cheapest": best["key"] if best else None, "runs": runs}, strict=True)
-        rep.plot(runs, specs, spreads, ref, os.path.join(self.out, "study.png"))
+        if not self.a.no_plot:
+            rep.plot(runs, specs, spreads, ref, os.path.join(self.out, "study.png"))
         print(text)
         if best:
             with open(os.path.join(self.out, "setting.toml"), "w") as f:
@@ -349,7 +359,7 @@ class Study:
                      f"({best['speedup']:.2f}x the reference's speed); {self.out}/setting.toml")
         elif self.a.budget is not None:
             self.say(f"no setting is within --budget {self.a.budget:g}")
-        self.say(f"wrote {self.out}/table.md, study.json, study.png")
+        self.say(f"wrote {self.out}/table.md, study.json" + ("" if self.a.no_plot else ", study.png"))
 
 
 def failure(p):
