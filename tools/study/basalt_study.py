@@ -313,6 +313,10 @@ class Study:
                 runs.append({"key": f"{prec}-dtf{frac:g}-k{k:g}-skin{skin:g}", "kind": "setting", "setting": s})
         if any(r["setting"]["stiffness"] != 1 for r in runs):
             so.apply(self.scene, stiffness=0.5, scene_path=self.scene_path)  # a scene without contacts says so
+        for section in ("insert", "delete"):
+            if self.scene.get(section):
+                self.say(f"warning: {section}: its events count steps, so a setting with another dt has them at "
+                         "other times")
         self.say(f"{self.scene_path}: {info['particles']} particles, window t = 0 .. {self.t_end:g} "
                  f"({steps or '-'} steps of the scene's dt = {info['dt']:.4g}); {len(runs)} runs into {self.out}")
         return runs

@@ -89,7 +89,8 @@ def markdown(runs, specs, spreads, ref, budget=None, best=None, cpu=""):
         s = r["setting"]
         head = f"| {r['key']} | {s['precision']} | {s['dt_fraction']:g} | {s['stiffness']:g} | {s['skin']:g} |"
         if r["status"] != "ok":
-            out.append(head + f" | | {r['message']} |" + " |" * (len(specs) + 4))
+            msg = r["message"] if len(r["message"]) <= 110 else r["message"][:107] + "..."
+            out.append(head + f" | | {msg.replace('|', '/')} |" + " |" * (len(specs) + 4))
             continue
         errs = " | ".join(_err(r, q) for q in specs)
         mark = "yes" if r.get("pareto") else ""
