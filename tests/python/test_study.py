@@ -6,8 +6,6 @@ second call resumes without running again, and bad input stops with exit status 
 The modules' own pieces (scene overrides, TOML writer, quantities, the perturbation) are tested directly.
 """
 import json
-import os
-import pathlib
 import sys
 import tomllib
 

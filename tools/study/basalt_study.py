@@ -265,8 +265,8 @@ class Study:
             old = load_json(plan)
             changed = [k for k in ident if old.get(k) != ident[k]]
             if changed:
-                raise StudyError(f"{self.out}: a study of another scene or window is in this folder ({', '.join(changed)} "
-                                 "changed): give another --out, or remove the folder")
+                raise StudyError(f"{self.out}: a study of another scene or window is in this folder "
+                                 f"({', '.join(changed)} changed): give another --out, or remove the folder")
         rep.write_json(plan, ident)
         self.members = []
         for m in range(self.a.ensemble + 1):

@@ -83,21 +83,22 @@ def markdown(runs, specs, spreads, ref, budget=None, best=None, cpu=""):
         out += [f"Host: {cpu}. Speed-up: the reference's CPU seconds per simulated time unit over the setting's, "
                 "both measured in this study.", ""]
     out.append(f"| run | precision | dt fraction | stiffness | skin | dt | steps | {q_heads} | max error | "
-               "speed-up | M particle-steps/s | RSS B/particle | Pareto |")
-    out.append("|" + " --- |" * (12 + len(specs)))
+               "speed-up | simulated time per CPU s | M particle-steps/s | RSS B/particle | Pareto |")
+    out.append("|" + " --- |" * (13 + len(specs)))
     for r in runs:
         s = r["setting"]
         head = f"| {r['key']} | {s['precision']} | {s['dt_fraction']:g} | {s['stiffness']:g} | {s['skin']:g} |"
         if r["status"] != "ok":
             msg = r["message"] if len(r["message"]) <= 110 else r["message"][:107] + "..."
-            out.append(head + f" | | {msg.replace('|', '/')} |" + " |" * (len(specs) + 4))
+            out.append(head + f" | | {msg.replace('|', '/')} |" + " |" * (len(specs) + 5))
             continue
         errs = " | ".join(_err(r, q) for q in specs)
         mark = "yes" if r.get("pareto") else ""
         if best is r:
             mark += " **cheapest within budget**"
         out.append(head + f" {r['dt']:.4g} | {r['steps']} | {errs} | {r['max_error']:.2e} | {r['speedup']:.2f} | "
-                   f"{r['particle_steps_per_s'] / 1e6:.2f} | {r['rss_bytes_per_particle']:.0f} | {mark} |")
+                   f"{r['sim_time_per_cpu_s']:.3g} | {r['particle_steps_per_s'] / 1e6:.2f} | "
+                   f"{r['rss_bytes_per_particle']:.0f} | {mark} |")
     if budget is not None:
         out += ["", f"Budget {budget:g}: " + (f"the cheapest setting within it is **{best['key']}** ({label(best)}), "
                                               f"{best['speedup']:.2f}x the reference's speed." if best else
