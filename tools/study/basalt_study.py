@@ -191,6 +191,7 @@ class Study:
         if os.path.exists(done):
             self.say(f"[{k}/{total}] {run['key']}: finished earlier, kept ({done})")
             return load_json(done)
+        begun = time.time()  # the probe's time too, for the ETA
         geometry = self.members[run.get("member", 0)]
         scene_file = self.write_scene(folder, run["setting"], geometry, run.get("fixed_dt"))
         if run.get("fixed_dt"):  # an ensemble member: the reference's dt and particles, no probe needed
@@ -211,7 +212,7 @@ class Study:
         p = bt.run(self.command(scene_file, out, run["setting"]["precision"], steps, every), check=False,
                    env=self.env)
         wall = time.time() - start
-        self.spent += wall
+        self.spent += time.time() - begun
         self.work_done += steps * info["particles"]
         x, tv = bt.parse_run(p.stdout), bt.parse_time_v(p.stderr)
         if p.returncode != 0 or "cpu_s" not in x:
