@@ -123,39 +123,53 @@ def fragment(best, scene, scene_path, budget):
 
 
 def plot(runs, specs, spreads, ref, path):
-    """study.png: per quantity, relative error against speed-up, the ensemble spread as a band."""
+    """study.png: per quantity, relative error against speed-up; colour the stiffness scale, marker the precision,
+    size the dt fraction; the ensemble's spread as a grey band (below it: inside the noise)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     ok = [r for r in runs if r["status"] == "ok" and r["kind"] == "setting"]
-    stiff = sorted({r["setting"]["stiffness"] for r in ok}) or [1.0]
-    cmap = plt.get_cmap("viridis")
-    colour = {k: cmap(i / max(1, len(stiff) - 1)) for i, k in enumerate(stiff)}
+    stiff = sorted({r["setting"]["stiffness"] for r in ok}, reverse=True) or [1.0]
+    fracs = sorted({r["setting"]["dt_fraction"] for r in ok}) or [1.0]
+    colour = {k: plt.get_cmap("tab10")(i % 10) for i, k in enumerate(stiff)}
+    size = {f: 18 + 60 * i / max(1, len(fracs) - 1) for i, f in enumerate(fracs)}
     markers = {"double": "o", "float": "s", "mixed": "^"}
     n = max(1, len(specs))
-    fig, axes = plt.subplots(1, n, figsize=(5.5 * n, 4.2), squeeze=False)
-    floor = 1e-12
-    for ax, s in zip(axes[0], specs):
+    cols = min(2, n)
+    rows = (n + cols - 1) // cols
+    fig, axes = plt.subplots(rows, cols, figsize=(6.2 * cols, 4.4 * rows), squeeze=False)
+    for ax in axes.flat[n:]:
+        ax.set_visible(False)
+    for ax, s in zip(axes.flat, specs):
         q0 = ref["quantities"][s]
         rel_spread = spreads[s] / abs(q0) if q0 else spreads[s]
+        errs = [r["errors"][s] for r in ok if r["errors"][s] > 0] + ([rel_spread] if rel_spread > 0 else [])
+        low = min(errs) / 3 if errs else 1e-12
         for r in ok:
-            ax.scatter(r["speedup"], max(r["errors"][s], floor), marker=markers.get(r["setting"]["precision"], "x"),
-                       color=colour[r["setting"]["stiffness"]], edgecolors="k", linewidths=0.4, s=36)
+            st = r["setting"]
+            ax.scatter(r["speedup"], max(r["errors"][s], low), marker=markers.get(st["precision"], "x"),
+                       color=colour[st["stiffness"]], edgecolors="k", linewidths=0.4, s=size[st["dt_fraction"]])
         if rel_spread > 0:
-            ax.axhspan(floor, rel_spread, color="0.85", zorder=0, label="inside the ensemble spread")
+            ax.axhspan(low, rel_spread, color="0.88", zorder=0)
+            ax.axhline(rel_spread, color="0.5", lw=0.8, zorder=0)
         ax.set_xscale("log")
         ax.set_yscale("log")
+        ax.set_ylim(bottom=low)
         ax.set_xlabel("speed-up against the reference (CPU time per simulated time)")
         ax.set_ylabel("relative error")
         ax.set_title(s, fontsize=9)
+    first = axes.flat[0]
+    first.fill_between([], [], color="0.88", label="inside the ensemble spread")
     for k in stiff:
-        axes[0][0].scatter([], [], color=colour[k], label=f"stiffness x {k:g}")
+        first.scatter([], [], color=colour[k], label=f"stiffness x {k:g}")
     for p, m in markers.items():
         if any(r["setting"]["precision"] == p for r in ok):
-            axes[0][0].scatter([], [], marker=m, color="w", edgecolors="k", label=p)
-    axes[0][0].legend(fontsize=7)
+            first.scatter([], [], marker=m, color="w", edgecolors="k", label=p)
+    first.scatter([], [], marker="o", color="w", edgecolors="k", s=size[fracs[0]], label=f"dt fraction {fracs[0]:g}")
+    first.scatter([], [], marker="o", color="w", edgecolors="k", s=size[fracs[-1]], label=f"dt fraction {fracs[-1]:g}")
+    first.legend(fontsize=7)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    fig.savefig(path, dpi=100)
     plt.close(fig)
 
 
