@@ -111,8 +111,8 @@ def fragment(best, scene, scene_path, budget):
     import scene_overrides as so
     s = best["setting"]
     lines = [f"# basalt-study of {scene_path}: the cheapest setting within --budget {budget:g}",
-             f"# (largest error {best['max_error']:.2e}; {best['speedup']:.2f}x the reference's speed). Paste into "
-             "the scene:", "[run]", f'precision = "{s["precision"]}"',
+             f"# (every error within it or inside the ensemble's spread; largest {best['max_error']:.2e}; "
+             f"{best['speedup']:.2f}x the reference's speed). Paste into the scene:", "[run]", f'precision = "{s["precision"]}"',
              f"dt_fraction = {s['dt_fraction']!r}   # replaces run.dt", f"skin = {s['skin']!r}"]
     if s["stiffness"] != 1:
         lines.append(f"# contact stiffness x {s['stiffness']:g}: set these keys")
