@@ -268,3 +268,34 @@ def test_perturbed_members_move_by_the_nudge_alone(pile, tmp_path):
     assert d.min() > 0.5e-9 and d.max() < 1.5e-9
     for key in ("id", "radius", "tag"):
         assert np.array_equal(m1.particles[key], base.particles[key])
+
+
+def test_errors_spread_pareto_and_budget_on_made_up_runs():
+    import study_report
+
+    def r(key, kind, q, cpu, k=1.0):
+        return {"key": key, "kind": kind, "status": "ok", "quantities": {"q": q}, "cpu_s": cpu, "ranks": 1,
+                "sim_time": 1.0, "setting": {"precision": "double", "dt_fraction": 0.1, "stiffness": k, "skin": 0.1},
+                "dt": 0.1, "steps": 10, "sim_time_per_cpu_s": 1 / cpu, "particle_steps_per_s": 1e6,
+                "rss_bytes_per_particle": 1e3}
+
+    runs = [r("reference", "reference", 10.0, 8.0), r("ensemble1", "ensemble", 10.01, 8.0),
+            r("ensemble2", "ensemble", 9.98, 8.0), r("a", "setting", 10.015, 4.0),   # inside the noise
+            r("b", "setting", 10.5, 1.0, k=0.1), r("c", "setting", 10.5, 2.0),       # c: dominated by b
+            {"key": "d", "kind": "setting", "status": "failed", "message": "blow-up",
+             "setting": {"precision": "float", "dt_fraction": 1.0, "stiffness": 1.0, "skin": 0.1}}]
+    ref, spreads = study_report.evaluate(runs, ["q"])
+    assert spreads["q"] == pytest.approx(0.02)
+    a, b, c = runs[3], runs[4], runs[5]
+    assert a["errors"]["q"] == pytest.approx(1.5e-3) and a["noise"]["q"] == pytest.approx(0.75)
+    assert b["errors"]["q"] == pytest.approx(0.05) and b["noise"]["q"] == pytest.approx(25)
+    assert b["speedup"] == 8.0 and ref["speedup"] == 1.0
+    table = [x for x in runs if x["kind"] != "ensemble"]
+    study_report.pareto(table)
+    assert [x["key"] for x in table if x.get("pareto")] == ["reference", "a", "b"]
+    assert study_report.cheapest(table, 1e-4)["key"] == "a"      # above the budget, but inside the noise
+    assert study_report.cheapest(table, 0.1)["key"] == "b"
+    text = study_report.markdown(runs, ["q"], spreads, ref, 0.1, b)
+    assert "| d |" in text and "blow-up" in text and "**cheapest within budget**" in text
+    fragment = study_report.fragment(b, tomllib.loads(SCENE), "scene.toml", 0.1)
+    assert 'interactions[0] "grains": K = 200.0' in fragment and 'walls[3] "side_yW": K = 200.0' in fragment
