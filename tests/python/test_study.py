@@ -286,7 +286,7 @@ def test_errors_spread_pareto_and_budget_on_made_up_runs():
              "setting": {"precision": "float", "dt_fraction": 1.0, "stiffness": 1.0, "skin": 0.1}}]
     ref, spreads = study_report.evaluate(runs, ["q"])
     assert spreads["q"] == pytest.approx(0.02)
-    a, b, c = runs[3], runs[4], runs[5]
+    a, b = runs[3], runs[4]
     assert a["errors"]["q"] == pytest.approx(1.5e-3) and a["noise"]["q"] == pytest.approx(0.75)
     assert b["errors"]["q"] == pytest.approx(0.05) and b["noise"]["q"] == pytest.approx(25)
     assert b["speedup"] == 8.0 and ref["speedup"] == 1.0
