@@ -174,7 +174,9 @@ class Study:
         Kept in FOLDER/probe.json (the study's plan.json vouches for the scene and geometry)."""
         out, kept = os.path.join(folder, "probe"), os.path.join(folder, "probe.json")
         if os.path.exists(kept):
-            return load_json(kept), None
+            info = load_json(kept)
+            if info.get("checkpoint") is None or os.path.exists(info["checkpoint"]):  # not a moved folder
+                return info, None
         p = bt.run(self.command(scene_file, out, precision, 1, 1), check=False, env=self.env)
         info = bt.parse_run(p.stdout)
         if p.returncode != 0 or "dt" not in info:
