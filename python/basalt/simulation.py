@@ -109,6 +109,11 @@ class Wall:
     def normal(self):
         return self._state()["normal"]
 
+    @property
+    def active(self):
+        """Whether it touches particles (False for a wall removed, or declared with active = false)."""
+        return not self._state()["removed"]
+
     def set_velocity(self, v):
         """Move at velocity v (3 numbers) from now on, from where the wall is."""
         self._sim._core.set_wall_velocity(self.name, [float(c) for c in v])
@@ -119,6 +124,11 @@ class Wall:
     def remove(self):
         """The wall touches no particle from now on (a gate taken away)."""
         self._sim._core.remove_wall(self.name)
+
+    def add(self):
+        """Collective: the wall touches particles from now on (one the scene declares with active = false, or one
+        removed). Refused (basalt.InputError) when a particle's centre is behind it."""
+        self._sim._core.add_wall(self.name)
 
     def __repr__(self):
         s = self._state()

@@ -116,6 +116,7 @@ class Run {
   virtual void set_fixed_tags(std::vector<std::int64_t> tags) = 0;
   virtual void set_wall_velocity(const std::string& name, const std::array<double, 3>& v) = 0;
   virtual void remove_wall(const std::string& name) = 0;
+  virtual void add_wall(const std::string& name) = 0;
   virtual void set_body_force(const std::string& name, const std::string& keys) = 0;
   virtual py::list body_forces() const = 0;
   virtual void set_contact(const std::string& name, const std::string& keys) = 0;
@@ -199,6 +200,7 @@ class RunOf final : public Run {
     sim_->set_wall_velocity(name, v);
   }
   void remove_wall(const std::string& name) override { sim_->remove_wall(name); }
+  void add_wall(const std::string& name) override { sim_->add_wall(name); }
   void set_body_force(const std::string& name, const std::string& keys) override {
     sim_->set_body_force(name, keys);
   }
@@ -584,6 +586,7 @@ void bind_simulation(py::module_& m) {
       .def("set_wall_velocity", [](PySimulation& s, const std::string& name,
                                    std::array<double, 3> v) { s.run().set_wall_velocity(name, v); })
       .def("remove_wall", [](PySimulation& s, const std::string& name) { s.run().remove_wall(name); })
+      .def("add_wall", [](PySimulation& s, const std::string& name) { s.run().add_wall(name); })
       .def("state_changed", [](PySimulation& s) { s.run().state_changed(); })
       .def("set_body_force", [](PySimulation& s, const std::string& name,
                                 const std::string& keys) { s.run().set_body_force(name, keys); })

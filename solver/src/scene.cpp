@@ -323,6 +323,8 @@ Scene parse_scene_text(const std::string& text, const std::string& label, const 
         TableReader tm(*m, label, fmt::format("walls[{}].motion", k));
         w.motion = parse_motion(tm, w.normal);
       }
+      // A wall the run adds later (a stage's add_walls, Python's walls[name].add()): moves, touches nothing.
+      w.removed = !t.boolean_or("active", true);
       t.finish();
       s.walls.push_back(std::move(w));
     }

@@ -90,6 +90,11 @@ StageSpec parse_stage(TableReader& t, const std::vector<WallSpec>& walls,
       (void)find_wall(t, "remove_walls", walls, name);
       s.remove_walls.push_back(name);
     }
+  if (t.has("add_walls"))
+    for (const auto& name : t.strings_or("add_walls", {})) {
+      (void)find_wall(t, "add_walls", walls, name);
+      s.add_walls.push_back(name);
+    }
   if (const auto* v = t.subtable("wall_velocity")) {
     TableReader c(*v, t.file(), t.path() + ".wall_velocity");
     for (const auto& [key, node] : *v) {
@@ -169,6 +174,9 @@ void replay_stages(Scene& scene, const StageProgress& progress) {
     for (const auto& name : st.remove_walls)
       for (auto& w : scene.walls)
         if (w.name == name) w.removed = true;
+    for (const auto& name : st.add_walls)
+      for (auto& w : scene.walls)
+        if (w.name == name) w.removed = false;
     for (const auto& [name, v] : st.wall_velocity)
       for (auto& w : scene.walls) {
         if (w.name != name) continue;
@@ -210,6 +218,7 @@ std::int64_t run_stages(Simulation<Real>& sim, OutputSink& out, const std::vecto
     } else {
       progress.first_steps.push_back(sim.current_step());
       for (const auto& name : st.remove_walls) sim.remove_wall(name);
+      for (const auto& name : st.add_walls) sim.add_wall(name);
       for (const auto& [name, v] : st.wall_velocity) sim.set_wall_velocity(name, v);
       if (st.fixed_tags) sim.set_fixed_tags(*st.fixed_tags);
       if (st.dt > 0) {

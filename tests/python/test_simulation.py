@@ -135,6 +135,10 @@ def test_views_and_steering(tmp_path):
     sim.run(2000)
     assert sim.particles.x.max() > 6.5  # the pile runs out past where the gate was
     assert sim.walls["gate"].force == (0.0, 0.0, 0.0)
+    assert not sim.walls["gate"].active
+    with pytest.raises(basalt.InputError, match='wall "gate" cannot be added: .* behind it'):
+        sim.walls["gate"].add()  # the pile is past it now
+    assert not sim.walls["gate"].active
     # steering: a wall moves at the velocity it is given; dt; velocities written between steps
     floor = sim.walls["floor"]
     z0 = floor.position[2]

@@ -388,6 +388,60 @@ TEST(Steering, AContactGroupTakesNewParametersAndRefusesAnUnstableOne) {
   EXPECT_TRUE(std::isfinite(sim.kinetic_energy()));
 }
 
+TEST(Steering, AWallAddedMidRunCatchesTheFallingPileAndOneBehindParticlesIsRefused) {
+  // A stage takes the floor away and adds "catch" (active = false in the scene: the pile falls through it
+  // until then) 0.5 below the floor; the pile comes to rest on it. Adding "deep" (facing up at z = 3, the
+  // whole pile below it) is refused, naming a particle behind it.
+  const auto scene = basalt::test::scene_from(pile_scene("dt = 2e-3") + R"(
+[[walls]]
+name = "catch"
+point = [0.0, 0.0, -0.5]
+normal = [0.0, 0.0, 1.0]
+K = 1000.0
+active = false
+[[walls]]
+name = "deep"
+point = [0.0, 0.0, 3.0]
+normal = [0.0, 0.0, 1.0]
+K = 1000.0
+active = false
+[[body_forces]]
+type = "linear_damping"
+viscosity = 0.5
+[[stages]]
+name = "drop"
+remove_walls = ["floor"]
+steps = 400
+[[stages]]
+name = "catch"
+add_walls = ["catch"]
+steps = 4000
+)");
+  Simulation<double> sim(scene, pile(), MPI_COMM_WORLD, basalt::test::quiet());
+  EXPECT_TRUE(sim.walls().removed(sim.wall_index("catch")));
+  FieldRows rows(sim.comm(), nullptr);
+  std::vector<double> lowest;
+  run_stages(sim, rows, scene.stages,
+             [&](const StageSpec&, const StageReport&) { lowest.push_back(lowest_z(sim)); });
+  ASSERT_EQ(lowest.size(), 2u);
+  EXPECT_LT(lowest[0], 0.3);  // fell below the floor's place, still above the catch (its centre)
+  EXPECT_GT(lowest[0], -0.5);
+  EXPECT_FALSE(sim.walls().removed(sim.wall_index("catch")));
+  EXPECT_GT(lowest[1], -0.5);  // caught: resting on it, overlapping by a little
+  EXPECT_LT(lowest[1], 0.0);
+  double fz = sim.walls().force(sim.wall_index("catch"))[2];
+  if (sim.comm().size() > 1) fz = sim.comm().sum(fz);
+  EXPECT_LT(fz, 0.0);  // the pile's weight on it
+  try {
+    sim.add_wall("deep");
+    ADD_FAILURE() << "a wall with particles behind it was added";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("wall \"deep\" cannot be added: 48 particle(s)"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_TRUE(sim.walls().removed(sim.wall_index("deep")));
+}
+
 TEST(Steering, GravityChangedMidRunMovesTheCentreOfMassByTheNewAcceleration) {
   // In free fall (the floor taken away) the contacts cancel in the momentum: the centre of mass's vertical
   // velocity changes by g t, with the new g from the step it is set.

@@ -200,6 +200,10 @@ class Simulation {
   std::size_t wall_index(std::string_view name) const;
   /// The wall moves at velocity v from now on, from where it is (a servo wall stops steering itself).
   void set_wall_velocity(std::string_view name, const std::array<double, 3>& v);
+  /// The wall touches particles from now on (one the scene declared with active = false, or one removed):
+  /// the lists are rebuilt at once and the energy guard takes a new reference. InputError, nothing changed,
+  /// when a particle's centre is behind it (the wall would push it through), naming the particle.
+  void add_wall(std::string_view name);
   /// The wall stops touching particles (a gate taken away): the lists are rebuilt at once.
   void remove_wall(std::string_view name);
   /// New keys for the [[body_forces]] group `name` (TOML text of its table's keys, e.g. "acceleration = [0.0,

@@ -157,6 +157,10 @@ class Walls {
     removed_.resize(walls_.size(), 0);
     removed_[w] = 1;
   }
+  /// Wall w touches particles again from the next rebuild on (a wall added, a gate put back).
+  void restore(std::size_t w) {
+    if (w < removed_.size()) removed_[w] = 0;
+  }
   bool removed(std::size_t w) const { return w < removed_.size() && removed_[w]; }
 
   /// At a rebuild: the owned particles within reach of each wall (centre closer than radius + skin,

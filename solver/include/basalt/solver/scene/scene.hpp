@@ -48,7 +48,8 @@ struct WallSpec {
   /// interaction = "bonded": tags of the particles tied to the wall (candidates wherever they are).
   TagFilter bond_tags;
   WallMotion motion;
-  /// Taken away (a stage's remove_walls, replayed by a restart: stages.hpp): touches no particle.
+  /// Touches no particle: active = false in the scene (added later), or taken away (a stage's remove_walls,
+  /// replayed by a restart: stages.hpp).
   bool removed = false;
 
   bool bonds(std::int64_t tag) const {

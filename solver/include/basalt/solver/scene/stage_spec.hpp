@@ -30,6 +30,8 @@ struct StageSpec {
 
   // The changes at its start.
   std::vector<std::string> remove_walls;
+  std::vector<std::string>
+      add_walls;  ///< walls that touch particles from the stage's start (Simulation::add_wall)
   std::vector<std::pair<std::string, std::array<double, 3>>> wall_velocity;
   std::optional<std::vector<std::int64_t>> fixed_tags;
   double dt = 0;  ///< a new time step (0: unchanged)
