@@ -65,7 +65,7 @@ def silo_mesh(folder, diameter, height, orifice):
 def scene(geometry, mesh, out, radius, height):
     """Frictional rotating glass beads (scenes/hopper.toml's models) in the mesh silo, a frictional gate under the
     orifice, gravity and Cundall's local damping (for the fill; switched off for the discharge). The [[insert]]
-    entry never fires (its start lies beyond any run): it declares the radii the script pours (the contact reach
+    entry has count = 0 (no events of its own): it declares the radii the script pours (the contact reach
     and the critical step count them) and widens the decomposition's box to the silo. The [[delete]] takes out
     every grain 3 d below the silo's floor every 50 steps."""
     friction = {"K": K, "Ks": 0.5 * K, "mu": 0.5, "mu_dynamic": 0.4}
@@ -83,7 +83,7 @@ def scene(geometry, mesh, out, radius, height):
                         {"name": "damping", "type": "local_damping", "alpha": 0.3}],
         "insert": [{"name": "reach", "cylinder": {"base": [0.0, 0.0, 0.0], "axis": [0.0, 0.0, 1.0],
                                                   "radius": float(radius), "length": float(height)},
-                    "radius": [RMIN, RMAX], "count": 1, "start": 2**40}],
+                    "radius": [RMIN, RMAX], "count": 0}],
         "delete": [{"name": "outlet", "box": {"min": [-10 * radius, -10 * radius, -1.0e4],
                                               "max": [10 * radius, 10 * radius, -3.0 * D]}, "every": FIELD_EVERY}],
         "output": {"directory": str(out)},

@@ -49,7 +49,8 @@ InsertSpec parse_insert(TableReader& t, double density) {
     t.fail("radius", fmt::format("needs 0 < rmin <= rmax, got [{}, {}]", s.rmin, s.rmax));
   s.density = t.has("density") ? t.positive("density") : density;
   s.count = t.integer("count");
-  if (s.count < 1) t.fail("count", fmt::format("must be >= 1, got {}", s.count));
+  // count = 0: no events of its own; it declares a region and radii for a script's insert() calls.
+  if (s.count < 0) t.fail("count", fmt::format("must be >= 0, got {}", s.count));
   s.every = t.integer_or("every", 1);
   if (s.every < 1) t.fail("every", fmt::format("must be >= 1, got {}", s.every));
   s.start = t.integer_or("start", 0);

@@ -74,6 +74,23 @@ def test_bad_requests_are_python_exceptions(tmp_path):
         assert sim.total_particles == n0
 
 
+def test_a_count_zero_insert_declares_the_radii_a_script_pours(tmp_path):
+    """[[insert]] with count = 0 makes no events but lets insert() bring spheres larger than the geometry's."""
+    pack_bed(tmp_path)
+    scene = pile_scene(tmp_path)
+    scene["insert"] = [{"name": "declared", "box": {"min": [0.0, 0.0, 4.0], "max": [6.0, 6.0, 9.0]},
+                        "radius": [0.4, 0.9], "count": 0}]
+    with basalt.Simulation(scene) as sim:
+        n0 = sim.total_particles
+        sim.run(200)
+        assert sim.total_particles == n0 and sim.inserted == 0  # no events of its own
+        assert sim.insert(box=((0, 0, 4), (6, 6, 9)), radius=0.9, count=3, seed=3) == 3
+        with pytest.raises(ValueError, match="exceeds the largest radius"):
+            sim.insert(box=((0, 0, 4), (6, 6, 9)), radius=0.95, count=1)
+        sim.run(200)
+        assert sim.total_particles == n0 + 3
+
+
 def test_scene_pour_keeps_its_id_counter(tmp_path):
     """The scene's [[insert]] every 50 steps and [[delete]] at the floor: the checkpoint keeps the counter,
     and its ids are unique."""

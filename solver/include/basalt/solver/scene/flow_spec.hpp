@@ -95,7 +95,9 @@ struct InsertSpec {
   std::uint64_t seed = 1;
   std::int64_t attempts = 20;  ///< candidate places tried per particle asked
   /// Whether an event falls at step s (the step about to be made starts with it).
-  bool due(std::int64_t s) const { return s >= start && s < stop && (s - start) % every == 0; }
+  bool due(std::int64_t s) const {
+    return count > 0 && s >= start && s < stop && (s - start) % every == 0;
+  }
 };
 
 /// One [[delete]] entry: the particles (of `tags`, or all) whose centre is inside the region are taken
