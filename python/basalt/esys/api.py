@@ -1,0 +1,30 @@
+"""The names of esys.lsm that Basalt's ESyS front end provides (the shim's esys.lsm re-exports them), and the
+ones it refuses (a call raises NotSupportedError saying what Basalt offers)."""
+
+from .errors import NotSupportedError, refuse
+from .lsmmpi import LsmMpi
+from .particles import NRotSphere, RotSphere
+from .prms import (CheckPointPrms, GravityPrms, LinDampingPrms, NRotElasticPrms, NRotElasticWallPrms,
+                   ParticleScalarFieldSaverPrms, ParticleVectorFieldSaverPrms, Runnable, WallVectorFieldSaverPrms)
+from .refused import LSM, stubs
+from .vec3 import BoundingBox, Vec3
+
+globals().update(stubs("esys.lsm", LSM))
+
+SUPPORTED = ["LsmMpi", "NRotSphere", "RotSphere", "NRotElasticPrms", "NRotElasticWallPrms", "GravityPrms",
+             "LinDampingPrms", "CheckPointPrms", "ParticleScalarFieldSaverPrms", "ParticleVectorFieldSaverPrms",
+             "WallVectorFieldSaverPrms", "Runnable", "Vec3", "BoundingBox"]
+REFUSED = sorted(LSM)
+__all__ = SUPPORTED + REFUSED + ["NotSupportedError"]
+
+
+def module_getattr(module):
+    """A module __getattr__ refusing every other public name of `module` (e.g. "esys.lsm")."""
+    def __getattr__(name):
+        if name.startswith("__"):
+            raise AttributeError(name)
+        refuse(f"{module}.{name}", "not provided by the front end yet")
+    return __getattr__
+
+
+__doc__ += "\n\nNotSupportedError: " + (NotSupportedError.__doc__ or "")

@@ -1,0 +1,70 @@
+"""esys.lsm's parameter classes that Basalt's front end maps onto its own models (docs/esys.md), and the
+checkpoint and field-saver parameters. Each only holds its arguments; LsmMpi turns them into the scene."""
+
+from .vec3 import Vec3
+
+
+class NRotElasticPrms:
+    """Linear elastic repulsion between touching spheres. scaling=True (3-D): k = normalK (r1 + r2)/4."""
+
+    def __init__(self, name, normalK, scaling=True):
+        self.name, self.normalK, self.scaling = str(name), float(normalK), bool(scaling)
+
+
+class NRotElasticWallPrms:
+    """A wall's elastic repulsion: k = pi r normalK in 3-D (ESyS's convention)."""
+
+    def __init__(self, name, wallName, normalK):
+        self.name, self.wallName, self.normalK = str(name), str(wallName), float(normalK)
+
+
+class GravityPrms:
+    def __init__(self, name, acceleration):
+        self.name, self.acceleration = str(name), Vec3(acceleration)
+
+
+class LinDampingPrms:
+    """ESyS's linear viscous damping (its iterative rule, maxIterations as ESyS: docs/reference-runs.md)."""
+
+    def __init__(self, name, viscosity, maxIterations=100):
+        self.name, self.viscosity, self.maxIterations = str(name), float(viscosity), int(maxIterations)
+
+
+class CheckPointPrms:
+    def __init__(self, fileNamePrefix, beginTimeStep, endTimeStep, timeStepIncr):
+        self.fileNamePrefix = str(fileNamePrefix)
+        self.beginTimeStep, self.endTimeStep, self.timeStepIncr = int(beginTimeStep), int(endTimeStep), int(timeStepIncr)
+
+
+class _SaverPrms:
+    kind = ""
+
+    def __init__(self, fieldName, fileName, fileFormat, beginTimeStep, endTimeStep, timeStepIncr):
+        self.fieldName, self.fileName, self.fileFormat = str(fieldName), str(fileName), str(fileFormat)
+        self.beginTimeStep, self.endTimeStep, self.timeStepIncr = int(beginTimeStep), int(endTimeStep), int(timeStepIncr)
+
+
+class ParticleScalarFieldSaverPrms(_SaverPrms):
+    kind = "ParticleScalarFieldSaverPrms"
+
+
+class ParticleVectorFieldSaverPrms(_SaverPrms):
+    kind = "ParticleVectorFieldSaverPrms"
+
+
+class WallVectorFieldSaverPrms(_SaverPrms):
+    kind = "WallVectorFieldSaverPrms"
+
+    def __init__(self, wallName, fieldName, fileName, fileFormat, beginTimeStep, endTimeStep, timeStepIncr):
+        super().__init__(fieldName, fileName, fileFormat, beginTimeStep, endTimeStep, timeStepIncr)
+        self.wallName = [wallName] if isinstance(wallName, str) else [str(w) for w in wallName]
+
+
+class Runnable:
+    """Base class of the objects run before or after each time step (addPre/PostTimeStepRunnable): run()."""
+
+    def __init__(self):
+        pass
+
+    def run(self):
+        pass
