@@ -6,6 +6,7 @@ ESyS's scalings (NRotElastic, walls pi r K), ESyS's damping rule, no start-up ch
 Runnables, field savers and checkpointers run at ESyS's points of the step (docs/reference-runs.md)."""
 
 import atexit
+import math
 import os
 import shutil
 import tempfile
@@ -63,6 +64,7 @@ class LsmMpi:
         self._saved = -1                # the last step whose savers ran
         self._old = None                # positions at the last (emulated) neighbour-list rebuild
         self._prev_force = None         # the forces the last step used (ESyS's stored force)
+        self._prev_wall_force = {}      # wall name -> the force the last step's particles got from it
         self._rotational = False
 
     # -- set-up ---------------------------------------------------------------------------------------------
@@ -222,7 +224,8 @@ class LsmMpi:
             self._start()
         import numpy as np
 
-        track = bool(self._checkpointers)
+        # per step: the forces a step used (checkpoints, wall forces) and the neighbour-list rule (checkpoints)
+        track = bool(self._checkpointers) or any(getattr(s.prms, "fieldName", "") == "Force" for s in self._savers)
         if track and self._old is None:
             self._old = self._positions()
         self._save_due()
@@ -238,6 +241,7 @@ class LsmMpi:
             if track:
                 self._prev_force = np.column_stack([self._sim.particles.fx, self._sim.particles.fy,
                                                     self._sim.particles.fz])[self._order()].copy()
+                self._prev_wall_force = {n: -np.asarray(self._sim.walls[n].force) for n in self._walls}
             self._sim.run(n)
             self._t += n
             self._clock = self._t
@@ -284,10 +288,20 @@ class LsmMpi:
         if (d * d).sum(axis=1).max(initial=0.0) > (0.5 * self._verlet) ** 2:
             self._old = x
 
+    def _grid_domain(self):
+        """ESyS removes a particle once its centre leaves the spatial domain grown to whole cells of gridSpacing,
+        centred (measured: [-8, 8] with gridSpacing 2.5 keeps particles up to |x| = 8.75, with 3.0 up to 9)."""
+        lo, hi = [], []
+        for a, b in zip(self._domain_lo, self._domain_hi):
+            half = math.ceil((b - a) / self._grid - 1e-12) * self._grid / 2
+            lo.append((a + b) / 2 - half)
+            hi.append((a + b) / 2 + half)
+        return lo, hi
+
     def _leave_domain(self):
-        """ESyS deletes the particles that leave the spatial domain."""
+        """Deletes the particles outside the (grown) spatial domain, as ESyS does at its neighbour updates."""
         p = self._sim.particles
-        lo, hi, big = self._domain_lo, self._domain_hi, 1e30
+        (lo, hi), big = self._grid_domain(), 1e30
         for k, c in enumerate((p.x, p.y, p.z)):
             if len(c) and (c.min() < lo[k] or c.max() > hi[k]):
                 for side in (0, 1):
@@ -315,6 +329,10 @@ class LsmMpi:
         }
         state["force"] = (self._prev_force if self._prev_force is not None and len(self._prev_force) == len(ids)
                           else np.column_stack([p.fx, p.fy, p.fz])[order])
+        state["walls"] = {n: (pos, self._prev_wall_force.get(n, -f)) for n, (pos, f) in state["walls"].items()}
+        if self._t == 0:  # before the first step ESyS holds no forces
+            state["force"] = np.zeros_like(state["pos"])
+            state["walls"] = {n: (pos, np.zeros(3)) for n, (pos, f) in state["walls"].items()}
         state["old"] = self._old if self._old is not None and len(self._old) == len(ids) else state["pos"]
         if self._rotational:
             state["angvel"] = np.column_stack([p.wx, p.wy, p.wz])[order]

@@ -1,7 +1,7 @@
 # collide.py: two spheres meet head-on, ESyS-Particle tutorial style (bingle-like), own numbers.
 #   python3 -m basalt.esys collide.py        (or: mpirun -np 2 esysparticle collide.py)
 # Prints "contact STEP OVERLAP V1 V2" for every step in contact (a post-time-step Runnable) and the final
-# velocities; writes collide_t=*_0.txt/_1.txt checkpoints, ekin.dat (SUM) and vel.N.dat (RAW_WITH_ID).
+# velocities (at the last step); writes collide_t=*_0.txt/_1.txt checkpoints, ekin.dat (SUM) and vel.N.dat (RAW_WITH_ID).
 from esys.lsm import *
 from esys.lsm.util import Vec3, BoundingBox
 
@@ -39,12 +39,12 @@ class ContactWatch(Runnable):
         if gap < 0.0:
             print("contact %d %.12g %.12g %.12g" % (self.sim.getTimeStep(), -gap, ps[0].getVelocity()[0],
                                                     ps[1].getVelocity()[0]))
+        if self.sim.getTimeStep() == self.sim.getNumTimeSteps():  # the last step: the final state
+            for p in ps:
+                v = p.getVelocity()
+                print("final %d %.12g %.12g %.12g %g %g" % (p.getId(), v[0], v[1], v[2], p.getMass(), p.getRadius()))
 
 
 watch = ContactWatch(sim)
 sim.addPostTimeStepRunnable(watch)
 sim.run()
-for p in sorted(sim.getParticleList(), key=lambda p: p.getId()):
-    v = p.getVelocity()
-    print("final %d %.12g %.12g %.12g %g %g" % (p.getId(), v[0], v[1], v[2], p.getMass(), p.getRadius()))
-sim.exit()

@@ -2,7 +2,7 @@
 #   python3 -m basalt.esys fall.py            (or: mpirun -np 2 esysparticle fall.py)
 # Ball 0 falls freely from y = 4 (it reaches the floor after step ~1200); ball 7 is thrown sideways out of
 # the spatial domain (x > 8) and is deleted. A pre-time-step Runnable prints "pre STEP ID X Y Z VX VY VZ"
-# every 100 steps; savers: wall position and force (RAW_SERIES), e_kin (SUM), displacement (RAW2).
+# every 100 steps and the particle count at the last step; savers: wall position and force (RAW_SERIES), e_kin (SUM), displacement (RAW2).
 from esys.lsm import *
 from esys.lsm.util import Vec3, BoundingBox
 
@@ -46,10 +46,10 @@ class Report(Runnable):
                 x, v = p.getPosn(), p.getVelocity()
                 print("pre %d %d %.12g %.12g %.12g %.12g %.12g %.12g" % (n, p.getId(), x[0], x[1], x[2],
                                                                          v[0], v[1], v[2]))
+        if n == self.sim.getNumTimeSteps():
+            print("particles", len(self.sim.getParticleList()))
 
 
 report = Report(sim)
 sim.addPreTimeStepRunnable(report)
 sim.run()
-print("particles", len(sim.getParticleList()))
-sim.exit()

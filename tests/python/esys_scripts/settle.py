@@ -20,9 +20,21 @@ sim.createInteractionGroup(LinDampingPrms(name="air", viscosity=10.0, maxIterati
 sim.createFieldSaver(WallVectorFieldSaverPrms(wallName=["floor"], fieldName="Force", fileName="floor_force.dat",
                                               fileFormat="RAW_SERIES", beginTimeStep=0, endTimeStep=6000,
                                               timeStepIncr=100))
-sim.createCheckPointer(CheckPointPrms(fileNamePrefix="settle", beginTimeStep=6000, endTimeStep=6000,
-                                      timeStepIncr=1))
+sim.createCheckPointer(CheckPointPrms(fileNamePrefix="settle", beginTimeStep=1000, endTimeStep=6000,
+                                      timeStepIncr=1000))
+
+
+class Rest(Runnable):
+    def __init__(self, sim):
+        Runnable.__init__(self)
+        self.sim = sim
+
+    def run(self):
+        if self.sim.getTimeStep() == self.sim.getNumTimeSteps():
+            p = self.sim.getParticleList()[0]
+            print("rest %.12g" % p.getPosn()[1])
+
+
+rest = Rest(sim)
+sim.addPostTimeStepRunnable(rest)
 sim.run()
-p = sim.getParticleList()[0]
-print("rest %.12g %.12g" % (p.getPosn()[1], p.getVelocity()[1]))
-sim.exit()
