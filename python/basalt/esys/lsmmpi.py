@@ -239,14 +239,13 @@ class LsmMpi:
                 for r in self._pre:
                     r.run()
             if track:
+                self._rebuild_check()
                 self._prev_force = np.column_stack([self._sim.particles.fx, self._sim.particles.fy,
                                                     self._sim.particles.fz])[self._order()].copy()
                 self._prev_wall_force = {n: -np.asarray(self._sim.walls[n].force) for n in self._walls}
             self._sim.run(n)
             self._t += n
             self._clock = self._t
-            if track:
-                self._rebuild_check()
             self._leave_domain()
             self._save_due()
             for r in self._post:
@@ -278,8 +277,9 @@ class LsmMpi:
         return np.column_stack([p.x, p.y, p.z])[self._order()]
 
     def _rebuild_check(self):
-        """ESyS's neighbour-list rule (TSubLattice::checkNeighbors): after a step, when a particle has moved
-        more than verletDist/2 since the last rebuild, all 'old positions' become the current ones."""
+        """ESyS's neighbour-list rule (TSubLattice::checkNeighbors), checked as a step begins: when a particle has
+        moved more than verletDist/2 since the last rebuild, all 'old positions' become the current ones
+        (measured: a checkpoint of step n shows the rebuild of the positions after step n - 1, not n)."""
         x = self._positions()
         if len(x) != len(self._old):
             self._old = x
