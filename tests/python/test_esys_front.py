@@ -209,3 +209,25 @@ def test_no_esys_outside_the_runner(tmp_path):
     assert p.stdout.strip() in ("no esys", "real")
     if not pathlib.Path("/usr/lib/python3/dist-packages/esys").exists():
         assert p.stdout.strip() == "no esys"
+
+
+def test_basalt_esys_launcher(tmp_path):
+    """build/bin/basalt-esys: the same runner, next to basalt-run."""
+    launcher = pathlib.Path(os.environ.get("BASALT_BIN") or ROOT / "build" / "bin") / "basalt-esys"
+    if not launcher.exists():
+        pytest.skip(f"{launcher} not built")
+    script = tmp_path / "hello.py"
+    script.write_text("from esys.lsm.util import Vec3\nprint(Vec3(1, 2, 3).norm() ** 2)\n")
+    p = subprocess.run([str(launcher), str(script)], capture_output=True, text=True, timeout=60)
+    assert p.returncode == 0 and p.stdout == "14.0\n", p.stderr
+
+
+def test_compare_tool_skips_without_esys(tmp_path):
+    """tools/esys/compare_tutorial.py without ESyS-Particle's interpreter: Basalt's run only, exit 3, says why."""
+    env = {**os.environ, "PYTHONPATH": PACKAGE_DIR}
+    p = subprocess.run([sys.executable, str(ROOT / "tools" / "esys" / "compare_tutorial.py"), "--scripts", "fall",
+                        "--workdir", str(tmp_path / "cmp"), "--esys", "esysparticle-not-here", "--build", str(pathlib.Path(PACKAGE_DIR).parent)],
+                       capture_output=True, text=True, env=env, timeout=300)
+    assert p.returncode == 3, p.stdout + p.stderr
+    assert "ESyS-Particle comparison skipped: esysparticle-not-here not on PATH" in p.stdout
+    assert (tmp_path / "cmp" / "basalt" / "fall" / "ekin.dat").exists()

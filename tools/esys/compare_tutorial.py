@@ -3,7 +3,7 @@
 (`python3 -m basalt.esys`, docs/esys.md) in the same run, and compares what they print and write.
 
     /usr/bin/python3 tools/esys/compare_tutorial.py [--scripts collide fall settle] [--workdir DIR]
-        [--tolerance 1e-6] [--build build] [--doc docs/esys.md]
+        [--tolerance 1e-6] [--build build] [--esys esysparticle] [--doc docs/esys.md]
 
 The scripts are ours (tests/python/esys_scripts/), in the style of ESyS's tutorial. ESyS runs as
 `mpirun -np 2 esysparticle SCRIPT` (1 master + 1 worker), Basalt as `python3 -m basalt.esys SCRIPT`, each in
@@ -150,11 +150,12 @@ def main():
     ap.add_argument("--tolerance", type=float, default=1e-6)
     ap.add_argument("--build", default=os.path.join(bt.ROOT, "build"))
     ap.add_argument("--timeout", type=float, default=300)
+    ap.add_argument("--esys", default="esysparticle", help="ESyS-Particle's interpreter (default esysparticle)")
     ap.add_argument("--doc", help="write the table into this file between the compare_tutorial markers")
     args = ap.parse_args()
 
     env_b = dict(os.environ, PYTHONPATH=os.path.abspath(os.path.join(args.build, "python")))
-    missing = bt.esys_missing()
+    missing = [exe for exe in (args.esys, "mpirun") if shutil.which(exe) is None]
     if missing:
         print(f"ESyS-Particle comparison skipped: {', '.join(missing)} not on PATH "
               "(Debian: apt-get install --no-install-recommends esys-particle); Basalt's runs only")
@@ -172,7 +173,7 @@ def main():
             times.append((name, None, wall_b))
             continue
         dir_e = os.path.abspath(os.path.join(args.workdir, "esys", name))
-        out_e, wall_e, err = run(bt.esys_command(script, 2), dir_e, bt.esys_env(), args.timeout)
+        out_e, wall_e, err = run(bt.mpirun(2) + [args.esys, script], dir_e, bt.esys_env(), args.timeout)
         times.append((name, wall_e, wall_b))
         if err:
             print(f"{name}: ESyS-Particle failed: {err}")
