@@ -3,7 +3,7 @@
 (`python3 -m basalt.esys`, docs/esys.md) in the same run, and compares what they print and write.
 
     /usr/bin/python3 tools/esys/compare_tutorial.py [--scripts collide fall settle] [--workdir DIR]
-        [--tolerance 1e-6] [--build build] [--esys esysparticle] [--doc docs/esys.md]
+        [--tolerance 1e-6] [--build build | --pythonpath DIR] [--esys esysparticle] [--doc docs/esys.md]
 
 The scripts are ours (tests/python/esys_scripts/), in the style of ESyS's tutorial. ESyS runs as
 `mpirun -np 2 esysparticle SCRIPT` (1 master + 1 worker), Basalt as `python3 -m basalt.esys SCRIPT`, each in
@@ -17,7 +17,6 @@ Exit 1 on a mismatch; exit 3 (after Basalt's runs, nothing compared) when ESyS-P
 
 import argparse
 import collections
-import glob
 import os
 import re
 import shutil
@@ -148,13 +147,14 @@ def main():
     ap.add_argument("--scripts", nargs="+", default=["collide", "fall", "settle"])
     ap.add_argument("--workdir", default="out/esys-tutorial")
     ap.add_argument("--tolerance", type=float, default=1e-6)
-    ap.add_argument("--build", default=os.path.join(bt.ROOT, "build"))
+    ap.add_argument("--build", default=os.path.join(bt.ROOT, "build"), help="the build whose python/ to use")
+    ap.add_argument("--pythonpath", help="the folder holding the basalt package (default BUILD/python)")
     ap.add_argument("--timeout", type=float, default=300)
     ap.add_argument("--esys", default="esysparticle", help="ESyS-Particle's interpreter (default esysparticle)")
     ap.add_argument("--doc", help="write the table into this file between the compare_tutorial markers")
     args = ap.parse_args()
 
-    env_b = dict(os.environ, PYTHONPATH=os.path.abspath(os.path.join(args.build, "python")))
+    env_b = dict(os.environ, PYTHONPATH=os.path.abspath(args.pythonpath or os.path.join(args.build, "python")))
     missing = [exe for exe in (args.esys, "mpirun") if shutil.which(exe) is None]
     if missing:
         print(f"ESyS-Particle comparison skipped: {', '.join(missing)} not on PATH "

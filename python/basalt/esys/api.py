@@ -1,13 +1,14 @@
 """The names of esys.lsm that Basalt's ESyS front end provides (the shim's esys.lsm re-exports them), and the
 ones it refuses (a call raises NotSupportedError saying what Basalt offers)."""
 
+# re-exported through __all__ (SUPPORTED)
 from .errors import NotSupportedError, refuse
-from .lsmmpi import LsmMpi
-from .particles import NRotSphere, RotSphere
-from .prms import (CheckPointPrms, GravityPrms, LinDampingPrms, NRotElasticPrms, NRotElasticWallPrms,
+from .lsmmpi import LsmMpi  # noqa: F401
+from .particles import NRotSphere, RotSphere  # noqa: F401
+from .prms import (CheckPointPrms, GravityPrms, LinDampingPrms, NRotElasticPrms, NRotElasticWallPrms,  # noqa: F401
                    ParticleScalarFieldSaverPrms, ParticleVectorFieldSaverPrms, Runnable, WallVectorFieldSaverPrms)
 from .refused import LSM, stubs
-from .vec3 import BoundingBox, Vec3
+from .vec3 import BoundingBox, Vec3  # noqa: F401
 
 globals().update(stubs("esys.lsm", LSM))
 

@@ -63,7 +63,7 @@ class LsmMpi:
         self._clock = 0                 # what getTimeStep() returns (t + 1 inside pre-time-step runnables)
         self._saved = -1                # the last step whose savers ran
         self._old = None                # positions at the last (emulated) neighbour-list rebuild
-        self._prev_force = None         # the forces the last step used (ESyS's stored force)
+        self._prev_force = None         # (ids, forces) the last step used (ESyS's stored force)
         self._prev_wall_force = {}      # wall name -> the force the last step's particles got from it
         self._rotational = False
 
@@ -240,8 +240,10 @@ class LsmMpi:
                     r.run()
             if track:
                 self._rebuild_check()
-                self._prev_force = np.column_stack([self._sim.particles.fx, self._sim.particles.fy,
-                                                    self._sim.particles.fz])[self._order()].copy()
+                order = self._order()
+                self._prev_force = (np.asarray(self._sim.particles.id)[order].copy(),
+                                    np.column_stack([self._sim.particles.fx, self._sim.particles.fy,
+                                                     self._sim.particles.fz])[order])
                 self._prev_wall_force = {n: -np.asarray(self._sim.walls[n].force) for n in self._walls}
             self._sim.run(n)
             self._t += n
@@ -308,8 +310,7 @@ class LsmMpi:
                     a, b = [-big] * 3, [big] * 3
                     (b if side == 0 else a)[k] = lo[k] if side == 0 else hi[k]
                     self._sim.delete(box=(a, b))
-                if self._old is not None:
-                    self._old = None  # rebuilt next step
+                if self._old is not None:  # ESyS removes particles at a neighbour rebuild
                     self._old = self._positions()
                 return self._leave_domain()
 
@@ -327,8 +328,11 @@ class LsmMpi:
             "walls": {n: (np.asarray(w.position), np.asarray(w.force)) for n, w in
                       ((n, self._sim.walls[n]) for n in self._walls)},
         }
-        state["force"] = (self._prev_force if self._prev_force is not None and len(self._prev_force) == len(ids)
-                          else np.column_stack([p.fx, p.fy, p.fz])[order])
+        if self._prev_force is not None:  # the forces the last step used, by id (a removal may come between)
+            prev_ids, prev = self._prev_force
+            state["force"] = prev[np.searchsorted(prev_ids, ids)]
+        else:
+            state["force"] = np.column_stack([p.fx, p.fy, p.fz])[order]
         state["walls"] = {n: (pos, self._prev_wall_force.get(n, -f)) for n, (pos, f) in state["walls"].items()}
         if self._t == 0:  # before the first step ESyS holds no forces
             state["force"] = np.zeros_like(state["pos"])

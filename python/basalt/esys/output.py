@@ -4,8 +4,6 @@ field savers of createFieldSaver, in ESyS 2.3.5's formats (as its Debian build w
 A `state` is the LsmMpi's snapshot after a step: numpy arrays in id order (id, pos, vel, radius, mass, tag,
 init, force, old) and walls {name: (position, force)}."""
 
-import os
-
 from .errors import refuse
 
 
@@ -119,8 +117,3 @@ class FieldSaver(_Schedule):
             row = "".join(" ".join("%.10e" % c for c in state["walls"][w][k]) + "  " for w in p.wallName)
             with open(p.fileName, "a") as f:
                 f.write(row + "\n")
-
-
-def remove_if_empty(path):
-    if os.path.isdir(path) and not os.listdir(path):
-        os.rmdir(path)

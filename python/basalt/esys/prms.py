@@ -33,7 +33,8 @@ class LinDampingPrms:
 class CheckPointPrms:
     def __init__(self, fileNamePrefix, beginTimeStep, endTimeStep, timeStepIncr):
         self.fileNamePrefix = str(fileNamePrefix)
-        self.beginTimeStep, self.endTimeStep, self.timeStepIncr = int(beginTimeStep), int(endTimeStep), int(timeStepIncr)
+        self.beginTimeStep, self.endTimeStep = int(beginTimeStep), int(endTimeStep)
+        self.timeStepIncr = int(timeStepIncr)
 
 
 class _SaverPrms:
@@ -41,7 +42,8 @@ class _SaverPrms:
 
     def __init__(self, fieldName, fileName, fileFormat, beginTimeStep, endTimeStep, timeStepIncr):
         self.fieldName, self.fileName, self.fileFormat = str(fieldName), str(fileName), str(fileFormat)
-        self.beginTimeStep, self.endTimeStep, self.timeStepIncr = int(beginTimeStep), int(endTimeStep), int(timeStepIncr)
+        self.beginTimeStep, self.endTimeStep = int(beginTimeStep), int(endTimeStep)
+        self.timeStepIncr = int(timeStepIncr)
 
 
 class ParticleScalarFieldSaverPrms(_SaverPrms):

@@ -75,15 +75,16 @@ def build(lsm, workdir):
 
 
 def _set_initial_velocities(sim, vel, angvel):
-    """The created particles' velocities, written into the run's arrays before the first step."""
+    """The created particles' velocities ({id: [3 numbers]}), written into the run's arrays before the first
+    step; then the forces are recomputed (the damping reads velocities)."""
+    import numpy as np
+
     part = sim.particles
-    for k, (name, comp) in enumerate((("vx", 0), ("vy", 1), ("vz", 2))):
-        a = part.__getattr__(name)
-        for i, pid in enumerate(part.id):
-            a[i] = vel[int(pid)][comp]
-    if angvel and any(any(w) for w in angvel.values()):
-        for name, comp in (("wx", 0), ("wy", 1), ("wz", 2)):
-            a = part.__getattr__(name)
-            for i, pid in enumerate(part.id):
-                a[i] = angvel[int(pid)][comp]
+    ids = np.asarray(part.id)
+    for table, names in ((vel, ("vx", "vy", "vz")), (angvel, ("wx", "wy", "wz"))):
+        if not table or not any(any(v) for v in table.values()):
+            continue
+        values = np.array([table[int(i)] for i in ids], dtype=float).reshape(len(ids), 3)
+        for k, name in enumerate(names):
+            getattr(part, name)[:] = values[:, k]
     sim.state_changed()
