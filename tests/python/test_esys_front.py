@@ -157,13 +157,59 @@ def test_settled_ball_carries_its_weight(tmp_path):
     assert row[17] == pytest.approx(0.0, abs=1e-5)  # the force of the last step: weight and floor balance
 
 
+# -- a bonded block (gravity_cube-like) ---------------------------------------------------------------------------
+def test_cubic_block_is_close_packed():
+    """CubicBlock: touching spheres 2r apart, 12 neighbours inside (a close packing), ids 0.. in order, mass r^3;
+    ConnectionFinder bonds exactly the touching pairs; rotate turns by |axis| clockwise about it, as ESyS."""
+    import numpy as np
+
+    from basalt.esys.blocks import ConnectionFinder, CubicBlock
+    from basalt.esys.vec3 import Vec3
+
+    r = 0.5
+    block = CubicBlock(dimCount=[5, 5, 5], radius=r)
+    spheres = list(block)
+    assert [s.getId() for s in spheres] == list(range(125))
+    assert {s.getMass() for s in spheres} == {r ** 3} and {s.getTag() for s in spheres} == {0}
+    x = np.array([s.getPosn().toList() for s in spheres])
+    d = np.sqrt(((x[:, None, :] - x[None, :, :]) ** 2).sum(axis=2)) + np.eye(len(x)) * 9
+    assert d.min() == pytest.approx(2 * r, abs=1e-12)
+    touching = {(i, j) for i, j in zip(*np.nonzero(d < 2 * r + 1e-9)) if i < j}
+    assert max(np.bincount(np.array(sorted(touching)).ravel())) == 12
+    bonds = {(c.getId1(), c.getId2()) for c in ConnectionFinder(maxDist=0.005, bondTag=3, pList=block)}
+    assert bonds == touching
+    turned = Vec3(1, 0, 0).rotate(axis=Vec3(0, 0, math.pi / 6), axisPt=Vec3(0, 0, 0))
+    assert turned.toList() == pytest.approx([math.cos(math.pi / 6), -0.5, 0.0], abs=1e-15)
+
+
+def test_bonded_block_falls_and_bounces(tmp_path):
+    out = front(SCRIPTS / "cube_drop.py", tmp_path).stdout
+    assert lines(out, "mass") == [[0, 0.125], [1, 0.125], [2, 0.125]]  # ESyS: a block's spheres get r^3
+    centre = lines(out, "centre")
+    assert len(centre) == 12
+    x0, z0 = centre[0][1], centre[0][3]
+    for _, x, y, z in centre:  # no force along x or z but internal ones: the centre only moves along y
+        assert x == pytest.approx(x0, abs=1e-8) and z == pytest.approx(z0, abs=1e-8)
+    ys = [c[2] for c in centre]
+    assert ys[1] < ys[0] and max(ys[3:]) > min(ys[:4])  # falls, hits the floor, bounces
+    rows = [line.split() for line in (tmp_path / "posn.3.dat").read_text().splitlines()]
+    assert len(rows) == 64 and all(len(r) == 7 for r in rows)
+    assert min(float(r[2]) for r in rows) > -2.0  # no sphere centre through the floor (y = -2)
+
+
 # -- refusals, the runner ----------------------------------------------------------------------------------------
 REFUSED = {
     "sim.createInteractionGroup(RotFrictionPrms(name='f', normalK=1.0, dynamicMu=0.5, staticMu=0.5, shearK=1.0))":
         ("esys.lsm.RotFrictionPrms", 'rot_friction'),
     "sim.createExclusion('a', 'b')": ("LsmMpi.createExclusion", "linear_elastic"),
-    "from esys.lsm.geometry import CubicBlock\nCubicBlock(dimCount=[2, 2, 2], radius=0.5)":
-        ("esys.lsm.geometry.CubicBlock", "basalt.pack"),
+    "from esys.lsm.geometry import HexagonalBlock\nHexagonalBlock(dimCount=[2, 2, 2], radius=0.5)":
+        ("esys.lsm.geometry.HexagonalBlock", "basalt.pack"),
+    "sim.createInteractionGroup(NRotElasticPrms(name='e', normalK=1.0, scaling=True))\n"
+    "sim.createInteractionGroup(NRotBondPrms(name='b', normalK=1.0, breakDistance=1.0, tag=1))\n"
+    "sim.initNeighbourSearch(particleType='NRotSphere', gridSpacing=2.5, verletDist=0.5)\n"
+    "sim.setTimeStepSize(0.001)\nsim.setSpatialDomain(BoundingBox(Vec3(-5, -5, -5), Vec3(5, 5, 5)))\n"
+    "sim.createParticle(NRotSphere(id=0, posn=Vec3(0, 0, 0), radius=0.5, mass=1.0))\nsim.run()":
+        ("NRotElasticPrms together with bonds", "createExclusion"),
     "sim.setParticleDensity(tag=0, mask=-1, Density=2.0)": ("LsmMpi.setParticleDensity", "mass="),
     "sim.createFieldSaver(ParticleScalarFieldSaverPrms(fieldName='sigma_xx_2d', fileName='s', fileFormat='SUM', "
     "beginTimeStep=0, endTimeStep=1, timeStepIncr=1))": ("fieldName='sigma_xx_2d'", "e_kin"),

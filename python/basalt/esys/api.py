@@ -5,14 +5,16 @@ ones it refuses (a call raises NotSupportedError saying what Basalt offers)."""
 from .errors import NotSupportedError, refuse
 from .lsmmpi import LsmMpi  # noqa: F401
 from .particles import NRotSphere, RotSphere  # noqa: F401
-from .prms import (CheckPointPrms, GravityPrms, LinDampingPrms, NRotElasticPrms, NRotElasticWallPrms,  # noqa: F401
+from .prms import (CheckPointPrms, GravityPrms, LinDampingPrms, NRotBondPrms, NRotElasticPrms,  # noqa: F401
+                   NRotElasticWallPrms,
                    ParticleScalarFieldSaverPrms, ParticleVectorFieldSaverPrms, Runnable, WallVectorFieldSaverPrms)
 from .refused import LSM, stubs
 from .vec3 import BoundingBox, Vec3  # noqa: F401
 
 globals().update(stubs("esys.lsm", LSM))
 
-SUPPORTED = ["LsmMpi", "NRotSphere", "RotSphere", "NRotElasticPrms", "NRotElasticWallPrms", "GravityPrms",
+SUPPORTED = ["LsmMpi", "NRotSphere", "RotSphere", "NRotElasticPrms", "NRotBondPrms", "NRotElasticWallPrms",
+             "GravityPrms",
              "LinDampingPrms", "CheckPointPrms", "ParticleScalarFieldSaverPrms", "ParticleVectorFieldSaverPrms",
              "WallVectorFieldSaverPrms", "Runnable", "Vec3", "BoundingBox"]
 REFUSED = sorted(LSM)

@@ -22,8 +22,8 @@ CHUNK = 100
 
 _HINTS = {
     "setParticleDensity": "give each NRotSphere/RotSphere its mass (mass=...), as the tutorial's scripts do",
-    "createExclusion": "Basalt's linear_elastic never acts on bonded pairs (scene models, docs/scenes.md)",
-    "createConnections": "bonds come with a Basalt geometry (basalt.pack, .geo files) in basalt.Simulation",
+    "createExclusion": "Basalt's linear_elastic never acts on bonded pairs (scene models, docs/scenes.md); "
+                       "the front end refuses NRotElasticPrms together with bonds",
     "readGeometry": "basalt.read_geometry reads .geo files for basalt.Simulation",
     "moveWallBy": "a scene wall's motion, or basalt.Simulation's walls[name].set_velocity",
     "setParticleNonDynamic": "the scene's particles.fixed_tags or basalt.Simulation.fix(tag)",
@@ -51,6 +51,8 @@ class LsmMpi:
         self._domain_lo = self._domain_hi = None
         self._particles = []            # NRotSphere/RotSphere as created
         self._pair = []                 # NRotElasticPrms
+        self._bond_groups = []          # NRotBondPrms
+        self._bonds = []                # (id1, id2, tag) from createConnections
         self._wall_k = {}               # wall name -> NRotElasticWallPrms
         self._walls = {}                # name -> (posn, normal), in creation order
         self._body = []                 # GravityPrms, LinDampingPrms
@@ -123,8 +125,24 @@ class LsmMpi:
         self._particles.append(particle)
 
     def createParticles(self, particles):
+        """NRotSphere/RotSphere objects, or a generated block's SimpleSpheres (CubicBlock): each becomes a
+        particle of the run's type with the sphere's id, tag, radius and mass (r^3, as ESyS)."""
+        from .blocks import SimpleSphere
+
+        kind = RotSphere if self._particle_type == "RotSphere" else NRotSphere
         for p in particles:
+            if isinstance(p, SimpleSphere):
+                q = kind(p.getId(), p.getPosn(), p.getRadius(), p.getMass())
+                q.setTag(p.getTag())
+                p = q
             self.createParticle(p)
+
+    def createConnections(self, connections):
+        """Bonds (ConnectionFinder's, or objects with getId1, getId2, getTag) for NRotBondPrms groups."""
+        self._setup("createConnections")
+        for c in connections:
+            i, j = int(c.getId1()), int(c.getId2())
+            self._bonds.append((min(i, j), max(i, j), int(c.getTag())))
 
     def _name(self, prms):
         if prms.name in self._group_names:
@@ -139,6 +157,12 @@ class LsmMpi:
         if isinstance(prms, P.NRotElasticPrms):
             self._name(prms)
             self._pair.append(prms)
+        elif isinstance(prms, P.NRotBondPrms):
+            if any(g.tag == prms.tag for g in self._bond_groups):
+                refuse(f"LsmMpi.createInteractionGroup({kind}): a second group on bond tag {prms.tag}",
+                       "one bond group per tag")
+            self._name(prms)
+            self._bond_groups.append(prms)
         elif isinstance(prms, P.NRotElasticWallPrms):
             if prms.wallName not in self._walls:
                 raise ValueError(f"LsmMpi.createInteractionGroup({kind}): no wall named {prms.wallName!r}")
@@ -153,7 +177,7 @@ class LsmMpi:
             self._name(prms)
             self._body.append(prms)
         else:
-            refuse(f"LsmMpi.createInteractionGroup({kind})", "the front end maps NRotElasticPrms, "
+            refuse(f"LsmMpi.createInteractionGroup({kind})", "the front end maps NRotElasticPrms, NRotBondPrms, "
                    "NRotElasticWallPrms, GravityPrms and LinDampingPrms so far")
 
     def createWall(self, name, posn, normal):
@@ -244,7 +268,8 @@ class LsmMpi:
                 self._prev_force = (np.asarray(self._sim.particles.id)[order].copy(),
                                     np.column_stack([self._sim.particles.fx, self._sim.particles.fy,
                                                      self._sim.particles.fz])[order])
-                self._prev_wall_force = {n: -np.asarray(self._sim.walls[n].force) for n in self._walls}
+                # the push on the particles (+ 0.0: no "-0" where the wall touches nothing, as ESyS prints)
+                self._prev_wall_force = {n: 0.0 - np.asarray(self._sim.walls[n].force) for n in self._walls}
             self._sim.run(n)
             self._t += n
             self._clock = self._t

@@ -52,9 +52,27 @@ class CheckPointer(_Schedule):
             tail = " ".join(_g9(v) for v in (state["mass"][i], *state["init"][i], *state["old"][i],
                                               *state["vel"][i], *state["force"][i], 0, 0, 0))
             rows.append(f"{head} {int(state['id'][i])} {int(state['tag'][i])} {tail}\n")
-        rows.append("0\nTMIG 0\n")
+        rows.append(self._bond_section())
+        rows.append("TMIG 0\n")
         with open(data, "w") as f:
             f.write("".join(rows))
+
+
+    def _bond_section(self):
+        """ESyS's bonded groups: their count, then per group 'Bonded', the bond count and 'id1 id2 tag' lines
+        (sorted, as ESyS writes them after createConnections)."""
+        lsm = self.lsm
+        if not lsm._bond_groups:
+            return "0\n"
+        if len(lsm._bond_groups) > 1:
+            refuse("LsmMpi.createCheckPointer with several NRotBondPrms groups", "one bond group is written so "
+                   "far; basalt.Simulation.checkpoint() writes Basalt's checkpoints")
+        if lsm._sim.broken_bonds() > 0:
+            refuse("LsmMpi.createCheckPointer after a bond broke", "the front end writes the bonds of an "
+                   "intact run so far; Basalt's checkpoints list every bond and its state")
+        tag = lsm._bond_groups[0].tag
+        bonds = sorted(b for b in set(lsm._bonds) if b[2] == tag)
+        return f"1\nBonded\n{len(bonds)}\n" + "".join(f"{i} {j} {t}\n" for i, j, t in bonds)
 
 
 class FieldSaver(_Schedule):

@@ -11,6 +11,15 @@ class NRotElasticPrms:
         self.name, self.normalK, self.scaling = str(name), float(normalK), bool(scaling)
 
 
+class NRotBondPrms:
+    """Linear elastic bonds between the connections of `tag` (createConnections): rest length r1 + r2, break
+    when (d - r0)/r0 > breakDistance; scaling=True (3-D): k = normalK (r1 + r2)/4."""
+
+    def __init__(self, name, normalK, breakDistance, tag=0, scaling=True):
+        self.name, self.normalK, self.breakDistance = str(name), float(normalK), float(breakDistance)
+        self.tag, self.scaling = int(tag), bool(scaling)
+
+
 class NRotElasticWallPrms:
     """A wall's elastic repulsion: k = pi r normalK in 3-D (ESyS's convention)."""
 

@@ -7,7 +7,6 @@ _SCENE = "Basalt has it as a scene model (basalt.Simulation with a scene dict, d
 
 # esys.lsm: parameter classes and savers -> what Basalt offers
 LSM = {
-    "NRotBondPrms": _SCENE + 'type = "linear_bond", rest_length = "sum_of_radii"',
     "RotBondPrms": _SCENE + 'type = "rot_bond"',
     "BrittleBeamPrms": _SCENE + 'type = "rot_bond" with youngs_modulus, cohesion, tan_friction_angle',
     "NRotFrictionPrms": _SCENE + 'type = "friction", convention = "esys"',
@@ -38,9 +37,8 @@ LSM = {
 _PACK = "Basalt packs spheres with basalt.pack (box, cylinder, sphere, mesh; lattice=True for a regular one)"
 # esys.lsm.geometry: generators
 GEOMETRY = {name: _PACK for name in (
-    "CubicBlock", "HexagonalBlock", "SimpleBlock", "RandomBoxPacker", "RandomSpherePacker",
-    "SimpleSphereCollection", "ParticleCollection", "ConnectionFinder", "GrainCollection")}
-GEOMETRY["ConnectionFinder"] = "basalt.pack makes the bonds of a packing (bond_tolerance, bond_tag)"
+    "HexagonalBlock", "SimpleBlock", "RandomBoxPacker", "RandomSpherePacker", "SimpleSphereCollection",
+    "ParticleCollection", "GrainCollection")}
 
 
 def stub(module, name, offer):

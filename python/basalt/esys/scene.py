@@ -14,6 +14,7 @@
 import os
 
 from . import prms as P
+from .errors import refuse
 
 
 def scene_dict(lsm, geometry_file, output_dir):
@@ -25,6 +26,23 @@ def scene_dict(lsm, geometry_file, output_dir):
             rotation = True
         else:
             interactions.append({"type": "linear_elastic", "K": g.normalK})
+    radius = {p.getId(): p.getRadius() for p in lsm._particles}
+    for g in lsm._bond_groups:
+        bond = {"type": "linear_bond", "K": g.normalK, "rest_length": "sum_of_radii",
+                "break_strain": g.breakDistance, "bond_tag": g.tag}
+        if g.scaling:  # ESyS: k = normalK (r0/2)^2 / r0 per bond; one k per Basalt group
+            r0 = {radius[i] + radius[j] for i, j, t in lsm._bonds if t == g.tag}
+            if len(r0) > 1:
+                refuse(f"LsmMpi: NRotBondPrms({g.name!r}, scaling=True) on bonds of different r1 + r2",
+                       "the front end maps scaled bonds of one size (a CubicBlock's); Basalt's linear_bond "
+                       "has one K per group")
+            if r0:
+                eff = 0.5 * r0.pop()
+                bond["K"] = g.normalK * (eff * eff) / (2.0 * eff)
+        interactions.append(bond)
+    if (lsm._bonds or lsm._bond_groups) and lsm._pair:
+        refuse("LsmMpi: NRotElasticPrms together with bonds", "ESyS's NRotElastic also pushes bonded pairs "
+               "unless createExclusion; the front end maps neither yet (Basalt's models: docs/scenes.md)")
     walls = []
     for name, (posn, normal) in lsm._walls.items():
         k = lsm._wall_k.get(name)
@@ -62,7 +80,16 @@ def build(lsm, workdir):
     if len(np.unique(ids)) != len(ids):
         raise ValueError("LsmMpi: two particles have the same id")
     pos = np.array([p.getPosn().toList() for p in ps], dtype=float)
-    geo = Geometry(pos, np.array([p.getRadius() for p in ps]), id=ids,
+    bonds = sorted(set(lsm._bonds))
+    known = set(ids.tolist())
+    for i, j, _ in bonds:
+        if i not in known or j not in known:
+            raise ValueError(f"LsmMpi.createConnections: a bond between {i} and {j}, not both particles")
+    extra = {}
+    if bonds:
+        extra = {"bonds": np.array([(i, j) for i, j, _ in bonds], dtype=np.int64),
+                 "bond_tag": np.array([t for _, _, t in bonds], dtype=np.int32)}
+    geo = Geometry(pos, np.array([p.getRadius() for p in ps]), id=ids, **extra,
                    tag=np.array([p.getTag() for p in ps], dtype=np.int32),
                    mass=np.array([p.getMass() for p in ps]), box_min=lsm._domain_lo, box_max=lsm._domain_hi)
     path = os.path.join(workdir, "particles.h5")

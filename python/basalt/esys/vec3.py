@@ -55,24 +55,29 @@ class Vec3:
         return Vec3(*(-a for a in self._v))
 
     def dot(self, v):
-        return sum(a * b for a, b in zip(self._v, v))
+        a, b = self._v, list(v)
+        return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
     def cross(self, v):
         a, b = self._v, list(v)
         return Vec3(a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
 
     def norm(self):
-        return math.sqrt(self.dot(self))
+        x, y, z = self._v
+        return math.sqrt(x * x + y * y + z * z)
 
     def rotate(self, axis, axisPt):
-        """This point rotated about the axis through axisPt, counter-clockwise by |axis| radians (Rodrigues)."""
-        angle = axis.norm()
-        if angle == 0.0:
+        """This point rotated about the axis through axisPt by |axis| radians, with ESyS's formula and sense
+        (Foundation/vec3.hpp: r cos + n (n.r)(1 - cos) + (r x n) sin; (1, 0, 0) about +z by pi/6 gives
+        (0.866, -0.5, 0)), operation for operation."""
+        axis, axisPt = Vec3(axis), Vec3(axisPt)
+        phi = axis.norm()
+        if not phi > 0.0:
             return Vec3(self)
-        k = axis / angle
-        p = self - axisPt
-        c, s = math.cos(angle), math.sin(angle)
-        return axisPt + p * c + k.cross(p) * s + k * (k.dot(p) * (1.0 - c))
+        r = self - axisPt
+        n = axis / phi
+        c = math.cos(phi)
+        return r * c + n * (n.dot(r) * (1 - c)) + r.cross(n) * math.sin(phi) + axisPt
 
     def toList(self):
         return list(self._v)
