@@ -157,6 +157,27 @@ def test_settled_ball_carries_its_weight(tmp_path):
     assert row[17] == pytest.approx(0.0, abs=1e-5)  # the force of the last step: weight and floor balance
 
 
+def test_rotsphere_e_kin_has_the_rotation(tmp_path):
+    """RotSphere: e_kin = 1/2 m v^2 + 1/2 (2/5 m r^2) w^2 (ESyS 2.3.5 prints 0.8355 and 0.0675 here too)."""
+    script = tmp_path / "spin.py"
+    script.write_text(
+        "from esys.lsm import *\nfrom esys.lsm.util import Vec3, BoundingBox\n"
+        "sim = LsmMpi(numWorkerProcesses=1, mpiDimList=[1, 1, 1])\n"
+        "sim.initNeighbourSearch(particleType='RotSphere', gridSpacing=2.5, verletDist=0.5)\n"
+        "sim.setNumTimeSteps(10)\nsim.setTimeStepSize(0.001)\n"
+        "sim.setSpatialDomain(BoundingBox(Vec3(-5, -5, -5), Vec3(5, 5, 5)))\n"
+        "p = RotSphere(id=0, posn=Vec3(0, 0, 0), radius=0.8, mass=1.5)\n"
+        "p.setLinearVelocity(Vec3(0.3, 0.0, 0.0))\np.setAngularVelocity(Vec3(0.0, 0.0, 2.0))\n"
+        "sim.createParticle(p)\n"
+        "for f in ('e_kin', 'e_kin_linear'):\n"
+        "    sim.createFieldSaver(ParticleScalarFieldSaverPrms(fieldName=f, fileName=f + '.dat', fileFormat='SUM',\n"
+        "                         beginTimeStep=0, endTimeStep=10, timeStepIncr=5))\n"
+        "sim.run()\n")
+    front(script, tmp_path)
+    assert (tmp_path / "e_kin.dat").read_text() == "0.8355\n" * 3
+    assert (tmp_path / "e_kin_linear.dat").read_text() == "0.0675\n" * 3
+
+
 # -- a bonded block (gravity_cube-like) ---------------------------------------------------------------------------
 def test_cubic_block_is_close_packed():
     """CubicBlock: touching spheres 2r apart, 12 neighbours inside (a close packing), ids 0.. in order, mass r^3;

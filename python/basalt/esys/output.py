@@ -78,7 +78,7 @@ class CheckPointer(_Schedule):
 class FieldSaver(_Schedule):
     """One createFieldSaver: its field read from the state and written in its file format."""
 
-    SCALAR = {"e_kin": "e_kin", "e_kin_linear": "e_kin_linear"}
+    SCALAR = ("e_kin", "e_kin_linear")
     VECTOR = ("velocity", "displacement", "position", "force")
     WALL = ("Position", "Force")
 
@@ -91,9 +91,6 @@ class FieldSaver(_Schedule):
             if field not in self.SCALAR:
                 refuse(call, f"particle scalar fields here: {', '.join(self.SCALAR)}; Basalt's own "
                              "[[output.fields]] have more (docs/scenes.md)")
-            if lsm._rotational and field == "e_kin":
-                refuse(call, "e_kin of RotSphere particles is not written here yet; e_kin_linear is, and "
-                             "Basalt's kinetic_energy field has both parts")
             if fmt not in ("SUM", "MAX"):
                 refuse(call, "particle scalar fields are written as SUM or MAX here; RAW2/RAW_WITH_ID of "
                              "vectors are")
@@ -117,6 +114,9 @@ class FieldSaver(_Schedule):
         if p.kind == "ParticleScalarFieldSaverPrms":
             v = state["vel"]
             e = 0.5 * state["mass"] * (v * v).sum(axis=1)
+            if p.fieldName == "e_kin" and "angvel" in state:  # RotSphere: + 1/2 I w^2, I = 2/5 m r^2
+                w = state["angvel"]
+                e = e + 0.5 * (0.4 * state["mass"] * state["radius"] ** 2) * (w * w).sum(axis=1)
             value = e.sum() if p.fileFormat == "SUM" else (e.max() if len(e) else 0.0)
             with open(p.fileName, "a") as f:
                 f.write(_g(value) + "\n")
