@@ -133,6 +133,30 @@ def test_particle_leaving_the_domain_is_deleted(fall):
     assert len((d / "disp.0.dat").read_text().splitlines()) == 1  # RAW2 at step 500: ball 0 only
 
 
+def test_domain_is_grown_to_whole_grid_cells(tmp_path):
+    """ESyS keeps a particle until its centre leaves the domain grown to whole gridSpacing cells, centred:
+    [-8, 8] with gridSpacing 2.5 is 7 cells, |x| <= 8.75 (measured: ESyS removed it 3 steps after x passed
+    8.75, at its next neighbour update). Basalt's front end removes it at the end of that step."""
+    script = tmp_path / "leave.py"
+    script.write_text(
+        "from esys.lsm import *\nfrom esys.lsm.util import Vec3, BoundingBox\n"
+        "sim = LsmMpi(numWorkerProcesses=1, mpiDimList=[1, 1, 1])\n"
+        "sim.initNeighbourSearch(particleType='NRotSphere', gridSpacing=2.5, verletDist=0.5)\n"
+        "sim.setNumTimeSteps(1800)\nsim.setTimeStepSize(0.001)\n"
+        "sim.setSpatialDomain(BoundingBox(Vec3(-8, -8, -8), Vec3(8, 8, 8)))\n"
+        "p = NRotSphere(id=0, posn=Vec3(7.0, 0, 0), radius=0.5, mass=1.0)\n"
+        "p.setLinearVelocity(Vec3(1.0, 0, 0))\nsim.createParticle(p)\n"
+        "sim.createParticle(NRotSphere(id=1, posn=Vec3(0, 0, 0), radius=0.5, mass=1.0))\n"
+        "class W(Runnable):\n"
+        "    def __init__(self, sim):\n        Runnable.__init__(self)\n        self.sim, self.n = sim, 2\n"
+        "    def run(self):\n"
+        "        n = len(self.sim.getParticleList())\n"
+        "        if n != self.n:\n            print('gone', self.sim.getTimeStep())\n            self.n = n\n"
+        "w = W(sim)\nsim.addPostTimeStepRunnable(w)\nsim.run()\n")
+    out = front(script, tmp_path).stdout
+    assert out == "gone 1751\n"  # x = 7 + n dt passes 8.75 at step 1751 (not 8 at step 1001)
+
+
 def test_wall_savers_raw_series(fall):
     d, _ = fall
     pos = (d / "floor_Position.dat").read_text().splitlines()
