@@ -248,8 +248,8 @@ class LsmMpi:
             self._start()
         import numpy as np
 
-        # per step: the forces a step used (checkpoints, wall forces) and the neighbour-list rule (checkpoints)
-        track = bool(self._checkpointers) or any(getattr(s.prms, "fieldName", "") == "Force" for s in self._savers)
+        # per step: the forces a step used (checkpoints, force savers) and the neighbour-list rule (checkpoints)
+        track = bool(self._checkpointers) or any(s.prms.fieldName.lower() == "force" for s in self._savers)
         if track and self._old is None:
             self._old = self._positions()
         self._save_due()
@@ -269,7 +269,7 @@ class LsmMpi:
                                     np.column_stack([self._sim.particles.fx, self._sim.particles.fy,
                                                      self._sim.particles.fz])[order])
                 # the push on the particles (+ 0.0: no "-0" where the wall touches nothing, as ESyS prints)
-                self._prev_wall_force = {n: 0.0 - np.asarray(self._sim.walls[n].force) for n in self._walls}
+                self._prev_wall_force = {w: 0.0 - np.asarray(self._sim.walls[w].force) for w in self._walls}
             self._sim.run(n)
             self._t += n
             self._clock = self._t

@@ -2,7 +2,8 @@
 #   python3 -m basalt.esys fall.py            (or: mpirun -np 2 esysparticle fall.py)
 # Ball 0 falls freely from y = 4 (it reaches the floor after step ~1200); ball 7 is thrown sideways out of
 # the spatial domain (x > 8) and is deleted. A pre-time-step Runnable prints "pre STEP ID X Y Z VX VY VZ"
-# every 100 steps and the particle count at the last step; savers: wall position and force (RAW_SERIES), e_kin (SUM), displacement (RAW2).
+# every 100 steps and the particle count at the last step; savers: wall position and force (RAW_SERIES), e_kin (SUM),
+# displacement (RAW2), force (RAW_WITH_ID).
 from esys.lsm import *
 from esys.lsm.util import Vec3, BoundingBox
 
@@ -32,6 +33,8 @@ sim.createFieldSaver(ParticleScalarFieldSaverPrms(fieldName="e_kin", fileName="e
                                                   beginTimeStep=0, endTimeStep=1500, timeStepIncr=50))
 sim.createFieldSaver(ParticleVectorFieldSaverPrms(fieldName="displacement", fileName="disp", fileFormat="RAW2",
                                                   beginTimeStep=500, endTimeStep=1500, timeStepIncr=500))
+sim.createFieldSaver(ParticleVectorFieldSaverPrms(fieldName="force", fileName="force", fileFormat="RAW_WITH_ID",
+                                                  beginTimeStep=0, endTimeStep=1500, timeStepIncr=300))
 
 
 class Report(Runnable):
