@@ -109,6 +109,25 @@ def test_checkpoint_text_format(collide):
     assert re.fullmatch(r"(\S+ ){21}\S+", rows[1])
 
 
+def test_checkpoint_old_positions_follow_the_rebuild_rule(collide):
+    """Columns 10-12 hold the positions at ESyS's last neighbour rebuild: checked as step s begins, a rebuild
+    when a particle has moved more than verletDist/2 (0.2) since the last one. Before the contact both spheres
+    move at constant speed (2 and -1), so the rule can be replayed here with the same floating-point steps."""
+    d, _ = collide
+    x, old = [-3.0, 3.0], [-3.0, 3.0]
+    expected = {}
+    for step in range(1, 1001):
+        if max((a - b) ** 2 for a, b in zip(x, old)) > (0.5 * 0.4) ** 2:
+            old = list(x)
+        x = [x[0] + 2.0 * DT, x[1] + -1.0 * DT]
+        if step % 500 == 0:
+            expected[step] = list(old)
+    for step, (old0, old1) in expected.items():
+        rows = (d / f"collide_t={step}_1.txt").read_text().splitlines()[1:3]
+        assert [float(r.split()[10]) for r in rows] == [float("%.9g" % old0), float("%.9g" % old1)]
+    assert expected[500][0] != -3.0 + 500 * 2.0 * DT  # a rebuild happened, and not at the checkpoint itself
+
+
 # -- gravity and a floor ----------------------------------------------------------------------------------------
 G = -9.81
 
