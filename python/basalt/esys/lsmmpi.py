@@ -392,9 +392,12 @@ class LsmMpi:
         return Vec3(*self._sim.walls[name].position)
 
     def getWallForce(self, name):
-        if self._sim is None:
+        """The wall saver's Force: the wall's push on the particles in the last step (0 before the first)."""
+        if self._sim is None or self._t == 0:
             return Vec3(0.0, 0.0, 0.0)
-        return Vec3(*self._sim.walls[name].force)
+        if name in self._prev_wall_force:
+            return Vec3(*self._prev_wall_force[name])
+        return Vec3(*(0.0 - c for c in self._sim.walls[name].force))
 
 
 def _copy(p):
