@@ -268,8 +268,10 @@ class LsmMpi:
                 self._prev_force = (np.asarray(self._sim.particles.id)[order].copy(),
                                     np.column_stack([self._sim.particles.fx, self._sim.particles.fy,
                                                      self._sim.particles.fz])[order])
-                # the push on the particles (+ 0.0: no "-0" where the wall touches nothing, as ESyS prints)
+            if n == 1:  # the walls' push on the particles (+ 0.0: no "-0" where nothing touches, as ESyS prints)
                 self._prev_wall_force = {w: 0.0 - np.asarray(self._sim.walls[w].force) for w in self._walls}
+            else:  # a chunk: savers and getWallForce fall back to the current forces
+                self._prev_wall_force = {}
             self._sim.run(n)
             self._t += n
             self._clock = self._t
