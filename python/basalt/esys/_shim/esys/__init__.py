@@ -1,0 +1,1 @@
+"""Basalt's stand-in for ESyS-Particle's `esys` package: on sys.path only inside `python3 -m basalt.esys`."""

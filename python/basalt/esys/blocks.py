@@ -1,0 +1,162 @@
+"""esys.lsm.geometry's CubicBlock, SimpleSphere and ConnectionFinder, as ESyS-Particle 2.3.5 makes them
+(Geometry/ClosePackIterator.hpp, CubicBlockIterator.hpp, DistConnections.hpp; checked against ESyS's own
+module, docs/esys.md): the same spheres in the same order, bit for bit."""
+
+import math
+
+from .vec3 import Vec3
+
+_SQRT_1_OVER_3 = 1.0 / math.sqrt(3.0)
+_SQRT_8_OVER_3 = math.sqrt(8.0 / 3.0)
+_SQRT_3 = math.sqrt(3.0)
+
+
+class SimpleSphere:
+    """A sphere of a generated block: id, position, radius, tag 0 and mass r^3 (ESyS's SimpleSphere)."""
+
+    def __init__(self, id=0, posn=(0.0, 0.0, 0.0), radius=1.0, mass=None, tag=0):
+        self._id, self._posn, self._radius = int(id), Vec3(posn), float(radius)
+        self._mass = self._radius ** 3 if mass is None else float(mass)
+        self._tag = int(tag)
+
+    def getId(self):
+        return self._id
+
+    def setId(self, i):
+        self._id = int(i)
+
+    def getTag(self):
+        return self._tag
+
+    def setTag(self, t):
+        self._tag = int(t)
+
+    def getPosn(self):
+        return Vec3(self._posn)
+
+    getPos = getCentre = getCenter = getPosn
+
+    def setPosn(self, p):
+        self._posn = Vec3(p)
+
+    setPos = setCentre = setCenter = setPosn
+
+    def getRadius(self):
+        return self._radius
+
+    getRad = getRadius
+
+    def setRadius(self, r):
+        self._radius = float(r)
+
+    setRad = setRadius
+
+    def getMass(self):
+        return self._mass
+
+    def setMass(self, m):
+        self._mass = float(m)
+
+    def rotate(self, axis, axisPt):
+        self._posn = self._posn.rotate(axis, axisPt)
+
+    def translate(self, translation):
+        self._posn = self._posn + Vec3(translation)
+
+
+def _x_offset(a, b, r):
+    """CubicBlockIterator's offset matrix for the first axis: m(0, a % 6, b % 6)."""
+    row = (0.0, 0.0, r, 0.0, 0.0, r) if a % 2 == 0 else (r, r, 0.0, r, r, 0.0)
+    return row[b % 6]
+
+
+class CubicBlock:
+    """CubicBlock(dimCount=[nx, ny, nz], radius): ESyS's close-packed block (rows along x 2r apart, offset by
+    r; rows along z r sqrt(3) apart; layers along y r sqrt(8/3) apart, shifted along z by 2r/sqrt(3), r/sqrt(3)).
+    Only ESyS's default orientation."""
+
+    def __init__(self, dimCount, radius, orientation=None):
+        if orientation is not None:
+            from .errors import refuse
+            refuse("esys.lsm.geometry.CubicBlock(orientation=...)", "the default orientation is supported")
+        counts = [max(int(c), 1) for c in dimCount]
+        r = float(radius)
+        dim = (0, 2, 1)  # ClosePackIterator's map for the default orientation
+        z_shift = (0.0, 2.0 * _SQRT_1_OVER_3 * r, _SQRT_1_OVER_3 * r)
+        self._spheres = []
+        for k in range(counts[2]):
+            for j in range(counts[1]):
+                for i in range(counts[0]):
+                    idx = (i, j, k)
+                    centre = [0.0, 0.0, 0.0]
+                    centre[dim[0]] = _x_offset(idx[1] % 6, idx[2] % 6, r) + idx[0] * (r * 2.0)
+                    centre[dim[1]] = z_shift[idx[2] % 3] + idx[1] * (r * _SQRT_3)
+                    centre[dim[2]] = 0.0 + idx[2] * (r * _SQRT_8_OVER_3)
+                    self._spheres.append(SimpleSphere(len(self._spheres), Vec3(0.0, 0.0, 0.0) + Vec3(centre), r))
+
+    def __iter__(self):
+        return iter(self._spheres)
+
+    def __len__(self):
+        return len(self._spheres)
+
+    def getNumSpheres(self):
+        return len(self._spheres)
+
+    def rotate(self, axis, axisPt):
+        for s in self._spheres:
+            s.rotate(axis, axisPt)
+
+    def translate(self, translation):
+        for s in self._spheres:
+            s.translate(translation)
+
+
+class Connection:
+    def __init__(self, id1, id2, tag):
+        self._ids, self._tag = (int(id1), int(id2)), int(tag)
+
+    def getId1(self):
+        return self._ids[0]
+
+    def getId2(self):
+        return self._ids[1]
+
+    def getTag(self):
+        return self._tag
+
+
+class ConnectionFinder:
+    """ConnectionFinder(maxDist, bondTag, pList): a bond between every two spheres of pList whose gap
+    d - r1 - r2 is below maxDist (ESyS's DistConnections), smaller id first, sorted."""
+
+    def __init__(self, maxDist=0.01, bondTag=0, pList=()):
+        self._max, self._tag, self._connections = float(maxDist), int(bondTag), []
+        self._particles = []
+        self.addParticles(pList)
+
+    def addParticles(self, pList):
+        import numpy as np
+
+        self._particles += list(pList)
+        ps = sorted(self._particles, key=lambda p: p.getId())
+        pos = np.array([p.getPosn().toList() for p in ps]).reshape(-1, 3)
+        rad = np.array([p.getRadius() for p in ps])
+        found = []
+        for a in range(len(ps)):
+            d = np.sqrt(((pos[a + 1:] - pos[a]) ** 2).sum(axis=1))
+            for b in np.nonzero(d - rad[a + 1:] - rad[a] < self._max)[0]:
+                found.append((ps[a].getId(), ps[a + 1 + b].getId()))
+        self._connections = [Connection(i, j, self._tag) for i, j in sorted(found)]
+
+    def __iter__(self):
+        return iter(self._connections)
+
+    def __len__(self):
+        return len(self._connections)
+
+    def getNumConnections(self):
+        return len(self._connections)
+
+    def getNumParticles(self):
+        return len(self._particles)

@@ -1,0 +1,408 @@
+"""LsmMpi: ESyS-Particle's simulation object, on top of basalt.Simulation (docs/esys.md).
+
+The set-up calls collect the scene (particles, interaction groups, walls, savers); the first run() or
+runTimeStep() starts a basalt.Simulation from it, with ESyS's conventions: symplectic Euler, masses as given,
+ESyS's scalings (NRotElastic, walls pi r K), ESyS's damping rule, no start-up checks ESyS does not make.
+Runnables, field savers and checkpointers run at ESyS's points of the step (docs/reference-runs.md)."""
+
+import atexit
+import math
+import os
+import shutil
+import tempfile
+
+from .errors import refuse
+from .output import CheckPointer, FieldSaver
+from .particles import NRotSphere, RotSphere
+from .vec3 import Vec3
+
+# Without runnables or a checkpointer the run goes in chunks up to the next saver's step, at most this many
+# steps (particles that left the spatial domain are deleted at each chunk's end).
+CHUNK = 100
+
+_HINTS = {
+    "setParticleDensity": "give each NRotSphere/RotSphere its mass (mass=...), as the tutorial's scripts do",
+    "createExclusion": "Basalt's linear_elastic never acts on bonded pairs (scene models, docs/scenes.md); "
+                       "the front end refuses NRotElasticPrms together with bonds",
+    "readGeometry": "basalt.read_geometry reads .geo files for basalt.Simulation",
+    "moveWallBy": "a scene wall's motion, or basalt.Simulation's walls[name].set_velocity",
+    "setParticleNonDynamic": "the scene's particles.fixed_tags or basalt.Simulation.fix(tag)",
+    "setParticleNonRotational": "NRotSphere particles",
+    "createSphereBody": "Basalt's planar and mesh walls (docs/scenes.md)",
+    "loadCheckPoint": "basalt-run --restart with Basalt's HDF5 checkpoints",
+    "setVerbosity": "nothing: Basalt's front end prints no log",
+}
+
+
+class LsmMpi:
+    """LsmMpi(numWorkerProcesses, mpiDimList): the simulation. Basalt runs it in this one process (its own
+    decomposition); numWorkerProcesses and mpiDimList are accepted and not needed."""
+
+    def __init__(self, numWorkerProcesses=1, mpiDimList=None):
+        if int(os.environ.get("OMPI_COMM_WORLD_SIZE", "1")) > 1:
+            refuse("LsmMpi under mpirun with several ranks",
+                   "Basalt's ESyS front end runs the script in one process: `python3 -m basalt.esys script.py` "
+                   "(basalt.Simulation scripts run on several ranks)")
+        self.numWorkerProcesses, self.mpiDimList = int(numWorkerProcesses), list(mpiDimList or [1, 1, 1])
+        self._particle_type = None
+        self._verlet = None
+        self._dt = None
+        self._num_steps = 0
+        self._domain_lo = self._domain_hi = None
+        self._particles = []            # NRotSphere/RotSphere as created
+        self._pair = []                 # NRotElasticPrms
+        self._bond_groups = []          # NRotBondPrms
+        self._bonds = []                # (id1, id2, tag) from createConnections
+        self._wall_k = {}               # wall name -> NRotElasticWallPrms
+        self._walls = {}                # name -> (posn, normal), in creation order
+        self._body = []                 # GravityPrms, LinDampingPrms
+        self._group_names = set()
+        self._savers, self._checkpointers = [], []
+        self._pre, self._post = [], []
+        self._sim = None
+        self._dir = None
+        self._t = 0                     # steps completed
+        self._clock = 0                 # what getTimeStep() returns (t + 1 inside pre-time-step runnables)
+        self._saved = -1                # the last step whose savers ran
+        self._old = None                # positions at the last (emulated) neighbour-list rebuild
+        self._prev_force = None         # (ids, forces) the last step used (ESyS's stored force)
+        self._prev_wall_force = {}      # wall name -> the force the last step's particles got from it
+        self._rotational = False
+
+    # -- set-up ---------------------------------------------------------------------------------------------
+    def initNeighbourSearch(self, particleType, gridSpacing, verletDist):
+        if particleType not in ("NRotSphere", "RotSphere"):
+            refuse(f"LsmMpi.initNeighbourSearch(particleType={particleType!r})",
+                   "NRotSphere and RotSphere are supported")
+        self._particle_type, self._grid, self._verlet = particleType, float(gridSpacing), float(verletDist)
+        self._rotational = particleType == "RotSphere"
+
+    def setSpatialDomain(self, bBox, circDimList=None):
+        if circDimList and any(circDimList):
+            refuse("LsmMpi.setSpatialDomain(circDimList=...)", "Basalt scenes have periodic boundaries "
+                   "(basalt.Simulation, docs/scenes.md); the front end does not map them yet")
+        self._domain_lo, self._domain_hi = bBox.getMinPt().toTuple(), bBox.getMaxPt().toTuple()
+
+    def setTimeStepSize(self, dt):
+        self._dt = float(dt)
+        if self._sim is not None:
+            self._sim.dt = self._dt
+
+    def getTimeStepSize(self):
+        return self._dt
+
+    def setNumTimeSteps(self, numTimeSteps):
+        self._num_steps = int(numTimeSteps)
+
+    def getNumTimeSteps(self):
+        return self._num_steps
+
+    def getTimeStep(self):
+        return self._clock
+
+    def force2dComputations(self, do2d=True):
+        if do2d:
+            refuse("LsmMpi.force2dComputations(True)", "Basalt runs 3-D only")
+
+    def _setup(self, call):
+        if self._sim is not None:
+            refuse(f"LsmMpi.{call} after the run started",
+                   "Basalt's scene is fixed once it runs; basalt.Simulation inserts particles (insert) and "
+                   "steers walls between runs")
+
+    def createParticle(self, particle):
+        self._setup("createParticle")
+        if not isinstance(particle, NRotSphere):
+            raise TypeError(f"LsmMpi.createParticle: an NRotSphere or RotSphere, got {type(particle).__name__}")
+        want = RotSphere if self._particle_type == "RotSphere" else NRotSphere
+        if self._particle_type is None:
+            raise ValueError("LsmMpi.createParticle before initNeighbourSearch(particleType=...)")
+        if type(particle) is not want:
+            raise TypeError(f"LsmMpi.createParticle: a {type(particle).__name__} in a {self._particle_type} run "
+                            "(initNeighbourSearch's particleType)")
+        if particle.getMass() <= 0.0:
+            raise ValueError(f"LsmMpi.createParticle: particle {particle.getId()} has mass {particle.getMass()}")
+        self._particles.append(particle)
+
+    def createParticles(self, particles):
+        """NRotSphere/RotSphere objects, or a generated block's SimpleSpheres (CubicBlock): each becomes a
+        particle of the run's type with the sphere's id, tag, radius and mass (r^3, as ESyS)."""
+        from .blocks import SimpleSphere
+
+        kind = RotSphere if self._particle_type == "RotSphere" else NRotSphere
+        for p in particles:
+            if isinstance(p, SimpleSphere):
+                q = kind(p.getId(), p.getPosn(), p.getRadius(), p.getMass())
+                q.setTag(p.getTag())
+                p = q
+            self.createParticle(p)
+
+    def createConnections(self, connections):
+        """Bonds (ConnectionFinder's, or objects with getId1, getId2, getTag) for NRotBondPrms groups."""
+        self._setup("createConnections")
+        for c in connections:
+            i, j = int(c.getId1()), int(c.getId2())
+            self._bonds.append((min(i, j), max(i, j), int(c.getTag())))
+
+    def _name(self, prms):
+        if prms.name in self._group_names:
+            raise ValueError(f"LsmMpi.createInteractionGroup: a group named {prms.name!r} exists")
+        self._group_names.add(prms.name)
+
+    def createInteractionGroup(self, prms):
+        from . import prms as P
+
+        self._setup("createInteractionGroup")
+        kind = type(prms).__name__
+        if isinstance(prms, P.NRotElasticPrms):
+            self._name(prms)
+            self._pair.append(prms)
+        elif isinstance(prms, P.NRotBondPrms):
+            if any(g.tag == prms.tag for g in self._bond_groups):
+                refuse(f"LsmMpi.createInteractionGroup({kind}): a second group on bond tag {prms.tag}",
+                       "one bond group per tag")
+            self._name(prms)
+            self._bond_groups.append(prms)
+        elif isinstance(prms, P.NRotElasticWallPrms):
+            if prms.wallName not in self._walls:
+                raise ValueError(f"LsmMpi.createInteractionGroup({kind}): no wall named {prms.wallName!r}")
+            if prms.wallName in self._wall_k:
+                refuse(f"LsmMpi.createInteractionGroup({kind}) on wall {prms.wallName!r} twice",
+                       "a Basalt wall has one interaction")
+            self._name(prms)
+            self._wall_k[prms.wallName] = prms
+        elif isinstance(prms, (P.GravityPrms, P.LinDampingPrms)):
+            if any(type(b) is type(prms) for b in self._body):
+                refuse(f"LsmMpi.createInteractionGroup: a second {kind}", "one group of each body force")
+            self._name(prms)
+            self._body.append(prms)
+        else:
+            refuse(f"LsmMpi.createInteractionGroup({kind})", "the front end maps NRotElasticPrms, NRotBondPrms, "
+                   "NRotElasticWallPrms, GravityPrms and LinDampingPrms so far")
+
+    def createWall(self, name, posn, normal):
+        self._setup("createWall")
+        if name in self._walls:
+            raise ValueError(f"LsmMpi.createWall: a wall named {name!r} exists")
+        n = Vec3(normal)
+        if n.norm() == 0.0:
+            raise ValueError(f"LsmMpi.createWall({name!r}): the normal has zero length")
+        self._walls[str(name)] = (Vec3(posn), n)
+
+    def createCheckPointer(self, prms):
+        self._setup("createCheckPointer")
+        if self._rotational:
+            refuse("LsmMpi.createCheckPointer in a RotSphere run", "the front end writes NRotSphere "
+                   "checkpoints so far; basalt.Simulation.checkpoint() writes Basalt's")
+        self._checkpointers.append(CheckPointer(prms, self))
+
+    def createFieldSaver(self, prms):
+        self._setup("createFieldSaver")
+        self._savers.append(FieldSaver(prms, self))
+
+    def addPreTimeStepRunnable(self, runnable):
+        self._pre.append(runnable)
+
+    def addPostTimeStepRunnable(self, runnable):
+        self._post.append(runnable)
+
+    def __getattr__(self, name):
+        if name.startswith("_"):
+            raise AttributeError(name)
+        refuse(f"LsmMpi.{name}", _HINTS.get(name, "not provided by the front end yet"))
+
+    # -- running --------------------------------------------------------------------------------------------
+    def run(self):
+        """Runs the remaining steps up to setNumTimeSteps."""
+        self._advance(self._num_steps)
+
+    def runTimeStep(self):
+        self._advance(self._t + 1)
+
+    def exit(self):
+        if self._sim is not None:
+            self._sim.close()
+            self._sim = None
+        self._cleanup()
+
+    def _cleanup(self):
+        if self._dir is not None:
+            shutil.rmtree(self._dir, ignore_errors=True)
+            self._dir = None
+
+    def _start(self):
+        from .scene import build
+
+        if self._dt is None:
+            raise ValueError("LsmMpi.run: no time step (setTimeStepSize)")
+        if self._domain_lo is None:
+            raise ValueError("LsmMpi.run: no spatial domain (setSpatialDomain)")
+        if not self._particles:
+            raise ValueError("LsmMpi.run: no particles (createParticle)")
+        self._dir = tempfile.mkdtemp(prefix="basalt-esys-")
+        atexit.register(self._cleanup)
+        self._sim, self._ids, self._init = build(self, self._dir)
+
+    def _advance(self, target):
+        if self._sim is None:
+            self._start()
+        import numpy as np
+
+        # per step: the forces a step used (checkpoints, force savers) and the neighbour-list rule (checkpoints)
+        track = bool(self._checkpointers) or any(s.prms.fieldName.lower() == "force" for s in self._savers)
+        if track and self._old is None:
+            self._old = self._positions()
+        self._save_due()
+        while self._t < target:
+            if self._pre or self._post or track:
+                n = 1
+            else:
+                n = min([target, self._t + CHUNK] + [s for s in self._next_saves() if s is not None]) - self._t
+            if self._pre:
+                self._clock = self._t + 1
+                for r in self._pre:
+                    r.run()
+            if track:
+                self._rebuild_check()
+                order = self._order()
+                self._prev_force = (np.asarray(self._sim.particles.id)[order].copy(),
+                                    np.column_stack([self._sim.particles.fx, self._sim.particles.fy,
+                                                     self._sim.particles.fz])[order])
+            if n == 1:  # the walls' push on the particles (+ 0.0: no "-0" where nothing touches, as ESyS prints)
+                self._prev_wall_force = {w: 0.0 - np.asarray(self._sim.walls[w].force) for w in self._walls}
+            else:  # a chunk: savers and getWallForce fall back to the current forces
+                self._prev_wall_force = {}
+            self._sim.run(n)
+            self._t += n
+            self._clock = self._t
+            self._leave_domain()
+            self._save_due()
+            for r in self._post:
+                r.run()
+
+    def _next_saves(self):
+        return [s.next_after(self._t) for s in (*self._savers, *self._checkpointers)]
+
+    def _save_due(self):
+        if self._saved >= self._t:
+            return
+        self._saved = self._t
+        due = [s for s in (*self._savers, *self._checkpointers) if s.due(self._t)]
+        if due:
+            state = self._state()
+            for s in due:
+                s.write(self._t, state)
+
+    # -- state ----------------------------------------------------------------------------------------------
+    def _order(self):
+        import numpy as np
+
+        return np.argsort(self._sim.particles.id, kind="stable")
+
+    def _positions(self):
+        import numpy as np
+
+        p = self._sim.particles
+        return np.column_stack([p.x, p.y, p.z])[self._order()]
+
+    def _rebuild_check(self):
+        """ESyS's neighbour-list rule (TSubLattice::checkNeighbors), checked as a step begins: when a particle has
+        moved more than verletDist/2 since the last rebuild, all 'old positions' become the current ones
+        (measured: a checkpoint of step n shows the rebuild of the positions after step n - 1, not n)."""
+        x = self._positions()
+        if len(x) != len(self._old):
+            self._old = x
+            return
+        d = x - self._old
+        if (d * d).sum(axis=1).max(initial=0.0) > (0.5 * self._verlet) ** 2:
+            self._old = x
+
+    def _grid_domain(self):
+        """ESyS removes a particle once its centre leaves the spatial domain grown to whole cells of gridSpacing,
+        centred (measured: [-8, 8] with gridSpacing 2.5 keeps particles up to |x| = 8.75, with 3.0 up to 9)."""
+        lo, hi = [], []
+        for a, b in zip(self._domain_lo, self._domain_hi):
+            half = math.ceil((b - a) / self._grid - 1e-12) * self._grid / 2
+            lo.append((a + b) / 2 - half)
+            hi.append((a + b) / 2 + half)
+        return lo, hi
+
+    def _leave_domain(self):
+        """Deletes the particles outside the (grown) spatial domain, as ESyS does at its neighbour updates."""
+        p = self._sim.particles
+        (lo, hi), big = self._grid_domain(), 1e30
+        for k, c in enumerate((p.x, p.y, p.z)):
+            if len(c) and (c.min() < lo[k] or c.max() > hi[k]):
+                for side in (0, 1):
+                    a, b = [-big] * 3, [big] * 3
+                    (b if side == 0 else a)[k] = lo[k] if side == 0 else hi[k]
+                    self._sim.delete(box=(a, b))
+                if self._old is not None:  # ESyS removes particles at a neighbour rebuild
+                    self._old = self._positions()
+                return self._leave_domain()
+
+    def _state(self):
+        import numpy as np
+
+        p, order = self._sim.particles, self._order()
+        ids = np.asarray(p.id)[order]
+        where = np.searchsorted(self._ids, ids)
+        state = {
+            "id": ids, "tag": np.asarray(p.tag)[order], "radius": np.asarray(p.radius)[order],
+            "mass": 1.0 / np.asarray(p.inv_mass)[order],
+            "pos": np.column_stack([p.x, p.y, p.z])[order], "vel": np.column_stack([p.vx, p.vy, p.vz])[order],
+            "init": self._init[where],
+            "walls": {n: (np.asarray(w.position), np.asarray(w.force)) for n, w in
+                      ((n, self._sim.walls[n]) for n in self._walls)},
+        }
+        if self._prev_force is not None:  # the forces the last step used, by id (a removal may come between)
+            prev_ids, prev = self._prev_force
+            state["force"] = prev[np.searchsorted(prev_ids, ids)]
+        else:
+            state["force"] = np.column_stack([p.fx, p.fy, p.fz])[order]
+        state["walls"] = {n: (pos, self._prev_wall_force.get(n, -f)) for n, (pos, f) in state["walls"].items()}
+        if self._t == 0:  # before the first step ESyS holds no forces
+            state["force"] = np.zeros_like(state["pos"])
+            state["walls"] = {n: (pos, np.zeros(3)) for n, (pos, f) in state["walls"].items()}
+        state["old"] = self._old if self._old is not None and len(self._old) == len(ids) else state["pos"]
+        if self._rotational:
+            state["angvel"] = np.column_stack([p.wx, p.wy, p.wz])[order]
+        return state
+
+    def getParticleList(self):
+        """The particles now (copies, in id order)."""
+        if self._sim is None:
+            return [_copy(p) for p in sorted(self._particles, key=lambda q: q.getId())]
+        s = self._state()
+        kind = RotSphere if self._rotational else NRotSphere
+        out = []
+        for i in range(len(s["id"])):
+            q = kind(int(s["id"][i]), Vec3(*s["init"][i]), float(s["radius"][i]), float(s["mass"][i]))
+            q._posn, q._vel, q._tag = Vec3(*s["pos"][i]), Vec3(*s["vel"][i]), int(s["tag"][i])
+            q._force = Vec3(*s["force"][i])
+            if self._rotational:
+                q._angvel = Vec3(*s["angvel"][i])
+            out.append(q)
+        return out
+
+    def getNumParticles(self):
+        return len(self._particles) if self._sim is None else self._sim.total_particles
+
+    def getWallPosition(self, name):
+        if self._sim is None:
+            return Vec3(self._walls[name][0])
+        return Vec3(*self._sim.walls[name].position)
+
+    def getWallForce(self, name):
+        """The wall saver's Force: the wall's push on the particles in the last step (0 before the first)."""
+        if self._sim is None or self._t == 0:
+            return Vec3(0.0, 0.0, 0.0)
+        if name in self._prev_wall_force:
+            return Vec3(*self._prev_wall_force[name])
+        return Vec3(*(0.0 - c for c in self._sim.walls[name].force))
+
+
+def _copy(p):
+    q = type(p).__new__(type(p))
+    q.__dict__.update({k: (Vec3(v) if isinstance(v, Vec3) else v) for k, v in p.__dict__.items()})
+    return q

@@ -1,0 +1,137 @@
+"""ESyS-Particle's output files written from a Basalt run: the text checkpoints of createCheckPointer and the
+field savers of createFieldSaver, in ESyS 2.3.5's formats (as its Debian build writes them, docs/esys.md).
+
+A `state` is the LsmMpi's snapshot after a step: numpy arrays in id order (id, pos, vel, radius, mass, tag,
+init, force, old) and walls {name: (position, force)}."""
+
+from .errors import refuse
+
+
+def _g(v):
+    return "%g" % v  # C++'s default ostream: 6 significant digits (particle fields)
+
+
+def _g9(v):
+    return "%.9g" % v  # the checkpoints' particle lines: 9 significant digits
+
+
+class _Schedule:
+    def __init__(self, prms):
+        self.begin, self.end, self.incr = prms.beginTimeStep, prms.endTimeStep, max(prms.timeStepIncr, 1)
+
+    def due(self, t):
+        return self.begin <= t <= self.end and (t - self.begin) % self.incr == 0
+
+    def next_after(self, t):
+        """The first due step > t, or None."""
+        if t < self.begin:
+            return self.begin
+        n = self.begin + ((t - self.begin) // self.incr + 1) * self.incr
+        return n if n <= self.end else None
+
+
+class CheckPointer(_Schedule):
+    """PREFIX_t=T_0.txt (the master's header) and PREFIX_t=T_1.txt (the one worker's particles)."""
+
+    def __init__(self, prms, lsm):
+        super().__init__(prms)
+        self.prefix, self.lsm = prms.fileNamePrefix, lsm
+
+    def write(self, t, state):
+        lsm = self.lsm
+        lo, hi = lsm._domain_lo, lsm._domain_hi
+        data = f"{self.prefix}_t={t}_1.txt"
+        with open(f"{self.prefix}_t={t}_0.txt", "w") as f:
+            f.write(f"V 3\n{lsm._num_steps}\n{_g(lsm._dt)}\n{t}\nESyS-Particle_2.3.4_bzr_rev. \n"
+                    f"BoundingBox {' '.join(_g(v) for v in (*lo, *hi))}\nPeriodicBoundaries 0 0 0\n"
+                    f"Dimension 3D\n{data}")
+        rows = [f"{len(state['id'])}\n"]
+        for i in range(len(state["id"])):
+            nums = [*state["pos"][i], state["radius"][i]]
+            head = " ".join(_g9(v) for v in nums)
+            tail = " ".join(_g9(v) for v in (state["mass"][i], *state["init"][i], *state["old"][i],
+                                              *state["vel"][i], *state["force"][i], 0, 0, 0))
+            rows.append(f"{head} {int(state['id'][i])} {int(state['tag'][i])} {tail}\n")
+        rows.append(self._bond_section())
+        rows.append("TMIG 0\n")
+        with open(data, "w") as f:
+            f.write("".join(rows))
+
+
+    def _bond_section(self):
+        """ESyS's bonded groups: their count, then per group 'Bonded', the bond count and 'id1 id2 tag' lines
+        (sorted, as ESyS writes them after createConnections)."""
+        lsm = self.lsm
+        if not lsm._bond_groups:
+            return "0\n"
+        if len(lsm._bond_groups) > 1:
+            refuse("LsmMpi.createCheckPointer with several NRotBondPrms groups", "one bond group is written so "
+                   "far; basalt.Simulation.checkpoint() writes Basalt's checkpoints")
+        if lsm._sim.broken_bonds() > 0:
+            refuse("LsmMpi.createCheckPointer after a bond broke", "the front end writes the bonds of an "
+                   "intact run so far; Basalt's checkpoints list every bond and its state")
+        tag = lsm._bond_groups[0].tag
+        bonds = sorted(b for b in set(lsm._bonds) if b[2] == tag)
+        return f"1\nBonded\n{len(bonds)}\n" + "".join(f"{i} {j} {t}\n" for i, j, t in bonds)
+
+
+class FieldSaver(_Schedule):
+    """One createFieldSaver: its field read from the state and written in its file format."""
+
+    SCALAR = ("e_kin", "e_kin_linear")
+    VECTOR = ("velocity", "displacement", "position", "force")
+    WALL = ("Position", "Force")
+
+    def __init__(self, prms, lsm):
+        super().__init__(prms)
+        self.prms, self.count = prms, 0
+        kind, field, fmt = prms.kind, prms.fieldName, prms.fileFormat
+        call = f"LsmMpi.createFieldSaver({kind}(fieldName={field!r}, fileFormat={fmt!r}))"
+        if kind == "ParticleScalarFieldSaverPrms":
+            if field not in self.SCALAR:
+                refuse(call, f"particle scalar fields here: {', '.join(self.SCALAR)}; Basalt's own "
+                             "[[output.fields]] have more (docs/scenes.md)")
+            if fmt not in ("SUM", "MAX"):
+                refuse(call, "particle scalar fields are written as SUM or MAX here; RAW2/RAW_WITH_ID of "
+                             "vectors are")
+        elif kind == "ParticleVectorFieldSaverPrms":
+            if field not in self.VECTOR:
+                refuse(call, f"particle vector fields here: {', '.join(self.VECTOR)}")
+            if fmt not in ("RAW2", "RAW_WITH_ID"):
+                refuse(call, "particle vector fields are written as RAW2 or RAW_WITH_ID here")
+        elif kind == "WallVectorFieldSaverPrms":
+            if field not in self.WALL:
+                refuse(call, "wall fields here: Position, Force")
+            if fmt != "RAW_SERIES":
+                refuse(call, "wall fields are written as RAW_SERIES here")
+            for w in prms.wallName:
+                if w not in lsm._walls:
+                    raise ValueError(f"{call}: no wall named {w!r} (createWall first)")
+        # ESyS opens its files for appending (ios::app); so does this.
+
+    def write(self, t, state):
+        p = self.prms
+        if p.kind == "ParticleScalarFieldSaverPrms":
+            v = state["vel"]
+            e = 0.5 * state["mass"] * (v * v).sum(axis=1)
+            if p.fieldName == "e_kin" and "angvel" in state:  # RotSphere: + 1/2 I w^2, I = 2/5 m r^2
+                w = state["angvel"]
+                e = e + 0.5 * (0.4 * state["mass"] * state["radius"] ** 2) * (w * w).sum(axis=1)
+            value = e.sum() if p.fileFormat == "SUM" else (e.max() if len(e) else 0.0)
+            with open(p.fileName, "a") as f:
+                f.write(_g(value) + "\n")
+        elif p.kind == "ParticleVectorFieldSaverPrms":
+            value = {"velocity": state["vel"], "position": state["pos"], "force": state["force"],
+                     "displacement": state["pos"] - state["init"]}[p.fieldName]
+            lines = []
+            for i in range(len(state["id"])):
+                nums = " ".join(_g(c) for c in (*state["pos"][i], *value[i]))
+                lines.append(f"{int(state['id'][i])} {nums}\n" if p.fileFormat == "RAW_WITH_ID" else nums + "\n")
+            with open(f"{p.fileName}.{self.count}.dat", "a") as f:
+                f.write("".join(lines))
+            self.count += 1
+        else:
+            k = 0 if p.fieldName == "Position" else 1
+            row = "".join(" ".join("%.10e" % c for c in state["walls"][w][k]) + "  " for w in p.wallName)
+            with open(p.fileName, "a") as f:
+                f.write(row + "\n")

@@ -1,0 +1,117 @@
+"""The Basalt scene of an LsmMpi's set-up: ESyS's calls mapped onto Basalt's models (docs/esys.md).
+
+    NRotElasticPrms(scaling=False)  -> linear_elastic, K = normalK
+    NRotElasticPrms(scaling=True)   -> k = normalK (r1 + r2)/4 per pair (ESyS's 3-D scaling): Basalt's
+                                       rot_friction with scaling = true, Ks = 0 and mu = 0 (no shear force,
+                                       no moment: the same normal force), particles.rotation on
+    NRotElasticWallPrms             -> the wall's K with stiffness = "esys_pi_r" (k = pi r K)
+    a wall without a group          -> K = 0 (ESyS: no force on it)
+    GravityPrms, LinDampingPrms     -> [[body_forces]] gravity, linear_damping (ESyS's iterative rule)
+    always                          -> symplectic Euler (ESyS's integrator), masses as given, skin = verletDist,
+                                       no energy check and no start-up overlap/dt refusal (ESyS has neither)
+"""
+
+import os
+
+from . import prms as P
+from .errors import refuse
+
+
+def scene_dict(lsm, geometry_file, output_dir):
+    interactions, rotation = [], lsm._rotational
+    for g in lsm._pair:
+        if g.scaling:
+            interactions.append({"type": "rot_friction", "K": g.normalK, "Ks": 0.0, "mu": 0.0, "mu_dynamic": 0.0,
+                                 "convention": "esys", "scaling": True})
+            rotation = True
+        else:
+            interactions.append({"type": "linear_elastic", "K": g.normalK})
+    radius = {p.getId(): p.getRadius() for p in lsm._particles}
+    for g in lsm._bond_groups:
+        bond = {"type": "linear_bond", "K": g.normalK, "rest_length": "sum_of_radii",
+                "break_strain": g.breakDistance, "bond_tag": g.tag}
+        if g.scaling:  # ESyS: k = normalK (r0/2)^2 / r0 per bond; one k per Basalt group
+            r0 = {radius[i] + radius[j] for i, j, t in lsm._bonds if t == g.tag}
+            if len(r0) > 1:
+                refuse(f"LsmMpi: NRotBondPrms({g.name!r}, scaling=True) on bonds of different r1 + r2",
+                       "the front end maps scaled bonds of one size (a CubicBlock's); Basalt's linear_bond "
+                       "has one K per group")
+            if r0:
+                eff = 0.5 * r0.pop()
+                bond["K"] = g.normalK * (eff * eff) / (2.0 * eff)
+        interactions.append(bond)
+    if (lsm._bonds or lsm._bond_groups) and lsm._pair:
+        refuse("LsmMpi: NRotElasticPrms together with bonds", "ESyS's NRotElastic also pushes bonded pairs "
+               "unless createExclusion; the front end maps neither yet (Basalt's models: docs/scenes.md)")
+    walls = []
+    for name, (posn, normal) in lsm._walls.items():
+        k = lsm._wall_k.get(name)
+        walls.append({"name": name, "point": posn.toList(), "normal": normal.toList(),
+                      "K": k.normalK if k else 0.0, "stiffness": "esys_pi_r"})
+    body = []
+    for b in lsm._body:
+        if isinstance(b, P.GravityPrms):
+            body.append({"type": "gravity", "acceleration": b.acceleration.toList()})
+        else:
+            body.append({"type": "linear_damping", "viscosity": b.viscosity, "iterations": b.maxIterations})
+    scene = {
+        "geometry": {"file": geometry_file},
+        "particles": {"rotation": rotation},
+        "run": {"dt": lsm._dt, "skin": lsm._verlet, "integrator": "symplectic_euler", "force_dt": True,
+                "force_overlap": True, "energy_check_every": 0},
+        "output": {"directory": output_dir},
+    }
+    for key, value in (("interactions", interactions), ("walls", walls), ("body_forces", body)):
+        if value:
+            scene[key] = value
+    return scene
+
+
+def build(lsm, workdir):
+    """Writes the particles as a Basalt geometry in workdir and starts the run: (Simulation, ids sorted,
+    initial positions in that order)."""
+    import numpy as np
+
+    from ..geometry import Geometry
+    from ..simulation import Simulation
+
+    ps = sorted(lsm._particles, key=lambda p: p.getId())
+    ids = np.array([p.getId() for p in ps], dtype=np.int64)
+    if len(np.unique(ids)) != len(ids):
+        raise ValueError("LsmMpi: two particles have the same id")
+    pos = np.array([p.getPosn().toList() for p in ps], dtype=float)
+    bonds = sorted(set(lsm._bonds))
+    known = set(ids.tolist())
+    for i, j, _ in bonds:
+        if i not in known or j not in known:
+            raise ValueError(f"LsmMpi.createConnections: a bond between {i} and {j}, not both particles")
+    extra = {}
+    if bonds:
+        extra = {"bonds": np.array([(i, j) for i, j, _ in bonds], dtype=np.int64),
+                 "bond_tag": np.array([t for _, _, t in bonds], dtype=np.int32)}
+    geo = Geometry(pos, np.array([p.getRadius() for p in ps]), id=ids, **extra,
+                   tag=np.array([p.getTag() for p in ps], dtype=np.int32),
+                   mass=np.array([p.getMass() for p in ps]), box_min=lsm._domain_lo, box_max=lsm._domain_hi)
+    path = os.path.join(workdir, "particles.h5")
+    geo.write(path)
+    sim = Simulation(scene_dict(lsm, path, os.path.join(workdir, "out")))
+    vel = {p.getId(): p.getVelocity().toList() for p in ps}
+    angvel = {p.getId(): p.getAngularVelocity().toList() for p in ps if hasattr(p, "getAngularVelocity")}
+    _set_initial_velocities(sim, vel, angvel)
+    return sim, ids, pos
+
+
+def _set_initial_velocities(sim, vel, angvel):
+    """The created particles' velocities ({id: [3 numbers]}), written into the run's arrays before the first
+    step; then the forces are recomputed (the damping reads velocities)."""
+    import numpy as np
+
+    part = sim.particles
+    ids = np.asarray(part.id)
+    for table, names in ((vel, ("vx", "vy", "vz")), (angvel, ("wx", "wy", "wz"))):
+        if not table or not any(any(v) for v in table.values()):
+            continue
+        values = np.array([table[int(i)] for i in ids], dtype=float).reshape(len(ids), 3)
+        for k, name in enumerate(names):
+            getattr(part, name)[:] = values[:, k]
+    sim.state_changed()

@@ -1,0 +1,345 @@
+"""Basalt's ESyS-Particle front end (python/basalt/esys, docs/esys.md): tutorial-style scripts
+(tests/python/esys_scripts/, our own) run through `python3 -m basalt.esys` against closed forms, the savers'
+and checkpoints' text formats line by line, refused calls, and no shadowing of a real `esys` elsewhere.
+ESyS-Particle itself is not needed (tools/esys/compare_tutorial.py compares with it when installed)."""
+
+import math
+import os
+import pathlib
+import re
+import subprocess
+import sys
+
+import pytest
+
+from conftest import ROOT
+
+SCRIPTS = ROOT / "tests" / "python" / "esys_scripts"
+basalt = pytest.importorskip("basalt")
+PACKAGE_DIR = os.path.dirname(os.path.dirname(os.path.abspath(basalt.__file__)))  # the build's python/
+
+
+def front(script, cwd, *args, check=True):
+    """python3 -m basalt.esys SCRIPT in cwd; returns the CompletedProcess."""
+    env = {k: v for k, v in os.environ.items() if not k.startswith("OMPI_COMM_WORLD")}
+    env["PYTHONPATH"] = PACKAGE_DIR
+    p = subprocess.run([sys.executable, "-m", "basalt.esys", str(script), *args], cwd=cwd, capture_output=True,
+                       text=True, env=env, timeout=300)
+    if check and p.returncode != 0:
+        pytest.fail(f"basalt.esys {script} exited {p.returncode}:\n{p.stdout}\n{p.stderr}")
+    return p
+
+
+@pytest.fixture(scope="module")
+def collide(tmp_path_factory):
+    d = tmp_path_factory.mktemp("collide")
+    return d, front(SCRIPTS / "collide.py", d).stdout
+
+
+@pytest.fixture(scope="module")
+def fall(tmp_path_factory):
+    d = tmp_path_factory.mktemp("fall")
+    return d, front(SCRIPTS / "fall.py", d).stdout
+
+
+def lines(out, key):
+    return [[float(w) for w in line.split()[1:]] for line in out.splitlines() if line.startswith(key + " ")]
+
+
+# -- the collision (bingle-like) ------------------------------------------------------------------------------
+M1, M2, R1, R2, K, DT = 1.0, 2.0, 1.0, 1.25, 5000.0, 1e-3
+
+
+def test_collision_rebounds_as_the_closed_form(collide):
+    _, out = collide
+    final = {int(r[0]): r[1:] for r in lines(out, "final")}
+    u1, u2 = 2.0, -1.0  # head-on along x (same y, z): an elastic collision of two masses
+    w1 = ((M1 - M2) * u1 + 2 * M2 * u2) / (M1 + M2)
+    w2 = ((M2 - M1) * u2 + 2 * M1 * u1) / (M1 + M2)
+    assert final[0][0] == pytest.approx(w1, abs=0.02) and final[1][0] == pytest.approx(w2, abs=0.02)
+    assert final[0][1] == 0.0 and final[0][2] == 0.0 and final[1][1] == 0.0
+    # momentum exactly, energy to symplectic Euler's O(dt) error
+    assert M1 * final[0][0] + M2 * final[1][0] == pytest.approx(M1 * u1 + M2 * u2, abs=1e-12)
+    e = 0.5 * M1 * final[0][0] ** 2 + 0.5 * M2 * final[1][0] ** 2
+    assert e == pytest.approx(3.0, rel=5e-3)
+    assert final[0][3:] == [M1, R1] and final[1][3:] == [M2, R2]
+
+
+def test_contact_stiffness_is_esys_scaled(collide):
+    """NRotElasticPrms(scaling=True): k = normalK (r1 + r2)/4. Each contact step's velocity change is
+    dt k overlap / m from the previous step's overlap (symplectic Euler), and the contact lasts pi/omega."""
+    _, out = collide
+    rows = lines(out, "contact")
+    k = K * (R1 + R2) / 4
+    for prev, cur in zip(rows, rows[1:]):
+        if cur[0] != prev[0] + 1:
+            continue
+        assert cur[2] - prev[2] == pytest.approx(-DT * k * prev[1] / M1, rel=1e-9, abs=1e-12)
+        assert cur[3] - prev[3] == pytest.approx(DT * k * prev[1] / M2, rel=1e-9, abs=1e-12)
+    omega = math.sqrt(k * (M1 + M2) / (M1 * M2))
+    assert len(rows) == pytest.approx(math.pi / omega / DT, abs=2)  # unscaled K would give 36 steps, not 48
+
+
+def test_energy_saver_and_velocity_files(collide):
+    d, _ = collide
+    ekin = (d / "ekin.dat").read_text().splitlines()
+    assert len(ekin) == 301 and ekin[0] == "3" and all(re.fullmatch(r"-?[0-9.]+(e[-+]\d+)?", v) for v in ekin)
+    assert all(len(v.replace(".", "").replace("-", "").lstrip("0")) <= 6 for v in ekin)  # 6 significant digits
+    assert [float(v) for v in ekin[:5]] == [3.0] * 5  # before the contact: 1/2 1 2^2 + 1/2 2 1^2
+    vel = sorted(p.name for p in d.glob("vel.*.dat"))
+    assert vel == ["vel.0.dat", "vel.1.dat", "vel.2.dat", "vel.3.dat"]
+    assert (d / "vel.0.dat").read_text() == "0 -3 0.5 0.25 2 0 0\n1 3 0.5 0.25 -1 0 0\n"
+    row = (d / "vel.3.dat").read_text().splitlines()[0].split()
+    assert len(row) == 7 and row[0] == "0" and float(row[4]) == pytest.approx(-2.0, abs=0.02)
+
+
+def test_checkpoint_text_format(collide):
+    d, _ = collide
+    assert sorted(p.name for p in d.glob("collide_t=*_0.txt")) == sorted(
+        f"collide_t={t}_0.txt" for t in range(0, 3001, 500))
+    head = (d / "collide_t=500_0.txt").read_text()
+    assert head == ("V 3\n3000\n0.001\n500\nESyS-Particle_2.3.4_bzr_rev. \nBoundingBox -15 -15 -15 15 15 15\n"
+                    "PeriodicBoundaries 0 0 0\nDimension 3D\ncollide_t=500_1.txt")
+    rows = (d / "collide_t=0_1.txt").read_text().splitlines()
+    assert rows == ["2", "-3 0.5 0.25 1 0 -1 1 -3 0.5 0.25 -3 0.5 0.25 2 0 0 0 0 0 0 0 0",
+                    "3 0.5 0.25 1.25 1 -1 2 3 0.5 0.25 3 0.5 0.25 -1 0 0 0 0 0 0 0 0", "0", "TMIG 0"]
+    rows = (d / "collide_t=500_1.txt").read_text().splitlines()
+    x = [float(w) for w in rows[1].split()]
+    assert len(x) == 22 and x[0] == pytest.approx(-3 + 2 * 0.5, abs=1e-9)  # 500 steps at 2: not yet touching
+    assert re.fullmatch(r"(\S+ ){21}\S+", rows[1])
+
+
+def test_checkpoint_old_positions_follow_the_rebuild_rule(collide):
+    """Columns 10-12 hold the positions at ESyS's last neighbour rebuild: checked as step s begins, a rebuild
+    when a particle has moved more than verletDist/2 (0.2) since the last one. Before the contact both spheres
+    move at constant speed (2 and -1), so the rule can be replayed here with the same floating-point steps."""
+    d, _ = collide
+    x, old = [-3.0, 3.0], [-3.0, 3.0]
+    expected = {}
+    for step in range(1, 1001):
+        if max((a - b) ** 2 for a, b in zip(x, old)) > (0.5 * 0.4) ** 2:
+            old = list(x)
+        x = [x[0] + 2.0 * DT, x[1] + -1.0 * DT]
+        if step % 500 == 0:
+            expected[step] = list(old)
+    for step, (old0, old1) in expected.items():
+        rows = (d / f"collide_t={step}_1.txt").read_text().splitlines()[1:3]
+        assert [float(r.split()[10]) for r in rows] == [float("%.9g" % old0), float("%.9g" % old1)]
+    assert expected[500][0] != -3.0 + 500 * 2.0 * DT  # a rebuild happened, and not at the checkpoint itself
+
+
+# -- gravity and a floor ----------------------------------------------------------------------------------------
+G = -9.81
+
+
+def test_free_fall_is_symplectic_euler_exactly(fall):
+    """v(n) = v0 + n g dt and y(n) = y0 + n v0 dt + g dt^2 n(n+1)/2 (ESyS's symplectic Euler), to rounding."""
+    _, out = fall
+    rows = [r for r in lines(out, "pre") if r[1] == 0 and r[0] <= 1001]
+    assert len(rows) == 11
+    for n1, _, x, y, z, vx, vy, vz in rows:
+        n = n1 - 1  # a pre-time-step Runnable of step n + 1 sees the state after step n
+        assert vy == pytest.approx(1.5 + n * G * DT, abs=1e-11)
+        assert y == pytest.approx(4.0 + n * 1.5 * DT + G * DT * DT * n * (n + 1) / 2, abs=1e-11)
+        assert x == pytest.approx(0.5 + n * 0.25 * DT, abs=1e-11) and vx == 0.25 and z == -0.5 and vz == 0.0
+
+
+def test_particle_leaving_the_domain_is_deleted(fall):
+    d, out = fall
+    seen = sorted({int(r[0]) for r in lines(out, "pre") if r[1] == 7})
+    assert seen and max(seen) < 400  # x = 4 + 12 t leaves x = 8 at t = 1/3
+    assert "particles 1" in out.splitlines()
+    assert len((d / "disp.0.dat").read_text().splitlines()) == 1  # RAW2 at step 500: ball 0 only
+
+
+def test_domain_is_grown_to_whole_grid_cells(tmp_path):
+    """ESyS keeps a particle until its centre leaves the domain grown to whole gridSpacing cells, centred:
+    [-8, 8] with gridSpacing 2.5 is 7 cells, |x| <= 8.75 (measured: ESyS removed it 3 steps after x passed
+    8.75, at its next neighbour update). Basalt's front end removes it at the end of that step."""
+    script = tmp_path / "leave.py"
+    script.write_text(
+        "from esys.lsm import *\nfrom esys.lsm.util import Vec3, BoundingBox\n"
+        "sim = LsmMpi(numWorkerProcesses=1, mpiDimList=[1, 1, 1])\n"
+        "sim.initNeighbourSearch(particleType='NRotSphere', gridSpacing=2.5, verletDist=0.5)\n"
+        "sim.setNumTimeSteps(1800)\nsim.setTimeStepSize(0.001)\n"
+        "sim.setSpatialDomain(BoundingBox(Vec3(-8, -8, -8), Vec3(8, 8, 8)))\n"
+        "p = NRotSphere(id=0, posn=Vec3(7.0, 0, 0), radius=0.5, mass=1.0)\n"
+        "p.setLinearVelocity(Vec3(1.0, 0, 0))\nsim.createParticle(p)\n"
+        "sim.createParticle(NRotSphere(id=1, posn=Vec3(0, 0, 0), radius=0.5, mass=1.0))\n"
+        "class W(Runnable):\n"
+        "    def __init__(self, sim):\n        Runnable.__init__(self)\n        self.sim, self.n = sim, 2\n"
+        "    def run(self):\n"
+        "        n = len(self.sim.getParticleList())\n"
+        "        if n != self.n:\n            print('gone', self.sim.getTimeStep())\n            self.n = n\n"
+        "w = W(sim)\nsim.addPostTimeStepRunnable(w)\nsim.run()\n")
+    out = front(script, tmp_path).stdout
+    assert out == "gone 1751\n"  # x = 7 + n dt passes 8.75 at step 1751 (not 8 at step 1001)
+
+
+def test_wall_savers_raw_series(fall):
+    d, _ = fall
+    pos = (d / "floor_Position.dat").read_text().splitlines()
+    assert len(pos) == 301 and set(pos) == {"0.0000000000e+00 -5.0000000000e+00 0.0000000000e+00  "}
+    force = [[float(w) for w in line.split()] for line in (d / "floor_Force.dat").read_text().splitlines()]
+    assert all(f == [0.0, 0.0, 0.0] for f in force[:200])  # the ball is in the air until step ~1100
+    assert max(f[1] for f in force) > 50.0 and min(f[1] for f in force) >= 0.0  # ESyS: the push on the particles
+
+
+def test_settled_ball_carries_its_weight(tmp_path):
+    out = front(SCRIPTS / "settle.py", tmp_path).stdout
+    m, r, k = 1.8, 1.25, 2000.0
+    force = (tmp_path / "floor_force.dat").read_text().splitlines()
+    fx, fy, fz = (float(w) for w in force[-1].split())
+    assert fy == pytest.approx(-m * G, rel=1e-6) and fx == 0.0 and fz == 0.0  # the wall's push on the ball
+    y = float(out.split("rest ")[1].split()[0])
+    assert y == pytest.approx(-5.0 + r - m * -G / (math.pi * r * k), abs=1e-6)
+    saved = sorted(p.name for p in tmp_path.glob("settle_t=*_1.txt"))
+    assert saved == sorted(f"settle_t={t}_1.txt" for t in range(1000, 6001, 1000))
+    row = [float(w) for w in (tmp_path / "settle_t=6000_1.txt").read_text().splitlines()[1].split()]
+    assert row[1] == pytest.approx(y, abs=1e-8) and abs(row[14]) < 1e-6  # at rest
+    assert row[17] == pytest.approx(0.0, abs=1e-5)  # the force of the last step: weight and floor balance
+
+
+def test_rotsphere_e_kin_has_the_rotation(tmp_path):
+    """RotSphere: e_kin = 1/2 m v^2 + 1/2 (2/5 m r^2) w^2 (ESyS 2.3.5 prints 0.8355 and 0.0675 here too)."""
+    script = tmp_path / "spin.py"
+    script.write_text(
+        "from esys.lsm import *\nfrom esys.lsm.util import Vec3, BoundingBox\n"
+        "sim = LsmMpi(numWorkerProcesses=1, mpiDimList=[1, 1, 1])\n"
+        "sim.initNeighbourSearch(particleType='RotSphere', gridSpacing=2.5, verletDist=0.5)\n"
+        "sim.setNumTimeSteps(10)\nsim.setTimeStepSize(0.001)\n"
+        "sim.setSpatialDomain(BoundingBox(Vec3(-5, -5, -5), Vec3(5, 5, 5)))\n"
+        "p = RotSphere(id=0, posn=Vec3(0, 0, 0), radius=0.8, mass=1.5)\n"
+        "p.setLinearVelocity(Vec3(0.3, 0.0, 0.0))\np.setAngularVelocity(Vec3(0.0, 0.0, 2.0))\n"
+        "sim.createParticle(p)\n"
+        "for f in ('e_kin', 'e_kin_linear'):\n"
+        "    sim.createFieldSaver(ParticleScalarFieldSaverPrms(fieldName=f, fileName=f + '.dat', fileFormat='SUM',\n"
+        "                         beginTimeStep=0, endTimeStep=10, timeStepIncr=5))\n"
+        "sim.run()\n")
+    front(script, tmp_path)
+    assert (tmp_path / "e_kin.dat").read_text() == "0.8355\n" * 3
+    assert (tmp_path / "e_kin_linear.dat").read_text() == "0.0675\n" * 3
+
+
+# -- a bonded block (gravity_cube-like) ---------------------------------------------------------------------------
+def test_cubic_block_is_close_packed():
+    """CubicBlock: touching spheres 2r apart, 12 neighbours inside (a close packing), ids 0.. in order, mass r^3;
+    ConnectionFinder bonds exactly the touching pairs; rotate turns by |axis| clockwise about it, as ESyS."""
+    import numpy as np
+
+    from basalt.esys.blocks import ConnectionFinder, CubicBlock
+    from basalt.esys.vec3 import Vec3
+
+    r = 0.5
+    block = CubicBlock(dimCount=[5, 5, 5], radius=r)
+    spheres = list(block)
+    assert [s.getId() for s in spheres] == list(range(125))
+    assert {s.getMass() for s in spheres} == {r ** 3} and {s.getTag() for s in spheres} == {0}
+    x = np.array([s.getPosn().toList() for s in spheres])
+    d = np.sqrt(((x[:, None, :] - x[None, :, :]) ** 2).sum(axis=2)) + np.eye(len(x)) * 9
+    assert d.min() == pytest.approx(2 * r, abs=1e-12)
+    touching = {(i, j) for i, j in zip(*np.nonzero(d < 2 * r + 1e-9)) if i < j}
+    assert max(np.bincount(np.array(sorted(touching)).ravel())) == 12
+    bonds = {(c.getId1(), c.getId2()) for c in ConnectionFinder(maxDist=0.005, bondTag=3, pList=block)}
+    assert bonds == touching
+    turned = Vec3(1, 0, 0).rotate(axis=Vec3(0, 0, math.pi / 6), axisPt=Vec3(0, 0, 0))
+    assert turned.toList() == pytest.approx([math.cos(math.pi / 6), -0.5, 0.0], abs=1e-15)
+
+
+def test_bonded_block_falls_and_bounces(tmp_path):
+    out = front(SCRIPTS / "cube_drop.py", tmp_path).stdout
+    assert lines(out, "mass") == [[0, 0.125], [1, 0.125], [2, 0.125]]  # ESyS: a block's spheres get r^3
+    centre = lines(out, "centre")
+    assert len(centre) == 12
+    x0, z0 = centre[0][1], centre[0][3]
+    for _, x, y, z in centre:  # no force along x or z but internal ones: the centre only moves along y
+        assert x == pytest.approx(x0, abs=1e-8) and z == pytest.approx(z0, abs=1e-8)
+    ys = [c[2] for c in centre]
+    assert ys[1] < ys[0] and max(ys[3:]) > min(ys[:4])  # falls, hits the floor, bounces
+    rows = [line.split() for line in (tmp_path / "posn.3.dat").read_text().splitlines()]
+    assert len(rows) == 64 and all(len(r) == 7 for r in rows)
+    assert min(float(r[2]) for r in rows) > -2.0  # no sphere centre through the floor (y = -2)
+
+
+# -- refusals, the runner ----------------------------------------------------------------------------------------
+REFUSED = {
+    "sim.createInteractionGroup(RotFrictionPrms(name='f', normalK=1.0, dynamicMu=0.5, staticMu=0.5, shearK=1.0))":
+        ("esys.lsm.RotFrictionPrms", 'rot_friction'),
+    "sim.createExclusion('a', 'b')": ("LsmMpi.createExclusion", "linear_elastic"),
+    "from esys.lsm.geometry import HexagonalBlock\nHexagonalBlock(dimCount=[2, 2, 2], radius=0.5)":
+        ("esys.lsm.geometry.HexagonalBlock", "basalt.pack"),
+    "sim.createInteractionGroup(NRotElasticPrms(name='e', normalK=1.0, scaling=True))\n"
+    "sim.createInteractionGroup(NRotBondPrms(name='b', normalK=1.0, breakDistance=1.0, tag=1))\n"
+    "sim.initNeighbourSearch(particleType='NRotSphere', gridSpacing=2.5, verletDist=0.5)\n"
+    "sim.setTimeStepSize(0.001)\nsim.setSpatialDomain(BoundingBox(Vec3(-5, -5, -5), Vec3(5, 5, 5)))\n"
+    "sim.createParticle(NRotSphere(id=0, posn=Vec3(0, 0, 0), radius=0.5, mass=1.0))\nsim.run()":
+        ("NRotElasticPrms together with bonds", "createExclusion"),
+    "sim.setParticleDensity(tag=0, mask=-1, Density=2.0)": ("LsmMpi.setParticleDensity", "mass="),
+    "sim.createFieldSaver(ParticleScalarFieldSaverPrms(fieldName='sigma_xx_2d', fileName='s', fileFormat='SUM', "
+    "beginTimeStep=0, endTimeStep=1, timeStepIncr=1))": ("fieldName='sigma_xx_2d'", "e_kin"),
+    "from esys.lsm import SomethingElse": ("esys.lsm.SomethingElse", "not provided"),
+}
+
+
+@pytest.mark.parametrize("call", list(REFUSED))
+def test_unsupported_call_is_refused_with_a_message(tmp_path, call):
+    script = tmp_path / "refused.py"
+    script.write_text("from esys.lsm import *\nfrom esys.lsm.util import Vec3, BoundingBox\n"
+                      "sim = LsmMpi(numWorkerProcesses=1, mpiDimList=[1, 1, 1])\n" + call + "\nprint('not refused')\n")
+    p = front(script, tmp_path, check=False)
+    assert p.returncode != 0 and "not refused" not in p.stdout
+    assert "NotSupportedError" in p.stderr and "Basalt's ESyS-Particle front end" in p.stderr
+    for word in REFUSED[call]:
+        assert word in p.stderr
+
+
+def test_povray_import_names_basalt_view(tmp_path):
+    script = tmp_path / "vis.py"
+    script.write_text("from esys.lsm.vis import povray\n")
+    p = front(script, tmp_path, check=False)
+    assert p.returncode != 0 and "basalt-view" in p.stderr
+
+
+def test_script_sees_its_arguments_and_folder(tmp_path):
+    (tmp_path / "helper.py").write_text("VALUE = 42\n")
+    script = tmp_path / "args.py"
+    script.write_text("import sys\nfrom helper import VALUE\nfrom esys.lsm.util import Vec3\n"
+                      "print(sys.argv[1:], VALUE, Vec3(1, 2.5, -0.125), __name__)\n")
+    assert front(script, tmp_path, "--steps", "3").stdout == "['--steps', '3'] 42 1 2.5 -0.125 __main__\n"
+
+
+def test_no_esys_outside_the_runner(tmp_path):
+    """Imported normally, Basalt adds no `esys`: `import esys` fails, or finds a real ESyS-Particle."""
+    code = ("import basalt, basalt.esys, sys\n"
+            "assert basalt.esys.SHIM_ROOT not in sys.path\n"
+            "try:\n    import esys\nexcept ImportError:\n    print('no esys')\n"
+            "else:\n    print('real' if 'basalt' not in (esys.__file__ or '') + str(esys.__path__) else 'shim')\n")
+    env = {**os.environ, "PYTHONPATH": PACKAGE_DIR}
+    p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path, timeout=60, env=env)
+    assert p.returncode == 0, p.stderr
+    assert p.stdout.strip() in ("no esys", "real")
+    if not pathlib.Path("/usr/lib/python3/dist-packages/esys").exists():
+        assert p.stdout.strip() == "no esys"
+
+
+def test_basalt_esys_launcher(tmp_path):
+    """build/bin/basalt-esys: the same runner, next to basalt-run."""
+    launcher = pathlib.Path(os.environ.get("BASALT_BIN") or ROOT / "build" / "bin") / "basalt-esys"
+    if not launcher.exists():
+        pytest.skip(f"{launcher} not built")
+    script = tmp_path / "hello.py"
+    script.write_text("from esys.lsm.util import Vec3\nprint(Vec3(1, 2, 3).norm() ** 2)\n")
+    p = subprocess.run([str(launcher), str(script)], capture_output=True, text=True, timeout=60)
+    assert p.returncode == 0 and p.stdout == "14.0\n", p.stderr
+
+
+def test_compare_tool_skips_without_esys(tmp_path):
+    """tools/esys/compare_tutorial.py without ESyS-Particle's interpreter: Basalt's run only, exit 3, says why."""
+    env = {**os.environ, "PYTHONPATH": PACKAGE_DIR}
+    p = subprocess.run([sys.executable, str(ROOT / "tools" / "esys" / "compare_tutorial.py"), "--scripts", "fall",
+                        "--workdir", str(tmp_path / "cmp"), "--esys", "esysparticle-not-here",
+                        "--pythonpath", PACKAGE_DIR],
+                       capture_output=True, text=True, env=env, timeout=300)
+    assert p.returncode == 3, p.stdout + p.stderr
+    assert "ESyS-Particle comparison skipped: esysparticle-not-here not on PATH" in p.stdout
+    assert (tmp_path / "cmp" / "basalt" / "fall" / "ekin.dat").exists()
