@@ -121,6 +121,13 @@ class Wall:
     def stop(self):
         self.set_velocity((0.0, 0.0, 0.0))
 
+    def set_motion(self, type, **keys):
+        """Move from now on, from where the wall is, by a motion of the scene's walls[k].motion (docs/scenes.md),
+        its times counting from now: set_motion("servo", target_force=5.0, gain=0.01, max_speed=0.5),
+        set_motion("sine", amplitude=0.1, period=2.0), set_motion("ramp", velocity=(0, 0, -1), ramp_time=0.5)."""
+        keys = dict(keys, type=type)
+        self._sim._core.set_wall_motion(self.name, self._sim._keys_text(keys))
+
     def remove(self):
         """The wall touches no particle from now on (a gate taken away)."""
         self._sim._core.remove_wall(self.name)

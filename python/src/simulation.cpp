@@ -117,6 +117,7 @@ class Run {
   virtual void set_wall_velocity(const std::string& name, const std::array<double, 3>& v) = 0;
   virtual void remove_wall(const std::string& name) = 0;
   virtual void add_wall(const std::string& name) = 0;
+  virtual void set_wall_motion(const std::string& name, const std::string& keys) = 0;
   virtual void set_body_force(const std::string& name, const std::string& keys) = 0;
   virtual py::list body_forces() const = 0;
   virtual void set_contact(const std::string& name, const std::string& keys) = 0;
@@ -201,6 +202,9 @@ class RunOf final : public Run {
   }
   void remove_wall(const std::string& name) override { sim_->remove_wall(name); }
   void add_wall(const std::string& name) override { sim_->add_wall(name); }
+  void set_wall_motion(const std::string& name, const std::string& keys) override {
+    sim_->set_wall_motion(name, keys);
+  }
   void set_body_force(const std::string& name, const std::string& keys) override {
     sim_->set_body_force(name, keys);
   }
@@ -587,6 +591,8 @@ void bind_simulation(py::module_& m) {
                                    std::array<double, 3> v) { s.run().set_wall_velocity(name, v); })
       .def("remove_wall", [](PySimulation& s, const std::string& name) { s.run().remove_wall(name); })
       .def("add_wall", [](PySimulation& s, const std::string& name) { s.run().add_wall(name); })
+      .def("set_wall_motion", [](PySimulation& s, const std::string& name,
+                                 const std::string& keys) { s.run().set_wall_motion(name, keys); })
       .def("state_changed", [](PySimulation& s) { s.run().state_changed(); })
       .def("set_body_force", [](PySimulation& s, const std::string& name,
                                 const std::string& keys) { s.run().set_body_force(name, keys); })

@@ -41,53 +41,6 @@ std::string group_name(TableReader& t, const std::string& fallback, std::set<std
   return name;
 }
 
-WallMotion parse_motion(TableReader& t, const std::array<double, 3>& normal) {
-  WallMotion m;
-  const std::string type =
-      t.choice_or("type", {"fixed", "constant_velocity", "half_sine", "sine", "ramp", "servo"}, "fixed");
-  if (type == "fixed") {
-    m.type = WallMotion::Type::fixed;
-  } else if (type == "constant_velocity") {
-    m.type = WallMotion::Type::constant_velocity;
-    m.velocity = t.vec3("velocity");
-  } else if (type == "ramp") {
-    m.type = WallMotion::Type::ramp;
-    m.velocity = t.vec3("velocity");
-    m.ramp_time = t.non_negative("ramp_time");
-    m.start_time = t.number_or("start_time", 0.0);
-    // A negative t0 (at most ramp_time before the start) puts the run's start inside the ramp: ESyS's
-    // WallLoaderRunnable, a pre-time-step runnable, is matched by t0 = -dt/2 (docs/scenes.md).
-    if (!std::isfinite(m.start_time) || m.start_time < -m.ramp_time)
-      t.fail("start_time", "must be finite and >= -ramp_time");
-  } else if (type == "servo") {
-    m.type = WallMotion::Type::servo;
-    const bool force = t.has("target_force"), stress = t.has("target_stress");
-    if (force == stress)
-      t.fail(force ? "target_stress" : "target_force",
-             force ? "give target_force or target_stress (with area), not both"
-                   : "missing: a servo wall needs target_force, or target_stress and area");
-    if (force) {
-      m.servo.target_force = t.number("target_force");
-      if (!std::isfinite(m.servo.target_force)) t.fail("target_force", "must be finite");
-      if (t.has("area")) t.fail("area", "only with target_stress (target_force is already a force)");
-    } else {
-      const double sigma = t.number("target_stress");
-      if (!std::isfinite(sigma)) t.fail("target_stress", "must be finite");
-      m.servo.target_force = sigma * t.positive("area");
-    }
-    m.servo.gain = t.positive("gain");
-    m.servo.max_speed = t.positive("max_speed");
-  } else {
-    m.type = type == "half_sine" ? WallMotion::Type::half_sine : WallMotion::Type::sine;
-    m.amplitude = t.number("amplitude");
-    if (!std::isfinite(m.amplitude)) t.fail("amplitude", "must be finite");
-    m.period = t.positive("period");
-    m.direction = t.has("direction") ? unit(t, "direction") : normal;
-  }
-  t.finish();
-  return m;
-}
-
 /// One [[mesh_walls]] table: the mesh read and placed (scale, then offset), its model, sides, tags, motion.
 MeshWallSpec parse_mesh_wall(TableReader& t, const std::string& label, const std::string& path,
                              const fs::path& base_dir) {
@@ -147,6 +100,53 @@ std::string scene_too_large(const std::string& label, std::uintmax_t bytes) {
 }
 
 }  // namespace
+
+WallMotion parse_motion(TableReader& t, const std::array<double, 3>& normal) {
+  WallMotion m;
+  const std::string type =
+      t.choice_or("type", {"fixed", "constant_velocity", "half_sine", "sine", "ramp", "servo"}, "fixed");
+  if (type == "fixed") {
+    m.type = WallMotion::Type::fixed;
+  } else if (type == "constant_velocity") {
+    m.type = WallMotion::Type::constant_velocity;
+    m.velocity = t.vec3("velocity");
+  } else if (type == "ramp") {
+    m.type = WallMotion::Type::ramp;
+    m.velocity = t.vec3("velocity");
+    m.ramp_time = t.non_negative("ramp_time");
+    m.start_time = t.number_or("start_time", 0.0);
+    // A negative t0 (at most ramp_time before the start) puts the run's start inside the ramp: ESyS's
+    // WallLoaderRunnable, a pre-time-step runnable, is matched by t0 = -dt/2 (docs/scenes.md).
+    if (!std::isfinite(m.start_time) || m.start_time < -m.ramp_time)
+      t.fail("start_time", "must be finite and >= -ramp_time");
+  } else if (type == "servo") {
+    m.type = WallMotion::Type::servo;
+    const bool force = t.has("target_force"), stress = t.has("target_stress");
+    if (force == stress)
+      t.fail(force ? "target_stress" : "target_force",
+             force ? "give target_force or target_stress (with area), not both"
+                   : "missing: a servo wall needs target_force, or target_stress and area");
+    if (force) {
+      m.servo.target_force = t.number("target_force");
+      if (!std::isfinite(m.servo.target_force)) t.fail("target_force", "must be finite");
+      if (t.has("area")) t.fail("area", "only with target_stress (target_force is already a force)");
+    } else {
+      const double sigma = t.number("target_stress");
+      if (!std::isfinite(sigma)) t.fail("target_stress", "must be finite");
+      m.servo.target_force = sigma * t.positive("area");
+    }
+    m.servo.gain = t.positive("gain");
+    m.servo.max_speed = t.positive("max_speed");
+  } else {
+    m.type = type == "half_sine" ? WallMotion::Type::half_sine : WallMotion::Type::sine;
+    m.amplitude = t.number("amplitude");
+    if (!std::isfinite(m.amplitude)) t.fail("amplitude", "must be finite");
+    m.period = t.positive("period");
+    m.direction = t.has("direction") ? unit(t, "direction") : normal;
+  }
+  t.finish();
+  return m;
+}
 
 Scene parse_scene_text(const std::string& text, const std::string& label, const fs::path& base_dir) {
   if (text.size() > kMaxSceneBytes) throw InputError(scene_too_large(label, text.size()));

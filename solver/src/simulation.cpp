@@ -377,6 +377,32 @@ void Simulation<Real>::set_wall_velocity(std::string_view name, const std::array
   forces_.walls().set_velocity(wall_index(name), v, time_);
 }
 
+namespace {
+
+/// The TOML text of a group's keys given from a script (set_body_force, set_contact); InputError naming the
+/// group when it does not parse.
+toml::table parse_group_keys(const std::string& keys, const std::string& label) {
+  try {
+    return toml::parse(keys, label);
+  } catch (const toml::parse_error& e) {
+    throw InputError(fmt::format("{}: {}", label, e.description()));
+  }
+}
+
+}  // namespace
+
+template <class Real>
+void Simulation<Real>::set_wall_motion(std::string_view name, const std::string& keys) {
+  const std::size_t w = wall_index(name);
+  auto& walls = forces_.walls();
+  const std::string label = fmt::format("walls \"{}\".motion", name);
+  const toml::table table = parse_group_keys(keys, label);
+  TableReader t(table, label, std::string(name) + ".motion");
+  const WallMotion m = parse_motion(t, walls.spec(w).normal);
+  t.finish();
+  walls.set_motion(w, m, time_);
+}
+
 template <class Real>
 void Simulation<Real>::add_wall(std::string_view name) {
   const std::size_t w = wall_index(name);
@@ -415,20 +441,6 @@ void Simulation<Real>::remove_wall(std::string_view name) {
   forces_.walls().remove(wall_index(name));
   force_rebuild();
 }
-
-namespace {
-
-/// The TOML text of a group's keys given from a script (set_body_force, set_contact); InputError naming the
-/// group when it does not parse.
-toml::table parse_group_keys(const std::string& keys, const std::string& label) {
-  try {
-    return toml::parse(keys, label);
-  } catch (const toml::parse_error& e) {
-    throw InputError(fmt::format("{}: {}", label, e.description()));
-  }
-}
-
-}  // namespace
 
 template <class Real>
 void Simulation<Real>::set_body_force(std::string_view name, const std::string& keys) {

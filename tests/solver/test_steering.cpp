@@ -442,6 +442,36 @@ steps = 4000
   EXPECT_TRUE(sim.walls().removed(sim.wall_index("deep")));
 }
 
+TEST(Steering, AMotionSetMidRunStartsItsClockThereAndAServoHoldsItsTarget) {
+  // set_wall_motion: the piston (z = 10, facing down) moves at constant velocity from where it is, its
+  // clock starting now (z = 10 - v (t - t0), not 10 - v t); then a servo set mid-run brings it onto the
+  // damped pile and holds the compressive force at its target.
+  const auto scene = basalt::test::scene_from(pile_scene("dt = 2e-3") + R"(
+[[body_forces]]
+type = "linear_damping"
+viscosity = 1.0
+)");
+  Simulation<double> sim(scene, pile(), MPI_COMM_WORLD, basalt::test::quiet());
+  FieldRows rows(sim.comm(), nullptr);
+  const std::size_t piston = sim.wall_index("piston");
+  sim.run(100, rows);
+  sim.set_wall_motion("piston", "type = \"constant_velocity\"\nvelocity = [0.0, 0.0, -2.0]");
+  sim.run(1000, rows);
+  EXPECT_NEAR(sim.walls().point(piston)[2], 10.0 - 2.0 * 1000 * 2e-3, 1e-9);  // 6: above the pile (< 3)
+  sim.set_wall_motion("piston", "type = \"servo\"\ntarget_force = 20.0\ngain = 0.02\nmax_speed = 1.0");
+  sim.run(8000, rows);
+  double fz = sim.walls().force(piston)[2];
+  if (sim.comm().size() > 1) fz = sim.comm().sum(fz);
+  EXPECT_NEAR(fz, 20.0, 0.5);  // the particles push it up (its normal is -z) with the target force
+  EXPECT_LT(sim.walls().point(piston)[2], 3.5);
+  try {
+    sim.set_wall_motion("piston", "type = \"servo\"\ntarget_force = 20.0\ngain = 0.02");
+    ADD_FAILURE() << "a servo without max_speed was taken";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("max_speed"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Steering, GravityChangedMidRunMovesTheCentreOfMassByTheNewAcceleration) {
   // In free fall (the floor taken away) the contacts cancel in the momentum: the centre of mass's vertical
   // velocity changes by g t, with the new g from the step it is set.

@@ -200,6 +200,10 @@ class Simulation {
   std::size_t wall_index(std::string_view name) const;
   /// The wall moves at velocity v from now on, from where it is (a servo wall stops steering itself).
   void set_wall_velocity(std::string_view name, const std::array<double, 3>& v);
+  /// The wall moves from now on, from where it is, by the motion table `keys` (TOML text of walls[k].motion's
+  /// keys, e.g. "type = \"servo\"\ntarget_force = 5.0\ngain = 0.01\nmax_speed = 0.5"; its times count from
+  /// now), checked as the scene's. InputError naming the key, nothing changed, on a bad table.
+  void set_wall_motion(std::string_view name, const std::string& keys);
   /// The wall touches particles from now on (one the scene declared with active = false, or one removed):
   /// the lists are rebuilt at once and the energy guard takes a new reference. InputError, nothing changed,
   /// when a particle's centre is behind it (the wall would push it through), naming the particle.

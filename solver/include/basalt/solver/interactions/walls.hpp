@@ -152,6 +152,14 @@ class Walls {
     m.start_time = t;
     walls_[w].point = point_[w];
   }
+  /// From time t on, wall w moves by m from where it is, m's clock starting at t (a servo wall starts at rest
+  /// and steers itself from the next step's force).
+  void set_motion(std::size_t w, WallMotion m, double t) {
+    m.origin_time = t;
+    walls_[w].motion = m;
+    walls_[w].point = point_[w];
+    velocity_[w] = servo(w) ? std::array<double, 3>{0, 0, 0} : m.velocity_at(t);
+  }
   /// Wall w touches no particle from the next rebuild on (a gate taken away); it keeps its place and motion.
   void remove(std::size_t w) {
     removed_.resize(walls_.size(), 0);

@@ -261,6 +261,9 @@ Scene parse_scene(const std::filesystem::path& file);
 Scene parse_scene_text(const std::string& text, const std::string& label,
                        const std::filesystem::path& base_dir);
 
+/// A planar wall's motion table (walls[k].motion; Simulation::set_wall_motion), `normal` the wall's.
+WallMotion parse_motion(TableReader& t, const std::array<double, 3>& normal);
+
 /// Column names of fields.csv for these savers (after "step" and "time").
 std::vector<std::string> field_columns(const Scene& scene);
 /// The columns one saver writes (wall_force x, y, z; broken_bonds one per failure mode; else one).

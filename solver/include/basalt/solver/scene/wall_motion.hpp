@@ -42,6 +42,9 @@ struct WallMotion {
   double ramp_time = 0;   ///< ramp: T_r, the time from rest to the full velocity (0: a step)
   double start_time = 0;  ///< ramp: t0, the wall rests before it (>= -ramp_time: may precede the start)
   ServoControl servo;     ///< servo only
+  /// When its clock starts: a motion set mid-run (Walls::set_motion) runs on t - origin_time (0 for the
+  /// scene's: t - 0 is t to the bit).
+  double origin_time = 0;
 
   /// ramp: the fraction of the full velocity at time t, and its integral from 0 to t.
   double ramp_fraction(double t) const {
@@ -58,6 +61,7 @@ struct WallMotion {
   bool moves() const { return type != Type::fixed; }
 
   std::array<double, 3> velocity_at(double t) const {
+    t -= origin_time;
     switch (type) {
       case Type::fixed:
       case Type::servo:
@@ -81,6 +85,7 @@ struct WallMotion {
 
   /// Displacement from the initial position at time t (exact integral of velocity_at).
   std::array<double, 3> displacement_at(double t) const {
+    t -= origin_time;
     double s = 0;
     switch (type) {
       case Type::fixed:
