@@ -146,6 +146,14 @@ def test_views_and_steering(tmp_path):
     sim.run(100)
     assert floor.position[2] - z0 == pytest.approx(0.01 * 100 * sim.dt)
     floor.stop()
+    rear = sim.walls["rear"]  # any motion of the scene's, its clock starting now
+    y0 = rear.position[1]
+    rear.set_motion("constant_velocity", velocity=(0.0, -0.01, 0.0))
+    sim.run(100)
+    assert rear.position[1] - y0 == pytest.approx(-0.01 * 100 * sim.dt)
+    with pytest.raises(basalt.InputError, match="type"):
+        rear.set_motion("wobble")
+    rear.stop()
     assert 2e-3 < sim.critical_dt < 1.0  # the scene's dt = 2e-3 runs below its critical step
     sim.dt = 1e-3
     assert sim.dt == 1e-3
