@@ -7,10 +7,10 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <numbers>
 #include <string_view>
 
 #include "basalt/solver/core/errors.hpp"
+#include "basalt/solver/core/sphere_mass.hpp"
 #include "basalt/solver/models/registry.hpp"
 #include "basalt/solver/parallel/communicator.hpp"
 
@@ -49,7 +49,7 @@ GeometrySummary summarize_geometry(const Scene& scene, const io::Geometry& g, co
   s.has_mass = g.has_mass();
   for (std::size_t i = 0; i < g.size(); ++i) {
     const double r = g.radius[i];
-    const double m = g.has_mass() ? g.mass[i] : scene.density * 4.0 / 3.0 * std::numbers::pi * r * r * r;
+    const double m = g.has_mass() ? g.mass[i] : sphere_mass(scene.density, r);
     if (!(m > 0) || !std::isfinite(m) || !std::isfinite(1 / m)) {
       if (g.has_mass())
         s.mass_error = fmt::format(
@@ -64,9 +64,7 @@ GeometrySummary summarize_geometry(const Scene& scene, const io::Geometry& g, co
       return s;
     }
     s.m_min = std::min(s.m_min, m);
-    s.m_min_pow = std::min(
-        s.m_min_pow,
-        g.has_mass() ? g.mass[i] : scene.density * 4.0 / 3.0 * std::numbers::pi * std::pow(g.radius[i], 3));
+    s.m_min_pow = std::min(s.m_min_pow, g.has_mass() ? g.mass[i] : sphere_mass(scene.density, g.radius[i]));
     s.rmin = std::min(s.rmin, r);
     s.rmax = std::max(s.rmax, r);
     s.xmax = std::max(

@@ -6,9 +6,9 @@
 #include <cmath>
 #include <cstdlib>
 #include <limits>
-#include <numbers>
 
 #include "basalt/solver/core/errors.hpp"
+#include "basalt/solver/core/sphere_mass.hpp"
 #include "basalt/solver/integrate/integrators.hpp"
 #include "basalt/solver/models/registry.hpp"
 #include "basalt/solver/scene/load_checks.hpp"
@@ -19,7 +19,7 @@ namespace basalt::solver {
 namespace {
 
 double particle_mass(const io::Geometry& g, std::size_t i, double density) {
-  return g.has_mass() ? g.mass[i] : density * 4.0 / 3.0 * std::numbers::pi * std::pow(g.radius[i], 3);
+  return g.has_mass() ? g.mass[i] : sphere_mass(density, g.radius[i]);
 }
 
 double distance(const io::Vec3& a, const io::Vec3& b) {

@@ -9,10 +9,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 
 #include "basalt/solver/core/errors.hpp"
 #include "basalt/solver/core/particle_source.hpp"
+#include "basalt/solver/core/sphere_mass.hpp"
 #include "basalt/solver/neighbor/cell_grid.hpp"
 #include "basalt/solver/simulation.hpp"
 
@@ -39,7 +39,7 @@ void Simulation<Real>::include_flow(GeometrySummary& s) const {
   for (const auto& i : scene_.inserts) {
     s.rmin = std::min(s.rmin, i.rmin);
     s.rmax = std::max(s.rmax, i.rmax);
-    s.m_min_pow = std::min(s.m_min_pow, i.density * 4.0 / 3.0 * std::numbers::pi * std::pow(i.rmin, 3));
+    s.m_min_pow = std::min(s.m_min_pow, sphere_mass(i.density, i.rmin));
   }
 }
 
@@ -77,7 +77,7 @@ void Simulation<Real>::check_insert(const InsertSpec& s) const {
                     "geometry's and the "
                     "scene's [[insert]] radii): declare the largest radius in an [[insert]] of the scene",
                     s.name, s.rmax, rmax_run_));
-  const double m = s.density * 4.0 / 3.0 * std::numbers::pi * std::pow(s.rmin, 3);
+  const double m = sphere_mass(s.density, s.rmin);
   if (m < stability_.m_min * (1 - 1e-12) && stability_.dt_critical > 0 && !scene_.force_dt &&
       !options_.force_dt) {
     // The lightest newcomer's contacts: the critical step scales with sqrt(m).

@@ -7,10 +7,10 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
-#include <numbers>
 #include <unordered_map>
 #include <vector>
 
+#include "basalt/solver/core/sphere_mass.hpp"
 #include "basalt/solver/scene/flow_spec.hpp"
 
 namespace basalt::solver {
@@ -45,7 +45,7 @@ inline std::vector<NewParticle> insertion_candidates(const InsertSpec& s, std::i
     c.x = s.region.sample(unit_random(key + 1), unit_random(key + 2), unit_random(key + 3), c.radius);
     c.v = s.velocity;
     c.tag = s.tag;
-    c.inv_mass = 1.0 / (s.density * 4.0 / 3.0 * std::numbers::pi * std::pow(c.radius, 3));
+    c.inv_mass = 1.0 / sphere_mass(s.density, c.radius);
   }
   return out;
 }
