@@ -681,14 +681,15 @@ class PairDriver final : public ContactDriver<Real, Model, PairDriver<Real, Mode
   }
 
   /// The loops step over bonded pairs (they act by their bond): a history restored for one (a contact
-  /// before its bond formed) is dropped here, as a parting contact's would be, its energy dissipated.
+  /// before its bond formed) is dropped here, as a parting contact's would be, its energy dissipated
+  /// (models with a dissipation term, as the loops: a scalar law's too).
   void drop_bonded(const Particles<Real>& p, const PairList& list, std::vector<History>& hist, bool own) {
     if (list.bonded.empty()) return;
     for (std::size_t i = 0; i + 1 < list.offset.size(); ++i)
       for (auto e = list.offset[i]; e < list.offset[i + 1]; ++e) {
         if (list.bonded[e] == 0 || !holds(hist[e])) continue;
         const auto j = static_cast<std::size_t>(list.neigh[e]);
-        if constexpr (kKinematic) {
+        if constexpr (kDissipates) {
           const int g = group_of(p.tag[i], p.tag[j]);
           if (g >= 0 && (own || p.id[i] < p.id[j]))
             dissipated_ += Model::parting_energy(coeffs_[static_cast<std::size_t>(g)], hist[e]);
