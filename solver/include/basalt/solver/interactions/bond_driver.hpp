@@ -9,31 +9,25 @@
 #include <string_view>
 #include <vector>
 
-#include "basalt/solver/interactions/force_compute.hpp"
+#include "basalt/solver/interactions/driver_base.hpp"
 
 namespace basalt::solver {
 
 template <class Real, class Model>
-class BondDriver final : public ForceCompute<Real> {
+class BondDriver final : public ModelDriver<Real, Model> {
+  using Base = ModelDriver<Real, Model>;
+
  public:
-  using Coeffs = typename Model::template Coeffs<Real>;
+  using Coeffs = typename Base::Coeffs;
 
   /// Takes the scene's bond groups (all of model Model: Bonds::group indexes them).
   explicit BondDriver(const std::vector<InteractionSpec>& groups) {
     for (const auto& g : groups) {
-      params_.push_back(g.template params_of<Model>());
-      coeffs_.push_back(Model::template coeffs<Real>(params_.back()));
+      this->add_group(g.template params_of<Model>());
       breakable_ = breakable_ || Model::breakable(params_.back());
     }
   }
 
-  std::string_view model() const override { return Model::name; }
-  ModelKind kind() const override { return ModelKind::bond; }
-  double max_stiffness(double rmax) const override {
-    double m = 0;
-    for (const auto& p : params_) m = std::max(m, Model::max_stiffness(p, rmax));
-    return m;
-  }
   bool can_break() const override { return breakable_; }
   double rest_length(std::size_t g, double ri, double rj, double r) const override {
     return Model::rest_length(params_[g], ri, rj, r);
@@ -93,7 +87,10 @@ class BondDriver final : public ForceCompute<Real> {
             ++p.bonds_broken[i];
             if constexpr (BothOwned) ++p.bonds_broken[j];
           }
-          if (BothOwned || p.id[i] < p.id[j]) s.broken.push_back(record(s, k, i, j, r, r0));
+          if (BothOwned || p.id[i] < p.id[j])  // a tension failure
+            s.broken.push_back(broken_bond<Real>(bonds.a[k], bonds.b[k], double(r), double(r0),
+                                                 bonds.group_of(k), 0, {x[i], y[i], z[i]}, p.radius[i],
+                                                 {x[j], y[j], z[j]}, p.radius[j]));
           continue;
         }
       }
@@ -112,25 +109,7 @@ class BondDriver final : public ForceCompute<Real> {
     return energy;
   }
 
-  /// The break record of bond k (ends i, j): a tension failure at the spheres' contact point.
-  static BrokenBond record(const ForceState<Real>& s, std::size_t k, std::size_t i, std::size_t j, Real r,
-                           Real r0) {
-    const auto& p = s.p;
-    const double w = double(p.radius[i]) / (double(p.radius[i]) + double(p.radius[j]));
-    return {s.bonds.a[k],
-            s.bonds.b[k],
-            double(r),
-            double(r0),
-            -1,
-            s.bonds.group_of(k),
-            0,
-            double(p.x[i]) + w * (double(p.x[j]) - double(p.x[i])),
-            double(p.y[i]) + w * (double(p.y[j]) - double(p.y[i])),
-            double(p.z[i]) + w * (double(p.z[j]) - double(p.z[i]))};
-  }
-
-  std::vector<typename Model::Params> params_;
-  std::vector<Coeffs> coeffs_;
+  using Base::params_, Base::coeffs_;
   bool breakable_ = false;
   std::vector<std::size_t> gone_;
 };

@@ -10,35 +10,28 @@
 #include <string_view>
 #include <vector>
 
-#include "basalt/solver/interactions/force_compute.hpp"
+#include "basalt/solver/interactions/driver_base.hpp"
+#include "basalt/solver/interactions/history_records.hpp"
 #include "basalt/solver/models/bonded_wall.hpp"
 
 namespace basalt::solver {
 
 template <class Real, class Model = BondedWall>
-class BondedWallDriver final : public ForceCompute<Real> {
+class BondedWallDriver final : public ContactDriver<Real, Model, BondedWallDriver<Real, Model>> {
+  using Base = ContactDriver<Real, Model, BondedWallDriver<Real, Model>>;
+
  public:
-  using Coeffs = typename Model::template Coeffs<Real>;
-  using History = typename Model::History;
+  using Coeffs = typename Base::Coeffs;
+  using History = typename Base::History;
+  static_assert(Base::kHistory);
 
   explicit BondedWallDriver(const std::vector<WallSpec>& walls) {
     for (std::size_t w = 0; w < walls.size(); ++w) {
       if (walls[w].model != Model::name) continue;
       index_.push_back(w);
-      params_.push_back(walls[w].template params_of<Model>());
-      coeffs_.push_back(Model::template coeffs<Real>(params_.back()));
+      this->add_group(walls[w].template params_of<Model>());
     }
     hist_.resize(index_.size());
-    pending_.width = history_width<Model>();
-  }
-
-  std::string_view model() const override { return Model::name; }
-  Fields reads() const override { return Model::reads; }
-  ModelKind kind() const override { return ModelKind::wall; }
-  double max_stiffness(double rmax) const override {
-    double m = 0;
-    for (const auto& p : params_) m = std::max(m, Model::max_stiffness(p, rmax));
-    return m;
   }
 
   double compute(ForceState<Real>& s, Part part, bool energy, bool /*advance*/) override {
@@ -55,23 +48,23 @@ class BondedWallDriver final : public ForceCompute<Real> {
       const auto& at = walls.point(w);
       const auto& cand = walls.candidates(w);
       auto& h = hist_[k];
-      h.assign(cand.size(), History{});
+      // (a record is saved only for a bond, bonded = 1: a history holds something exactly when bonded)
+      restore_candidates(p, cand, pending_, records, wall_id(k), h);
       for (std::size_t c = 0; c < cand.size(); ++c) {
         const auto i = static_cast<std::size_t>(cand[c]);
-        const auto r = pending_.empty() ? -1 : records.find(p.id[i], wall_id(k));
-        if (r >= 0) {
-          std::memcpy(static_cast<void*>(&h[c]), pending_.at(static_cast<std::size_t>(r)), sizeof(History));
-        } else if (spec.bonds(p.tag[i])) {  // first met: the rest offset is where it is now
+        if (!holds(h[c]) && spec.bonds(p.tag[i]))  // first met: the rest offset is where it is now
           h[c] = {double(p.x[i]) - at[0], double(p.y[i]) - at[1], double(p.z[i]) - at[2], 1.0};
-        }
       }
     }
     pending_.clear();
   }
-  void save_history(const Particles<Real>& p) override { collect(p, pending_); }
-  ContactRecords* pending() override { return &pending_; }
-  void history_records(const Particles<Real>& p, ContactRecords& out) const override { collect(p, out); }
-  std::size_t history_bytes() const override { return basalt::solver::history_bytes<Model>(); }
+  /// The records of the bonds (ContactDriver: save_history, history_records).
+  void collect(const Particles<Real>& p, ContactRecords& out) const {
+    out.width = history_width<Model>();
+    if (!walls_) return;
+    for (std::size_t k = 0; k < index_.size(); ++k)
+      collect_candidates(p, walls_->candidates(index_[k]), hist_[k], wall_id(k), out);
+  }
   std::size_t memory_bytes() const override {
     std::size_t b = 0;
     for (const auto& h : hist_) b += h.capacity() * sizeof(History);
@@ -79,19 +72,7 @@ class BondedWallDriver final : public ForceCompute<Real> {
   }
 
  private:
-  std::int64_t wall_id(std::size_t k) const { return -1 - static_cast<std::int64_t>(index_[k]); }
-
-  void collect(const Particles<Real>& p, ContactRecords& out) const {
-    out.width = history_width<Model>();
-    if (!walls_) return;
-    for (std::size_t k = 0; k < index_.size(); ++k) {
-      const auto& cand = walls_->candidates(index_[k]);
-      for (std::size_t c = 0; c < cand.size() && c < hist_[k].size(); ++c)
-        if (hist_[k][c].bonded != 0)
-          out.push(p.id[static_cast<std::size_t>(cand[c])], wall_id(k),
-                   reinterpret_cast<const double*>(&hist_[k][c]));
-    }
-  }
+  std::int64_t wall_id(std::size_t k) const { return wall_record_id(index_[k]); }
 
   template <bool Energy>
   double loop(Particles<Real>& p, Walls& walls) {
@@ -137,11 +118,9 @@ class BondedWallDriver final : public ForceCompute<Real> {
     return energy;
   }
 
+  using Base::coeffs_, Base::pending_;
   std::vector<std::size_t> index_;
-  std::vector<typename Model::Params> params_;
-  std::vector<Coeffs> coeffs_;
   std::vector<std::vector<History>> hist_;  ///< per wall of this model, per candidate
-  ContactRecords pending_;
   const Walls* walls_ = nullptr;
 };
 

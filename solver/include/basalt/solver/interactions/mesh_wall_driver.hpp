@@ -24,17 +24,20 @@
 #include <string_view>
 #include <vector>
 
-#include "basalt/solver/interactions/force_compute.hpp"
+#include "basalt/solver/interactions/driver_base.hpp"
+#include "basalt/solver/interactions/history_records.hpp"
 
 namespace basalt::solver {
 
 template <class Real, class Model>
-class MeshWallDriver final : public ForceCompute<Real> {
+class MeshWallDriver final : public ContactDriver<Real, Model, MeshWallDriver<Real, Model>> {
+  using Base = ContactDriver<Real, Model, MeshWallDriver<Real, Model>>;
+
  public:
-  using Coeffs = typename Model::template Coeffs<Real>;
-  using History = typename Model::History;
+  using Coeffs = typename Base::Coeffs;
+  using History = typename Base::History;
   static constexpr bool kKinematic = (Model::reads & kVelocity) != 0;
-  static constexpr bool kHistory = basalt::solver::history_bytes<Model>() > 0;
+  using Base::kHistory;
   /// Contacts per (particle, mesh) pair whose history is kept (a sphere in a box's corner has three;
   /// in the silo's floor-wall corner up to four, two wall facets and the floor); more start fresh.
   static constexpr std::size_t kSlots = 4;
@@ -44,32 +47,14 @@ class MeshWallDriver final : public ForceCompute<Real> {
     for (std::size_t w = 0; w < meshes.size(); ++w) {
       if (meshes[w].model != Model::name) continue;
       index_.push_back(w);
-      params_.push_back(meshes[w].template params_of<Model>());
-      coeffs_.push_back(Model::template coeffs<Real>(params_.back()));
+      this->add_group(meshes[w].template params_of<Model>());
     }
     hist_.resize(index_.size());
-    pending_.width = history_width<Model>();
-  }
-
-  std::string_view model() const override { return Model::name; }
-  Fields reads() const override { return Model::reads; }
-  ModelKind kind() const override { return ModelKind::wall; }
-  std::string_view dissipation_term() const override {
-    if constexpr (kKinematic) return Model::dissipation_term;
-    return {};
-  }
-  double dissipated() const override { return dissipated_; }
-  std::size_t sliding_contacts() const override { return sliding_; }
-  void set_dissipated(double d) override { dissipated_ = d; }
-  void set_time_step(double dt) override { dt_ = Real(dt); }
-  double max_stiffness(double rmax) const override {
-    double m = 0;
-    for (const auto& p : params_) m = std::max(m, Model::max_stiffness(p, rmax));
-    return m;
   }
 
   double compute(ForceState<Real>& s, Part part, bool energy, bool advance) override {
     if (part != Part::owned) return 0;
+    this->start_step(part, advance);
     walls_ = &s.walls;
     if constexpr (kKinematic) {
       if (advance) return energy ? loop<true, true>(s.p, s.walls) : loop<false, true>(s.p, s.walls);
@@ -112,14 +97,19 @@ class MeshWallDriver final : public ForceCompute<Real> {
       pending_.clear();
     }
   }
-  void save_history(const Particles<Real>& p) override {
-    if constexpr (kHistory) collect(p, pending_);
+  /// The records of the meshes' contacts, one per slot in slot order (ContactDriver: save_history,
+  /// history_records).
+  void collect(const Particles<Real>& p, ContactRecords& out) const {
+    out.width = history_width<Model>();
+    if (!walls_) return;
+    for (std::size_t k = 0; k < index_.size(); ++k) {
+      const auto& cand = walls_->mesh_candidates(index_[k]);
+      for (std::size_t c = 0; c < cand.size() && c < hist_[k].size(); ++c)
+        for (std::size_t s = 0; s < hist_[k][c].n; ++s)
+          out.push(p.id[static_cast<std::size_t>(cand[c])], wall_id(k),
+                   reinterpret_cast<const double*>(&hist_[k][c].h[s]));
+    }
   }
-  ContactRecords* pending() override { return kHistory ? &pending_ : nullptr; }
-  void history_records(const Particles<Real>& p, ContactRecords& out) const override {
-    if constexpr (kHistory) collect(p, out);
-  }
-  std::size_t history_bytes() const override { return basalt::solver::history_bytes<Model>(); }
   std::size_t memory_bytes() const override {
     std::size_t b = 0;
     for (const auto& h : hist_) b += h.capacity() * sizeof(Slots);
@@ -133,19 +123,7 @@ class MeshWallDriver final : public ForceCompute<Real> {
   };
 
   /// The second id of a mesh contact's record: -1 - (planar walls + the mesh's index in the scene).
-  std::int64_t wall_id(std::size_t k) const { return -1 - static_cast<std::int64_t>(planar_ + index_[k]); }
-
-  void collect(const Particles<Real>& p, ContactRecords& out) const {
-    out.width = history_width<Model>();
-    if (!walls_) return;
-    for (std::size_t k = 0; k < index_.size(); ++k) {
-      const auto& cand = walls_->mesh_candidates(index_[k]);
-      for (std::size_t c = 0; c < cand.size() && c < hist_[k].size(); ++c)
-        for (std::size_t s = 0; s < hist_[k][c].n; ++s)
-          out.push(p.id[static_cast<std::size_t>(cand[c])], wall_id(k),
-                   reinterpret_cast<const double*>(&hist_[k][c].h[s]));
-    }
-  }
+  std::int64_t wall_id(std::size_t k) const { return wall_record_id(planar_ + index_[k]); }
 
   /// slot_of[j]: the slot of `old` contact j takes, or -1 (fresh). Greedy over (slot, contact) pairs
   /// by |s.n| / |s| ascending.
@@ -231,10 +209,8 @@ class MeshWallDriver final : public ForceCompute<Real> {
             if constexpr (kHistory)
               if (j < slot_of.size() && slot_of[j] >= 0) h = hist[ci].h[static_cast<std::size_t>(slot_of[j])];
             Model::template contact<Advance>(c, h, kin, f);
-            if constexpr (kHistory) {
-              static const History zero{};
-              if (std::memcmp(&h, &zero, sizeof(History)) != 0 && next.n < kSlots) next.h[next.n++] = h;
-            }
+            if constexpr (kHistory)
+              if (holds(h) && next.n < kSlots) next.h[next.n++] = h;
             if constexpr (Advance) {
               dissipated += f.dissipated;
               sliding += f.sliding;
@@ -252,9 +228,8 @@ class MeshWallDriver final : public ForceCompute<Real> {
           p.fy[i] += f.fy;
           p.fz[i] += f.fz;
           if (rot) {  // (q - x) x F with q - x = -arm n
-            p.tx[i] += -f.arm_i * (ny * f.fz - nz * f.fy) + f.mx;
-            p.ty[i] += -f.arm_i * (nz * f.fx - nx * f.fz) + f.my;
-            p.tz[i] += -f.arm_i * (nx * f.fy - ny * f.fx) + f.mz;
+            const auto t = arm_torque(-f.arm_i, nx, ny, nz, f);
+            p.tx[i] += t.x, p.ty[i] += t.y, p.tz[i] += t.z;
           }
           wfx -= double(f.fx);
           wfy -= double(f.fy);
@@ -277,20 +252,15 @@ class MeshWallDriver final : public ForceCompute<Real> {
       walls.mesh_power(w) = power;
     }
     dissipated_ += dissipated;
-    if (Advance) sliding_ = sliding;
+    if (Advance) sliding_ += sliding;
     return energy;
   }
 
-  std::size_t planar_ = 0;          ///< planar walls in the scene (mesh history ids follow theirs)
-  std::vector<std::size_t> index_;  ///< the mesh walls this model acts through
-  std::vector<typename Model::Params> params_;
-  std::vector<Coeffs> coeffs_;
+  std::size_t planar_ = 0;  ///< planar walls in the scene (mesh history ids follow theirs)
+  using Base::coeffs_, Base::pending_, Base::dissipated_, Base::sliding_, Base::dt_;
+  std::vector<std::size_t> index_;        ///< the mesh walls this model acts through
   std::vector<std::vector<Slots>> hist_;  ///< per mesh of this model, per candidate
-  ContactRecords pending_;
   const Walls* walls_ = nullptr;
-  double dissipated_ = 0;
-  std::size_t sliding_ = 0;  ///< contacts that slid at the last real step (as the planar walls')
-  Real dt_ = 0;
 };
 
 }  // namespace basalt::solver

@@ -16,23 +16,11 @@
 #include <type_traits>
 #include <vector>
 
-#include "basalt/solver/interactions/force_compute.hpp"
+#include "basalt/solver/interactions/driver_base.hpp"
+#include "basalt/solver/interactions/history_records.hpp"
 #include "basalt/solver/models/contract.hpp"
 
 namespace basalt::solver {
-
-/// Whether a contact history holds anything (a bit set). Every model's apart() clears its history to all
-/// bits zero, and a clear history parts with no energy, so a pair apart whose history is clear needs
-/// neither. (Bits, not values: a -0 is cleared to +0 as before.)
-template <class History>
-inline bool holds(const History& h) {
-  static_assert(std::is_trivially_copyable_v<History> && sizeof(History) % sizeof(std::uint64_t) == 0);
-  std::uint64_t w[sizeof(History) / sizeof(std::uint64_t)];
-  std::memcpy(w, &h, sizeof(History));
-  std::uint64_t any = 0;
-  for (const auto v : w) any |= v;
-  return any != 0;
-}
 
 namespace detail {
 /// Eight values of Real and eight indices of its width: the operands of a permutation
@@ -54,11 +42,13 @@ struct Eight<float> {
 }  // namespace detail
 
 template <class Real, class Model>
-class PairDriver final : public ForceCompute<Real> {
+class PairDriver final : public ContactDriver<Real, Model, PairDriver<Real, Model>> {
+  using Base = ContactDriver<Real, Model, PairDriver<Real, Model>>;
+
  public:
-  using Coeffs = typename Model::template Coeffs<Real>;
-  using History = typename Model::History;
-  static constexpr bool kHistory = basalt::solver::history_bytes<Model>() > 0;
+  using Coeffs = typename Base::Coeffs;
+  using History = typename Base::History;
+  using Base::kHistory;
   /// A model reading velocities gets the pair's kinematics and returns a force vector and torques
   /// (loop_kinematic); the others a scalar force along the line of centres (loop).
   static constexpr bool kKinematic = (Model::reads & kVelocity) != 0;
@@ -67,13 +57,11 @@ class PairDriver final : public ForceCompute<Real> {
   explicit PairDriver(const std::vector<InteractionSpec>& groups) {
     for (const auto& g : groups) {
       if (g.model != Model::name) continue;
-      params_.push_back(g.template params_of<Model>());
-      coeffs_.push_back(Model::template coeffs<Real>(params_.back()));
+      this->add_group(g.template params_of<Model>());
       tags_.push_back(g.tags);
       names_.push_back(g.name);
     }
     uniform_ = tags_.size() == 1 && tags_[0].empty();
-    pending_.width = history_width<Model>();
   }
 
   /// New parameters for the group g.name (its tags stay: the lists' split among models is the rebuild's).
@@ -81,21 +69,12 @@ class PairDriver final : public ForceCompute<Real> {
   bool reconfigure(const InteractionSpec& g) override {
     for (std::size_t k = 0; k < names_.size(); ++k)
       if (names_[k] == g.name && g.model == Model::name) {
-        params_[k] = g.template params_of<Model>();
-        coeffs_[k] = Model::template coeffs<Real>(params_[k]);
+        this->set_group(k, g.template params_of<Model>());
         return true;
       }
     return false;
   }
 
-  std::string_view model() const override { return Model::name; }
-  Fields reads() const override { return Model::reads; }
-  ModelKind kind() const override { return ModelKind::pair; }
-  double max_stiffness(double rmax) const override {
-    double m = 0;
-    for (const auto& p : params_) m = std::max(m, Model::max_stiffness(p, rmax));
-    return m;
-  }
   /// Group taking a pair of particles with these tags, or -1.
   int group_of(std::int64_t ti, std::int64_t tj) const {
     for (std::size_t g = 0; g < tags_.size(); ++g) {
@@ -107,23 +86,14 @@ class PairDriver final : public ForceCompute<Real> {
   /// One group for every pair of tags.
   bool takes_all() const { return uniform_; }
 
-  std::string_view dissipation_term() const override {
-    if constexpr (kDissipates) return Model::dissipation_term;
-    return {};
-  }
   double reach(double rmax) const override {
     double m = 0;
     for (const auto& p : params_) m = std::max(m, pair_reach<Model>(p, rmax));
     return m;
   }
-  double dissipated() const override { return dissipated_; }
-  std::size_t sliding_contacts() const override { return sliding_; }
-  void set_dissipated(double d) override { dissipated_ = d; }
-  void set_time_step(double dt) override { dt_ = Real(dt); }
-
   double compute(ForceState<Real>& s, Part part, bool energy, bool advance) override {
     const bool own = part == Part::owned;
-    if (own && advance) sliding_ = 0;
+    this->start_step(part, advance);
     const PairList& list = own ? *own_ : *ghost_;
     History* h = own ? hist_own_.data() : hist_ghost_.data();
     if constexpr (kLanes) rows_ = own ? row_own_.data() : row_ghost_.data();
@@ -147,31 +117,21 @@ class PairDriver final : public ForceCompute<Real> {
     }
     if constexpr (kHistory) {
       const ContactLookup records(pending_);
-      restore(l.p, *own_, records, hist_own_);
-      restore(l.p, *ghost_, records, hist_ghost_);
+      restore_pairs<Model>(l.p, *own_, pending_, records, hist_own_);
+      restore_pairs<Model>(l.p, *ghost_, pending_, records, hist_ghost_);
       pending_.clear();
       drop_bonded(l.p, *own_, hist_own_, true);
       drop_bonded(l.p, *ghost_, hist_ghost_, false);
     }
   }
 
-  void save_history(const Particles<Real>& p) override {
-    if constexpr (kHistory) {
-      if (own_ == nullptr) return;
-      collect(p, *own_, hist_own_, pending_);
-      collect(p, *ghost_, hist_ghost_, pending_);
-    }
+  /// The records of the listed contacts (ContactDriver: save_history, history_records): the pairs to a
+  /// ghost too, as the other rank saves its own history of each (contact_history.hpp).
+  void collect(const Particles<Real>& p, ContactRecords& out) const {
+    if (own_ == nullptr) return;
+    collect_pairs<Model>(p, *own_, hist_own_, out);
+    collect_pairs<Model>(p, *ghost_, hist_ghost_, out);
   }
-  ContactRecords* pending() override { return kHistory ? &pending_ : nullptr; }
-  void history_records(const Particles<Real>& p, ContactRecords& out) const override {
-    if constexpr (kHistory) {
-      if (own_ == nullptr) return;
-      // The pairs to a ghost too: the other rank saves its own history of each (contact_history.hpp).
-      collect(p, *own_, hist_own_, out);
-      collect(p, *ghost_, hist_ghost_, out);
-    }
-  }
-  std::size_t history_bytes() const override { return basalt::solver::history_bytes<Model>(); }
   std::size_t contacts() const override { return own_ ? own_->pairs() + ghost_->pairs() : 0; }
   std::size_t memory_bytes() const override {
     std::size_t b = (hist_own_.capacity() + hist_ghost_.capacity()) * basalt::solver::history_bytes<Model>();
@@ -438,17 +398,17 @@ class PairDriver final : public ForceCompute<Real> {
           fz[j] -= f.fz;
         }
         if constexpr (Rot) {
-          // Arms: c - x_i = -arm_i n, c - x_j = (r - arm_i) n, n = d / r; torque = arm x force.
+          // Arms: c - x_i = -arm_i n, c - x_j = (r - arm_i) n, n = d / r (j's torque is minus its arm's).
           const Real inv_r = Real(1) / k.r;  // the model's own 1 / r, computed once
-          const Real si = -f.arm_i * inv_r, sj = (k.r - f.arm_i) * inv_r;
-          const Real cx = dy * f.fz - dz * f.fy, cy = dz * f.fx - dx * f.fz, cz = dx * f.fy - dy * f.fx;
-          txi += si * cx + f.mx;
-          tyi += si * cy + f.my;
-          tzi += si * cz + f.mz;
+          const auto ti = arm_torque(-f.arm_i * inv_r, dx, dy, dz, f);
+          txi += ti.x;
+          tyi += ti.y;
+          tzi += ti.z;
           if constexpr (Newton) {
-            tx[j] -= sj * cx + f.mx;
-            ty[j] -= sj * cy + f.my;
-            tz[j] -= sj * cz + f.mz;
+            const auto tj = arm_torque((k.r - f.arm_i) * inv_r, dx, dy, dz, f);
+            tx[j] -= tj.x;
+            ty[j] -= tj.y;
+            tz[j] -= tj.z;
           }
         }
         if (Newton || id[i] < id[j]) {
@@ -720,32 +680,16 @@ class PairDriver final : public ForceCompute<Real> {
     out.index_loose();
   }
 
-  static bool is_default(const History& h) {
-    static const History zero{};
-    return std::memcmp(&h, &zero, sizeof(History)) == 0;
-  }
-
-  /// Records of the listed contacts whose history is not the default, in the listed orientation.
-  static void collect(const Particles<Real>& p, const PairList& list, const std::vector<History>& hist,
-                      ContactRecords& out) {
-    out.width = history_width<Model>();
-    for (std::size_t i = 0; i + 1 < list.offset.size(); ++i)
-      for (auto k = list.offset[i]; k < list.offset[i + 1]; ++k) {
-        const auto j = static_cast<std::size_t>(list.neigh[k]);
-        if (is_default(hist[k])) continue;
-        out.push(p.id[i], p.id[j], reinterpret_cast<const double*>(&hist[k]));
-      }
-  }
-
   /// The loops step over bonded pairs (they act by their bond): a history restored for one (a contact
-  /// before its bond formed) is dropped here, as a parting contact's would be, its energy dissipated.
+  /// before its bond formed) is dropped here, as a parting contact's would be, its energy dissipated
+  /// (models with a dissipation term, as the loops: a scalar law's too).
   void drop_bonded(const Particles<Real>& p, const PairList& list, std::vector<History>& hist, bool own) {
     if (list.bonded.empty()) return;
     for (std::size_t i = 0; i + 1 < list.offset.size(); ++i)
       for (auto e = list.offset[i]; e < list.offset[i + 1]; ++e) {
         if (list.bonded[e] == 0 || !holds(hist[e])) continue;
         const auto j = static_cast<std::size_t>(list.neigh[e]);
-        if constexpr (kKinematic) {
+        if constexpr (kDissipates) {
           const int g = group_of(p.tag[i], p.tag[j]);
           if (g >= 0 && (own || p.id[i] < p.id[j]))
             dissipated_ += Model::parting_energy(coeffs_[static_cast<std::size_t>(g)], hist[e]);
@@ -754,33 +698,16 @@ class PairDriver final : public ForceCompute<Real> {
       }
   }
 
-  /// History for each listed pair from the pending records (default when none).
-  void restore(const Particles<Real>& p, const PairList& list, const ContactLookup& records,
-               std::vector<History>& hist) const {
-    hist.assign(list.pairs(), History{});
-    if (pending_.empty()) return;
-    for (std::size_t i = 0; i + 1 < list.offset.size(); ++i)
-      for (auto k = list.offset[i]; k < list.offset[i + 1]; ++k) {
-        const auto j = static_cast<std::size_t>(list.neigh[k]);
-        const auto r = records.find(p.id[i], p.id[j]);
-        if (r < 0) continue;
-        std::memcpy(static_cast<void*>(&hist[k]), pending_.at(static_cast<std::size_t>(r)), sizeof(History));
-        if (pending_.a[static_cast<std::size_t>(r)] != p.id[i]) hist[k] = Model::flip(hist[k]);
-      }
-  }
-
   static constexpr int kLaneWidth = kContactLaneWidth;
   /// The model decides when a pair interacts (models/contract.hpp, touching()).
   static constexpr bool kTouching = contract::HasTouching<Model, Real>;
-  /// The model names a ledger term for the energy it dissipates.
-  static constexpr bool kDissipates = requires { Model::dissipation_term; };
+  using Base::coeffs_, Base::params_, Base::pending_, Base::dissipated_, Base::sliding_, Base::dt_;
+  using Base::kDissipates;
   static constexpr bool kLanes = requires(const Coeffs& c, ContactLanes<Real, kLaneWidth, History>& b) {
     Model::template contact_lanes<true>(c, b);
   };
   struct NoLanes {};
   [[no_unique_address]] std::conditional_t<kLanes, ContactLanes<Real, kLaneWidth, History>, NoLanes> lanes_{};
-  std::vector<typename Model::Params> params_;
-  std::vector<Coeffs> coeffs_;
   std::vector<TagFilter> tags_;
   std::vector<std::string> names_;  ///< each group's name (reconfigure)
   bool uniform_ = false;
@@ -790,10 +717,6 @@ class PairDriver final : public ForceCompute<Real> {
   std::vector<History> hist_own_, hist_ghost_;
   std::vector<std::uint32_t> row_own_, row_ghost_;  ///< with lanes: each listed pair's row (row_of)
   const std::uint32_t* rows_ = nullptr;             ///< those of the list compute() loops over
-  ContactRecords pending_;
-  double dissipated_ = 0;    ///< this rank's share of the energy dissipated since the start
-  std::size_t sliding_ = 0;  ///< contacts sliding at the last real step
-  Real dt_ = 0;
 };
 
 }  // namespace basalt::solver

@@ -15,33 +15,26 @@
 #include <string_view>
 #include <vector>
 
-#include "basalt/solver/interactions/force_compute.hpp"
+#include "basalt/solver/interactions/driver_base.hpp"
 
 namespace basalt::solver {
 
 template <class Real, class Model>
-class RotBondDriver final : public ForceCompute<Real> {
+class RotBondDriver final : public ModelDriver<Real, Model> {
+  using Base = ModelDriver<Real, Model>;
+
  public:
-  using Coeffs = typename Model::template Coeffs<Real>;
+  using Coeffs = typename Base::Coeffs;
 
   explicit RotBondDriver(const std::vector<InteractionSpec>& groups) {
     for (const auto& g : groups) {
-      params_.push_back(g.template params_of<Model>());
-      coeffs_.push_back(Model::template coeffs<Real>(params_.back()));
+      this->add_group(g.template params_of<Model>());
       breakable_ = breakable_ || Model::breakable(params_.back());
     }
     atan2_lanes_ = !params_.empty() &&
                    std::all_of(params_.begin(), params_.end(), [](const auto& p) { return p.atan2_angles; });
   }
 
-  std::string_view model() const override { return Model::name; }
-  ModelKind kind() const override { return ModelKind::bond; }
-  Fields reads() const override { return Model::reads; }
-  double max_stiffness(double rmax) const override {
-    double m = 0;
-    for (const auto& p : params_) m = std::max(m, Model::max_stiffness(p, rmax));
-    return m;
-  }
   bool can_break() const override { return breakable_; }
   std::size_t memory_bytes() const override {
     return table_.bytes() + gone_.capacity() * sizeof(std::size_t);
@@ -144,12 +137,10 @@ class RotBondDriver final : public ForceCompute<Real> {
           typename Model::template Geometry<Real> g;
           g.x1 = {p.x[n1], p.y[n1], p.z[n1]};
           g.x2 = {p.x[n2], p.y[n2], p.z[n2]};
-          const auto &x2 = g.x2, d = g.x1 - g.x2;
-          const double w = double(p.radius[n2]) / double(p.radius[n1] + p.radius[n2]);
-          s.broken.push_back({bonds.a[k], bonds.b[k], double(d.norm()), double(bonds.r0[k]), -1,
-                              bonds.group_of(k), static_cast<std::uint8_t>(mode),
-                              double(x2.x) + w * double(d.x), double(x2.y) + w * double(d.y),
-                              double(x2.z) + w * double(d.z)});
+          s.broken.push_back(broken_bond<Real>(bonds.a[k], bonds.b[k], double((g.x1 - g.x2).norm()),
+                                               double(bonds.r0[k]), bonds.group_of(k),
+                                               static_cast<std::uint8_t>(mode), {p.x[n2], p.y[n2], p.z[n2]},
+                                               p.radius[n2], {p.x[n1], p.y[n1], p.z[n1]}, p.radius[n1]));
         }
       }
     }
@@ -186,8 +177,7 @@ class RotBondDriver final : public ForceCompute<Real> {
     for (std::size_t k = n; k < n + kLanes; ++k) table_.copy(k, n > 0 ? n - 1 : k);
   }
 
-  std::vector<typename Model::Params> params_;
-  std::vector<Coeffs> coeffs_;
+  using Base::params_, Base::coeffs_;
   bool breakable_ = false;
   bool atan2_lanes_ =
       false;  ///< every group takes atan2 angles: the lanes evaluate them (else the acos ones)

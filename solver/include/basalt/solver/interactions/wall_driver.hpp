@@ -14,17 +14,20 @@
 #include <type_traits>
 #include <vector>
 
-#include "basalt/solver/interactions/force_compute.hpp"
+#include "basalt/solver/interactions/driver_base.hpp"
+#include "basalt/solver/interactions/history_records.hpp"
 
 namespace basalt::solver {
 
 template <class Real, class Model>
-class WallDriver final : public ForceCompute<Real> {
+class WallDriver final : public ContactDriver<Real, Model, WallDriver<Real, Model>> {
+  using Base = ContactDriver<Real, Model, WallDriver<Real, Model>>;
+
  public:
-  using Coeffs = typename Model::template Coeffs<Real>;
-  using History = typename Model::History;
+  using Coeffs = typename Base::Coeffs;
+  using History = typename Base::History;
   static constexpr bool kKinematic = (Model::reads & kVelocity) != 0;
-  static constexpr bool kHistory = basalt::solver::history_bytes<Model>() > 0;
+  using Base::kHistory;
   static constexpr int kLaneWidth = kContactLaneWidth;
   using Lanes = WallLanes<Real, kLaneWidth, History>;
   /// The model evaluates contacts side by side (Model::contact_lanes, model.hpp WallLanes).
@@ -37,32 +40,14 @@ class WallDriver final : public ForceCompute<Real> {
     for (std::size_t w = 0; w < walls.size(); ++w) {
       if (walls[w].model != Model::name) continue;
       index_.push_back(w);
-      params_.push_back(walls[w].template params_of<Model>());
-      coeffs_.push_back(Model::template coeffs<Real>(params_.back()));
+      this->add_group(walls[w].template params_of<Model>());
     }
     hist_.resize(index_.size());
-    pending_.width = history_width<Model>();
-  }
-
-  std::string_view model() const override { return Model::name; }
-  Fields reads() const override { return Model::reads; }
-  ModelKind kind() const override { return ModelKind::wall; }
-  std::string_view dissipation_term() const override {
-    if constexpr (kKinematic) return Model::dissipation_term;
-    return {};
-  }
-  double dissipated() const override { return dissipated_; }
-  std::size_t sliding_contacts() const override { return sliding_; }
-  void set_dissipated(double d) override { dissipated_ = d; }
-  void set_time_step(double dt) override { dt_ = Real(dt); }
-  double max_stiffness(double rmax) const override {
-    double m = 0;
-    for (const auto& p : params_) m = std::max(m, Model::max_stiffness(p, rmax));
-    return m;
   }
 
   double compute(ForceState<Real>& s, Part part, bool energy, bool advance) override {
     if (part != Part::owned) return 0;
+    this->start_step(part, advance);
     if constexpr (kKinematic) {
       if (advance)
         return energy ? loop_kinematic<true, true>(s.p, s.walls) : loop_kinematic<false, true>(s.p, s.walls);
@@ -77,28 +62,18 @@ class WallDriver final : public ForceCompute<Real> {
     walls_ = &walls;
     if constexpr (kHistory) {
       const ContactLookup records(pending_);
-      for (std::size_t k = 0; k < index_.size(); ++k) {
-        const auto& cand = walls.candidates(index_[k]);
-        auto& h = hist_[k];
-        h.assign(cand.size(), History{});
-        if (pending_.empty()) continue;
-        for (std::size_t c = 0; c < cand.size(); ++c) {
-          const auto r = records.find(p.id[static_cast<std::size_t>(cand[c])], wall_id(k));
-          if (r >= 0)
-            std::memcpy(static_cast<void*>(&h[c]), pending_.at(static_cast<std::size_t>(r)), sizeof(History));
-        }
-      }
+      for (std::size_t k = 0; k < index_.size(); ++k)
+        restore_candidates(p, walls.candidates(index_[k]), pending_, records, wall_id(k), hist_[k]);
       pending_.clear();
     }
   }
-  void save_history(const Particles<Real>& p) override {
-    if constexpr (kHistory) collect(p, pending_);
+  /// The records of the walls' contacts (ContactDriver: save_history, history_records).
+  void collect(const Particles<Real>& p, ContactRecords& out) const {
+    out.width = history_width<Model>();
+    if (!walls_) return;
+    for (std::size_t k = 0; k < index_.size(); ++k)
+      collect_candidates(p, walls_->candidates(index_[k]), hist_[k], wall_id(k), out);
   }
-  ContactRecords* pending() override { return kHistory ? &pending_ : nullptr; }
-  void history_records(const Particles<Real>& p, ContactRecords& out) const override {
-    if constexpr (kHistory) collect(p, out);
-  }
-  std::size_t history_bytes() const override { return basalt::solver::history_bytes<Model>(); }
   std::size_t memory_bytes() const override {
     std::size_t b = 0;
     for (const auto& h : hist_) b += h.capacity() * sizeof(History);
@@ -107,20 +82,7 @@ class WallDriver final : public ForceCompute<Real> {
 
  private:
   /// The second id of a wall contact's record: -1 - the wall's index in the scene.
-  std::int64_t wall_id(std::size_t k) const { return -1 - static_cast<std::int64_t>(index_[k]); }
-
-  void collect(const Particles<Real>& p, ContactRecords& out) const {
-    out.width = history_width<Model>();
-    if (!walls_) return;
-    static const History zero{};
-    for (std::size_t k = 0; k < index_.size(); ++k) {
-      const auto& cand = walls_->candidates(index_[k]);
-      for (std::size_t c = 0; c < cand.size() && c < hist_[k].size(); ++c)
-        if (std::memcmp(&hist_[k][c], &zero, sizeof(History)) != 0)
-          out.push(p.id[static_cast<std::size_t>(cand[c])], wall_id(k),
-                   reinterpret_cast<const double*>(&hist_[k][c]));
-    }
-  }
+  std::int64_t wall_id(std::size_t k) const { return wall_record_id(index_[k]); }
 
   /// Wall w's unit normal, point and velocity in the loops' precision.
   struct Plane {
@@ -271,7 +233,7 @@ class WallDriver final : public ForceCompute<Real> {
       walls.force(w) = {wfx, wfy, wfz};
     }
     dissipated_ += dissipated + parted;
-    if (Advance) sliding_ = sliding;
+    if (Advance) sliding_ += sliding;
     return energy;
   }
 
@@ -375,9 +337,8 @@ class WallDriver final : public ForceCompute<Real> {
         fy[i] += f.fy;
         fz[i] += f.fz;
         if constexpr (Rot) {  // (c - x) x F with c - x = -arm n
-          tx[i] += -f.arm_i * (kin.ny * f.fz - kin.nz * f.fy) + f.mx;
-          ty[i] += -f.arm_i * (kin.nz * f.fx - kin.nx * f.fz) + f.my;
-          tz[i] += -f.arm_i * (kin.nx * f.fy - kin.ny * f.fx) + f.mz;
+          const auto t = arm_torque(-f.arm_i, kin.nx, kin.ny, kin.nz, f);
+          tx[i] += t.x, ty[i] += t.y, tz[i] += t.z;
         }
         wfx -= double(f.fx);
         wfy -= double(f.fy);
@@ -391,21 +352,16 @@ class WallDriver final : public ForceCompute<Real> {
       walls.force(w) = {wfx, wfy, wfz};
     }
     dissipated_ += dissipated;
-    if (Advance) sliding_ = sliding;
+    if (Advance) sliding_ += sliding;
     return energy;
   }
 
   struct NoLanes {};
   [[no_unique_address]] std::conditional_t<kLanes, Lanes, NoLanes> lanes_{};  ///< (with contact_lanes)
-  std::vector<std::size_t> index_;  ///< the walls this model acts through
-  std::vector<typename Model::Params> params_;
-  std::vector<Coeffs> coeffs_;
+  using Base::coeffs_, Base::pending_, Base::dissipated_, Base::sliding_, Base::dt_;
+  std::vector<std::size_t> index_;          ///< the walls this model acts through
   std::vector<std::vector<History>> hist_;  ///< per wall of this model, per candidate
-  ContactRecords pending_;
   const Walls* walls_ = nullptr;
-  double dissipated_ = 0;
-  std::size_t sliding_ = 0;
-  Real dt_ = 0;
 };
 
 }  // namespace basalt::solver
