@@ -263,8 +263,14 @@ def test_bonded_block_falls_and_bounces(tmp_path):
 
 # -- refusals, the runner ----------------------------------------------------------------------------------------
 REFUSED = {
-    "sim.createInteractionGroup(RotFrictionPrms(name='f', normalK=1.0, dynamicMu=0.5, staticMu=0.5, shearK=1.0))":
-        ("esys.lsm.RotFrictionPrms", 'rot_friction'),
+    "sim.createInteractionGroup(HertzMindlinPrms(name='h', youngsModulus=1.0, poissonsRatio=0.25, cor=0.5))":
+        ("esys.lsm.HertzMindlinPrms", 'hertz_mindlin'),
+    "sim.initNeighbourSearch(particleType='RotSphere', gridSpacing=2.5, verletDist=0.5)\n"
+    "sim.createInteractionGroup(RotFrictionPrms(name='f', normalK=1.0, dynamicMu=0.5, staticMu=0.5, shearK=1.0, "
+    "meanR_scaling=False))": ("RotFrictionPrms(meanR_scaling=False)", "mean radius"),
+    "sim.initNeighbourSearch(particleType='RotSphere', gridSpacing=2.5, verletDist=0.5)\n"
+    "sim.createInteractionGroup(RotFrictionPrms(name='f', normalK=1.0, dynamicMu=0.5, staticMu=0.5, shearK=1.0))\n"
+    "sim.createInteractionGroup(NRotElasticPrms(name='e', normalK=1.0))": ("a second contact group", "'f'"),
     "sim.createExclusion('a', 'b')": ("LsmMpi.createExclusion", "linear_elastic"),
     "from esys.lsm.geometry import HexagonalBlock\nHexagonalBlock(dimCount=[2, 2, 2], radius=0.5)":
         ("esys.lsm.geometry.HexagonalBlock", "basalt.pack"),
@@ -343,3 +349,40 @@ def test_compare_tool_skips_without_esys(tmp_path):
     assert p.returncode == 3, p.stdout + p.stderr
     assert "ESyS-Particle comparison skipped: esysparticle-not-here not on PATH" in p.stdout
     assert (tmp_path / "cmp" / "basalt" / "fall" / "ekin.dat").exists()
+
+
+# -- friction (slide.py): closed forms of a sliding ball -------------------------------------------------------
+def _ball_rows(out):
+    return [[float(v) for v in line.split()[1:]] for line in out.splitlines() if line.startswith("ball ")]
+
+
+def test_rot_friction_slides_at_mu_g_then_rolls_at_five_sevenths(tmp_path):
+    g, mu, v0, r, m, R = 10.0, 0.5, 1.0, 0.5, 1.0, 1000.0
+    rows = _ball_rows(front(SCRIPTS / "slide.py", tmp_path, "rot").stdout)
+    assert [int(t) for t, *_ in rows] == list(range(100, 3001, 100))
+    by = {int(t): (x, y, v, w) for t, x, y, v, w in rows}
+    dt = 1.0e-4
+    # sliding (steps 100-400): friction mu m g against the slide, its moment spins the ball up (I = 2/5 m r^2;
+    # ESyS's lever: the contact point at r d/(r + R) from the centre, d = r + R - overlap)
+    assert (by[400][2] - by[100][2]) / (300 * dt) == pytest.approx(-mu * g, rel=1e-3)
+    assert (by[400][3] - by[100][3]) / (300 * dt) == pytest.approx(-2.5 * mu * g / r, rel=1e-3)
+    # friction's impulse about the contact point is zero: m v - I w_z / lever = m v0 at every row (within 5e-4:
+    # gravity's pull along the big sphere's curved top, g x / R, adds up to 3e-4 over the run)
+    lever = r * (r + R - 1e-3) / (r + R)
+    for t, (x, y, v, w) in by.items():
+        assert m * v - 0.4 * m * r * r * w / lever == pytest.approx(m * v0, abs=5e-4), t
+    # then it rolls (v = -w_z r) at 5/7 v0, the shear spring ringing around it
+    late = [by[t] for t in range(1000, 3001, 100)]
+    assert sum(v for _, _, v, _ in late) / len(late) == pytest.approx(5.0 / 7.0 * v0, rel=0.02)
+    assert abs(sum(v + w * r for _, _, v, w in late) / len(late)) < 0.02
+    assert by[700][2] < 0.72  # the rolling began (at t = v0 / (3.5 mu g) = 571 steps)
+
+
+def test_nrot_friction_stops_the_slide_after_v0_squared_over_2_mu_g(tmp_path):
+    g, mu, v0 = 10.0, 0.5, 1.0
+    rows = _ball_rows(front(SCRIPTS / "slide.py", tmp_path, "nrot").stdout)
+    by = {int(t): (x, y, v, w) for t, x, y, v, w in rows}
+    assert (by[1000][2] - by[100][2]) / (900 * 1.0e-4) == pytest.approx(-mu * g, rel=1e-3)
+    assert all(w == 0.0 for _, _, _, w in by.values())
+    late = [by[t] for t in range(2200, 3001, 100)]
+    assert sum(x for x, _, _, _ in late) / len(late) == pytest.approx(v0 * v0 / (2 * mu * g), rel=0.02)

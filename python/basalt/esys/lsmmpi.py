@@ -154,7 +154,21 @@ class LsmMpi:
 
         self._setup("createInteractionGroup")
         kind = type(prms).__name__
-        if isinstance(prms, P.NRotElasticPrms):
+        if isinstance(prms, (P.NRotElasticPrms, P.RotFrictionPrms, P.NRotFrictionPrms)):
+            if self._pair:
+                refuse(f"LsmMpi.createInteractionGroup({kind}): a second contact group (with "
+                       f"{type(self._pair[0]).__name__} {self._pair[0].name!r})",
+                       "one contact group (NRotElastic, RotFriction, FrictionPrms or NRotFriction) per run")
+            if isinstance(prms, P.RotFrictionPrms):
+                if not self._rotational:
+                    raise ValueError(f"LsmMpi.createInteractionGroup({kind}): RotFriction acts between RotSpheres "
+                                     "(initNeighbourSearch(particleType=\"RotSphere\", ...))")
+                if prms.scaling and not prms.meanR_scaling:
+                    refuse(f"LsmMpi.createInteractionGroup({kind}(meanR_scaling=False))",
+                           "Basalt's rot_friction scales by the mean radius (meanR_scaling=True)")
+                if prms.dynamicMu > prms.staticMu:
+                    refuse(f"LsmMpi.createInteractionGroup({kind}): dynamicMu {prms.dynamicMu} > staticMu "
+                           f"{prms.staticMu}", "Basalt's rot_friction needs mu_dynamic <= mu")
             self._name(prms)
             self._pair.append(prms)
         elif isinstance(prms, P.NRotBondPrms):
@@ -171,14 +185,18 @@ class LsmMpi:
                        "a Basalt wall has one interaction")
             self._name(prms)
             self._wall_k[prms.wallName] = prms
-        elif isinstance(prms, (P.GravityPrms, P.LinDampingPrms)):
+        elif isinstance(prms, (P.GravityPrms, P.LinDampingPrms, P.RotDampingPrms)):
+            if isinstance(prms, P.RotDampingPrms) and not self._rotational:
+                raise ValueError(f"LsmMpi.createInteractionGroup({kind}): rotational damping acts on RotSpheres "
+                                 "(initNeighbourSearch(particleType=\"RotSphere\", ...))")
             if any(type(b) is type(prms) for b in self._body):
                 refuse(f"LsmMpi.createInteractionGroup: a second {kind}", "one group of each body force")
             self._name(prms)
             self._body.append(prms)
         else:
-            refuse(f"LsmMpi.createInteractionGroup({kind})", "the front end maps NRotElasticPrms, NRotBondPrms, "
-                   "NRotElasticWallPrms, GravityPrms and LinDampingPrms so far")
+            refuse(f"LsmMpi.createInteractionGroup({kind})", "the front end maps NRotElasticPrms, RotFrictionPrms, "
+                   "FrictionPrms, NRotFrictionPrms, NRotBondPrms, NRotElasticWallPrms, GravityPrms, LinDampingPrms "
+                   "and RotDampingPrms so far")
 
     def createWall(self, name, posn, normal):
         self._setup("createWall")

@@ -9,9 +9,6 @@ _SCENE = "Basalt has it as a scene model (basalt.Simulation with a scene dict, d
 LSM = {
     "RotBondPrms": _SCENE + 'type = "rot_bond"',
     "BrittleBeamPrms": _SCENE + 'type = "rot_bond" with youngs_modulus, cohesion, tan_friction_angle',
-    "NRotFrictionPrms": _SCENE + 'type = "friction", convention = "esys"',
-    "RotFrictionPrms": _SCENE + 'type = "rot_friction", convention = "esys"',
-    "FrictionPrms": _SCENE + 'type = "rot_friction", convention = "esys", scaling = true',
     "RotElasticPrms": _SCENE + 'type = "linear_elastic"',
     "HertzianElasticPrms": _SCENE + 'type = "hertz_mindlin"',
     "HertzianViscoElasticPrms": _SCENE + 'type = "hertz_mindlin"',
@@ -19,7 +16,6 @@ LSM = {
     "HertzMindlinPrms": _SCENE + 'type = "hertz_mindlin"',
     "HertzMindlinViscoPrms": _SCENE + 'type = "hertz_mindlin"',
     "LinearDashpotPrms": "Basalt has no dashpot pair model; damping is the linear_damping body force",
-    "RotDampingPrms": _SCENE + '[[body_forces]] type = "rotational_damping"',
     "NRotBondedWallPrms": _SCENE + '[[walls]] interaction = "bonded"',
     "RotBondedWallPrms": _SCENE + '[[walls]] interaction = "bonded"',
     "ViscWallPrms": "Basalt's walls are elastic, frictional, Hertz-Mindlin or bonded (docs/scenes.md)",
