@@ -3,6 +3,7 @@
 #   rot:  RotSpheres, RotFrictionPrms: the slide decelerates at mu g while the spin grows at 2.5 mu g / r, until
 #         the ball rolls at 5/7 of its throw; m v + I w / lever stays m v0 (friction's impulse about the contact)
 #   nrot: NRotSpheres, NRotFrictionPrms: the slide decelerates at mu g and stops after v0^2 / (2 mu g)
+# ESyS finds pairs and wall contacts within one gridSpacing: it must exceed the big sphere's diameter.
 import sys
 
 from esys.lsm import *
@@ -12,7 +13,7 @@ kind = sys.argv[1] if len(sys.argv) > 1 else "rot"
 g, mu, v0, r, m, K = 10.0, 0.5, 1.0, 0.5, 1.0, 1.0e4
 R, M, KW = 1000.0, 1.0e6, 1.0e4
 sim = LsmMpi(numWorkerProcesses=1, mpiDimList=[1, 1, 1])
-sim.initNeighbourSearch(particleType="RotSphere" if kind == "rot" else "NRotSphere", gridSpacing=2.5,
+sim.initNeighbourSearch(particleType="RotSphere" if kind == "rot" else "NRotSphere", gridSpacing=2 * R + 100,
                         verletDist=0.2)
 sim.setNumTimeSteps(3000)
 sim.setTimeStepSize(1.0e-4)
