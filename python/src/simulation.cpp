@@ -121,7 +121,7 @@ class Run {
   virtual py::list body_forces() const = 0;
   virtual void set_contact(const std::string& name, const std::string& keys) = 0;
   virtual py::list contacts() const = 0;
-  virtual void state_changed() = 0;
+  virtual void state_changed(bool advance_history) = 0;
   /// Particles in and out now (keys: the TOML of an [[insert]] / [[delete]] table); how many.
   virtual std::int64_t insert(const std::string& keys) = 0;
   virtual std::int64_t remove(const std::string& keys) = 0;
@@ -217,7 +217,7 @@ class RunOf final : public Run {
     for (const auto& b : scene_.body_forces) l.append(py::make_tuple(b.name, b.model));
     return l;
   }
-  void state_changed() override { sim_->state_changed(); }
+  void state_changed(bool advance_history) override { sim_->state_changed(advance_history); }
   std::int64_t insert(const std::string& keys) override {
     return sim_->insert_particles(parse_keys(
         keys, "insert", [&](solver::TableReader& t) { return solver::parse_insert(t, scene_.density); }));
@@ -587,7 +587,10 @@ void bind_simulation(py::module_& m) {
                                    std::array<double, 3> v) { s.run().set_wall_velocity(name, v); })
       .def("remove_wall", [](PySimulation& s, const std::string& name) { s.run().remove_wall(name); })
       .def("add_wall", [](PySimulation& s, const std::string& name) { s.run().add_wall(name); })
-      .def("state_changed", [](PySimulation& s) { s.run().state_changed(); })
+      .def(
+          "state_changed",
+          [](PySimulation& s, bool advance_history) { s.run().state_changed(advance_history); },
+          py::arg("advance_history") = false)
       .def("set_body_force", [](PySimulation& s, const std::string& name,
                                 const std::string& keys) { s.run().set_body_force(name, keys); })
       .def("body_forces", [](PySimulation& s) { return s.run().body_forces(); })

@@ -510,10 +510,10 @@ void Simulation<Real>::set_contact(std::string_view name, const std::string& key
 }
 
 template <class Real>
-void Simulation<Real>::state_changed() {
+void Simulation<Real>::state_changed(bool advance_history) {
   integrator_.forget_energy();
   wall_work_in_ = 0;
-  start_ledger(compute_forces<true>());
+  start_ledger(compute_forces<true>(false, advance_history));
 }
 
 template <class Real>

@@ -115,7 +115,8 @@ def build(lsm, workdir):
 
 def _set_initial_velocities(sim, vel, angvel):
     """The created particles' velocities ({id: [3 numbers]}), written into the run's arrays before the first
-    step; then the forces are recomputed (the damping reads velocities)."""
+    step; then the forces are recomputed (the damping reads velocities) and the contacts' shear springs take
+    that computation's increment dt u(0), as ESyS's first step does (measured with slide.py)."""
     import numpy as np
 
     part = sim.particles
@@ -126,4 +127,4 @@ def _set_initial_velocities(sim, vel, angvel):
         values = np.array([table[int(i)] for i in ids], dtype=float).reshape(len(ids), 3)
         for k, name in enumerate(names):
             getattr(part, name)[:] = values[:, k]
-    sim.state_changed()
+    sim._core.state_changed(advance_history=True)

@@ -185,8 +185,10 @@ class Simulation {
   /// Collective: number of bonds.
   std::int64_t bond_count() const;
   /// Collective: call after changing particle state from outside (e.g. initial velocities): recomputes
-  /// forces and the energy the stability guard starts from.
-  void state_changed();
+  /// forces and the energy the stability guard starts from. advance_history: the contacts' history (shear
+  /// springs) takes this computation's increment, as a step's does (ESyS's first step increments the spring
+  /// of a contact present at the start with the initial velocities: Basalt's ESyS front end).
+  void state_changed(bool advance_history = false);
   /// Collective: rebuilds the lists now (migrating particles), then recomputes forces.
   void force_rebuild();
 
