@@ -115,6 +115,7 @@ class Run {
   virtual void set_dt(double dt) = 0;
   virtual void set_fixed_tags(std::vector<std::int64_t> tags) = 0;
   virtual void set_wall_velocity(const std::string& name, const std::array<double, 3>& v) = 0;
+  virtual void move_wall_by(const std::string& name, const std::array<double, 3>& u) = 0;
   virtual void remove_wall(const std::string& name) = 0;
   virtual void add_wall(const std::string& name) = 0;
   virtual void set_body_force(const std::string& name, const std::string& keys) = 0;
@@ -198,6 +199,9 @@ class RunOf final : public Run {
   void set_fixed_tags(std::vector<std::int64_t> tags) override { sim_->set_fixed_tags(std::move(tags)); }
   void set_wall_velocity(const std::string& name, const std::array<double, 3>& v) override {
     sim_->set_wall_velocity(name, v);
+  }
+  void move_wall_by(const std::string& name, const std::array<double, 3>& u) override {
+    sim_->move_wall_by(name, u);
   }
   void remove_wall(const std::string& name) override { sim_->remove_wall(name); }
   void add_wall(const std::string& name) override { sim_->add_wall(name); }
@@ -585,6 +589,8 @@ void bind_simulation(py::module_& m) {
            [](PySimulation& s, std::vector<std::int64_t> t) { s.run().set_fixed_tags(std::move(t)); })
       .def("set_wall_velocity", [](PySimulation& s, const std::string& name,
                                    std::array<double, 3> v) { s.run().set_wall_velocity(name, v); })
+      .def("move_wall_by", [](PySimulation& s, const std::string& name,
+                              std::array<double, 3> u) { s.run().move_wall_by(name, u); })
       .def("remove_wall", [](PySimulation& s, const std::string& name) { s.run().remove_wall(name); })
       .def("add_wall", [](PySimulation& s, const std::string& name) { s.run().add_wall(name); })
       .def(

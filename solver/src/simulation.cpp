@@ -378,6 +378,15 @@ void Simulation<Real>::set_wall_velocity(std::string_view name, const std::array
 }
 
 template <class Real>
+void Simulation<Real>::move_wall_by(std::string_view name, const std::array<double, 3>& u) {
+  for (double c : u)
+    if (!std::isfinite(c))
+      throw InputError(fmt::format("wall \"{}\": the displacement must be finite", name));
+  forces_.walls().shift(wall_index(name), u);
+  state_changed();
+}
+
+template <class Real>
 void Simulation<Real>::add_wall(std::string_view name) {
   const std::size_t w = wall_index(name);
   auto& walls = forces_.walls();

@@ -386,3 +386,18 @@ def test_nrot_friction_stops_the_slide_after_v0_squared_over_2_mu_g(tmp_path):
     assert all(w == 0.0 for _, _, _, w in by.values())
     late = [by[t] for t in range(2200, 3001, 100)]
     assert sum(x for x, _, _, _ in late) / len(late) == pytest.approx(v0 * v0 / (2 * mu * g), rel=0.02)
+
+
+# -- moveWallBy (press.py): a platen moved by a pre-time-step Runnable ------------------------------------------
+def test_move_wall_by_moves_the_platen_before_the_step_forces(tmp_path):
+    d, r, K = 1.0e-4, 0.5, 1000.0
+    out = front(SCRIPTS / "press.py", tmp_path).stdout
+    rows = [[float(v) for v in line.split()[1:]] for line in out.splitlines() if line.startswith("platen ")]
+    assert [int(t) for t, *_ in rows] == list(range(20, 401, 20))
+    for t, y, fy, ball_y in rows:
+        assert y == pytest.approx(r - t * d, abs=1e-12)  # moved N times by d (after the set-up move to r)
+        # the force of step N sees the platen moved N times (ESyS's order), not N - 1: pi r K N d on the ball
+        assert fy == pytest.approx(-math.pi * r * K * t * d, rel=1e-6)
+        assert abs(ball_y) < 1e-8  # the heavy ball gives way by ~1e-9
+    saved = [line.split() for line in (tmp_path / "platen.dat").read_text().splitlines()]
+    assert [float(s[1]) for s in saved] == pytest.approx([r - 50 * k * d for k in range(9)], abs=1e-12)

@@ -25,7 +25,6 @@ _HINTS = {
     "createExclusion": "Basalt's linear_elastic never acts on bonded pairs (scene models, docs/scenes.md); "
                        "the front end refuses NRotElasticPrms together with bonds",
     "readGeometry": "basalt.read_geometry reads .geo files for basalt.Simulation",
-    "moveWallBy": "a scene wall's motion, or basalt.Simulation's walls[name].set_velocity",
     "setParticleNonDynamic": "the scene's particles.fixed_tags or basalt.Simulation.fix(tag)",
     "setParticleNonRotational": "NRotSphere particles",
     "createSphereBody": "Basalt's planar and mesh walls (docs/scenes.md)",
@@ -206,6 +205,19 @@ class LsmMpi:
         if n.norm() == 0.0:
             raise ValueError(f"LsmMpi.createWall({name!r}): the normal has zero length")
         self._walls[str(name)] = (Vec3(posn), n)
+
+    def moveWallBy(self, wallName, d):
+        """Moves the wall by d now, as ESyS does (a Runnable's move before a step is in that step's forces): the
+        run's wall is shifted and the forces of the coming step recomputed (basalt Wall.move_by)."""
+        name = str(wallName)
+        if name not in self._walls:
+            raise ValueError(f"LsmMpi.moveWallBy: no wall named {name!r}")
+        d = Vec3(d)
+        if self._sim is None:
+            posn, normal = self._walls[name]
+            self._walls[name] = (posn + d, normal)
+        else:
+            self._sim.walls[name].move_by(d.toList())
 
     def createCheckPointer(self, prms):
         self._setup("createCheckPointer")

@@ -202,6 +202,9 @@ class Simulation {
   std::size_t wall_index(std::string_view name) const;
   /// The wall moves at velocity v from now on, from where it is (a servo wall stops steering itself).
   void set_wall_velocity(std::string_view name, const std::array<double, 3>& v);
+  /// Collective: moves the planar wall by u now and recomputes the forces (ESyS-Particle's moveWallBy; the
+  /// contacts' history is not advanced again).
+  void move_wall_by(std::string_view name, const std::array<double, 3>& u);
   /// The wall touches particles from now on (one the scene declared with active = false, or one removed):
   /// the lists are rebuilt at once and the energy guard takes a new reference. InputError, nothing changed,
   /// when a particle's centre is behind it (the wall would push it through), naming the particle.

@@ -152,6 +152,14 @@ class Walls {
     m.start_time = t;
     walls_[w].point = point_[w];
   }
+  /// Shifts wall w by u now, with the anchor of its motion (ESyS's moveWallBy: its motion goes on from
+  /// there).
+  void shift(std::size_t w, const std::array<double, 3>& u) {
+    for (int d = 0; d < 3; ++d) {
+      walls_[w].point[d] += u[d];
+      point_[w][d] += u[d];
+    }
+  }
   /// Wall w touches no particle from the next rebuild on (a gate taken away); it keeps its place and motion.
   void remove(std::size_t w) {
     removed_.resize(walls_.size(), 0);
