@@ -281,6 +281,9 @@ REFUSED = {
     "sim.createParticle(NRotSphere(id=0, posn=Vec3(0, 0, 0), radius=0.5, mass=1.0))\nsim.run()":
         ("NRotElasticPrms together with bonds", "createExclusion"),
     "sim.setParticleDensity(tag=0, mask=-1, Density=2.0)": ("LsmMpi.setParticleDensity", "mass="),
+    "from esys.lsm.geometry import RandomBoxPacker\nRandomBoxPacker(minRadius=0.2, maxRadius=0.5)":
+        ("esys.lsm.geometry.RandomBoxPacker", "not reproduced", "basalt.pack.box"),
+    "sim.setVelocityOfWall('w', Vec3(0, 1, 0))": ("LsmMpi.setVelocityOfWall", "moveWallBy"),
     "sim.createFieldSaver(ParticleScalarFieldSaverPrms(fieldName='sigma_xx_2d', fileName='s', fileFormat='SUM', "
     "beginTimeStep=0, endTimeStep=1, timeStepIncr=1))": ("fieldName='sigma_xx_2d'", "e_kin"),
     "from esys.lsm import SomethingElse": ("esys.lsm.SomethingElse", "not provided"),

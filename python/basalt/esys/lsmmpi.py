@@ -22,6 +22,8 @@ CHUNK = 100
 
 _HINTS = {
     "setParticleDensity": "give each NRotSphere/RotSphere its mass (mass=...), as the tutorial's scripts do",
+    "setVelocityOfWall": "moveWallBy from a Runnable (each step's displacement), or basalt.Simulation's "
+                         "walls[name].set_velocity",
     "createExclusion": "Basalt's linear_elastic never acts on bonded pairs (scene models, docs/scenes.md); "
                        "the front end refuses NRotElasticPrms together with bonds",
     "readGeometry": "basalt.read_geometry reads .geo files for basalt.Simulation",
