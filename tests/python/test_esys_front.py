@@ -404,3 +404,38 @@ def test_move_wall_by_moves_the_platen_before_the_step_forces(tmp_path):
         assert abs(ball_y) < 1e-8  # the heavy ball gives way by ~1e-9
     saved = [line.split() for line in (tmp_path / "platen.dat").read_text().splitlines()]
     assert [float(s[1]) for s in saved] == pytest.approx([r - 50 * k * d for k in range(9)], abs=1e-12)
+
+
+# -- LinDampingPrms and RotDampingPrms on RotSpheres (spin.py) ---------------------------------------------------
+def _esys_damped(x, nu, dt, steps):
+    """ESyS's damping rule (docs/reference-runs.md) on a free particle's v or w: u0 = 0; u <- x - nu dt u while
+    e^2 > 1e-12, e = |u_new - u|^2 (so 2 or 3 iterations here); then x -= dt nu u, each step."""
+    for _ in range(steps):
+        u, count = [0.0, 0.0, 0.0], 0
+        while True:
+            new = [c - nu * dt * a for c, a in zip(x, u)]
+            e = sum((a - b) ** 2 for a, b in zip(new, u))
+            u, count = new, count + 1
+            if not (e * e > 1e-12 and count < 100):
+                break
+        x = [c - dt * nu * a for c, a in zip(x, u)]
+    return x
+
+
+def test_lin_and_rot_damping_follow_esys_iteration_rule(tmp_path):
+    dt, nu_lin, nu_rot = 1.0e-3, 2.0, 3.0
+    start = {0: ((0.5, 0.2, 0.0), (0.0, 0.0, 4.0)), 1: ((0.0, -0.3, 0.1), (2.0, -1.0, 0.5))}
+    out = front(SCRIPTS / "spin.py", tmp_path).stdout
+    rows = [line.split()[1:] for line in out.splitlines() if line.startswith("spin ")]
+    assert len(rows) == 40
+    for t, i, *vals in rows:
+        t, i = int(t), int(i)
+        v0, w0 = start[i]
+        assert [float(x) for x in vals[:3]] == pytest.approx(_esys_damped(v0, nu_lin, dt, t), rel=1e-9, abs=1e-15)
+        assert [float(x) for x in vals[3:]] == pytest.approx(_esys_damped(w0, nu_rot, dt, t), rel=1e-9, abs=1e-15)
+    # the rule is told apart: the converged damping 1/(1 + nu dt) per step is 1e-5 off after 1,000 steps, one
+    # iteration (1 - nu dt) 3e-3
+    assert rows[-1][:2] == ["1000", "1"]
+    wz = float(rows[-1][7])
+    assert abs(wz / (0.5 / (1.0 + nu_rot * dt) ** 1000) - 1.0) > 1e-6
+    assert abs(wz / (0.5 * (1.0 - nu_rot * dt) ** 1000) - 1.0) > 1e-3
