@@ -118,6 +118,11 @@ class Wall:
         """Move at velocity v (3 numbers) from now on, from where the wall is."""
         self._sim._core.set_wall_velocity(self.name, [float(c) for c in v])
 
+    def move_by(self, u):
+        """Collective: moves the wall by u (3 numbers) now, and its motion on from there; the forces are recomputed
+        (ESyS-Particle's moveWallBy)."""
+        self._sim._core.move_wall_by(self.name, [float(c) for c in u])
+
     def stop(self):
         self.set_velocity((0.0, 0.0, 0.0))
 

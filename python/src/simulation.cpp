@@ -115,6 +115,7 @@ class Run {
   virtual void set_dt(double dt) = 0;
   virtual void set_fixed_tags(std::vector<std::int64_t> tags) = 0;
   virtual void set_wall_velocity(const std::string& name, const std::array<double, 3>& v) = 0;
+  virtual void move_wall_by(const std::string& name, const std::array<double, 3>& u) = 0;
   virtual void remove_wall(const std::string& name) = 0;
   virtual void add_wall(const std::string& name) = 0;
   virtual void set_wall_motion(const std::string& name, const std::string& keys) = 0;
@@ -122,7 +123,7 @@ class Run {
   virtual py::list body_forces() const = 0;
   virtual void set_contact(const std::string& name, const std::string& keys) = 0;
   virtual py::list contacts() const = 0;
-  virtual void state_changed() = 0;
+  virtual void state_changed(bool advance_history) = 0;
   /// Particles in and out now (keys: the TOML of an [[insert]] / [[delete]] table); how many.
   virtual std::int64_t insert(const std::string& keys) = 0;
   virtual std::int64_t remove(const std::string& keys) = 0;
@@ -200,6 +201,9 @@ class RunOf final : public Run {
   void set_wall_velocity(const std::string& name, const std::array<double, 3>& v) override {
     sim_->set_wall_velocity(name, v);
   }
+  void move_wall_by(const std::string& name, const std::array<double, 3>& u) override {
+    sim_->move_wall_by(name, u);
+  }
   void remove_wall(const std::string& name) override { sim_->remove_wall(name); }
   void add_wall(const std::string& name) override { sim_->add_wall(name); }
   void set_wall_motion(const std::string& name, const std::string& keys) override {
@@ -221,7 +225,7 @@ class RunOf final : public Run {
     for (const auto& b : scene_.body_forces) l.append(py::make_tuple(b.name, b.model));
     return l;
   }
-  void state_changed() override { sim_->state_changed(); }
+  void state_changed(bool advance_history) override { sim_->state_changed(advance_history); }
   std::int64_t insert(const std::string& keys) override {
     return sim_->insert_particles(parse_keys(
         keys, "insert", [&](solver::TableReader& t) { return solver::parse_insert(t, scene_.density); }));
@@ -589,11 +593,16 @@ void bind_simulation(py::module_& m) {
            [](PySimulation& s, std::vector<std::int64_t> t) { s.run().set_fixed_tags(std::move(t)); })
       .def("set_wall_velocity", [](PySimulation& s, const std::string& name,
                                    std::array<double, 3> v) { s.run().set_wall_velocity(name, v); })
+      .def("move_wall_by", [](PySimulation& s, const std::string& name,
+                              std::array<double, 3> u) { s.run().move_wall_by(name, u); })
       .def("remove_wall", [](PySimulation& s, const std::string& name) { s.run().remove_wall(name); })
       .def("add_wall", [](PySimulation& s, const std::string& name) { s.run().add_wall(name); })
       .def("set_wall_motion", [](PySimulation& s, const std::string& name,
                                  const std::string& keys) { s.run().set_wall_motion(name, keys); })
-      .def("state_changed", [](PySimulation& s) { s.run().state_changed(); })
+      .def(
+          "state_changed",
+          [](PySimulation& s, bool advance_history) { s.run().state_changed(advance_history); },
+          py::arg("advance_history") = false)
       .def("set_body_force", [](PySimulation& s, const std::string& name,
                                 const std::string& keys) { s.run().set_body_force(name, keys); })
       .def("body_forces", [](PySimulation& s) { return s.run().body_forces(); })

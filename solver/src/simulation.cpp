@@ -404,6 +404,15 @@ void Simulation<Real>::set_wall_motion(std::string_view name, const std::string&
 }
 
 template <class Real>
+void Simulation<Real>::move_wall_by(std::string_view name, const std::array<double, 3>& u) {
+  for (double c : u)
+    if (!std::isfinite(c))
+      throw InputError(fmt::format("wall \"{}\": the displacement must be finite", name));
+  forces_.walls().shift(wall_index(name), u);
+  state_changed();
+}
+
+template <class Real>
 void Simulation<Real>::add_wall(std::string_view name) {
   const std::size_t w = wall_index(name);
   auto& walls = forces_.walls();
@@ -522,10 +531,10 @@ void Simulation<Real>::set_contact(std::string_view name, const std::string& key
 }
 
 template <class Real>
-void Simulation<Real>::state_changed() {
+void Simulation<Real>::state_changed(bool advance_history) {
   integrator_.forget_energy();
   wall_work_in_ = 0;
-  start_ledger(compute_forces<true>());
+  start_ledger(compute_forces<true>(false, advance_history));
 }
 
 template <class Real>

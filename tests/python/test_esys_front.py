@@ -263,8 +263,14 @@ def test_bonded_block_falls_and_bounces(tmp_path):
 
 # -- refusals, the runner ----------------------------------------------------------------------------------------
 REFUSED = {
-    "sim.createInteractionGroup(RotFrictionPrms(name='f', normalK=1.0, dynamicMu=0.5, staticMu=0.5, shearK=1.0))":
-        ("esys.lsm.RotFrictionPrms", 'rot_friction'),
+    "sim.createInteractionGroup(HertzMindlinPrms(name='h', youngsModulus=1.0, poissonsRatio=0.25, cor=0.5))":
+        ("esys.lsm.HertzMindlinPrms", 'hertz_mindlin'),
+    "sim.initNeighbourSearch(particleType='RotSphere', gridSpacing=2.5, verletDist=0.5)\n"
+    "sim.createInteractionGroup(RotFrictionPrms(name='f', normalK=1.0, dynamicMu=0.5, staticMu=0.5, shearK=1.0, "
+    "meanR_scaling=False))": ("RotFrictionPrms(meanR_scaling=False)", "mean radius"),
+    "sim.initNeighbourSearch(particleType='RotSphere', gridSpacing=2.5, verletDist=0.5)\n"
+    "sim.createInteractionGroup(RotFrictionPrms(name='f', normalK=1.0, dynamicMu=0.5, staticMu=0.5, shearK=1.0))\n"
+    "sim.createInteractionGroup(NRotElasticPrms(name='e', normalK=1.0))": ("a second contact group", "'f'"),
     "sim.createExclusion('a', 'b')": ("LsmMpi.createExclusion", "linear_elastic"),
     "from esys.lsm.geometry import HexagonalBlock\nHexagonalBlock(dimCount=[2, 2, 2], radius=0.5)":
         ("esys.lsm.geometry.HexagonalBlock", "basalt.pack"),
@@ -275,6 +281,9 @@ REFUSED = {
     "sim.createParticle(NRotSphere(id=0, posn=Vec3(0, 0, 0), radius=0.5, mass=1.0))\nsim.run()":
         ("NRotElasticPrms together with bonds", "createExclusion"),
     "sim.setParticleDensity(tag=0, mask=-1, Density=2.0)": ("LsmMpi.setParticleDensity", "mass="),
+    "from esys.lsm.geometry import RandomBoxPacker\nRandomBoxPacker(minRadius=0.2, maxRadius=0.5)":
+        ("esys.lsm.geometry.RandomBoxPacker", "not reproduced", "basalt.pack.box"),
+    "sim.setVelocityOfWall('w', Vec3(0, 1, 0))": ("LsmMpi.setVelocityOfWall", "moveWallBy"),
     "sim.createFieldSaver(ParticleScalarFieldSaverPrms(fieldName='sigma_xx_2d', fileName='s', fileFormat='SUM', "
     "beginTimeStep=0, endTimeStep=1, timeStepIncr=1))": ("fieldName='sigma_xx_2d'", "e_kin"),
     "from esys.lsm import SomethingElse": ("esys.lsm.SomethingElse", "not provided"),
@@ -343,3 +352,90 @@ def test_compare_tool_skips_without_esys(tmp_path):
     assert p.returncode == 3, p.stdout + p.stderr
     assert "ESyS-Particle comparison skipped: esysparticle-not-here not on PATH" in p.stdout
     assert (tmp_path / "cmp" / "basalt" / "fall" / "ekin.dat").exists()
+
+
+# -- friction (slide.py): closed forms of a sliding ball -------------------------------------------------------
+def _ball_rows(out):
+    return [[float(v) for v in line.split()[1:]] for line in out.splitlines() if line.startswith("ball ")]
+
+
+def test_rot_friction_slides_at_mu_g_then_rolls_at_five_sevenths(tmp_path):
+    g, mu, v0, r, m, R = 10.0, 0.5, 1.0, 0.5, 1.0, 1000.0
+    rows = _ball_rows(front(SCRIPTS / "slide.py", tmp_path, "rot").stdout)
+    assert [int(t) for t, *_ in rows] == list(range(100, 3001, 100))
+    by = {int(t): (x, y, v, w) for t, x, y, v, w in rows}
+    dt = 1.0e-4
+    # sliding (steps 100-400): friction mu m g against the slide, its moment spins the ball up (I = 2/5 m r^2;
+    # ESyS's lever: the contact point at r d/(r + R) from the centre, d = r + R - overlap)
+    assert (by[400][2] - by[100][2]) / (300 * dt) == pytest.approx(-mu * g, rel=1e-3)
+    assert (by[400][3] - by[100][3]) / (300 * dt) == pytest.approx(-2.5 * mu * g / r, rel=1e-3)
+    # friction's impulse about the contact point is zero: m v - I w_z / lever = m v0 at every row (within 5e-4:
+    # gravity's pull along the big sphere's curved top, g x / R, adds up to 3e-4 over the run)
+    lever = r * (r + R - 1e-3) / (r + R)
+    for t, (x, y, v, w) in by.items():
+        assert m * v - 0.4 * m * r * r * w / lever == pytest.approx(m * v0, abs=5e-4), t
+    # then it rolls (v = -w_z r) at 5/7 v0, the shear spring ringing around it
+    late = [by[t] for t in range(1000, 3001, 100)]
+    assert sum(v for _, _, v, _ in late) / len(late) == pytest.approx(5.0 / 7.0 * v0, rel=0.02)
+    assert abs(sum(v + w * r for _, _, v, w in late) / len(late)) < 0.02
+    assert by[700][2] < 0.72  # the rolling began (at t = v0 / (3.5 mu g) = 571 steps)
+
+
+def test_nrot_friction_stops_the_slide_after_v0_squared_over_2_mu_g(tmp_path):
+    g, mu, v0 = 10.0, 0.5, 1.0
+    rows = _ball_rows(front(SCRIPTS / "slide.py", tmp_path, "nrot").stdout)
+    by = {int(t): (x, y, v, w) for t, x, y, v, w in rows}
+    assert (by[1000][2] - by[100][2]) / (900 * 1.0e-4) == pytest.approx(-mu * g, rel=1e-3)
+    assert all(w == 0.0 for _, _, _, w in by.values())
+    late = [by[t] for t in range(2200, 3001, 100)]
+    assert sum(x for x, _, _, _ in late) / len(late) == pytest.approx(v0 * v0 / (2 * mu * g), rel=0.02)
+
+
+# -- moveWallBy (press.py): a platen moved by a pre-time-step Runnable ------------------------------------------
+def test_move_wall_by_moves_the_platen_before_the_step_forces(tmp_path):
+    d, r, K = 1.0e-4, 0.5, 1000.0
+    out = front(SCRIPTS / "press.py", tmp_path).stdout
+    rows = [[float(v) for v in line.split()[1:]] for line in out.splitlines() if line.startswith("platen ")]
+    assert [int(t) for t, *_ in rows] == list(range(20, 401, 20))
+    for t, y, fy, ball_y in rows:
+        assert y == pytest.approx(r - t * d, abs=1e-12)  # moved N times by d (after the set-up move to r)
+        # the force of step N sees the platen moved N times (ESyS's order), not N - 1: pi r K N d on the ball
+        assert fy == pytest.approx(-math.pi * r * K * t * d, rel=1e-6)
+        assert abs(ball_y) < 1e-8  # the heavy ball gives way by ~1e-9
+    saved = [line.split() for line in (tmp_path / "platen.dat").read_text().splitlines()]
+    assert [float(s[1]) for s in saved] == pytest.approx([r - 50 * k * d for k in range(9)], abs=1e-12)
+
+
+# -- LinDampingPrms and RotDampingPrms on RotSpheres (spin.py) ---------------------------------------------------
+def _esys_damped(x, nu, dt, steps):
+    """ESyS's damping rule (docs/reference-runs.md) on a free particle's v or w: u0 = 0; u <- x - nu dt u while
+    e^2 > 1e-12, e = |u_new - u|^2 (so 2 or 3 iterations here); then x -= dt nu u, each step."""
+    for _ in range(steps):
+        u, count = [0.0, 0.0, 0.0], 0
+        while True:
+            new = [c - nu * dt * a for c, a in zip(x, u)]
+            e = sum((a - b) ** 2 for a, b in zip(new, u))
+            u, count = new, count + 1
+            if not (e * e > 1e-12 and count < 100):
+                break
+        x = [c - dt * nu * a for c, a in zip(x, u)]
+    return x
+
+
+def test_lin_and_rot_damping_follow_esys_iteration_rule(tmp_path):
+    dt, nu_lin, nu_rot = 1.0e-3, 2.0, 3.0
+    start = {0: ((0.5, 0.2, 0.0), (0.0, 0.0, 4.0)), 1: ((0.0, -0.3, 0.1), (2.0, -1.0, 0.5))}
+    out = front(SCRIPTS / "spin.py", tmp_path).stdout
+    rows = [line.split()[1:] for line in out.splitlines() if line.startswith("spin ")]
+    assert len(rows) == 40
+    for t, i, *vals in rows:
+        t, i = int(t), int(i)
+        v0, w0 = start[i]
+        assert [float(x) for x in vals[:3]] == pytest.approx(_esys_damped(v0, nu_lin, dt, t), rel=1e-9, abs=1e-15)
+        assert [float(x) for x in vals[3:]] == pytest.approx(_esys_damped(w0, nu_rot, dt, t), rel=1e-9, abs=1e-15)
+    # the rule is told apart: the converged damping 1/(1 + nu dt) per step is 1e-5 off after 1,000 steps, one
+    # iteration (1 - nu dt) 3e-3
+    assert rows[-1][:2] == ["1000", "1"]
+    wz = float(rows[-1][7])
+    assert abs(wz / (0.5 / (1.0 + nu_rot * dt) ** 1000) - 1.0) > 1e-6
+    assert abs(wz / (0.5 * (1.0 - nu_rot * dt) ** 1000) - 1.0) > 1e-3

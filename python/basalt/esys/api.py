@@ -5,8 +5,8 @@ ones it refuses (a call raises NotSupportedError saying what Basalt offers)."""
 from .errors import NotSupportedError, refuse
 from .lsmmpi import LsmMpi  # noqa: F401
 from .particles import NRotSphere, RotSphere  # noqa: F401
-from .prms import (CheckPointPrms, GravityPrms, LinDampingPrms, NRotBondPrms, NRotElasticPrms,  # noqa: F401
-                   NRotElasticWallPrms,
+from .prms import (CheckPointPrms, FrictionPrms, GravityPrms, LinDampingPrms, NRotBondPrms,  # noqa: F401
+                   NRotElasticPrms, NRotElasticWallPrms, NRotFrictionPrms, RotDampingPrms, RotFrictionPrms,
                    ParticleScalarFieldSaverPrms, ParticleVectorFieldSaverPrms, Runnable, WallVectorFieldSaverPrms)
 from .refused import LSM, stubs
 from .vec3 import BoundingBox, Vec3  # noqa: F401
@@ -14,7 +14,7 @@ from .vec3 import BoundingBox, Vec3  # noqa: F401
 globals().update(stubs("esys.lsm", LSM))
 
 SUPPORTED = ["LsmMpi", "NRotSphere", "RotSphere", "NRotElasticPrms", "NRotBondPrms", "NRotElasticWallPrms",
-             "GravityPrms",
+             "RotFrictionPrms", "FrictionPrms", "NRotFrictionPrms", "RotDampingPrms", "GravityPrms",
              "LinDampingPrms", "CheckPointPrms", "ParticleScalarFieldSaverPrms", "ParticleVectorFieldSaverPrms",
              "WallVectorFieldSaverPrms", "Runnable", "Vec3", "BoundingBox"]
 REFUSED = sorted(LSM)

@@ -22,10 +22,11 @@ CHUNK = 100
 
 _HINTS = {
     "setParticleDensity": "give each NRotSphere/RotSphere its mass (mass=...), as the tutorial's scripts do",
+    "setVelocityOfWall": "moveWallBy from a Runnable (each step's displacement), or basalt.Simulation's "
+                         "walls[name].set_velocity",
     "createExclusion": "Basalt's linear_elastic never acts on bonded pairs (scene models, docs/scenes.md); "
                        "the front end refuses NRotElasticPrms together with bonds",
     "readGeometry": "basalt.read_geometry reads .geo files for basalt.Simulation",
-    "moveWallBy": "a scene wall's motion, or basalt.Simulation's walls[name].set_velocity",
     "setParticleNonDynamic": "the scene's particles.fixed_tags or basalt.Simulation.fix(tag)",
     "setParticleNonRotational": "NRotSphere particles",
     "createSphereBody": "Basalt's planar and mesh walls (docs/scenes.md)",
@@ -154,7 +155,21 @@ class LsmMpi:
 
         self._setup("createInteractionGroup")
         kind = type(prms).__name__
-        if isinstance(prms, P.NRotElasticPrms):
+        if isinstance(prms, (P.NRotElasticPrms, P.RotFrictionPrms, P.NRotFrictionPrms)):
+            if self._pair:
+                refuse(f"LsmMpi.createInteractionGroup({kind}): a second contact group (with "
+                       f"{type(self._pair[0]).__name__} {self._pair[0].name!r})",
+                       "one contact group (NRotElastic, RotFriction, FrictionPrms or NRotFriction) per run")
+            if isinstance(prms, P.RotFrictionPrms):
+                if not self._rotational:
+                    raise ValueError(f"LsmMpi.createInteractionGroup({kind}): RotFriction acts between RotSpheres "
+                                     "(initNeighbourSearch(particleType=\"RotSphere\", ...))")
+                if prms.scaling and not prms.meanR_scaling:
+                    refuse(f"LsmMpi.createInteractionGroup({kind}(meanR_scaling=False))",
+                           "Basalt's rot_friction scales by the mean radius (meanR_scaling=True)")
+                if prms.dynamicMu > prms.staticMu:
+                    refuse(f"LsmMpi.createInteractionGroup({kind}): dynamicMu {prms.dynamicMu} > staticMu "
+                           f"{prms.staticMu}", "Basalt's rot_friction needs mu_dynamic <= mu")
             self._name(prms)
             self._pair.append(prms)
         elif isinstance(prms, P.NRotBondPrms):
@@ -171,14 +186,18 @@ class LsmMpi:
                        "a Basalt wall has one interaction")
             self._name(prms)
             self._wall_k[prms.wallName] = prms
-        elif isinstance(prms, (P.GravityPrms, P.LinDampingPrms)):
+        elif isinstance(prms, (P.GravityPrms, P.LinDampingPrms, P.RotDampingPrms)):
+            if isinstance(prms, P.RotDampingPrms) and not self._rotational:
+                raise ValueError(f"LsmMpi.createInteractionGroup({kind}): rotational damping acts on RotSpheres "
+                                 "(initNeighbourSearch(particleType=\"RotSphere\", ...))")
             if any(type(b) is type(prms) for b in self._body):
                 refuse(f"LsmMpi.createInteractionGroup: a second {kind}", "one group of each body force")
             self._name(prms)
             self._body.append(prms)
         else:
-            refuse(f"LsmMpi.createInteractionGroup({kind})", "the front end maps NRotElasticPrms, NRotBondPrms, "
-                   "NRotElasticWallPrms, GravityPrms and LinDampingPrms so far")
+            refuse(f"LsmMpi.createInteractionGroup({kind})", "the front end maps NRotElasticPrms, RotFrictionPrms, "
+                   "FrictionPrms, NRotFrictionPrms, NRotBondPrms, NRotElasticWallPrms, GravityPrms, LinDampingPrms "
+                   "and RotDampingPrms so far")
 
     def createWall(self, name, posn, normal):
         self._setup("createWall")
@@ -188,6 +207,19 @@ class LsmMpi:
         if n.norm() == 0.0:
             raise ValueError(f"LsmMpi.createWall({name!r}): the normal has zero length")
         self._walls[str(name)] = (Vec3(posn), n)
+
+    def moveWallBy(self, wallName, d):
+        """Moves the wall by d now, as ESyS does (a Runnable's move before a step is in that step's forces): the
+        run's wall is shifted and the forces of the coming step recomputed (basalt Wall.move_by)."""
+        name = str(wallName)
+        if name not in self._walls:
+            raise ValueError(f"LsmMpi.moveWallBy: no wall named {name!r}")
+        d = Vec3(d)
+        if self._sim is None:
+            posn, normal = self._walls[name]
+            self._walls[name] = (posn + d, normal)
+        else:
+            self._sim.walls[name].move_by(d.toList())
 
     def createCheckPointer(self, prms):
         self._setup("createCheckPointer")

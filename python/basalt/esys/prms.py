@@ -1,6 +1,8 @@
 """esys.lsm's parameter classes that Basalt's front end maps onto its own models (docs/esys.md), and the
 checkpoint and field-saver parameters. Each only holds its arguments; LsmMpi turns them into the scene."""
 
+import math
+
 from .vec3 import Vec3
 
 
@@ -79,3 +81,40 @@ class Runnable:
 
     def run(self):
         pass
+
+
+class RotFrictionPrms:
+    """ESyS's RotFriction between RotSpheres (Basalt's rot_friction, convention "esys": docs/reference-runs.md,
+    "Granular conventions"). rigid is accepted and, as in ESyS 2.3.5, has no effect (its master never sends it to
+    the workers)."""
+
+    def __init__(self, name, normalK, dynamicMu, staticMu, shearK, scaling=True, rigid=False, meanR_scaling=True):
+        self.name, self.normalK, self.shearK = str(name), float(normalK), float(shearK)
+        self.dynamicMu, self.staticMu = float(dynamicMu), float(staticMu)
+        self.scaling, self.rigid, self.meanR_scaling = bool(scaling), bool(rigid), bool(meanR_scaling)
+
+
+class FrictionPrms(RotFrictionPrms):
+    """ESyS's FrictionPrms: the same rotational model with normalK = pi E, shearK = pi E / (2 (1 + nu)) and
+    scaling=True (ESyS's RotFricInteraction.cpp)."""
+
+    def __init__(self, name, youngsModulus, poissonsRatio, dynamicMu, staticMu, rigid=False, meanR_scaling=True):
+        E, nu = float(youngsModulus), float(poissonsRatio)
+        super().__init__(name, math.pi * E, dynamicMu, staticMu, math.pi * E / (2.0 * (1.0 + nu)), True, rigid,
+                         meanR_scaling)
+
+
+class NRotFrictionPrms:
+    """ESyS's NRotFriction (Basalt's friction, convention "esys"): one coefficient dynamicMu for sticking and
+    sliding; scaling=True: K and Ks times (r1 + r2)/2."""
+
+    def __init__(self, name, normalK, dynamicMu, shearK, scaling=True):
+        self.name, self.normalK, self.dynamicMu = str(name), float(normalK), float(dynamicMu)
+        self.shearK, self.scaling = float(shearK), bool(scaling)
+
+
+class RotDampingPrms:
+    """ESyS's rotational viscous damping of RotSpheres (its iterative rule on the moment, maxIterations as ESyS)."""
+
+    def __init__(self, name, viscosity, maxIterations=100):
+        self.name, self.viscosity, self.maxIterations = str(name), float(viscosity), int(maxIterations)

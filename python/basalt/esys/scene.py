@@ -6,7 +6,10 @@
                                        no moment: the same normal force), particles.rotation on
     NRotElasticWallPrms             -> the wall's K with stiffness = "esys_pi_r" (k = pi r K)
     a wall without a group          -> K = 0 (ESyS: no force on it)
-    GravityPrms, LinDampingPrms     -> [[body_forces]] gravity, linear_damping (ESyS's iterative rule)
+    RotFrictionPrms, FrictionPrms   -> rot_friction, convention "esys" (FrictionPrms: K = pi E, Ks = pi E/(2(1 + nu)),
+                                       scaling); NRotFrictionPrms -> friction, convention "esys", mu = dynamicMu
+    GravityPrms, LinDampingPrms,    -> [[body_forces]] gravity, linear_damping, rotational_damping (ESyS's
+    RotDampingPrms                     iterative rule)
     always                          -> symplectic Euler (ESyS's integrator), masses as given, skin = verletDist,
                                        no energy check and no start-up overlap/dt refusal (ESyS has neither)
 """
@@ -20,7 +23,14 @@ from .errors import refuse
 def scene_dict(lsm, geometry_file, output_dir):
     interactions, rotation = [], lsm._rotational
     for g in lsm._pair:
-        if g.scaling:
+        if isinstance(g, P.RotFrictionPrms):  # also FrictionPrms (K = pi E, Ks = pi E / (2 (1 + nu)))
+            interactions.append({"type": "rot_friction", "K": g.normalK, "Ks": g.shearK, "mu": g.staticMu,
+                                 "mu_dynamic": g.dynamicMu, "convention": "esys", "scaling": g.scaling})
+            rotation = True
+        elif isinstance(g, P.NRotFrictionPrms):
+            interactions.append({"type": "friction", "K": g.normalK, "Ks": g.shearK, "mu": g.dynamicMu,
+                                 "mu_dynamic": g.dynamicMu, "convention": "esys", "scaling": g.scaling})
+        elif g.scaling:
             interactions.append({"type": "rot_friction", "K": g.normalK, "Ks": 0.0, "mu": 0.0, "mu_dynamic": 0.0,
                                  "convention": "esys", "scaling": True})
             rotation = True
@@ -52,6 +62,8 @@ def scene_dict(lsm, geometry_file, output_dir):
     for b in lsm._body:
         if isinstance(b, P.GravityPrms):
             body.append({"type": "gravity", "acceleration": b.acceleration.toList()})
+        elif isinstance(b, P.RotDampingPrms):
+            body.append({"type": "rotational_damping", "viscosity": b.viscosity, "iterations": b.maxIterations})
         else:
             body.append({"type": "linear_damping", "viscosity": b.viscosity, "iterations": b.maxIterations})
     scene = {
@@ -103,7 +115,8 @@ def build(lsm, workdir):
 
 def _set_initial_velocities(sim, vel, angvel):
     """The created particles' velocities ({id: [3 numbers]}), written into the run's arrays before the first
-    step; then the forces are recomputed (the damping reads velocities)."""
+    step; then the forces are recomputed (the damping reads velocities) and the contacts' shear springs take
+    that computation's increment dt u(0), as ESyS's first step does (measured with slide.py)."""
     import numpy as np
 
     part = sim.particles
@@ -114,4 +127,4 @@ def _set_initial_velocities(sim, vel, angvel):
         values = np.array([table[int(i)] for i in ids], dtype=float).reshape(len(ids), 3)
         for k, name in enumerate(names):
             getattr(part, name)[:] = values[:, k]
-    sim.state_changed()
+    sim._core.state_changed(advance_history=True)

@@ -185,8 +185,10 @@ class Simulation {
   /// Collective: number of bonds.
   std::int64_t bond_count() const;
   /// Collective: call after changing particle state from outside (e.g. initial velocities): recomputes
-  /// forces and the energy the stability guard starts from.
-  void state_changed();
+  /// forces and the energy the stability guard starts from. advance_history: the contacts' history (shear
+  /// springs) takes this computation's increment, as a step's does (ESyS's first step increments the spring
+  /// of a contact present at the start with the initial velocities: Basalt's ESyS front end).
+  void state_changed(bool advance_history = false);
   /// Collective: rebuilds the lists now (migrating particles), then recomputes forces.
   void force_rebuild();
 
@@ -204,6 +206,9 @@ class Simulation {
   /// keys, e.g. "type = \"servo\"\ntarget_force = 5.0\ngain = 0.01\nmax_speed = 0.5"; its times count from
   /// now), checked as the scene's. InputError naming the key, nothing changed, on a bad table.
   void set_wall_motion(std::string_view name, const std::string& keys);
+  /// Collective: moves the planar wall by u now and recomputes the forces (ESyS-Particle's moveWallBy; the
+  /// contacts' history is not advanced again).
+  void move_wall_by(std::string_view name, const std::array<double, 3>& u);
   /// The wall touches particles from now on (one the scene declared with active = false, or one removed):
   /// the lists are rebuilt at once and the energy guard takes a new reference. InputError, nothing changed,
   /// when a particle's centre is behind it (the wall would push it through), naming the particle.

@@ -160,6 +160,14 @@ class Walls {
     walls_[w].point = point_[w];
     velocity_[w] = servo(w) ? std::array<double, 3>{0, 0, 0} : m.velocity_at(t);
   }
+  /// Shifts wall w by u now, with the anchor of its motion (ESyS's moveWallBy: its motion goes on from
+  /// there).
+  void shift(std::size_t w, const std::array<double, 3>& u) {
+    for (int d = 0; d < 3; ++d) {
+      walls_[w].point[d] += u[d];
+      point_[w][d] += u[d];
+    }
+  }
   /// Wall w touches no particle from the next rebuild on (a gate taken away); it keeps its place and motion.
   void remove(std::size_t w) {
     removed_.resize(walls_.size(), 0);
