@@ -417,19 +417,11 @@ void Simulation<Real>::add_wall(std::string_view name) {
   const std::size_t w = wall_index(name);
   auto& walls = forces_.walls();
   if (!walls.removed(w)) return;
-  const auto& spec = walls.spec(w);
-  const auto& x = walls.point(w);
   // A particle it touches whose centre is behind the plane would be pushed through it: refused (collective).
   std::int64_t behind = 0, first = -1;
-  for (std::size_t i = 0; i < p_.n_owned; ++i) {
-    if (!spec.tags.empty() && std::find(spec.tags.begin(), spec.tags.end(), p_.tag[i]) == spec.tags.end())
-      continue;
-    const double d = (double(p_.x[i]) - x[0]) * spec.normal[0] + (double(p_.y[i]) - x[1]) * spec.normal[1] +
-                     (double(p_.z[i]) - x[2]) * spec.normal[2];
-    if (d < 0) {
-      if (behind++ == 0) first = p_.id[i];
-    }
-  }
+  for (std::size_t i = 0; i < p_.n_owned; ++i)
+    if (walls.touches_tag(w, p_.tag[i]) && walls.distance(w, p_.x[i], p_.y[i], p_.z[i]) < 0 && behind++ == 0)
+      first = p_.id[i];
   if (comm().size() > 1) {
     behind = comm().sum(static_cast<long long>(behind));
     first = static_cast<std::int64_t>(comm().max(static_cast<double>(first)));
@@ -441,8 +433,8 @@ void Simulation<Real>::add_wall(std::string_view name) {
                     "delete them",
                     name, behind, first));
   walls.restore(w);
-  force_rebuild();
-  state_changed();
+  rebuild();
+  state_changed();  // (the forces with the wall, and the energy guard's new reference)
 }
 
 template <class Real>

@@ -179,6 +179,17 @@ class Walls {
   }
   bool removed(std::size_t w) const { return w < removed_.size() && removed_[w]; }
 
+  /// The signed distance of point x from wall w's plane now (positive on the particles' side).
+  double distance(std::size_t w, double x, double y, double z) const {
+    const auto& n = walls_[w].normal;
+    return (x - point_[w][0]) * n[0] + (y - point_[w][1]) * n[1] + (z - point_[w][2]) * n[2];
+  }
+  /// Whether wall w touches particles of this tag (its tags, or all when it names none).
+  bool touches_tag(std::size_t w, std::int64_t tag) const {
+    const auto& tags = walls_[w].tags;
+    return tags.empty() || std::find(tags.begin(), tags.end(), tag) != tags.end();
+  }
+
   /// At a rebuild: the owned particles within reach of each wall (centre closer than radius + skin,
   /// taking the wall's tags), so that steps loop over those only.
   template <class Real>
@@ -195,11 +206,8 @@ class Walls {
           c.push_back(static_cast<std::int32_t>(i));
           continue;
         }
-        const double d = (p.x[i] - point_[w][0]) * spec.normal[0] + (p.y[i] - point_[w][1]) * spec.normal[1] +
-                         (p.z[i] - point_[w][2]) * spec.normal[2];
-        if (d >= double(p.radius[i]) + skin) continue;
-        if (!spec.tags.empty() && std::find(spec.tags.begin(), spec.tags.end(), p.tag[i]) == spec.tags.end())
-          continue;
+        if (distance(w, p.x[i], p.y[i], p.z[i]) >= double(p.radius[i]) + skin) continue;
+        if (!touches_tag(w, p.tag[i])) continue;
         c.push_back(static_cast<std::int32_t>(i));
       }
     }
