@@ -242,6 +242,28 @@ def test_quantities_reduce_as_named():
     assert quantities.Quantity("fields.a:max").measure(fields, None, 0, 3) == 5.0
     assert quantities.Quantity("fields.a:mean").measure(fields, None, 1, 2) == 4.0
 
+    # A loading curve: force rising linearly at 10 per unit time to a peak 50 at t = 5, then falling; bonds
+    # breaking in two columns.
+    t = np.arange(0.0, 10.5, 0.5)
+    force = np.where(t <= 5, 10 * t, 50 - 20 * (t - 5))
+    fields = {"time": t, "step": t, "f": force, "b1": np.floor(t), "b2": 2 * np.floor(t)}
+    assert quantities.Quantity("fields.f:argmax").measure(fields, None, 0, 10) == 5.0
+    assert quantities.Quantity("fields.f:argmin").measure(fields, None, 0, 10) == 10.0
+    assert quantities.Quantity("fields.f:argmax").measure(fields, None, 0, 4) == 4.0
+    assert quantities.Quantity("fields.f:half_max_slope").measure(fields, None, 0, 10) == pytest.approx(10.0)
+    assert quantities.Quantity("fields.b1+b2:at_max(f)").measure(fields, None, 0, 10) == 15.0
+    assert quantities.Quantity("fields.b1:at_max(f)*1.2").measure(fields, None, 0, 10) == 6.0
+    assert quantities.Quantity("fields.f:at_max(f)*1.25").measure(fields, None, 0, 10) == pytest.approx(25.0)
+    assert quantities.Quantity("fields.f:at_min(b1+b2)").measure(fields, None, 2, 10) == 20.0
+    with pytest.raises(quantities.QuantityError, match="past the last saved row"):
+        quantities.Quantity("fields.b1:at_max(f)*3").measure(fields, None, 0, 10)
+    with pytest.raises(quantities.QuantityError, match="positive number"):
+        quantities.Quantity("fields.b1:at_max(f)*0")
+    with pytest.raises(quantities.QuantityError, match="no field 'g'"):
+        quantities.Quantity("fields.b1:at_max(f+g)").check_fields(["step", "time", "f", "b1"])
+    with pytest.raises(quantities.QuantityError, match="unknown reduction"):
+        quantities.Quantity("fields.f:at_mid(b1)")
+
     class Ckpt:
         particles = {"position": np.array([[0, 0, 1.0], [0, 0, 2.0], [3, 4, 3.0]]), "radius": np.ones(3)}
         bonds = {"broken": np.array([0, 1, 1, 0])}
@@ -255,6 +277,53 @@ def test_quantities_reduce_as_named():
         quantities.Quantity("checkpoint.position:mean").measure(None, c, 0, 1)
     with pytest.raises(quantities.QuantityError, match="percentile"):
         quantities.Quantity("checkpoint.radius:p101")
+
+
+def test_rate_and_damping_scale_what_they_name():
+    scene = tomllib.loads(SCENE)
+    scene["walls"][1]["motion"] = {"type": "ramp", "velocity": [0.1, 0.0, 0.0], "ramp_time": 2.0, "start_time": -1.0}
+    scene["walls"][2]["motion"] = {"type": "servo", "target_force": 1.0, "gain": 1.0, "max_speed": 0.1}
+    scene["body_forces"].append({"type": "linear_damping", "viscosity": 0.5})
+    s = scene_overrides.apply(scene, rate=4.0, damping=0.1)
+    assert s["walls"][1]["motion"] == {"type": "ramp", "velocity": [0.4, 0.0, 0.0], "ramp_time": 0.5,
+                                       "start_time": -0.25}
+    assert s["walls"][2]["motion"] == scene["walls"][2]["motion"]  # a servo follows a force, not a clock
+    assert s["body_forces"][1]["viscosity"] == pytest.approx(0.05)
+    assert scene["walls"][1]["motion"]["velocity"] == [0.1, 0.0, 0.0]  # the user's scene is not touched
+    with pytest.raises(scene_overrides.SceneError, match="no wall with a prescribed motion"):
+        scene_overrides.apply(tomllib.loads(SCENE), rate=2.0)
+    with pytest.raises(scene_overrides.SceneError, match="no damping"):
+        scene_overrides.apply(tomllib.loads(SCENE), damping=2.0)
+    scene["body_forces"].append({"type": "local_damping", "alpha": 0.3})
+    with pytest.raises(scene_overrides.SceneError, match="alpha x 4 = 1.2"):
+        scene_overrides.apply(scene, damping=4.0)
+
+
+def test_a_faster_loading_reaches_the_same_state_in_less_time(pile):
+    """A piston closing at constant speed: at rate x2 the run lasts half as long, and the study reads its times
+    as the scene's loading time, so the piston's final position and the time of its largest x agree with the
+    scene's own rate (the piston touches nothing: no physics changes with the rate)."""
+    scene = tomllib.loads(SCENE)
+    scene["walls"].append({"name": "piston", "point": [20.0, 0.0, 0.0], "normal": [-1.0, 0.0, 0.0], "K": 2000.0,
+                           "motion": {"type": "constant_velocity", "velocity": [-1.0, 0.0, 0.0]}})
+    scene["output"]["fields"] = [{"type": "wall_position", "wall": "piston"}]
+    (pile / "piston.toml").write_text(scene_overrides.dumps(scene))
+    out = pile / "study-rate"
+    run([BIN / "basalt-study", pile / "piston.toml", "-q", "fields.wall_position_piston_x:last",
+         "-q", "fields.wall_position_piston_x:argmin", "--steps", "200", "--dt-fraction", "0.02", "--rate", "1,2",
+         "--ensemble", "1", "--no-plot", "-o", out])
+    runs = by_key(json.loads((out / "study.json").read_text()))
+    ref, fast = runs["reference"], runs["double-dtf0.02-k1-skin0.2-rate2"]
+    assert fast["setting"]["rate"] == 2.0 and fast["dt"] == ref["dt"]
+    assert fast["steps"] == pytest.approx(ref["steps"] / 2, abs=1)
+    t_end = 200 * 0.0025  # the window: 200 of the scene's steps
+    for r in (ref, fast):
+        assert r["quantities"]["fields.wall_position_piston_x:last"] == pytest.approx(20.0 - t_end, rel=1e-12)
+        # the last saved row inside the window, in the scene's time
+        assert r["quantities"]["fields.wall_position_piston_x:argmin"] == pytest.approx(t_end, abs=2 * ref["dt"])
+    assert fast["sim_time"] == pytest.approx(ref["sim_time"], rel=1e-9)  # the scene's loading time, not the run's
+    table = (out / "table.md").read_text()
+    assert "| rate |" in table and "| double-dtf0.02-k1-skin0.2-rate2 | double | 0.02 | 1 | 0.2 | 2 |" in table
 
 
 def test_perturbed_members_move_by_the_nudge_alone(pile, tmp_path):

@@ -60,8 +60,10 @@ def parse_args(argv):
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("scene", help="the scene (TOML, docs/scenes.md)")
     p.add_argument("-q", "--quantity", action="append", default=[], metavar="SPEC",
-                   help="a quantity of interest (repeatable): fields.COLUMN:last|max|min|mean or "
-                        "checkpoint.DATASET[.x|y|z|norm]:mean|max|min|sum|pP|count|count>V|count<V")
+                   help="a quantity of interest (repeatable): fields.COLUMN[+COLUMN...]:last|max|min|mean|argmax|"
+                        "argmin|half_max_slope|at_max(C)[*F]|at_min(C)[*F] or "
+                        "checkpoint.DATASET[.x|y|z|norm]:mean|max|min|sum|pP|count|count>V|count<V "
+                        "(tools/study/quantities.py)")
     w = p.add_mutually_exclusive_group()
     w.add_argument("--steps", type=int, help="window: this many steps of the scene's own dt (default run.steps)")
     w.add_argument("--time", type=float, help="window: this much simulated time")
@@ -71,6 +73,10 @@ def parse_args(argv):
     p.add_argument("--precision", help="ladder: double,float,mixed (default: the scene's)")
     p.add_argument("--stiffness", help="ladder: contact-stiffness scales (default 1)")
     p.add_argument("--skin", help="ladder: run.skin values (default: the scene's)")
+    p.add_argument("--rate", help="ladder: loading-rate scales of the walls' prescribed motions (default 1); the "
+                                  "window of a run at S is the scene's over S, and its fields' times are "
+                                  "multiplied by S (so a time reads as the scene's loading time)")
+    p.add_argument("--damping", help="ladder: scales of the body-force damping (default 1)")
     p.add_argument("--reference-dt-fraction", type=float, default=0.02, help="the reference's dt fraction (0.02)")
     p.add_argument("--ensemble", type=int, default=3, help="perturbed references (default 3)")
     p.add_argument("--perturbation", type=float, default=1e-9, help="their nudge, fraction of the radius (1e-9)")
@@ -100,7 +106,7 @@ def check_args(a):
         for v in a.precision:
             if v not in PRECISIONS:
                 raise StudyError(f"--precision: '{v}' is not one of {', '.join(PRECISIONS)}")
-    for name in ("dt_fraction", "stiffness", "skin"):
+    for name in ("dt_fraction", "stiffness", "skin", "rate", "damping"):
         v = getattr(a, name)
         if v is not None:
             setattr(a, name, numbers(v, "--" + name.replace("_", "-")))
@@ -161,7 +167,8 @@ class Study:
                                      "--frames-every", 0, "--quiet", np=self.a.np, timed=True)
 
     def write_scene(self, folder, setting, geometry, dt=None):
-        s = so.apply(self.scene, setting["dt_fraction"], setting["stiffness"], setting["skin"], self.scene_path, dt)
+        s = so.apply(self.scene, setting["dt_fraction"], setting["stiffness"], setting["skin"], self.scene_path, dt,
+                     rate=setting.get("rate", 1.0), damping=setting.get("damping", 1.0))
         s["geometry"]["file"] = geometry
         os.makedirs(folder, exist_ok=True)
         path = os.path.join(folder, "scene.toml")
@@ -203,8 +210,10 @@ class Study:
             if info is None:
                 return self.finish(done, run, status="failed", message=err)
         dt = info["dt"]
-        every = max(1, round(self.t_end / (dt * self.a.rows)))
-        steps = every * math.ceil(self.t_end / (dt * every) - 1e-9)
+        rate = run["setting"].get("rate", 1.0)
+        t_end = self.t_end / rate  # a faster loading reaches the scene's state sooner
+        every = max(1, round(t_end / (dt * self.a.rows)))
+        steps = every * math.ceil(t_end / (dt * every) - 1e-9)
         run.update(dt=dt, steps=steps, every=every, critical_step=info.get("critical_step"),
                    particles=info["particles"], ranks=self.a.np)
         self.say(f"[{k}/{total}] {run['key']}: {rep.label(run)}: {steps} steps of dt = {dt:.4g}"
@@ -221,8 +230,8 @@ class Study:
             self.say(f"  {run['key']} failed after {wall:.1f} s: {failure(p)}")
             return self.finish(done, run, status="failed", message=failure(p))
         run.update(status="ok", wall_s=wall, cpu_s=x["cpu_s"], loop_s=x["loop_s"],
-                   particle_steps_per_s=x["particle_steps_per_s"], sim_time=steps * dt,
-                   sim_time_per_cpu_s=steps * dt / (x["cpu_s"] * self.a.np) if x["cpu_s"] > 0 else float("nan"),
+                   particle_steps_per_s=x["particle_steps_per_s"], sim_time=steps * dt * rate,
+                   sim_time_per_cpu_s=steps * dt * rate / (x["cpu_s"] * self.a.np) if x["cpu_s"] > 0 else float("nan"),
                    max_rss_kb=tv.get("max_rss_kb", float("nan")),
                    rss_bytes_per_particle=tv.get("max_rss_kb", float("nan")) * 1024.0 / info["particles"],
                    array_bytes_per_particle=x.get("bytes_per_particle"), output=out)
@@ -252,6 +261,8 @@ class Study:
         import basalt
         fields = basalt.read_fields(os.path.join(run["output"], "fields.csv"))
         cols = {n: fields[n] for n in fields.dtype.names}
+        # At loading rate S a time t of the run is the scene's loading time S t (run["sim_time"] likewise).
+        cols["time"] = cols["time"] * run["setting"].get("rate", 1.0)
         ckpt = basalt.read_checkpoint(run["output"]) if any(q.needs_checkpoint for q in self.a.quantities) else None
         return {q.spec: q.measure(cols, ckpt, self.a.window_start, self.t_end) for q in self.a.quantities}
 
@@ -305,17 +316,25 @@ class Study:
                              "--dt-fraction")
         skins = self.a.skin or [own["skin"]]
         base = {"precision": "double", "dt_fraction": self.a.reference_dt_fraction, "stiffness": 1.0,
-                "skin": own["skin"]}
+                "skin": own["skin"], "rate": 1.0, "damping": 1.0}
         runs = [{"key": "reference", "kind": "reference", "setting": dict(base), "member": 0}]
         runs += [{"key": f"ensemble{m}", "kind": "ensemble", "setting": dict(base), "member": m}
                  for m in range(1, self.a.ensemble + 1)]
-        for prec, frac, k, skin in itertools.product(self.a.precision or [own["precision"]], fractions,
-                                                     self.a.stiffness or [1.0], skins):
-            s = {"precision": prec, "dt_fraction": frac, "stiffness": k, "skin": skin}
+        for prec, frac, k, skin, rate, damp in itertools.product(
+                self.a.precision or [own["precision"]], fractions, self.a.stiffness or [1.0], skins,
+                self.a.rate or [1.0], self.a.damping or [1.0]):
+            s = {"precision": prec, "dt_fraction": frac, "stiffness": k, "skin": skin, "rate": rate, "damping": damp}
             if s != base:
-                runs.append({"key": f"{prec}-dtf{frac:g}-k{k:g}-skin{skin:g}", "kind": "setting", "setting": s})
+                key = f"{prec}-dtf{frac:g}-k{k:g}-skin{skin:g}"  # the keys of studies without the newer axes
+                key += (f"-rate{rate:g}" if rate != 1 else "") + (f"-damp{damp:g}" if damp != 1 else "")
+                runs.append({"key": key, "kind": "setting", "setting": s})
+        # A scene without contacts, moving walls or damping says so before any run.
         if any(r["setting"]["stiffness"] != 1 for r in runs):
-            so.apply(self.scene, stiffness=0.5, scene_path=self.scene_path)  # a scene without contacts says so
+            so.apply(self.scene, stiffness=0.5, scene_path=self.scene_path)
+        if any(r["setting"]["rate"] != 1 for r in runs):
+            so.apply(self.scene, rate=0.5, scene_path=self.scene_path)
+        if any(r["setting"]["damping"] != 1 for r in runs):
+            so.apply(self.scene, damping=0.5, scene_path=self.scene_path)
         for section in ("insert", "delete"):
             if self.scene.get(section):
                 self.say(f"warning: {section}: its events count steps, so a setting with another dt has them at "

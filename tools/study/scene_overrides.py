@@ -11,6 +11,12 @@ Overrides (docs/accuracy.md, "Your own scene: basalt-study"):
                  E of hertz_mindlin and jkr groups, E and E_wall of hertz_mindlin walls. Bonds (linear_bond,
                  rot_bond, bonded walls) are not contacts and are left alone;
   * skin:        run.skin.
+  * rate:        the loading rate times the scale: every prescribed wall motion runs S times faster (velocities,
+                 amplitudes and angular velocities x S; periods, ramp times and start times / S), so the same
+                 displacements are reached in 1/S of the time; servo walls and fixed walls are left alone (a
+                 scene whose walls prescribe no motion has nothing to scale and is refused).
+  * damping:     every body-force damping times the scale: viscosity of linear_damping and rotational_damping,
+                 alpha of local_damping (alpha x S must stay below 1).
 Paths (geometry.file, mesh_walls[k].file) are made absolute, since the written scene lives elsewhere.
 """
 import copy
@@ -81,10 +87,62 @@ def stiffness_keys(scene):
     return found
 
 
-def apply(scene, dt_fraction=None, stiffness=None, skin=None, scene_path="scene", dt=None):
+RATE_TIMES = ("period", "ramp_time", "start_time")
+RATE_SPEEDS = ("velocity", "amplitude")
+DAMPING_KEYS = {"linear_damping": "viscosity", "rotational_damping": "viscosity", "local_damping": "alpha"}
+
+
+def _scaled(v, f):
+    return [x * f for x in v] if isinstance(v, list) else v * f
+
+
+def scale_rate(scene, rate, scene_path="scene"):
+    """Every prescribed wall motion of `scene` (changed in place) S = `rate` times faster."""
+    moving = 0
+    for section in ("walls", "mesh_walls"):
+        for w in scene.get(section, []):
+            m = w.get("motion")
+            if not m or m.get("type", "fixed") in ("fixed", "servo"):
+                continue
+            moving += 1
+            for key in RATE_SPEEDS:
+                if key in m:
+                    m[key] = _scaled(m[key], rate)
+            for key in RATE_TIMES:
+                if key in m:
+                    m[key] = m[key] / rate
+            if "rotation" in m and "angular_velocity" in m["rotation"]:
+                m["rotation"]["angular_velocity"] *= rate
+    if not moving:
+        raise SceneError(f"{scene_path}: walls: no wall with a prescribed motion (constant_velocity, ramp, sine, "
+                         "half_sine): a loading-rate scale has nothing to scale")
+
+
+def scale_damping(scene, factor, scene_path="scene"):
+    """Every body-force damping of `scene` (changed in place) times `factor`."""
+    found = 0
+    for k, b in enumerate(scene.get("body_forces", [])):
+        key = DAMPING_KEYS.get(b.get("type"))
+        if key and key in b:
+            b[key] = b[key] * factor
+            found += 1
+            if key == "alpha" and not b[key] < 1:
+                raise SceneError(f"{scene_path}: body_forces[{k}].alpha x {factor:g} = {b[key]:g}: local damping "
+                                 "needs alpha < 1")
+    if not found:
+        raise SceneError(f"{scene_path}: body_forces: no damping ({', '.join(DAMPING_KEYS)}): a damping scale has "
+                         "nothing to scale")
+
+
+def apply(scene, dt_fraction=None, stiffness=None, skin=None, scene_path="scene", dt=None, rate=None,
+          damping=None):
     """A copy of `scene` with the setting's overrides (None: the scene's own value); `dt`, a fixed step, wins
     over dt_fraction."""
     s = copy.deepcopy(scene)
+    if rate is not None and rate != 1:
+        scale_rate(s, float(rate), scene_path)
+    if damping is not None and damping != 1:
+        scale_damping(s, float(damping), scene_path)
     run = s["run"]
     if dt is not None:
         run.pop("dt_fraction", None)

@@ -63,7 +63,11 @@ def cheapest(settings, budget):
 
 def label(r):
     s = r["setting"]
-    return f"{s['precision']} dtf {s['dt_fraction']:g} k x{s['stiffness']:g} skin {s['skin']:g}"
+    text = f"{s['precision']} dtf {s['dt_fraction']:g} k x{s['stiffness']:g} skin {s['skin']:g}"
+    for key, name in (("rate", "rate"), ("damping", "damping")):
+        if s.get(key, 1.0) != 1:
+            text += f" {name} x{s[key]:g}"
+    return text
 
 
 def _err(r, s):
@@ -82,12 +86,16 @@ def markdown(runs, specs, spreads, ref, budget=None, best=None, cpu=""):
     if cpu:
         out += [f"Host: {cpu}. Speed-up: the reference's CPU seconds per simulated time unit over the setting's, "
                 "both measured in this study.", ""]
-    out.append(f"| run | precision | dt fraction | stiffness | skin | dt | steps | {q_heads} | max error | "
-               "speed-up | simulated time per CPU s | M particle-steps/s | RSS B/particle | Pareto |")
-    out.append("|" + " --- |" * (13 + len(specs)))
+    # Loading-rate and damping columns only in studies that vary them.
+    extra = [k for k in ("rate", "damping") if any(r["setting"].get(k, 1.0) != 1 for r in runs)]
+    out.append(f"| run | precision | dt fraction | stiffness | skin |{''.join(f' {k} |' for k in extra)} dt | steps | "
+               f"{q_heads} | max error | speed-up | simulated time per CPU s | M particle-steps/s | RSS B/particle | "
+               "Pareto |")
+    out.append("|" + " --- |" * (13 + len(extra) + len(specs)))
     for r in runs:
         s = r["setting"]
-        head = f"| {r['key']} | {s['precision']} | {s['dt_fraction']:g} | {s['stiffness']:g} | {s['skin']:g} |"
+        head = (f"| {r['key']} | {s['precision']} | {s['dt_fraction']:g} | {s['stiffness']:g} | {s['skin']:g} |"
+                + "".join(f" {s.get(k, 1.0):g} |" for k in extra))
         if r["status"] != "ok":
             msg = r["message"] if len(r["message"]) <= 110 else r["message"][:107] + "..."
             out.append(head + f" | | {msg.replace('|', '/')} |" + " |" * (len(specs) + 5))
@@ -119,6 +127,20 @@ def fragment(best, scene, scene_path, budget):
         scaled = so.apply(scene, stiffness=s["stiffness"])
         for where, table, key in so.stiffness_keys(scaled):
             lines.append(f"#   {where}: {key} = {table[key]!r}")
+    if s.get("rate", 1.0) != 1:
+        lines.append(f"# loading rate x {s['rate']:g}: these wall motions (and run.steps / {s['rate']:g})")
+        scaled = so.apply(scene, rate=s["rate"])
+        for section in ("walls", "mesh_walls"):
+            for w in scaled.get(section, []):
+                if w.get("motion", {}).get("type", "fixed") not in ("fixed", "servo"):
+                    lines.append(f"#   {section} \"{w.get('name', '')}\": motion = {so._value(w['motion'])}")
+    if s.get("damping", 1.0) != 1:
+        lines.append(f"# damping x {s['damping']:g}: set these keys")
+        scaled = so.apply(scene, damping=s["damping"])
+        for k, b in enumerate(scaled.get("body_forces", [])):
+            key = so.DAMPING_KEYS.get(b.get("type"))
+            if key and key in b:
+                lines.append(f"#   body_forces[{k}] \"{b['type']}\": {key} = {b[key]!r}")
     return "\n".join(lines) + "\n"
 
 
