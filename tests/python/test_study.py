@@ -326,6 +326,22 @@ def test_a_faster_loading_reaches_the_same_state_in_less_time(pile):
     assert "| rate |" in table and "| double-dtf0.02-k1-skin0.2-rate2 | double | 0.02 | 1 | 0.2 | 2 |" in table
 
 
+def test_presets_run_as_basalt_run_sets_them(pile):
+    """--presets: each preset is run by basalt-run --preset (its precision and dt fraction are the solver's, read
+    back from the run), and reported like any setting."""
+    out = pile / "study-presets"
+    run([BIN / "basalt-study", pile / "scene.toml", "-q", "fields.kinetic_energy:max", "--steps", "100",
+         "--dt-fraction", "0.2", "--presets", "--ensemble", "1", "--no-plot", "-o", out])
+    runs = by_key(json.loads((out / "study.json").read_text()))
+    chosen = {k: (runs[f"preset-{k}"]["setting"]["precision"], runs[f"preset-{k}"]["setting"]["dt_fraction"])
+              for k in ("fast", "balanced", "reference")}
+    assert chosen == {"fast": ("float", 0.5), "balanced": ("double", 0.25), "reference": ("double", 0.05)}
+    assert runs["preset-reference"]["steps"] == pytest.approx(10 * runs["preset-fast"]["steps"], rel=0.02)
+    assert runs["preset-balanced"]["dt"] == pytest.approx(0.25 / 0.2 * runs["double-dtf0.2-k1-skin0.2"]["dt"], rel=1e-9)
+    table = (out / "table.md").read_text()
+    assert "| preset-fast | float | 0.5 |" in table
+
+
 def test_perturbed_members_move_by_the_nudge_alone(pile, tmp_path):
     import basalt
     base = basalt.read_geometry(str(pile / "pile.h5"))

@@ -77,6 +77,9 @@ def parse_args(argv):
                                   "window of a run at S is the scene's over S, and its fields' times are "
                                   "multiplied by S (so a time reads as the scene's loading time)")
     p.add_argument("--damping", help="ladder: scales of the body-force damping (default 1)")
+    p.add_argument("--presets", action="store_true",
+                   help="also run basalt-run's presets (--preset fast, balanced, reference: docs/stability.md) as "
+                        "settings, to measure their error on this scene")
     p.add_argument("--reference-dt-fraction", type=float, default=0.02, help="the reference's dt fraction (0.02)")
     p.add_argument("--ensemble", type=int, default=3, help="perturbed references (default 3)")
     p.add_argument("--perturbation", type=float, default=1e-9, help="their nudge, fraction of the radius (1e-9)")
@@ -161,9 +164,11 @@ class Study:
 
     # ------------------------------------------------------------------------------------------- runs
 
-    def command(self, scene_file, out, precision, steps, every):
-        return bt.basalt_run_command(self.exe, scene_file, "--steps", steps, "--output", out, "--precision",
-                                     precision, "--fields-every", every, "--checkpoint-every", max(1, steps),
+    def command(self, scene_file, out, precision, steps, every, preset=None):
+        # A preset sets the precision and dt fraction itself (basalt-run --preset): those are its own.
+        chosen = ["--preset", preset] if preset else ["--precision", precision]
+        return bt.basalt_run_command(self.exe, scene_file, "--steps", steps, "--output", out, *chosen,
+                                     "--fields-every", every, "--checkpoint-every", max(1, steps),
                                      "--frames-every", 0, "--quiet", np=self.a.np, timed=True)
 
     def write_scene(self, folder, setting, geometry, dt=None):
@@ -176,7 +181,7 @@ class Study:
             f.write(so.dumps(s))
         return path
 
-    def probe(self, folder, scene_file, precision):
+    def probe(self, folder, scene_file, precision, preset=None):
         """basalt-run for one step: the dt, critical step and particles of a setting, the fields' columns.
         Kept in FOLDER/probe.json (the study's plan.json vouches for the scene and geometry)."""
         out, kept = os.path.join(folder, "probe"), os.path.join(folder, "probe.json")
@@ -184,7 +189,7 @@ class Study:
             info = load_json(kept)
             if info.get("checkpoint") is None or os.path.exists(info["checkpoint"]):  # not a moved folder
                 return info, None
-        p = bt.run(self.command(scene_file, out, precision, 1, 1), check=False, env=self.env)
+        p = bt.run(self.command(scene_file, out, precision, 1, 1, preset), check=False, env=self.env)
         info = bt.parse_run(p.stdout)
         if p.returncode != 0 or "dt" not in info:
             return None, failure(p)
@@ -206,9 +211,13 @@ class Study:
         if run.get("fixed_dt"):  # an ensemble member: the reference's dt and particles, no probe needed
             info = {"dt": run["fixed_dt"], "particles": run["particles"]}
         else:
-            info, err = self.probe(folder, scene_file, run["setting"]["precision"])
+            preset = run["setting"].get("preset")
+            info, err = self.probe(folder, scene_file, run["setting"]["precision"], preset)
             if info is None:
                 return self.finish(done, run, status="failed", message=err)
+            if preset:  # what the preset chose, for the table and the fragment
+                run["setting"].update(precision=info["precision"],
+                                      dt_fraction=float(f"{info['dt'] / info['critical_step']:.3g}"))
         dt = info["dt"]
         rate = run["setting"].get("rate", 1.0)
         t_end = self.t_end / rate  # a faster loading reaches the scene's state sooner
@@ -220,7 +229,8 @@ class Study:
                  + self.eta(total - k + 1, steps * info["particles"]))
         out = os.path.join(folder, "run")
         start = time.time()
-        p = bt.run(self.command(scene_file, out, run["setting"]["precision"], steps, every), check=False,
+        p = bt.run(self.command(scene_file, out, run["setting"]["precision"], steps, every,
+                                run["setting"].get("preset")), check=False,
                    env=self.env)
         wall = time.time() - start
         self.spent += time.time() - begun
@@ -328,6 +338,10 @@ class Study:
                 key = f"{prec}-dtf{frac:g}-k{k:g}-skin{skin:g}"  # the keys of studies without the newer axes
                 key += (f"-rate{rate:g}" if rate != 1 else "") + (f"-damp{damp:g}" if damp != 1 else "")
                 runs.append({"key": key, "kind": "setting", "setting": s})
+        if self.a.presets:
+            for name in ("fast", "balanced", "reference"):
+                s = dict(base, precision=None, dt_fraction=None, preset=name)
+                runs.append({"key": f"preset-{name}", "kind": "setting", "setting": s})
         # A scene without contacts, moving walls or damping says so before any run.
         if any(r["setting"]["stiffness"] != 1 for r in runs):
             so.apply(self.scene, stiffness=0.5, scene_path=self.scene_path)

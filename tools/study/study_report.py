@@ -61,9 +61,15 @@ def cheapest(settings, budget):
     return min(fits, key=lambda r: r["cost"]) if fits else None
 
 
+def _g(v):
+    return "-" if v is None else f"{v:g}"
+
+
 def label(r):
     s = r["setting"]
-    text = f"{s['precision']} dtf {s['dt_fraction']:g} k x{s['stiffness']:g} skin {s['skin']:g}"
+    text = f"{s['precision'] or '-'} dtf {_g(s['dt_fraction'])} k x{s['stiffness']:g} skin {s['skin']:g}"
+    if s.get("preset"):
+        text = f"preset {s['preset']} ({text})"
     for key, name in (("rate", "rate"), ("damping", "damping")):
         if s.get(key, 1.0) != 1:
             text += f" {name} x{s[key]:g}"
@@ -94,7 +100,7 @@ def markdown(runs, specs, spreads, ref, budget=None, best=None, cpu=""):
     out.append("|" + " --- |" * (13 + len(extra) + len(specs)))
     for r in runs:
         s = r["setting"]
-        head = (f"| {r['key']} | {s['precision']} | {s['dt_fraction']:g} | {s['stiffness']:g} | {s['skin']:g} |"
+        head = (f"| {r['key']} | {s['precision'] or '-'} | {_g(s['dt_fraction'])} | {s['stiffness']:g} | {s['skin']:g} |"
                 + "".join(f" {s.get(k, 1.0):g} |" for k in extra))
         if r["status"] != "ok":
             msg = r["message"] if len(r["message"]) <= 110 else r["message"][:107] + "..."
@@ -118,7 +124,8 @@ def fragment(best, scene, scene_path, budget):
     """TOML lines the user can paste into the scene for setting `best`."""
     import scene_overrides as so
     s = best["setting"]
-    lines = [f"# basalt-study of {scene_path}: the cheapest setting within --budget {budget:g}",
+    lines = [f"# basalt-study of {scene_path}: the cheapest setting within --budget {budget:g}"
+             + (f" (basalt-run --preset {s['preset']} does the same)" if s.get("preset") else ""),
              f"# (every error within it or inside the ensemble's spread; largest {best['max_error']:.2e}; "
              f"{best['speedup']:.2f}x the reference's speed). Paste into the scene:", "[run]", f'precision = "{s["precision"]}"',
              f"dt_fraction = {s['dt_fraction']!r}   # replaces run.dt", f"skin = {s['skin']!r}"]
@@ -171,6 +178,12 @@ def plot(runs, specs, spreads, ref, path):
             st = r["setting"]
             ax.scatter(r["speedup"], max(r["errors"][s], low), marker=markers.get(st["precision"], "x"),
                        color=colour[st["stiffness"]], edgecolors="k", linewidths=0.4, s=size[st["dt_fraction"]])
+            tag = " ".join(t for t in (st.get("preset") or "",
+                                        f"rate x{st['rate']:g}" if st.get("rate", 1.0) != 1 else "",
+                                        f"damping x{st['damping']:g}" if st.get("damping", 1.0) != 1 else "") if t)
+            if tag:  # the axes the markers do not show
+                ax.annotate(tag, (r["speedup"], max(r["errors"][s], low)), fontsize=6, xytext=(3, 3),
+                            textcoords="offset points")
         if rel_spread > 0:
             ax.axhspan(low, rel_spread, color="0.88", zorder=0)
             ax.axhline(rel_spread, color="0.5", lw=0.8, zorder=0)
