@@ -9,9 +9,10 @@
 #                     run in float: docs/stability.md);
 #   OUT_DIR/atan2     the same scene with angles = "atan2" (which float can run), double, float and mixed at
 #                     dt fractions 0.05 and 0.2;
-#   OUT_DIR/loading   the scene's step, loading rate x 0.5, 2, 4, 8 and damping x 0.1, 10 (quasi-static
+#   OUT_DIR/loading   the scene's step, loading rate x 0.5, 2, 4, 8 and damping x 0.1, 10; OUT_DIR/loading-slow
+#                     rate x 0.125, 0.25, 0.5 at the scene's damping (quasi-static
 #                     convergence: where the peak stops changing within the ensemble's spread).
-#   sh tools/studies/rock_study.sh [BUILD_DIR] [OUT_DIR]   (about 20 min on 2 quiet cores)
+#   sh tools/studies/rock_study.sh [BUILD_DIR] [OUT_DIR]   (about 25 min on 2 shared cores)
 # Each writes table.md, study.json, study.png, setting.toml.
 set -e
 build=${1:-build}
@@ -32,3 +33,5 @@ sed -e "s|^file = \"../docs/data/esys-ucs/box.geo\"|file = \"$PWD/docs/data/esys
 grep -q '^angles = "atan2"' "$out/ucs-esys-atan2.toml"
 study "$out/ucs-esys-atan2.toml" --precision double,float,mixed --dt-fraction 0.05,0.2 -o "$out/atan2"
 study scenes/ucs-esys.toml --dt-fraction 0.0548 --rate 0.5,1,2,4,8 --damping 0.1,1,10 -o "$out/loading"
+# Quasi-static convergence: slower loadings than the scene's (OUT_DIR/loading-slow).
+study scenes/ucs-esys.toml --dt-fraction 0.0548 --rate 0.125,0.25,0.5 -o "$out/loading-slow"
