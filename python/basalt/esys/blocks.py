@@ -113,6 +113,8 @@ class CubicBlock:
 
 
 class Connection:
+    """A tagged bond between two particle ids (ESyS's TaggedIdConnection(id1, id2, tag))."""
+
     def __init__(self, id1, id2, tag):
         self._ids, self._tag = (int(id1), int(id2)), int(tag)
 

@@ -7,8 +7,6 @@ _SCENE = "Basalt has it as a scene model (basalt.Simulation with a scene dict, d
 
 # esys.lsm: parameter classes and savers -> what Basalt offers
 LSM = {
-    "RotBondPrms": _SCENE + 'type = "rot_bond"',
-    "BrittleBeamPrms": _SCENE + 'type = "rot_bond" with youngs_modulus, cohesion, tan_friction_angle',
     "RotElasticPrms": _SCENE + 'type = "linear_elastic"',
     "HertzianElasticPrms": _SCENE + 'type = "hertz_mindlin"',
     "HertzianViscoElasticPrms": _SCENE + 'type = "hertz_mindlin"',

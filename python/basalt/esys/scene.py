@@ -38,6 +38,10 @@ def scene_dict(lsm, geometry_file, output_dir):
             interactions.append({"type": "linear_elastic", "K": g.normalK})
     radius = {p.getId(): p.getRadius() for p in lsm._particles}
     for g in lsm._bond_groups:
+        if not isinstance(g, P.NRotBondPrms):  # RotBondPrms, BrittleBeamPrms
+            interactions.append(dict(g.model(), bond_tag=g.tag))
+            rotation = True
+            continue
         bond = {"type": "linear_bond", "K": g.normalK, "rest_length": "sum_of_radii",
                 "break_strain": g.breakDistance, "bond_tag": g.tag}
         if g.scaling:  # ESyS: k = normalK (r0/2)^2 / r0 per bond; one k per Basalt group
@@ -50,9 +54,7 @@ def scene_dict(lsm, geometry_file, output_dir):
                 eff = 0.5 * r0.pop()
                 bond["K"] = g.normalK * (eff * eff) / (2.0 * eff)
         interactions.append(bond)
-    if (lsm._bonds or lsm._bond_groups) and lsm._pair:
-        refuse("LsmMpi: NRotElasticPrms together with bonds", "ESyS's NRotElastic also pushes bonded pairs "
-               "unless createExclusion; the front end maps neither yet (Basalt's models: docs/scenes.md)")
+    _check_exclusions(lsm)
     walls = []
     for name, (posn, normal) in lsm._walls.items():
         k = lsm._wall_k.get(name)
@@ -68,7 +70,9 @@ def scene_dict(lsm, geometry_file, output_dir):
             body.append({"type": "linear_damping", "viscosity": b.viscosity, "iterations": b.maxIterations})
     scene = {
         "geometry": {"file": geometry_file},
-        "particles": {"rotation": rotation},
+        # RotSphere checkpoints hold the orientations (kept without changing any other bit, docs/scenes.md)
+        "particles": dict({"rotation": rotation}, **({"orientation": True} if lsm._rotational and
+                                                      lsm._checkpointers else {})),
         "run": {"dt": lsm._dt, "skin": lsm._verlet, "integrator": "symplectic_euler", "force_dt": True,
                 "force_overlap": True, "energy_check_every": 0},
         "output": {"directory": output_dir},
@@ -77,6 +81,28 @@ def scene_dict(lsm, geometry_file, output_dir):
         if value:
             scene[key] = value
     return scene
+
+
+def _check_exclusions(lsm):
+    """Basalt's contact models never act on a bonded pair (until its bond breaks); ESyS's contact group does unless
+    createExclusion excludes it from the bond group. So with a contact group every bond must belong to a group
+    excluded from it."""
+    if not lsm._pair or not (lsm._bonds or lsm._bond_groups):
+        return
+    pair = lsm._pair[0]
+    groups = {g.tag: g for g in lsm._bond_groups}
+    for tag in sorted({t for _, _, t in lsm._bonds} | set(groups)):
+        g = groups.get(tag)
+        if g is None:
+            refuse(f"LsmMpi: connections of tag {tag} (no bond group) with the contact group {pair.name!r}",
+                   "ESyS's contact group acts on those pairs, Basalt's contacts skip every bonded pair: give the "
+                   "tag a bond group excluded from the contact group (createExclusion), or leave those connections "
+                   "out")
+        if (g.name, pair.name) not in lsm._exclusions:
+            refuse(f"LsmMpi: the contact group {pair.name!r} together with the bond group {g.name!r} without "
+                   f"createExclusion({g.name!r}, {pair.name!r})",
+                   "ESyS's contact group also pushes bonded pairs unless excluded; Basalt's contacts skip bonded "
+                   "pairs: add the exclusion (as ESyS's rot_compress does)")
 
 
 def build(lsm, workdir):
