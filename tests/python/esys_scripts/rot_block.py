@@ -6,7 +6,7 @@
 #   python3 -m basalt.esys rot_block.py [STEPS [NUDGE]]   (or: mpirun -np 2 esysparticle rot_block.py ...)
 # NUDGE shifts the block and the walls along x (a perturbation of the roundings only, for ESyS's own spread).
 # Prints "walls STEP FY_BOTTOM FY_TOP" (getWallForce, from a post-time-step Runnable) every 100 steps; savers:
-# both walls' Force and Position (RAW_SERIES) every 10 steps, e_kin (SUM) every 50.
+# both walls' Force and Position (RAW_SERIES) every 10 steps, e_kin (SUM) every 50; checkpoints at 0, 150, 300.
 import sys
 
 from esys.lsm import *
@@ -83,4 +83,6 @@ for field in ("Force", "Position"):
                                                   beginTimeStep=0, endTimeStep=STEPS, timeStepIncr=10))
 sim.createFieldSaver(ParticleScalarFieldSaverPrms(fieldName="e_kin", fileName="ekin.dat", fileFormat="SUM",
                                                   beginTimeStep=0, endTimeStep=STEPS, timeStepIncr=50))
+# checkpoints before the first bond breaks (about step 350)
+sim.createCheckPointer(CheckPointPrms(fileNamePrefix="rock", beginTimeStep=0, endTimeStep=300, timeStepIncr=150))
 sim.run()
