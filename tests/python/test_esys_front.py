@@ -246,6 +246,34 @@ def test_cubic_block_is_close_packed():
     assert turned.toList() == pytest.approx([math.cos(math.pi / 6), -0.5, 0.0], abs=1e-15)
 
 
+def test_hexag_block_is_hexagonal_close_packed():
+    """HexagBlock (ESyS's name; positions equal to ESyS's own module, docs/esys.md): touching spheres 2r apart, 12
+    neighbours inside, layers along y r sqrt(8/3) apart in the sequence ABAB (a sphere and the one two layers up
+    share x and z; one layer up they do not, as in CubicBlock's ABC), ids 0.. in order, mass r^3."""
+    import numpy as np
+
+    from basalt.esys.blocks import ConnectionFinder, CubicBlock, HexagBlock
+
+    r, n = 0.5, 6
+    for kind, period in ((HexagBlock, 2), (CubicBlock, 3)):
+        spheres = list(kind(dimCount=[n, n, n], radius=r))
+        assert [s.getId() for s in spheres] == list(range(n ** 3)) and {s.getMass() for s in spheres} == {r ** 3}
+        x = np.array([s.getPosn().toList() for s in spheres])
+        d = np.sqrt(((x[:, None, :] - x[None, :, :]) ** 2).sum(axis=2)) + np.eye(len(x)) * 9
+        assert d.min() == pytest.approx(2 * r, abs=1e-12)
+        touching = {(i, j) for i, j in zip(*np.nonzero(d < 2 * r + 1e-9)) if i < j}
+        assert max(np.bincount(np.array(sorted(touching)).ravel())) == 12
+        bonds = {(c.getId1(), c.getId2()) for c in ConnectionFinder(maxDist=0.005, bondTag=1, pList=spheres)}
+        assert bonds == touching
+        layer = n * n  # ids of one layer along y (k)
+        assert x[layer, 1] - x[0, 1] == pytest.approx(r * math.sqrt(8 / 3), rel=1e-14)
+        xz = x[:, [0, 2]]
+        assert np.allclose(xz[period * layer:2 * period * layer], xz[:period * layer], atol=1e-12)
+        assert not np.allclose(xz[layer:2 * layer], xz[:layer], atol=1e-3)
+        if period == 3:
+            assert not np.allclose(xz[2 * layer:3 * layer], xz[:layer], atol=1e-3)
+
+
 def test_bonded_block_falls_and_bounces(tmp_path):
     out = front(SCRIPTS / "cube_drop.py", tmp_path).stdout
     assert lines(out, "mass") == [[0, 0.125], [1, 0.125], [2, 0.125]]  # ESyS: a block's spheres get r^3
@@ -271,8 +299,8 @@ REFUSED = {
     "sim.initNeighbourSearch(particleType='RotSphere', gridSpacing=2.5, verletDist=0.5)\n"
     "sim.createInteractionGroup(RotFrictionPrms(name='f', normalK=1.0, dynamicMu=0.5, staticMu=0.5, shearK=1.0))\n"
     "sim.createInteractionGroup(NRotElasticPrms(name='e', normalK=1.0))": ("a second contact group", "'f'"),
-    "from esys.lsm.geometry import HexagonalBlock\nHexagonalBlock(dimCount=[2, 2, 2], radius=0.5)":
-        ("esys.lsm.geometry.HexagonalBlock", "basalt.pack"),
+    "from esys.lsm.geometry import SimpleBlock\nSimpleBlock(dimCount=[2, 2, 2], radius=0.5)":
+        ("esys.lsm.geometry.SimpleBlock", "basalt.pack"),
     "sim.createInteractionGroup(NRotElasticPrms(name='e', normalK=1.0, scaling=True))\n"
     "sim.createInteractionGroup(NRotBondPrms(name='b', normalK=1.0, breakDistance=1.0, tag=1))\n"
     "sim.initNeighbourSearch(particleType='NRotSphere', gridSpacing=2.5, verletDist=0.5)\n"

@@ -31,7 +31,7 @@ LSM = {
 _PACK = "Basalt packs spheres with basalt.pack (box, cylinder, sphere, mesh; lattice=True for a regular one)"
 # esys.lsm.geometry: generators
 GEOMETRY = {name: _PACK for name in (
-    "HexagonalBlock", "SimpleBlock", "RandomSpherePacker", "SimpleSphereCollection",
+    "SimpleBlock", "RandomSpherePacker", "SimpleSphereCollection",
     "ParticleCollection", "GrainCollection")}
 # ESyS's RandomBoxPacker gives the same packing in every run; the front end does not reproduce that packing yet,
 # and a different one would silently change the script's results
