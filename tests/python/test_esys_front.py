@@ -603,3 +603,20 @@ def test_rotsphere_checkpoint_orientation_turns_with_the_spin(tmp_path):
     half = w * 0.002 / 2
     expect = [math.cos(half)] + [c / w * math.sin(half) for c in (1.0, 2.0, 3.0)]
     assert row[22:26] == pytest.approx(expect, rel=2e-8)
+
+
+def test_scaled_nrot_bonds_of_several_sizes_each_have_their_k(tmp_path):
+    """chain.py: bonds of r1 + r2 = 0.8, 0.7, 0.7 (tag 1, scaling=True) and one unscaled (tag 2), all stretched
+    by 0.05: after one step each sphere has v = dt (sum of k_b 0.05 along its bonds)/m, k_b = normalK r0/4 per bond
+    (ESyS's scaling; one K for the group would fail) and 20 for the unscaled bond."""
+    out = front(SCRIPTS / "chain.py", tmp_path).stdout
+    rows = {int(w[2]): [float(v) for v in w[3:]] for w in (line.split() for line in out.splitlines())
+            if w[0] == "chain" and w[1] == "1"}
+    dt, s, m = 0.001, 0.05, [0.125, 0.027, 0.064, 0.027, 0.027]
+    k01, k12, k23 = 100 * 0.8 / 4, 100 * 0.7 / 4, 100 * 0.7 / 4
+    expect_vx = [k01 * s / m[0], (k12 - k01) * s / m[1], (k23 - k12) * s / m[2], -k23 * s / m[3], 0.0]
+    for i in range(5):
+        assert rows[i][2] == pytest.approx(dt * expect_vx[i], rel=1e-9, abs=1e-15), i
+    # the hanging bond (unscaled K = 20, rest 0.6, length 0.62) pulls 3 down and 4 up
+    assert rows[4][3] == pytest.approx(dt * 20 * 0.02 / m[4], rel=1e-9)
+    assert rows[3][3] == pytest.approx(-dt * 20 * 0.02 / m[3], rel=1e-9)
