@@ -6,8 +6,9 @@ from .errors import NotSupportedError, refuse
 from .lsmmpi import LsmMpi  # noqa: F401
 from .particles import NRotSphere, RotSphere  # noqa: F401
 from .prms import (BrittleBeamPrms, CheckPointPrms, FrictionPrms, GravityPrms, LinDampingPrms,  # noqa: F401
-                   NRotBondPrms, NRotElasticPrms, NRotElasticWallPrms, NRotFrictionPrms, RotBondPrms, RotDampingPrms, RotFrictionPrms,
-                   ParticleScalarFieldSaverPrms, ParticleVectorFieldSaverPrms, Runnable, WallVectorFieldSaverPrms)
+                   NRotBondPrms, NRotElasticPrms, NRotElasticWallPrms, NRotFrictionPrms, RotBondPrms,
+                   RotDampingPrms, RotFrictionPrms, ParticleScalarFieldSaverPrms, ParticleVectorFieldSaverPrms,
+                   Runnable, WallVectorFieldSaverPrms)
 from .refused import LSM, stubs
 from .vec3 import BoundingBox, Vec3  # noqa: F401
 
