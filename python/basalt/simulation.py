@@ -19,7 +19,8 @@ import os
 
 from ._core_loader import core
 
-_ARRAYS = ("x", "y", "z", "vx", "vy", "vz", "fx", "fy", "fz", "radius", "inv_mass", "id", "tag", "wx", "wy", "wz")
+_ARRAYS = ("x", "y", "z", "vx", "vy", "vz", "fx", "fy", "fz", "radius", "inv_mass", "id", "tag", "wx", "wy", "wz",
+           "qw", "qx", "qy", "qz")
 
 
 def _toml_value(v):

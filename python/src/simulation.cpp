@@ -305,9 +305,15 @@ class RunOf final : public Run {
       if (name == "wy") return view(p.wy);
       if (name == "wz") return view(p.wz);
     }
-    throw py::key_error(
-        "no particle array \"" + name +
-        "\" (x, y, z, vx, vy, vz, fx, fy, fz, radius, inv_mass, id, tag; wx, wy, wz with rotation)");
+    if (p.with_orientation) {
+      if (name == "qw") return view(p.qw);
+      if (name == "qx") return view(p.qx);
+      if (name == "qy") return view(p.qy);
+      if (name == "qz") return view(p.qz);
+    }
+    throw py::key_error("no particle array \"" + name +
+                        "\" (x, y, z, vx, vy, vz, fx, fy, fz, radius, inv_mass, id, tag; wx, wy, wz with "
+                        "rotation; qw, qx, qy, qz with particles.orientation)");
   }
 
   py::object gather(const std::string& name, py::handle owner) override {

@@ -246,6 +246,34 @@ def test_cubic_block_is_close_packed():
     assert turned.toList() == pytest.approx([math.cos(math.pi / 6), -0.5, 0.0], abs=1e-15)
 
 
+def test_hexag_block_is_hexagonal_close_packed():
+    """HexagBlock (ESyS's name; positions equal to ESyS's own module, docs/esys.md): touching spheres 2r apart, 12
+    neighbours inside, layers along y r sqrt(8/3) apart in the sequence ABAB (a sphere and the one two layers up
+    share x and z; one layer up they do not, as in CubicBlock's ABC), ids 0.. in order, mass r^3."""
+    import numpy as np
+
+    from basalt.esys.blocks import ConnectionFinder, CubicBlock, HexagBlock
+
+    r, n = 0.5, 6
+    for kind, period in ((HexagBlock, 2), (CubicBlock, 3)):
+        spheres = list(kind(dimCount=[n, n, n], radius=r))
+        assert [s.getId() for s in spheres] == list(range(n ** 3)) and {s.getMass() for s in spheres} == {r ** 3}
+        x = np.array([s.getPosn().toList() for s in spheres])
+        d = np.sqrt(((x[:, None, :] - x[None, :, :]) ** 2).sum(axis=2)) + np.eye(len(x)) * 9
+        assert d.min() == pytest.approx(2 * r, abs=1e-12)
+        touching = {(i, j) for i, j in zip(*np.nonzero(d < 2 * r + 1e-9)) if i < j}
+        assert max(np.bincount(np.array(sorted(touching)).ravel())) == 12
+        bonds = {(c.getId1(), c.getId2()) for c in ConnectionFinder(maxDist=0.005, bondTag=1, pList=spheres)}
+        assert bonds == touching
+        layer = n * n  # ids of one layer along y (k)
+        assert x[layer, 1] - x[0, 1] == pytest.approx(r * math.sqrt(8 / 3), rel=1e-14)
+        xz = x[:, [0, 2]]
+        assert np.allclose(xz[period * layer:2 * period * layer], xz[:period * layer], atol=1e-12)
+        assert not np.allclose(xz[layer:2 * layer], xz[:layer], atol=1e-3)
+        if period == 3:
+            assert not np.allclose(xz[2 * layer:3 * layer], xz[:layer], atol=1e-3)
+
+
 def test_bonded_block_falls_and_bounces(tmp_path):
     out = front(SCRIPTS / "cube_drop.py", tmp_path).stdout
     assert lines(out, "mass") == [[0, 0.125], [1, 0.125], [2, 0.125]]  # ESyS: a block's spheres get r^3
@@ -271,19 +299,18 @@ REFUSED = {
     "sim.initNeighbourSearch(particleType='RotSphere', gridSpacing=2.5, verletDist=0.5)\n"
     "sim.createInteractionGroup(RotFrictionPrms(name='f', normalK=1.0, dynamicMu=0.5, staticMu=0.5, shearK=1.0))\n"
     "sim.createInteractionGroup(NRotElasticPrms(name='e', normalK=1.0))": ("a second contact group", "'f'"),
-    "sim.createExclusion('a', 'b')": ("LsmMpi.createExclusion", "linear_elastic"),
-    "from esys.lsm.geometry import HexagonalBlock\nHexagonalBlock(dimCount=[2, 2, 2], radius=0.5)":
-        ("esys.lsm.geometry.HexagonalBlock", "basalt.pack"),
+    "from esys.lsm.geometry import SimpleBlock\nSimpleBlock(dimCount=[2, 2, 2], radius=0.5)":
+        ("esys.lsm.geometry.SimpleBlock", "basalt.pack"),
     "sim.createInteractionGroup(NRotElasticPrms(name='e', normalK=1.0, scaling=True))\n"
     "sim.createInteractionGroup(NRotBondPrms(name='b', normalK=1.0, breakDistance=1.0, tag=1))\n"
     "sim.initNeighbourSearch(particleType='NRotSphere', gridSpacing=2.5, verletDist=0.5)\n"
     "sim.setTimeStepSize(0.001)\nsim.setSpatialDomain(BoundingBox(Vec3(-5, -5, -5), Vec3(5, 5, 5)))\n"
     "sim.createParticle(NRotSphere(id=0, posn=Vec3(0, 0, 0), radius=0.5, mass=1.0))\nsim.run()":
-        ("NRotElasticPrms together with bonds", "createExclusion"),
+        ("contact group 'e' together with the bond group 'b' without createExclusion('b', 'e')",),
     "sim.setParticleDensity(tag=0, mask=-1, Density=2.0)": ("LsmMpi.setParticleDensity", "mass="),
     "from esys.lsm.geometry import RandomBoxPacker\nRandomBoxPacker(minRadius=0.2, maxRadius=0.5)":
         ("esys.lsm.geometry.RandomBoxPacker", "not reproduced", "basalt.pack.box"),
-    "sim.setVelocityOfWall('w', Vec3(0, 1, 0))": ("LsmMpi.setVelocityOfWall", "moveWallBy"),
+    "sim.setVelocityOfWall('w', Vec3(0, 1, 0))": ("LsmMpi.setVelocityOfWall", "ViscWallPrms", "moveWallBy"),
     "sim.createFieldSaver(ParticleScalarFieldSaverPrms(fieldName='sigma_xx_2d', fileName='s', fileFormat='SUM', "
     "beginTimeStep=0, endTimeStep=1, timeStepIncr=1))": ("fieldName='sigma_xx_2d'", "e_kin"),
     "from esys.lsm import SomethingElse": ("esys.lsm.SomethingElse", "not provided"),
@@ -439,3 +466,157 @@ def test_lin_and_rot_damping_follow_esys_iteration_rule(tmp_path):
     wz = float(rows[-1][7])
     assert abs(wz / (0.5 / (1.0 + nu_rot * dt) ** 1000) - 1.0) > 1e-6
     assert abs(wz / (0.5 * (1.0 - nu_rot * dt) ** 1000) - 1.0) > 1e-3
+
+
+ROT_PAIR = """from esys.lsm import *
+from esys.lsm.util import Vec3, BoundingBox
+from esys.lsm.geometry import TaggedIdConnection
+sim = LsmMpi(numWorkerProcesses=1, mpiDimList=[1, 1, 1])
+sim.initNeighbourSearch(particleType="RotSphere", gridSpacing=2.5, verletDist=0.2)
+sim.setNumTimeSteps(STEPS)
+sim.setTimeStepSize(0.001)
+sim.setSpatialDomain(BoundingBox(Vec3(-5, -5, -5), Vec3(5, 5, 5)))
+sim.createParticle(RotSphere(id=3, posn=Vec3(0, 0, 0), radius=0.5, mass=2.0))
+sim.createParticle(RotSphere(id=5, posn=Vec3(0.95, 0, 0), radius=0.4, mass=1.0))
+sim.createConnections([TaggedIdConnection(3, 5, 2)])
+sim.createInteractionGroup(BOND)
+CHECKPOINT
+sim.runTimeStep()
+print("v1 %.17g" % sorted(sim.getParticleList(), key=lambda p: p.getId())[0].getVelocity()[0])
+"""
+
+
+def rot_pair(tmp_path, name, bond, steps=1, checkpoint=""):
+    d = tmp_path / name
+    d.mkdir()
+    (d / "pair.py").write_text(ROT_PAIR.replace("BOND", bond).replace("STEPS", str(steps))
+                               .replace("CHECKPOINT", checkpoint))
+    return d, float(front(d / "pair.py", d).stdout.split("v1")[1])
+
+
+def test_rot_bond_prms_scale_per_bond_as_esys(tmp_path):
+    """Two RotSpheres 0.95 apart, bonded (rest length r1 + r2 = 0.9): after one step sphere 3 has
+    v = dt kn 0.05 / m with kn = normalK R^2/L (scaling, R = L/2 or min r) or normalK; BrittleBeamPrms with
+    E = normalK / pi is RotBondPrms with kn = kb = pi E, ks = kt = pi G (the same bits)."""
+    dt, L, m, K = 0.001, 0.95, 2.0, 1000.0
+    strengths = "normalBrkForce=1e9, shearBrkForce=1e9, torsionBrkForce=1e9, bendingBrkForce=1e9, tag=2"
+    for name, scaling, kn in (("mean", "", K * (L / 2) ** 2 / L),
+                              ("min", ", meanR_scaling=False", K * 0.4 ** 2 / L),
+                              ("plain", ", scaling=False", K)):
+        bond = (f"RotBondPrms(name='b', normalK={K}, shearK=400.0, torsionK=400.0, bendingK={K}, {strengths}"
+                f"{scaling if name != 'plain' else ''}{', scaling=False' if name == 'plain' else ''})")
+        _, v = rot_pair(tmp_path, name, bond)
+        assert v == pytest.approx(dt * kn * (L - 0.9) / m, rel=1e-12), name
+        if name == "mean":
+            v_rb = v
+    nu = K / (2 * 400.0) - 1
+    _, v_bb = rot_pair(tmp_path, "bb", f"BrittleBeamPrms(name='b', youngsModulus={K / math.pi!r}, "
+                                       f"poissonsRatio={nu!r}, cohesion=1e9, tanAngle=1.0, tag=2)")
+    assert v_bb == pytest.approx(v_rb, rel=1e-14)
+
+
+def test_rotsphere_checkpoint_has_orientation_and_angular_velocity(tmp_path):
+    """ESyS 2.3.5's RotSphere checkpoint (measured): the 22 columns, then the orientation w x y z and the
+    angular velocity; a BrittleBeam group's bonds under "RotBonded"."""
+    spin = ("sim.createCheckPointer(CheckPointPrms(fileNamePrefix='cp', beginTimeStep=0, endTimeStep=1, "
+            "timeStepIncr=1))")
+    d, _ = rot_pair(tmp_path, "cp", "BrittleBeamPrms(name='b', youngsModulus=1000.0, poissonsRatio=0.25, "
+                                    "cohesion=1e9, tanAngle=1.0, tag=2)", checkpoint=spin)
+    rows = (d / "cp_t=0_1.txt").read_text().splitlines()
+    assert rows[0] == "2" and rows[3:] == ["1", "RotBonded", "1", "3 5 2", "TMIG 0"]
+    assert rows[1].split()[22:] == ["1", "0", "0", "0", "0", "0", "0"]
+    after = [[float(w) for w in r.split()] for r in (d / "cp_t=1_1.txt").read_text().splitlines()[1:3]]
+    assert all(len(r) == 29 for r in after)
+    # the stretched bond turns nothing (to the acos floor of ESyS's angles, 1.5e-8 rad): orientation the
+    # identity, no spin; sphere 3 pulled along +x
+    assert after[0][22:29] == pytest.approx([1, 0, 0, 0, 0, 0, 0], abs=1e-7) and after[0][13] > 0
+
+
+def test_exclusion_needs_a_bond_and_a_contact_group(tmp_path):
+    script = tmp_path / "excl.py"
+    script.write_text("from esys.lsm import *\nsim = LsmMpi(numWorkerProcesses=1, mpiDimList=[1, 1, 1])\n"
+                      "sim.initNeighbourSearch(particleType='NRotSphere', gridSpacing=2.5, verletDist=0.5)\n"
+                      "sim.createInteractionGroup(GravityPrms(name='g', acceleration=Vec3(0, -1, 0)))\n"
+                      "sim.createInteractionGroup(NRotElasticPrms(name='e', normalK=1.0))\n"
+                      "sim.createExclusion('g', 'e')\n")
+    p = front(script, tmp_path, check=False)
+    assert p.returncode != 0 and "no contact or bond group named 'g'" in p.stderr
+
+
+def test_brittle_beam_block_between_walls(tmp_path):
+    """rot_block.py (BrittleBeam block, FrictionPrms excluded from the bonds, two walls moved by a Runnable):
+    the walls at the block's ends move by V dt sum f_k (f the ramp), the force of step 2 is 16 spheres' pi r K
+    times the first move (1e-9), then the pushes grow and the two walls' forces stay opposite."""
+    front(SCRIPTS / "rot_block.py", tmp_path, "300")
+    force = [[float(w) for w in r.split()] for r in (tmp_path / "walls_Force.dat").read_text().splitlines()]
+    posn = [[float(w) for w in r.split()] for r in (tmp_path / "walls_Position.dat").read_text().splitlines()]
+    assert len(force) == len(posn) == 31
+    moved = 0.1 * 1e-4 * sum(k / 500 for k in range(300))  # after 300 pre-time-step moves
+    assert posn[-1][1] - posn[0][1] == pytest.approx(moved, rel=1e-9)
+    assert posn[-1][4] - posn[0][4] == pytest.approx(-moved, rel=1e-9)
+    fy = [r[1] for r in force]
+    assert all(b > a for a, b in zip(fy[1:], fy[2:]))
+    assert all(r[4] == pytest.approx(-r[1], rel=2e-2) for r in force[5:])
+
+
+def test_read_geometry_takes_the_geo_file(tmp_path):
+    """geo_read.py: readGeometry's particles keep the file's ids, tags and radii with mass 4/3 pi r^3 (ESyS's
+    reader), its bounding box is the domain, its bonds (tag 7) hold the row together (NRotBond, excluded from
+    the elastic contacts); the NRotSphere checkpoint lists them."""
+    out = front(SCRIPTS / "geo_read.py", tmp_path).stdout
+    parts = [line.split()[1:] for line in out.splitlines() if line.startswith("particle ")]
+    assert [p[:3] for p in parts] == [["10", "3", "0.5"], ["11", "3", "0.5"], ["12", "3", "0.5"],
+                                      ["13", "3", "0.5"], ["20", "4", "0.4"]]
+    for p in parts:
+        r = float(p[2])
+        assert float(p[3]) == pytest.approx(4 / 3 * math.pi * r ** 3, rel=1e-11)
+    head = (tmp_path / "row_t=500_0.txt").read_text()
+    assert "BoundingBox -4 -4 -4 6 6 4\n" in head
+    rows = (tmp_path / "row_t=2000_1.txt").read_text().splitlines()
+    assert rows[6:] == ["1", "Bonded", "3", "10 11 7", "11 12 7", "12 13 7", "TMIG 0"]
+    row = [line.split() for line in out.splitlines() if line.startswith("row ")]
+    assert len(row) == 20 and float(row[0][2]) < 0  # the row falls
+
+
+def test_set_velocity_of_wall_hint_says_esys_never_moves_the_wall():
+    from basalt.esys.lsmmpi import _HINTS
+    assert "never moves the wall" in _HINTS["setVelocityOfWall"]
+
+
+def test_rotsphere_checkpoint_orientation_turns_with_the_spin(tmp_path):
+    """A free RotSphere spinning at w = (1, 2, 3): after 2 steps its checkpoint holds w and the orientation turned
+    by |w| 2 dt about w (Basalt's exact turn, docs/esys.md: ESyS's first-order update differs by (|w| dt)^2)."""
+    script = tmp_path / "spin1.py"
+    script.write_text("from esys.lsm import *\nfrom esys.lsm.util import Vec3, BoundingBox\n"
+                      "sim = LsmMpi(numWorkerProcesses=1, mpiDimList=[1, 1, 1])\n"
+                      "sim.initNeighbourSearch(particleType='RotSphere', gridSpacing=2.5, verletDist=0.5)\n"
+                      "sim.setNumTimeSteps(2)\nsim.setTimeStepSize(0.001)\n"
+                      "sim.setSpatialDomain(BoundingBox(Vec3(-12, -12, -12), Vec3(12, 12, 12)))\n"
+                      "p = RotSphere(id=3, posn=Vec3(0.1, 0.2, 0.3), radius=0.5, mass=0.7)\n"
+                      "p.setAngularVelocity(Vec3(1.0, 2.0, 3.0))\nsim.createParticle(p)\n"
+                      "sim.createCheckPointer(CheckPointPrms(fileNamePrefix='cp', beginTimeStep=0, endTimeStep=2, "
+                      "timeStepIncr=1))\nsim.run()\n")
+    front(script, tmp_path)
+    row = [float(w) for w in (tmp_path / "cp_t=2_1.txt").read_text().splitlines()[1].split()]
+    assert len(row) == 29 and row[26:29] == [1.0, 2.0, 3.0]
+    w = math.sqrt(14.0)
+    half = w * 0.002 / 2
+    expect = [math.cos(half)] + [c / w * math.sin(half) for c in (1.0, 2.0, 3.0)]
+    assert row[22:26] == pytest.approx(expect, rel=2e-8)
+
+
+def test_scaled_nrot_bonds_of_several_sizes_each_have_their_k(tmp_path):
+    """chain.py: bonds of r1 + r2 = 0.8, 0.7, 0.7 (tag 1, scaling=True) and one unscaled (tag 2), all stretched
+    by 0.05: after one step each sphere has v = dt (sum of k_b 0.05 along its bonds)/m, k_b = normalK r0/4 per bond
+    (ESyS's scaling; one K for the group would fail) and 20 for the unscaled bond."""
+    out = front(SCRIPTS / "chain.py", tmp_path).stdout
+    rows = {int(w[2]): [float(v) for v in w[3:]] for w in (line.split() for line in out.splitlines())
+            if w[0] == "chain" and w[1] == "1"}
+    dt, s, m = 0.001, 0.05, [0.125, 0.027, 0.064, 0.027, 0.027]
+    k01, k12, k23 = 100 * 0.8 / 4, 100 * 0.7 / 4, 100 * 0.7 / 4
+    expect_vx = [k01 * s / m[0], (k12 - k01) * s / m[1], (k23 - k12) * s / m[2], -k23 * s / m[3], 0.0]
+    for i in range(5):
+        assert rows[i][2] == pytest.approx(dt * expect_vx[i], rel=1e-9, abs=1e-15), i
+    # the hanging bond (unscaled K = 20, rest 0.6, length 0.62) pulls 3 down and 4 up
+    assert rows[4][3] == pytest.approx(dt * 20 * 0.02 / m[4], rel=1e-9)
+    assert rows[3][3] == pytest.approx(-dt * 20 * 0.02 / m[3], rel=1e-9)

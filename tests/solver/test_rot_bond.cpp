@@ -478,6 +478,60 @@ tan_friction_angle = 0.5
   EXPECT_NEAR(1 / k.imt, kPi * coh * R * R * R / 2, 1e-9 / k.imt);
 }
 
+// ESyS RotBondPrms(scaling=True): given stiffnesses and strengths scaled per bond as BrittleBeam's (ESyS's
+// CRotBondedInteraction), with R = L/2 ("mean") or min(r1, r2) ("min").
+TEST(RotBondLaw, GivenStiffnessesScaledPerBondAsEsysRotBondPrms) {
+  for (const bool mean : {true, false}) {
+    SCOPED_TRACE(mean ? "mean radius" : "min radius");
+    const auto scene = basalt::test::scene_from(std::string(R"(
+[run]
+dt = 1e-4
+steps = 0
+skin = 0.05
+[[interactions]]
+type = "rot_bond"
+kn = 1000.0
+ks = 300.0
+kb = 70.0
+kt = 20.0
+max_normal_force = 5.0
+max_shear_force = 6.0
+max_bending_moment = 7.0
+max_torsion_moment = 8.0
+scaling = true
+radius_scaling = ")") + (mean ? "mean" : "min") +
+                                                "\"\n");
+    const auto c = RotBond::coeffs<double>(scene.bonds.at(0).params_of<RotBond>());
+    const double L = 1.2, R = mean ? L / 2 : 0.5;
+    const auto k = RotBond::bond_coeffs(c, L, 0.5, 0.7);
+    EXPECT_NEAR(k.kn, 1000 * R * R / L, 1e-12 * k.kn);
+    EXPECT_NEAR(k.ks, 300 * R * R / L, 1e-12 * k.ks);
+    EXPECT_NEAR(k.kb, 70 * std::pow(R, 4) / (4 * L), 1e-12 * k.kb);
+    EXPECT_NEAR(k.kt, 20 * std::pow(R, 4) / (2 * L), 1e-12 * k.kt);
+    EXPECT_NEAR(1 / k.ifn, 5 * R * R, 1e-12 / k.ifn);
+    EXPECT_NEAR(1 / k.ifs, 6 * R * R, 1e-12 / k.ifs);
+    EXPECT_NEAR(1 / k.imb, 7 * R * R * R / 4, 1e-12 / k.imb);
+    EXPECT_NEAR(1 / k.imt, 8 * R * R * R / 2, 1e-12 / k.imt);
+  }
+  // Without scaling the given values are the bond's own; radius_scaling alone is an error.
+  const auto plain = basalt::test::scene_from(R"(
+[run]
+dt = 1e-4
+steps = 0
+skin = 0.05
+[[interactions]]
+type = "rot_bond"
+kn = 1000.0
+ks = 300.0
+kb = 70.0
+kt = 20.0
+)");
+  const auto k =
+      RotBond::bond_coeffs(RotBond::coeffs<double>(plain.bonds.at(0).params_of<RotBond>()), 1.2, 0.5, 0.7);
+  EXPECT_EQ(k.kn, 1000.0);
+  EXPECT_EQ(k.kb, 70.0);
+}
+
 TEST(RotBondLaw, FailureCriteriaPerMode) {
   RotBond::Coeffs<double> c{};
   c.truncated = 1, c.beta1 = 1, c.beta2 = 1;

@@ -79,6 +79,8 @@ def checkpoint_rows(path):
 CHECKPOINT_COLUMNS = [("position", 0, 3), ("radius, id, tag, mass", 3, 7), ("initial position", 7, 10),
                       ("position at the last neighbour rebuild", 10, 13), ("velocity", 13, 16),
                       ("force", 16, 19), ("circular shift", 19, 22)]
+# RotSphere checkpoints (ESyS 2.3.5, measured): the orientation w x y z and the angular velocity follow
+ROTATIONAL_COLUMNS = [("orientation", 22, 26), ("angular velocity", 26, 29)]
 
 
 def quantities(name, esys_dir, basalt_dir, esys_out, basalt_out):
@@ -95,7 +97,7 @@ def quantities(name, esys_dir, basalt_dir, esys_out, basalt_out):
     files = sorted(set(os.listdir(esys_dir)) | set(os.listdir(basalt_dir)))
     groups = collections.defaultdict(lambda: [[], [], 0])
     for f in files:
-        if f == "stdout.txt":
+        if f == "stdout.txt" or f.endswith(".geo"):  # a .geo is the script's own input (geo_read.py)
             continue
         fe, fb = os.path.join(esys_dir, f), os.path.join(basalt_dir, f)
         if not (os.path.exists(fe) and os.path.exists(fb)):
@@ -114,7 +116,8 @@ def quantities(name, esys_dir, basalt_dir, esys_out, basalt_out):
             if sorted(re_) != sorted(rb) or tail_e != tail_b:
                 out.append((f"checkpoint {f}", "different particles or sections"))
                 continue
-            for label, lo, hi in CHECKPOINT_COLUMNS:
+            width = min(len(r) for r in (*re_.values(), *rb.values())) if re_ else 0
+            for label, lo, hi in CHECKPOINT_COLUMNS + (ROTATIONAL_COLUMNS if width >= 29 else []):
                 g = groups[f"checkpoints: {label}"]
                 for pid in sorted(re_):
                     g[0].extend(re_[pid][lo:hi])
@@ -149,7 +152,7 @@ def deviation(a, b):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--scripts", nargs="+", default=["collide", "fall", "settle", "cube_drop", "block_large",
-                                                         "slide", "press", "spin"])
+                                                         "slide", "press", "spin", "geo_read", "chain"])
     ap.add_argument("--workdir", default="out/esys-tutorial")
     ap.add_argument("--tolerance", type=float, default=1e-6)
     ap.add_argument("--build", default=os.path.join(bt.ROOT, "build"), help="the build whose python/ to use")

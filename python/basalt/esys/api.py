@@ -5,15 +5,17 @@ ones it refuses (a call raises NotSupportedError saying what Basalt offers)."""
 from .errors import NotSupportedError, refuse
 from .lsmmpi import LsmMpi  # noqa: F401
 from .particles import NRotSphere, RotSphere  # noqa: F401
-from .prms import (CheckPointPrms, FrictionPrms, GravityPrms, LinDampingPrms, NRotBondPrms,  # noqa: F401
-                   NRotElasticPrms, NRotElasticWallPrms, NRotFrictionPrms, RotDampingPrms, RotFrictionPrms,
-                   ParticleScalarFieldSaverPrms, ParticleVectorFieldSaverPrms, Runnable, WallVectorFieldSaverPrms)
+from .prms import (BrittleBeamPrms, CheckPointPrms, FrictionPrms, GravityPrms, LinDampingPrms,  # noqa: F401
+                   NRotBondPrms, NRotElasticPrms, NRotElasticWallPrms, NRotFrictionPrms, RotBondPrms,
+                   RotDampingPrms, RotFrictionPrms, ParticleScalarFieldSaverPrms, ParticleVectorFieldSaverPrms,
+                   Runnable, WallVectorFieldSaverPrms)
 from .refused import LSM, stubs
 from .vec3 import BoundingBox, Vec3  # noqa: F401
 
 globals().update(stubs("esys.lsm", LSM))
 
-SUPPORTED = ["LsmMpi", "NRotSphere", "RotSphere", "NRotElasticPrms", "NRotBondPrms", "NRotElasticWallPrms",
+SUPPORTED = ["LsmMpi", "NRotSphere", "RotSphere", "NRotElasticPrms", "NRotBondPrms", "RotBondPrms",
+             "BrittleBeamPrms", "NRotElasticWallPrms",
              "RotFrictionPrms", "FrictionPrms", "NRotFrictionPrms", "RotDampingPrms", "GravityPrms",
              "LinDampingPrms", "CheckPointPrms", "ParticleScalarFieldSaverPrms", "ParticleVectorFieldSaverPrms",
              "WallVectorFieldSaverPrms", "Runnable", "Vec3", "BoundingBox"]

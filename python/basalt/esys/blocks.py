@@ -70,28 +70,28 @@ def _x_offset(a, b, r):
     return row[b % 6]
 
 
-class CubicBlock:
-    """CubicBlock(dimCount=[nx, ny, nz], radius): ESyS's close-packed block (rows along x 2r apart, offset by
-    r; rows along z r sqrt(3) apart; layers along y r sqrt(8/3) apart, shifted along z by 2r/sqrt(3), r/sqrt(3)).
-    Only ESyS's default orientation."""
+class _ClosePackBlock:
+    """ESyS's ClosePackIterator: sphere (i, j, k) at offsets(i, j, k) + (2r i, r sqrt(3) j, r sqrt(8/3) k) along the
+    axes (x, z, y) of the default orientation, i fastest; ids from 0 in that order."""
+
+    NAME = ""
 
     def __init__(self, dimCount, radius, orientation=None):
         if orientation is not None:
             from .errors import refuse
-            refuse("esys.lsm.geometry.CubicBlock(orientation=...)", "the default orientation is supported")
+            refuse(f"esys.lsm.geometry.{self.NAME}(orientation=...)", "the default orientation is supported")
         counts = [max(int(c), 1) for c in dimCount]
         r = float(radius)
         dim = (0, 2, 1)  # ClosePackIterator's map for the default orientation
-        z_shift = (0.0, 2.0 * _SQRT_1_OVER_3 * r, _SQRT_1_OVER_3 * r)
         self._spheres = []
         for k in range(counts[2]):
             for j in range(counts[1]):
                 for i in range(counts[0]):
-                    idx = (i, j, k)
+                    a, b = self._offsets(i, j, k, r)
                     centre = [0.0, 0.0, 0.0]
-                    centre[dim[0]] = _x_offset(idx[1] % 6, idx[2] % 6, r) + idx[0] * (r * 2.0)
-                    centre[dim[1]] = z_shift[idx[2] % 3] + idx[1] * (r * _SQRT_3)
-                    centre[dim[2]] = 0.0 + idx[2] * (r * _SQRT_8_OVER_3)
+                    centre[dim[0]] = a + i * (r * 2.0)
+                    centre[dim[1]] = b + j * (r * _SQRT_3)
+                    centre[dim[2]] = 0.0 + k * (r * _SQRT_8_OVER_3)
                     self._spheres.append(SimpleSphere(len(self._spheres), Vec3(0.0, 0.0, 0.0) + Vec3(centre), r))
 
     def __iter__(self):
@@ -112,7 +112,34 @@ class CubicBlock:
             s.translate(translation)
 
 
+class CubicBlock(_ClosePackBlock):
+    """CubicBlock(dimCount=[nx, ny, nz], radius): ESyS's close-packed block, layers in the sequence ABC (rows along
+    x 2r apart, offset by r; rows along z r sqrt(3) apart; layers along y r sqrt(8/3) apart, shifted along z by
+    2r/sqrt(3), r/sqrt(3)). Only ESyS's default orientation."""
+
+    NAME = "CubicBlock"
+
+    @staticmethod
+    def _offsets(i, j, k, r):
+        z_shift = (0.0, 2.0 * _SQRT_1_OVER_3 * r, _SQRT_1_OVER_3 * r)
+        return _x_offset(j % 6, k % 6, r), z_shift[k % 3]
+
+
+class HexagBlock(_ClosePackBlock):
+    """HexagBlock(dimCount=[nx, ny, nz], radius): ESyS's hexagonal close packing, layers in the sequence AB
+    (HexagBlockIterator: rows along x offset by r where j and k differ in parity; odd layers shifted along z by
+    r/sqrt(3)). Only ESyS's default orientation."""
+
+    NAME = "HexagBlock"
+
+    @staticmethod
+    def _offsets(i, j, k, r):
+        return (r if j % 2 != k % 2 else 0.0), (_SQRT_1_OVER_3 * r if k % 2 == 1 else 0.0)
+
+
 class Connection:
+    """A tagged bond between two particle ids (ESyS's TaggedIdConnection(id1, id2, tag))."""
+
     def __init__(self, id1, id2, tag):
         self._ids, self._tag = (int(id1), int(id2)), int(tag)
 

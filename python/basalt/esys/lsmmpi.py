@@ -22,11 +22,10 @@ CHUNK = 100
 
 _HINTS = {
     "setParticleDensity": "give each NRotSphere/RotSphere its mass (mass=...), as the tutorial's scripts do",
-    "setVelocityOfWall": "moveWallBy from a Runnable (each step's displacement), or basalt.Simulation's "
-                         "walls[name].set_velocity",
-    "createExclusion": "Basalt's linear_elastic never acts on bonded pairs (scene models, docs/scenes.md); "
-                       "the front end refuses NRotElasticPrms together with bonds",
-    "readGeometry": "basalt.read_geometry reads .geo files for basalt.Simulation",
+    "setVelocityOfWall": "in ESyS-Particle it sets the velocity a viscous wall interaction (ViscWallPrms) reads and "
+                         "never moves the wall (ESyS's TSubLattice::setVelocityOfWall; 2.3.5 hangs on it for an "
+                         "elastic wall, measured); to move a wall at constant velocity call moveWallBy from a "
+                         "Runnable (each step's displacement), or use basalt.Simulation's walls[name].set_velocity",
     "setParticleNonDynamic": "the scene's particles.fixed_tags or basalt.Simulation.fix(tag)",
     "setParticleNonRotational": "NRotSphere particles",
     "createSphereBody": "Basalt's planar and mesh walls (docs/scenes.md)",
@@ -58,6 +57,7 @@ class LsmMpi:
         self._walls = {}                # name -> (posn, normal), in creation order
         self._body = []                 # GravityPrms, LinDampingPrms
         self._group_names = set()
+        self._exclusions = set()        # (bond group name, contact group name) from createExclusion
         self._savers, self._checkpointers = [], []
         self._pre, self._post = [], []
         self._sim = None
@@ -138,6 +138,33 @@ class LsmMpi:
                 p = q
             self.createParticle(p)
 
+    def readGeometry(self, fileName):
+        """An ESyS .geo file (LSMGeometry, as GenGeo writes it; Basalt's reader): each sphere a particle of the run's
+        type with its id, tag, radius and mass 4/3 pi r^3 (ESyS's GeometryReader, 3-D), the file's bonds as
+        connections with their tags; the file's bounding box becomes the spatial domain unless one was set (as
+        ESyS: a set domain is kept)."""
+        from ..geometry import read_geometry
+
+        self._setup("readGeometry")
+        if self._particle_type is None:
+            raise ValueError("LsmMpi.readGeometry before initNeighbourSearch(particleType=...)")
+        g = read_geometry(str(fileName))
+        if any(g.periodic) and self._domain_lo is None:
+            refuse(f"LsmMpi.readGeometry({fileName!r}): a geometry with periodic boundaries",
+                   "Basalt scenes have periodic boundaries (basalt.Simulation, docs/scenes.md); the front end "
+                   "does not map them yet")
+        if self._domain_lo is None:
+            self._domain_lo, self._domain_hi = tuple(g.box_min.tolist()), tuple(g.box_max.tolist())
+        kind = RotSphere if self._rotational else NRotSphere
+        part = g.particles
+        for pid, x, r, tag in zip(part["id"].tolist(), part["position"].tolist(), part["radius"].tolist(),
+                                  part["tag"].tolist()):
+            p = kind(pid, Vec3(*x), r, (math.pi * r * r) * ((4.0 / 3.0) * r))  # ESyS's order of operations
+            p.setTag(tag)
+            self.createParticle(p)
+        for (i, j), t in zip(g.bonds["pairs"].tolist(), g.bonds["tag"].tolist()):
+            self._bonds.append((min(i, j), max(i, j), int(t)))
+
     def createConnections(self, connections):
         """Bonds (ConnectionFinder's, or objects with getId1, getId2, getTag) for NRotBondPrms groups."""
         self._setup("createConnections")
@@ -172,7 +199,10 @@ class LsmMpi:
                            f"{prms.staticMu}", "Basalt's rot_friction needs mu_dynamic <= mu")
             self._name(prms)
             self._pair.append(prms)
-        elif isinstance(prms, P.NRotBondPrms):
+        elif isinstance(prms, (P.NRotBondPrms, P.RotBondPrms, P.BrittleBeamPrms)):
+            if not isinstance(prms, P.NRotBondPrms) and not self._rotational:
+                raise ValueError(f"LsmMpi.createInteractionGroup({kind}): rotational bonds join RotSpheres "
+                                 "(initNeighbourSearch(particleType=\"RotSphere\", ...))")
             if any(g.tag == prms.tag for g in self._bond_groups):
                 refuse(f"LsmMpi.createInteractionGroup({kind}): a second group on bond tag {prms.tag}",
                        "one bond group per tag")
@@ -196,8 +226,28 @@ class LsmMpi:
             self._body.append(prms)
         else:
             refuse(f"LsmMpi.createInteractionGroup({kind})", "the front end maps NRotElasticPrms, RotFrictionPrms, "
-                   "FrictionPrms, NRotFrictionPrms, NRotBondPrms, NRotElasticWallPrms, GravityPrms, LinDampingPrms "
-                   "and RotDampingPrms so far")
+                   "FrictionPrms, NRotFrictionPrms, NRotBondPrms, RotBondPrms, BrittleBeamPrms, NRotElasticWallPrms, "
+                   "GravityPrms, LinDampingPrms and RotDampingPrms so far")
+
+    def createExclusion(self, interactionName1, interactionName2):
+        """No force of one group on the pairs the other (a bond group) joins: ESyS's exclusion of a contact group
+        from bonded pairs. Basalt's contact models never act on bonded pairs, so a contact group must be excluded
+        from every bond group (checked when the run starts); a bond that breaks leaves its pair to the contact
+        group from the next step, as in ESyS (docs/reference-runs.md)."""
+        self._setup("createExclusion")
+        names = {g.name: g for g in (*self._pair, *self._bond_groups)}
+        for n in (interactionName1, interactionName2):
+            if str(n) not in names:
+                others = self._group_names - set(names)
+                raise ValueError(f"LsmMpi.createExclusion: no contact or bond group named {str(n)!r}"
+                                 + (f" (exclusions between {', '.join(sorted(others))} are not mapped)"
+                                    if str(n) in others else ""))
+        a, b = names[str(interactionName1)], names[str(interactionName2)]
+        bond, pair = (a, b) if a in self._bond_groups else (b, a)
+        if bond not in self._bond_groups or pair not in self._pair:
+            refuse(f"LsmMpi.createExclusion({interactionName1!r}, {interactionName2!r})",
+                   "exclusions between a bond group and a contact group (Basalt's contacts skip bonded pairs)")
+        self._exclusions.add((bond.name, pair.name))
 
     def createWall(self, name, posn, normal):
         self._setup("createWall")
@@ -223,9 +273,6 @@ class LsmMpi:
 
     def createCheckPointer(self, prms):
         self._setup("createCheckPointer")
-        if self._rotational:
-            refuse("LsmMpi.createCheckPointer in a RotSphere run", "the front end writes NRotSphere "
-                   "checkpoints so far; basalt.Simulation.checkpoint() writes Basalt's")
         self._checkpointers.append(CheckPointer(prms, self))
 
     def createFieldSaver(self, prms):
@@ -399,6 +446,8 @@ class LsmMpi:
         state["old"] = self._old if self._old is not None and len(self._old) == len(ids) else state["pos"]
         if self._rotational:
             state["angvel"] = np.column_stack([p.wx, p.wy, p.wz])[order]
+            if self._checkpointers:  # the scene keeps orientations then (scene.py)
+                state["quat"] = np.column_stack([p.qw, p.qx, p.qy, p.qz])[order]
         return state
 
     def getParticleList(self):

@@ -51,6 +51,8 @@ class CheckPointer(_Schedule):
             head = " ".join(_g9(v) for v in nums)
             tail = " ".join(_g9(v) for v in (state["mass"][i], *state["init"][i], *state["old"][i],
                                               *state["vel"][i], *state["force"][i], 0, 0, 0))
+            if "quat" in state:  # RotSphere (ESyS 2.3.5, measured): orientation w x y z, angular velocity
+                tail += " " + " ".join(_g9(v) for v in (*state["quat"][i], *state["angvel"][i]))
             rows.append(f"{head} {int(state['id'][i])} {int(state['tag'][i])} {tail}\n")
         rows.append(self._bond_section())
         rows.append("TMIG 0\n")
@@ -65,14 +67,17 @@ class CheckPointer(_Schedule):
         if not lsm._bond_groups:
             return "0\n"
         if len(lsm._bond_groups) > 1:
-            refuse("LsmMpi.createCheckPointer with several NRotBondPrms groups", "one bond group is written so "
+            refuse("LsmMpi.createCheckPointer with several bond groups", "one bond group is written so "
                    "far; basalt.Simulation.checkpoint() writes Basalt's checkpoints")
         if lsm._sim.broken_bonds() > 0:
             refuse("LsmMpi.createCheckPointer after a bond broke", "the front end writes the bonds of an "
                    "intact run so far; Basalt's checkpoints list every bond and its state")
-        tag = lsm._bond_groups[0].tag
-        bonds = sorted(b for b in set(lsm._bonds) if b[2] == tag)
-        return f"1\nBonded\n{len(bonds)}\n" + "".join(f"{i} {j} {t}\n" for i, j, t in bonds)
+        from .prms import NRotBondPrms
+
+        group = lsm._bond_groups[0]
+        kind = "Bonded" if isinstance(group, NRotBondPrms) else "RotBonded"  # RotBond, BrittleBeam (measured)
+        bonds = sorted(b for b in set(lsm._bonds) if b[2] == group.tag)
+        return f"1\n{kind}\n{len(bonds)}\n" + "".join(f"{i} {j} {t}\n" for i, j, t in bonds)
 
 
 class FieldSaver(_Schedule):

@@ -118,3 +118,50 @@ class RotDampingPrms:
 
     def __init__(self, name, viscosity, maxIterations=100):
         self.name, self.viscosity, self.maxIterations = str(name), float(viscosity), int(maxIterations)
+
+
+class RotBondPrms:
+    """ESyS's RotBond between RotSpheres (Basalt's rot_bond, rest length r1 + r2): normal, shear, torsion and
+    bending springs and their strengths. scaling=True (ESyS's default): per bond, with R = L/2 (meanR_scaling) or
+    min(r1, r2), kn, ks x R^2/L, kb x R^4/(4L), kt x R^4/(2L), strengths x R^2, R^2, R^3/4 (bending), R^3/2
+    (torsion) (ESyS's CRotBondedInteraction). The criterion is ESyS's direct Mohr-Coulomb (truncated, beta1 =
+    beta2 = 1)."""
+
+    def __init__(self, name, normalK, shearK, torsionK, bendingK, normalBrkForce, shearBrkForce, torsionBrkForce,
+                 bendingBrkForce, tag=0, scaling=True, meanR_scaling=True, truncated=1.0):
+        self.name, self.tag = str(name), int(tag)
+        self.kn, self.ks, self.kt, self.kb = float(normalK), float(shearK), float(torsionK), float(bendingK)
+        self.fn_max, self.fs_max = float(normalBrkForce), float(shearBrkForce)
+        self.mt_max, self.mb_max = float(torsionBrkForce), float(bendingBrkForce)
+        self.scaling, self.meanR_scaling, self.truncated = bool(scaling), bool(meanR_scaling), float(truncated)
+        self.beta1 = self.beta2 = 1.0
+
+    def model(self):
+        """The rot_bond interaction of this group (without its bond_tag)."""
+        m = {"type": "rot_bond", "kn": self.kn, "ks": self.ks, "kb": self.kb, "kt": self.kt,
+             "max_normal_force": self.fn_max, "max_shear_force": self.fs_max, "max_bending_moment": self.mb_max,
+             "max_torsion_moment": self.mt_max, "scaling": self.scaling, "criterion": "esys",
+             "truncated": self.truncated, "beta1": self.beta1, "beta2": self.beta2, "rest_length": "sum_of_radii"}
+        if self.scaling:
+            m["radius_scaling"] = "mean" if self.meanR_scaling else "min"
+        return m
+
+
+class BrittleBeamPrms:
+    """ESyS's BrittleBeam (RotBond from elastic beam theory, always scaled per bond): kn = pi E R^2/L, ks = pi G
+    R^2/L, kb = pi E R^4/(4L), kt = pi G R^4/(2L), strengths from cohesion and tanAngle; Basalt's rot_bond with
+    youngs_modulus (docs/reference-runs.md, "Rotational bonds")."""
+
+    def __init__(self, name, youngsModulus, poissonsRatio, cohesion, tanAngle, tag=0, meanR_scaling=True,
+                 truncated=1.0, beta1=1.0, beta2=1.0):
+        self.name, self.tag = str(name), int(tag)
+        self.E, self.nu, self.cohesion, self.tanAngle = (float(youngsModulus), float(poissonsRatio),
+                                                         float(cohesion), float(tanAngle))
+        self.meanR_scaling, self.truncated = bool(meanR_scaling), float(truncated)
+        self.beta1, self.beta2 = float(beta1), float(beta2)
+
+    def model(self):
+        return {"type": "rot_bond", "youngs_modulus": self.E, "poissons_ratio": self.nu,
+                "radius_scaling": "mean" if self.meanR_scaling else "min", "cohesion": self.cohesion,
+                "tan_friction_angle": self.tanAngle, "criterion": "esys", "truncated": self.truncated,
+                "beta1": self.beta1, "beta2": self.beta2, "rest_length": "sum_of_radii"}

@@ -7,8 +7,6 @@ _SCENE = "Basalt has it as a scene model (basalt.Simulation with a scene dict, d
 
 # esys.lsm: parameter classes and savers -> what Basalt offers
 LSM = {
-    "RotBondPrms": _SCENE + 'type = "rot_bond"',
-    "BrittleBeamPrms": _SCENE + 'type = "rot_bond" with youngs_modulus, cohesion, tan_friction_angle',
     "RotElasticPrms": _SCENE + 'type = "linear_elastic"',
     "HertzianElasticPrms": _SCENE + 'type = "hertz_mindlin"',
     "HertzianViscoElasticPrms": _SCENE + 'type = "hertz_mindlin"',
@@ -33,7 +31,7 @@ LSM = {
 _PACK = "Basalt packs spheres with basalt.pack (box, cylinder, sphere, mesh; lattice=True for a regular one)"
 # esys.lsm.geometry: generators
 GEOMETRY = {name: _PACK for name in (
-    "HexagonalBlock", "SimpleBlock", "RandomSpherePacker", "SimpleSphereCollection",
+    "SimpleBlock", "RandomSpherePacker", "SimpleSphereCollection",
     "ParticleCollection", "GrainCollection")}
 # ESyS's RandomBoxPacker gives the same packing in every run; the front end does not reproduce that packing yet,
 # and a different one would silently change the script's results

@@ -36,23 +36,22 @@ def scene_dict(lsm, geometry_file, output_dir):
             rotation = True
         else:
             interactions.append({"type": "linear_elastic", "K": g.normalK})
-    radius = {p.getId(): p.getRadius() for p in lsm._particles}
+    split = bond_split(lsm)
     for g in lsm._bond_groups:
+        if not isinstance(g, P.NRotBondPrms):  # RotBondPrms, BrittleBeamPrms
+            interactions.append(dict(g.model(), bond_tag=g.tag))
+            rotation = True
+            continue
         bond = {"type": "linear_bond", "K": g.normalK, "rest_length": "sum_of_radii",
                 "break_strain": g.breakDistance, "bond_tag": g.tag}
-        if g.scaling:  # ESyS: k = normalK (r0/2)^2 / r0 per bond; one k per Basalt group
-            r0 = {radius[i] + radius[j] for i, j, t in lsm._bonds if t == g.tag}
-            if len(r0) > 1:
-                refuse(f"LsmMpi: NRotBondPrms({g.name!r}, scaling=True) on bonds of different r1 + r2",
-                       "the front end maps scaled bonds of one size (a CubicBlock's); Basalt's linear_bond "
-                       "has one K per group")
-            if r0:
-                eff = 0.5 * r0.pop()
-                bond["K"] = g.normalK * (eff * eff) / (2.0 * eff)
-        interactions.append(bond)
-    if (lsm._bonds or lsm._bond_groups) and lsm._pair:
-        refuse("LsmMpi: NRotElasticPrms together with bonds", "ESyS's NRotElastic also pushes bonded pairs "
-               "unless createExclusion; the front end maps neither yet (Basalt's models: docs/scenes.md)")
+        sizes = split.get(g.tag)
+        if not sizes:
+            interactions.append(bond)
+        for r0, geo_tag in sorted((sizes or {}).items()):
+            # ESyS: k = normalK (r0/2)^2 / r0 per bond (BondedInteraction.cpp); one Basalt group per r0
+            eff = 0.5 * r0
+            interactions.append(dict(bond, K=g.normalK * (eff * eff) / (2.0 * eff), bond_tag=geo_tag))
+    _check_exclusions(lsm)
     walls = []
     for name, (posn, normal) in lsm._walls.items():
         k = lsm._wall_k.get(name)
@@ -68,7 +67,9 @@ def scene_dict(lsm, geometry_file, output_dir):
             body.append({"type": "linear_damping", "viscosity": b.viscosity, "iterations": b.maxIterations})
     scene = {
         "geometry": {"file": geometry_file},
-        "particles": {"rotation": rotation},
+        # RotSphere checkpoints hold the orientations (kept without changing any other bit, docs/scenes.md)
+        "particles": dict({"rotation": rotation}, **({"orientation": True} if lsm._rotational and
+                                                      lsm._checkpointers else {})),
         "run": {"dt": lsm._dt, "skin": lsm._verlet, "integrator": "symplectic_euler", "force_dt": True,
                 "force_overlap": True, "energy_check_every": 0},
         "output": {"directory": output_dir},
@@ -77,6 +78,56 @@ def scene_dict(lsm, geometry_file, output_dir):
         if value:
             scene[key] = value
     return scene
+
+
+MAX_BOND_SIZES = 64
+
+
+def bond_split(lsm):
+    """{ESyS bond tag: {r1 + r2: the geometry's bond tag}} for the scaled NRotBondPrms groups: ESyS gives each bond
+    its own k = normalK (r0/2)^2/r0, Basalt's linear_bond one K per group, so the bonds of each size r0 = r1 + r2
+    get a group of their own (a tag of the written geometry; ESyS's tags stay in the script's view). One size keeps
+    the ESyS tag; at most MAX_BOND_SIZES sizes per group (a random packing's bonds are each of their own size)."""
+    radius = {p.getId(): p.getRadius() for p in lsm._particles}
+    used = {t for _, _, t in lsm._bonds} | {g.tag for g in lsm._bond_groups}
+    fresh = max(used, default=0) + 1
+    split = {}
+    for g in lsm._bond_groups:
+        if not (isinstance(g, P.NRotBondPrms) and g.scaling):
+            continue
+        sizes = sorted({radius[i] + radius[j] for i, j, t in lsm._bonds if t == g.tag})
+        if len(sizes) > MAX_BOND_SIZES:
+            refuse(f"LsmMpi: NRotBondPrms({g.name!r}, scaling=True) on bonds of {len(sizes)} different r1 + r2",
+                   f"the front end gives each bond size its own Basalt linear_bond group, up to {MAX_BOND_SIZES}; "
+                   "for a random packing use Basalt's linear_bond (one K) in a basalt.Simulation scene")
+        if len(sizes) == 1:
+            split[g.tag] = {sizes[0]: g.tag}
+        elif sizes:
+            split[g.tag] = {r0: fresh + k for k, r0 in enumerate(sizes)}
+            fresh += len(sizes)
+    return split
+
+
+def _check_exclusions(lsm):
+    """Basalt's contact models never act on a bonded pair (until its bond breaks); ESyS's contact group does unless
+    createExclusion excludes it from the bond group. So with a contact group every bond must belong to a group
+    excluded from it."""
+    if not lsm._pair or not (lsm._bonds or lsm._bond_groups):
+        return
+    pair = lsm._pair[0]
+    groups = {g.tag: g for g in lsm._bond_groups}
+    for tag in sorted({t for _, _, t in lsm._bonds} | set(groups)):
+        g = groups.get(tag)
+        if g is None:
+            refuse(f"LsmMpi: connections of tag {tag} (no bond group) with the contact group {pair.name!r}",
+                   "ESyS's contact group acts on those pairs, Basalt's contacts skip every bonded pair: give the "
+                   "tag a bond group excluded from the contact group (createExclusion), or leave those connections "
+                   "out")
+        if (g.name, pair.name) not in lsm._exclusions:
+            refuse(f"LsmMpi: the contact group {pair.name!r} together with the bond group {g.name!r} without "
+                   f"createExclusion({g.name!r}, {pair.name!r})",
+                   "ESyS's contact group also pushes bonded pairs unless excluded; Basalt's contacts skip bonded "
+                   "pairs: add the exclusion (as ESyS's rot_compress does)")
 
 
 def build(lsm, workdir):
@@ -99,8 +150,10 @@ def build(lsm, workdir):
             raise ValueError(f"LsmMpi.createConnections: a bond between {i} and {j}, not both particles")
     extra = {}
     if bonds:
+        split, radius = bond_split(lsm), {p.getId(): p.getRadius() for p in ps}
         extra = {"bonds": np.array([(i, j) for i, j, _ in bonds], dtype=np.int64),
-                 "bond_tag": np.array([t for _, _, t in bonds], dtype=np.int32)}
+                 "bond_tag": np.array([split[t][radius[i] + radius[j]] if t in split else t for i, j, t in bonds],
+                                      dtype=np.int32)}
     geo = Geometry(pos, np.array([p.getRadius() for p in ps]), id=ids, **extra,
                    tag=np.array([p.getTag() for p in ps], dtype=np.int32),
                    mass=np.array([p.getMass() for p in ps]), box_min=lsm._domain_lo, box_max=lsm._domain_hi)

@@ -22,6 +22,9 @@
 //   kn = pi E R^2/L, ks = pi G R^2/L, kb = pi E R^4/(4L), kt = pi G R^4/(2L).
 // Strengths from cohesion c and tan(phi) (scaled alike): Fn_max = pi c R^2/tan(phi), Fs_max = pi c R^2,
 // Mb_max = pi c R^3/(4 tan(phi)), Mt_max = pi c R^3/2; or given directly (max_normal_force, ...).
+// Given stiffnesses and strengths with scaling = true (ESyS "RotBondPrms", scaling=True) are per unit and
+// scaled per bond alike: kn R^2/L, ks R^2/L, kb R^4/(4L), kt R^4/(2L), Fn_max R^2, Fs_max R^2, Mb_max R^3/4,
+// Mt_max R^3/2 (BrittleBeam is this with kn = kb = pi E, ks = kt = pi G).
 // Failure (criterion = "esys", ESyS's direct Mohr-Coulomb): with Fn > 0 in tension,
 //   normal = Fn/Fn_max + beta1 Mb/Mb_max, shear = Fs/Fs_max + beta2 Mt/Mt_max,
 //   broken when normal > truncated or shear > 1 - normal;
@@ -173,11 +176,15 @@ struct RotBond {
       KeyDoc{"youngs_modulus", "E, force/length^2: stiffnesses from E and nu per bond (ESyS BrittleBeam)"},
       KeyDoc{"poissons_ratio", "nu, in (-1, 0.5] (with youngs_modulus; required)"},
       KeyDoc{"radius_scaling",
-             "\"mean\" (R = L/2, default) or \"min\" (R = min(r1, r2)), with youngs_modulus"},
+             "\"mean\" (R = L/2, default) or \"min\" (R = min(r1, r2)), with youngs_modulus or scaling"},
       KeyDoc{"kn", "normal stiffness, force/length (instead of youngs_modulus, with ks, kb, kt)"},
       KeyDoc{"ks", "shear stiffness, force/length"},
       KeyDoc{"kb", "bending stiffness, moment/radian"},
       KeyDoc{"kt", "torsion stiffness, moment/radian"},
+      KeyDoc{
+          "scaling",
+          "with kn...: false (default: kn... per bond as given) or true (ESyS RotBondPrms scaling=True: kn, "
+          "ks per unit R^2/L, kb per R^4/(4L), kt per R^4/(2L); strengths per R^2, R^3/4, R^3/2)"},
       KeyDoc{"cohesion",
              "c, force/length^2: strengths per bond (with youngs_modulus; default: never breaks)"},
       KeyDoc{"tan_friction_angle", "tan(phi) > 0 (with cohesion; ESyS tanAngle)"},
@@ -245,7 +252,7 @@ struct RotBond {
     const bool modulus = t.has("youngs_modulus");
     if (modulus) {
       for (const char* k : {"kn", "ks", "kb", "kt", "max_normal_force", "max_shear_force",
-                            "max_bending_moment", "max_torsion_moment"})
+                            "max_bending_moment", "max_torsion_moment", "scaling"})
         if (t.has(k))
           t.fail(k, "give either youngs_modulus (with poissons_ratio) or kn, ks, kb, kt, not both");
       p.scaled = true;
@@ -261,8 +268,14 @@ struct RotBond {
         t.fail("tan_friction_angle", "needs cohesion");
       }
     } else {
-      for (const char* k : {"poissons_ratio", "radius_scaling", "cohesion", "tan_friction_angle"})
+      for (const char* k : {"poissons_ratio", "cohesion", "tan_friction_angle"})
         if (t.has(k)) t.fail(k, "only with youngs_modulus");
+      // ESyS RotBondPrms(scaling=True): the given stiffnesses and strengths scaled per bond as BrittleBeam's.
+      p.scaled = t.boolean_or("scaling", false);
+      if (p.scaled)
+        p.mean_radius = t.choice_or("radius_scaling", {"mean", "min"}, "mean") == "mean";
+      else if (t.has("radius_scaling"))
+        t.fail("radius_scaling", "only with youngs_modulus or scaling = true");
       p.kn = t.non_negative("kn"), p.ks = t.non_negative("ks"), p.kb = t.non_negative("kb");
       p.kt = t.non_negative("kt");
       if (t.has("max_normal_force")) p.fn_max = t.positive("max_normal_force");
