@@ -198,7 +198,7 @@ typedef float VecF __attribute__((vector_size(kVectorBytes)));
 
 int main(int argc, char** argv) {
   CLI::App app{"machine_limits: memory bandwidth, gather cost and peak flops of this machine (JSON)"};
-  std::vector<double> sizes_mb{0.008, 0.25, 4, 256};
+  std::vector<double> sizes_mb{0.008, 0.25, 1, 4, 256};
   std::vector<int> thread_counts{1, 2};
   int repeats = 10;
   double gather_mb = 256;

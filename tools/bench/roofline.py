@@ -406,14 +406,14 @@ def render(rows, limits, a):
              "| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- |"]
     for r in rows:
         for phase, v in r["phases"].items():
-            lim = max(v["floor_bw"], v["floor_flops"], v["floor_gather"])
-            frac = f"{100 * lim / v['ns']:.0f} %" if v["ns"] > 0 else "-"
+            lim, which = max((v["floor_bw"], "bandwidth"), (v["floor_flops"], "compute"), (v["floor_gather"], "gathers"))
+            frac = f"{100 * lim / v['ns']:.0f} % ({which})" if v["ns"] > 0 else "-"
             lines.append(f"| {r['name']} | {phase} | {fmt_ns(v['ns'])} | {v['bytes']:.0f} | {v['flops']:.0f} | "
                          f"{v['gathers']:.1f} | {fmt_ns(v['floor_bw'])} | {fmt_ns(v['floor_mem'])} | "
                          f"{fmt_ns(v['floor_flops'])} | {fmt_ns(v['floor_gather'])} | {frac} | {v['note']} |")
         tot = {k: sum(v[k] for v in r["phases"].values()) for k in ("ns", "floor_bw", "floor_mem", "floor_flops",
                                                                     "floor_gather")}
-        lim = max(tot["floor_bw"], tot["floor_flops"], tot["floor_gather"])
+        lim = max(tot["floor_bw"], tot["floor_flops"], tot["floor_gather"])  # the largest of the step's floors
         lines.append(f"| {r['name']} | **step** ({r['loop_ns']:.1f} ns measured, {r['unmodelled_ns']:.1f} in "
                      f"forces' bookkeeping; arrays at {r['level']}, {r['bw']:.0f} GB/s) | {fmt_ns(tot['ns'])} | | | | "
                      f"{fmt_ns(tot['floor_bw'])} | {fmt_ns(tot['floor_mem'])} | {fmt_ns(tot['floor_flops'])} | "
