@@ -179,6 +179,8 @@ _DONE = re.compile(r"^done: (\d+) steps in ([0-9.]+) s \(([0-9.]+) steps/s, ([0-
 _CPU = re.compile(r"^cpu time of the loop: ([0-9.]+) s per rank \(max\), ([0-9]+) % of the wall time", re.M)
 _PHASES = re.compile(r"^time per step: (.*)$", re.M)
 _PHASE = re.compile(r"\s*([a-z ]+?) ([0-9.]+) ms \(([0-9.]+) %\)")
+_KINDS = re.compile(r"^forces by model kind: (.*)$", re.M)
+_KIND_TIME = re.compile(r"\s*([a-z ]+?) ([0-9.]+) ms")
 _ARRAYS = re.compile(r"^solver arrays: ([0-9.]+) MB \(([0-9]+) bytes per particle\)", re.M)
 _BALANCE = re.compile(r"^balance: max/mean particles per rank ([0-9.]+) at start, ([0-9.]+) at the end; (\d+) re-balance",
                       re.M)
@@ -201,6 +203,7 @@ def parse_run(text):
               startup_s, rebuilds
     cpu_s, cpu_percent      (the loop's CPU time per rank, max, and its share of the wall time)
     time_per_step           (that line's text after the colon), phases {name: (ms per step, % of loop)}
+    force_kinds             {bond|pair|wall|body force: ms per step} (the "forces by model kind" line)
     arrays_mb, bytes_per_particle   (the solver's arrays)
     balance_start, balance_end, rebalances   (several ranks)
     output {checkpoints|frames|fields: (files, MB, write s)}, compute_wait_s, io_cpu_s, io_wall_s
@@ -231,6 +234,9 @@ def parse_run(text):
         r["time_per_step"] = m.group(1).strip()
         r["phases"] = {p.group(1).strip(): (float(p.group(2)), float(p.group(3)))
                        for p in _PHASE.finditer(m.group(1))}
+    m = _KINDS.search(text)
+    if m:
+        r["force_kinds"] = {k.group(1).strip(): float(k.group(2)) for k in _KIND_TIME.finditer(m.group(1))}
     m = _ARRAYS.search(text)
     if m:
         r.update(arrays_mb=float(m.group(1)), bytes_per_particle=int(m.group(2)))

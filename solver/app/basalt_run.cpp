@@ -13,6 +13,7 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
@@ -22,6 +23,7 @@
 #include <limits>
 #include <memory>
 #include <optional>
+#include <string>
 
 #include "basalt/io/checkpoint.hpp"
 #include "basalt/io/checkpoint_rows.hpp"
@@ -334,6 +336,7 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
   const double cpu0 = cpu_seconds();
   // The phases of the loop alone: the start-up's first rebuild and force evaluation are timed too.
   const basalt::solver::PhaseTimes before = sim->times();
+  const std::array<double, 4> kinds_before = sim->force_seconds_by_kind();
   std::optional<std::string> run_error;
   if (client.error() && !cfg.continue_on_error) {
     run_error = *client.error();
@@ -377,6 +380,16 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
   const std::vector<double> by_rank =
       comm.size() > 1 ? comm.all_gather({t.forces, t.neighbor, t.communication, t.integration, t.output})
                       : std::vector<double>{};
+  // The forces phase by model kind (each kind's largest time over the ranks), for the roofline
+  // (tools/bench/roofline.py): the kinds' sum is the forces phase less its bookkeeping (zeroing, fixed
+  // particles, the ghost poke).
+  std::string kind_line = "forces by model kind:";
+  for (std::size_t k = 0; k < 4; ++k) {
+    const double s = comm.max(sim->force_seconds_by_kind()[k] - kinds_before[k]);
+    kind_line +=
+        fmt::format(" {} {:.4f} ms{}", basalt::solver::kind_name(static_cast<basalt::solver::ModelKind>(k)),
+                    1e3 * s / n, k + 1 < 4 ? "," : "");
+  }
   const double mem = comm.sum(double(sim->memory_bytes()));
   const double imbalance_end = sim->imbalance();
   if (root) {
@@ -394,6 +407,7 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
                           1e3 * parts[k] / n, 100 * parts[k] / std::max(loop, 1e-12),
                           k + 1 < basalt::run::kPhases ? "," : "");
     fmt::print("{}\n", line);
+    fmt::print("{}\n", kind_line);
     if (comm.size() > 1) fmt::print("{}", basalt::run::rank_spread(by_rank, n));
     fmt::print("solver arrays: {:.1f} MB ({:.0f} bytes per particle)\n", mem / 1e6,
                mem / double(sim->total_particles()));

@@ -51,6 +51,7 @@ def test_parse_run_one_rank():
     assert list(r["phases"]) == PHASES, r["phases"]
     assert r["phases"]["forces"] == (0.2059, 61.3) and r["phases"]["output"] == (0.0004, 0.1), r["phases"]
     assert r["time_per_step"].startswith("forces "), r["time_per_step"]
+    assert r["force_kinds"] == {"bond": 0.15, "pair": 0.04, "wall": 0.01, "body force": 0.0}, r["force_kinds"]
     assert r["arrays_mb"] == 2.1 and r["bytes_per_particle"] == 238, r
     assert set(r["output"]) == {"checkpoints", "frames", "fields"}, r["output"]
     assert r["output"]["fields"] == (1, 0.0, 0.0) and r["output"]["checkpoints"][0] == 0, r["output"]
@@ -218,6 +219,11 @@ def live_run(exe):
                     "cpu_s", "phases", "bytes_per_particle", "output", "compute_wait_s"):
             assert key in r, f"basalt-run's output has no '{key}' for the parser:\n{p.stdout}"
         assert r["particles"] == 8948 and r["loop_steps"] == 20 and list(r["phases"]) == PHASES, r
+        # the forces phase by model kind: the wave's bonds, contacts and wall, no body force; their sum is
+        # within the forces phase (printed to 0.1 us: rounding)
+        kinds = r["force_kinds"]
+        assert list(kinds) == ["bond", "pair", "wall", "body force"] and kinds["bond"] > 0, kinds
+        assert kinds["body force"] == 0 and sum(kinds.values()) <= r["phases"]["forces"][0] + 4e-4, (kinds, r)
         assert p.time["max_rss_kb"] > 0 and p.time["exit_status"] == 0, p.time
         c = bt.read_fields(d)
         assert c["step"] == list(range(1, 21)) and "kinetic_energy" in c, c

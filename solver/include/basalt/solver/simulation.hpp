@@ -154,6 +154,8 @@ class Simulation {
   }
   const Bonds<Real>& bonds() const { return bonds_; }
   const PairList& own_pairs() const { return forces_.own_pairs(); }
+  /// Seconds of force computation by model kind (bond, pair, wall, body), summed since construction.
+  const std::array<double, 4>& force_seconds_by_kind() const { return forces_.kind_seconds(); }
   const PairList& ghost_pairs() const { return forces_.ghost_pairs(); }
   const Decomposition& decomposition() const { return *dec_; }
   const Comm& comm() const { return dec_->comm(); }

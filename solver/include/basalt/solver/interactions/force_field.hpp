@@ -16,6 +16,7 @@
 #include "basalt/solver/neighbor/cell_grid.hpp"
 #include "basalt/solver/neighbor/verlet_list.hpp"
 #include "basalt/solver/scene/scene.hpp"
+#include "basalt/solver/timers.hpp"
 
 namespace basalt::solver {
 
@@ -90,17 +91,24 @@ class ForceField {
   /// Adds the forces of one part (Part::owned, then Part::ghost) and, with `energy`, the potentials.
   /// In the owned part `poke()` is called once between the bond models and the others (the ghost
   /// refresh in flight moves along while pairs are computed).
+  /// Each compute's time goes to its model kind (kind_seconds()); the poke's to none.
   template <class Poke>
   void add(ForceState<Real>& s, Part part, bool energy, bool advance, Poke&& poke) {
     bool poked = part != Part::owned;
+    Stopwatch sw;
     for (std::size_t k = 0; k < computes_.size(); ++k) {
       if (!poked && computes_[k]->kind() != ModelKind::bond) {
         poke();
         poked = true;
+        sw.lap();
       }
       pe_[compute_term_[k]] += computes_[k]->compute(s, part, energy, advance);
+      kind_seconds_[static_cast<std::size_t>(computes_[k]->kind())] += sw.lap();
     }
   }
+  /// Seconds spent in add() by the computes of each model kind (indexed by ModelKind: bond, pair, wall,
+  /// body), summed since construction: what basalt-run's "forces by model kind" line reports.
+  const std::array<double, 4>& kind_seconds() const { return kind_seconds_; }
 
   // Rebuilds.
   /// Before a rebuild (ghosts still present): contact histories into the pending records.
@@ -135,6 +143,7 @@ class ForceField {
   Exclusions exclusions_;
   Ledger ledger_;
   std::vector<std::size_t> compute_term_;  ///< the ledger term of each compute's potential
+  std::array<double, 4> kind_seconds_{};   ///< kind_seconds()
   std::size_t kinetic_term_ = 0, wall_work_term_ = 0;
   static constexpr std::size_t kNoTerm = std::size_t(-1);
   std::vector<char> body_term_;
