@@ -54,6 +54,30 @@ std::vector<Age> contact_ages(const Simulation<double>& sim, MPI_Comm comm) {
   return ages;
 }
 
+/// Collective: the history records of all ranks, each rank's own counted (not merged).
+int record_count(const Simulation<double>& sim, MPI_Comm comm) {
+  int mine = 0;
+  for (const auto& c : sim.force_computes()) {
+    ContactRecords r;
+    c->history_records(sim.particles(), r);
+    mine += static_cast<int>(r.size());
+  }
+  int all = 0;
+  MPI_Allreduce(&mine, &all, 1, MPI_INT, MPI_SUM, comm);
+  return all;
+}
+
+/// Collective: the rank owning particle `id`.
+int owner(const Simulation<double>& sim, std::int64_t id, MPI_Comm comm) {
+  int rank = 0, mine = -1, o = -1;
+  MPI_Comm_rank(comm, &rank);
+  const auto& p = sim.particles();
+  for (std::size_t i = 0; i < p.n_owned; ++i)
+    if (p.id[i] == id) mine = rank;
+  MPI_Allreduce(&mine, &o, 1, MPI_INT, MPI_MAX, comm);
+  return o;
+}
+
 /// Collective: position x and whether particle `id` is owned here (sums over ranks).
 double position_x(const Simulation<double>& sim, std::int64_t id, MPI_Comm comm) {
   const auto& p = sim.particles();
@@ -94,7 +118,7 @@ saturation = 50
   sim.state_changed();
 
   double expected = 0;  // steps in contact, counted here from the positions
-  int touching_steps = 0, crossed_while_touching = 0;
+  int touching_steps = 0, crossed_while_touching = 0, split_steps = 0;
   double last_x1 = position_x(sim, 1, basalt::test::world());
   for (int step = 1; step <= 400; ++step) {
     sim.step();
@@ -114,11 +138,20 @@ saturation = 50
       age = s;
     }
     EXPECT_LE(ages.size(), 1u) << "step " << step << ": a contact recorded twice";
+    // Each rank listing the contact records its own history of it (ForceCompute::history_records): a
+    // contact between two ranks' particles twice, one within a rank once.
+    if (touching) {
+      const int listing =
+          owner(sim, 1, basalt::test::world()) != owner(sim, 2, basalt::test::world()) ? 2 : 1;
+      EXPECT_EQ(record_count(sim, basalt::test::world()), listing) << "step " << step;
+      split_steps += listing == 2;
+    }
     ASSERT_EQ(age, expected) << "step " << step;
   }
   EXPECT_GT(touching_steps, 100) << "the spheres must have collided";
   if (n == 2) {
     EXPECT_EQ(crossed_while_touching, 1) << "sphere 1 must change rank during the contact";
+    EXPECT_GT(split_steps, 0) << "the contact must have been between two ranks' particles";
   }
   // The contact ended: both move apart, the faster one is now the right one.
   EXPECT_GT(position_x(sim, 2, basalt::test::world()) - position_x(sim, 1, basalt::test::world()), 1.0);

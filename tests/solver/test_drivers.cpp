@@ -7,7 +7,12 @@
 // - contact records go out and come back through the helpers unchanged, flipped when found the other way
 //   round, the cleared histories (+0 bits only) left out;
 // - a bond's break record gives the same point from either end, in double whatever the precision of the
-//   run (the rotational bond driver summed the radii and took the difference in Real).
+//   run (the rotational bond driver summed the radii and took the difference in Real);
+// - the pair driver counts the contacts sliding at a real step over both parts of the step (owned pairs,
+//   then pairs to a ghost), afresh each real step, and keeps the count through a step that is not real
+//   (one rule for every contact driver: ContactDriver::start_step), pair by pair and in lanes alike;
+// - a scalar law's pair loop tallies the parting energy of a history lost when its pair stops interacting
+//   (a JKR neck that breaks), as the velocity-dependent loops do (the copy in the scalar loop ignored it).
 #include <gtest/gtest.h>
 
 #include <any>
@@ -19,7 +24,10 @@
 #include "basalt/solver/interactions/driver_base.hpp"
 #include "basalt/solver/interactions/history_records.hpp"
 #include "basalt/solver/interactions/pair_driver.hpp"
+#include "basalt/solver/models/friction.hpp"
+#include "basalt/solver/models/hertz_mindlin.hpp"
 #include "basalt/solver/models/jkr.hpp"
+#include "scene_runs.hpp"
 
 using namespace basalt::solver;
 
@@ -147,4 +155,82 @@ void expect_break_point_from_either_end() {
 TEST(Drivers, BreakRecordIsTheSamePointFromEitherEnd) {
   expect_break_point_from_either_end<double>();
   expect_break_point_from_either_end<float>();
+}
+
+namespace {
+/// Sphere 0 touching sphere 1 (owned) and sphere 2 (a ghost) on either side along x, both sliding past it
+/// along y; each pair listed once, from sphere 0.
+struct SlidingPair {
+  Particles<double> p;
+  PairList own, ghost;
+  Bonds<double> bonds;
+  std::vector<BrokenBond> broken;
+  Walls walls{std::vector<WallSpec>{}};
+  SlidingPair() {
+    p.push_owned(0, 0.0, 0.0, 0.0, 1.0, 0, 1.0);
+    p.push_owned(1, 1.9, 0.0, 0.0, 1.0, 0, 1.0, 0.0, 1.0);
+    p.push_owned(2, -1.9, 0.0, 0.0, 1.0, 0, 1.0, 0.0, 1.0);
+    p.n_owned = 2;  // sphere 2 is a ghost
+    own.offset = {0, 1, 1};
+    own.neigh = {1};
+    own.index_loose();
+    ghost.offset = {0, 1, 1};
+    ghost.neigh = {2};
+    ghost.index_loose();
+  }
+  /// One step of the driver: the owned part, then the ghost part.
+  void step(ForceCompute<double>& d, bool advance) {
+    ForceState<double> s{p, bonds, broken, walls};
+    d.compute(s, Part::owned, false, advance);
+    d.compute(s, Part::ghost, false, advance);
+  }
+};
+
+template <class Model>
+void expect_both_parts_counted(const std::string& law) {
+  SlidingPair s;
+  const auto scene =
+      basalt::test::scene_from("[run]\ndt = 0.01\nsteps = 0\nskin = 0.1\n[[interactions]]\n" + law);
+  PairDriver<double, Model> driver(scene.contacts);
+  driver.set_time_step(0.01);
+  driver.rebuild(PairLists<double>{s.p, s.own, s.ghost, 1, {}}, 0);
+  for (int step = 0; step < 3; ++step) {
+    s.step(driver, true);
+    EXPECT_EQ(driver.sliding_contacts(), 2U)
+        << law << "step " << step << ": the owned pair and the pair to a ghost";
+  }
+  s.step(driver, false);
+  EXPECT_EQ(driver.sliding_contacts(), 2U) << law << "a step that is not real counts nothing";
+}
+}  // namespace
+
+TEST(Drivers, SlidingContactsCountBothPartsOfARealStepOnce) {
+  // Pair by pair (a scalar contact()), and in lanes (contact_lanes).
+  expect_both_parts_counted<Friction>("type = \"friction\"\nK = 1.0\nKs = 1.0\nmu = 0.01\n");
+  expect_both_parts_counted<HertzMindlin>("type = \"hertz_mindlin\"\nE = 1.0e4\nnu = 0.25\nmu = 0.01\n");
+}
+
+TEST(Drivers, ScalarLoopTalliesTheEnergyOfANeckThatBreaks) {
+  TwoSpheres s(false);
+  PairDriver<double, Jkr> driver({jkr_group()});
+  driver.rebuild(PairLists<double>{s.p, s.own, s.ghost, 1, {}}, 0);
+  Bonds<double> bonds;
+  std::vector<BrokenBond> broken;
+  Walls walls{std::vector<WallSpec>{}};
+  ForceState<double> st{s.p, bonds, broken, walls};
+  driver.compute(st, Part::owned, false, true);  // the spheres overlap: a neck forms
+  ContactRecords neck;
+  driver.history_records(s.p, neck);
+  ASSERT_EQ(neck.size(), 1U);
+  const double held = neck.at(0)[1];
+  ASSERT_GT(held, 0.0);
+  EXPECT_EQ(driver.dissipated(), 0.0);
+  s.p.x[1] = 5.0;  // far beyond the neck's reach, still listed
+  driver.compute(st, Part::owned, false, false);
+  EXPECT_EQ(driver.dissipated(), 0.0) << "a step that is not real changes no history";
+  driver.compute(st, Part::owned, false, true);
+  EXPECT_EQ(driver.dissipated(), held) << "the neck broke: what it held is dissipated";
+  ContactRecords none;
+  driver.history_records(s.p, none);
+  EXPECT_EQ(none.size(), 0U) << "and its history cleared";
 }

@@ -101,8 +101,10 @@ class ForceCompute {
   virtual void save_history(const Particles<Real>&) {}
   /// Records waiting for the next rebuild (carried by migration, filled by a restart); null: no history.
   virtual ContactRecords* pending() { return nullptr; }
-  /// This rank's history records for output: each contact once across ranks (owned-owned pairs, and
-  /// owned-ghost pairs by the rank owning the lower id); nothing without history.
+  /// This rank's history records for output (checkpoints): every contact it lists whose history holds
+  /// something, owned-ghost pairs included, so that a contact between two ranks' particles is written by
+  /// both, each with its own history in its own orientation (a restart gives each rank its own back:
+  /// contact_history.hpp, docs/formats.md); nothing without history.
   virtual void history_records(const Particles<Real>&, ContactRecords&) const {}
   /// Bytes of history per contact (0: none).
   virtual std::size_t history_bytes() const { return 0; }

@@ -18,6 +18,7 @@
 
 #include "basalt/solver/interactions/driver_base.hpp"
 #include "basalt/solver/interactions/history_records.hpp"
+#include "basalt/solver/interactions/lane_pass.hpp"
 #include "basalt/solver/models/contract.hpp"
 
 namespace basalt::solver {
@@ -433,16 +434,12 @@ class PairDriver final : public ContactDriver<Real, Model, PairDriver<Real, Mode
     return energy;
   }
 
-  /// rows() for a model with contact_lanes and one group: the pairs in contact are gathered kLaneWidth at
-  /// a time in list order, evaluated side by side, and their forces and torques added in list order, to
-  /// both particles in memory (summing particle i's row in registers, as rows() does, cost a mispredicted
-  /// branch at every row's end: 0.92x the time without it). Every contact goes through the lanes
-  /// (a short last batch repeats its last pair), so a pair's force does not depend on the rank or on
-  /// where in a batch it falls.
+  /// rows() for a model with contact_lanes and one group: the listed pairs in list order through the lane
+  /// pass (lane_pass.hpp), their forces and torques added in list order to both particles in memory (summing
+  /// particle i's row in registers, as rows() does, cost a mispredicted branch at every row's end: 0.92x the
+  /// time without it).
   template <bool Energy, bool Newton, bool Advance, bool Rot, bool Marked>
   double batches(Particles<Real>& p, const PairList& list, [[maybe_unused]] History* hist) {
-    double energy = 0, dissipated = 0;
-    std::size_t sliding = 0;
     const std::size_t n = p.n_owned;
     if (n == 0) return 0;  // (a rank without particles may have no list offsets at all)
     const std::uint32_t* __restrict off = list.offset.data();
@@ -462,62 +459,16 @@ class PairDriver final : public ContactDriver<Real, Model, PairDriver<Real, Mode
     const Coeffs c = coeffs_[0];
     auto& L = lanes_;
     L.dt = dt_;
-    // A batch's pairs: row, neighbour and list entry. The finding loop writes nothing else (a store per
-    // value costs more than loading it again): gather() loads the lanes' inputs from these, kLaneWidth
-    // at a time in vector registers.
-    alignas(64) std::uint32_t lane_i[kLaneWidth], lane_j[kLaneWidth], lane_e[kLaneWidth];
-    // The batch's size comes in as an argument, and the pairs that part are tallied apart, so that the
-    // gathering loop keeps both in registers (a captured counter would go through memory every pair).
-    const auto run = [&](const int filled) {
-      Model::template contact_lanes<Advance>(c, L);
-      for (int l = 0; l < filled; ++l) {
-        const std::size_t i = lane_i[l], j = lane_j[l];
-        const Real gx = L.fx[l], gy = L.fy[l], gz = L.fz[l];
-        fx[i] += gx, fy[i] += gy, fz[i] += gz;
-        if constexpr (Newton) fx[j] -= gx, fy[j] -= gy, fz[j] -= gz;
-        if constexpr (Rot) {
-          tx[i] += L.tix[l], ty[i] += L.tiy[l], tz[i] += L.tiz[l];
-          if constexpr (Newton) tx[j] += L.tjx[l], ty[j] += L.tjy[l], tz[j] += L.tjz[l];
-        }
-        if constexpr (kHistory && Advance) hist[lane_e[l]] = L.h[l];
-        if (Newton || id[i] < id[j]) {
-          if constexpr (Advance) {
-            dissipated += L.dissipated[l];
-            sliding += L.sliding[l] != Real(0);
-          }
-          if constexpr (Energy) {
-            ContactKinematics<Real> k{};
-            k.dx = L.dx[l], k.dy = L.dy[l], k.dz = L.dz[l], k.r = L.r[l], k.ri = L.ri[l], k.rj = L.rj[l];
-            energy += double(Model::energy(c, L.h[l], k));
-          }
-        }
-      }
-    };
-    // The lanes' inputs, once a batch's pairs are known (a short last batch repeats its last pair): particle
-    // data of both ends and the history. Every listed pair up to `last` has then been seen: the history of
-    // those that do not touch is cleared (the pairs that do get theirs back at the scatter).
-    std::size_t cleared = off[0];  // histories before this one are cleared
-    const auto complete = [&](const int filled, const std::size_t last) {
-      for (int l = filled; l < kLaneWidth; ++l)
-        lane_i[l] = lane_i[filled - 1], lane_j[l] = lane_j[filled - 1], lane_e[l] = lane_e[filled - 1];
-      gather<Rot>(p, lane_i, lane_j, L);
-      if constexpr (kHistory)
-        for (int l = 0; l < kLaneWidth; ++l) L.h[l] = hist[lane_e[l]];
-      if constexpr (kHistory && Advance) {
-        for (std::size_t e = cleared; e < last; ++e) Model::apart(hist[e]);
-        cleared = last;
-      }
-    };
-    // The pairs in contact are found with positions and radii alone, written to the next lane whether
-    // they touch or not and kept only if they do: no branch to mispredict, and little work for a listed
-    // pair apart (a third of them in a settled pile). What a listed pair apart still held is lost with its
-    // history (a shear spring's energy): dissipated.
-    // One loop over the listed pairs, each pair's row read from rows_ (a loop per row mispredicted its end
-    // at nearly every row: a settled pile's rows have 3 or 4 pairs).
-    int filled = 0;
-    double parted = 0;
+    // A batch's pairs: row and neighbour. The finding loop writes nothing else (a store per value costs more
+    // than loading it again): gather() loads the lanes' inputs from these, kLaneWidth at a time in vector
+    // registers.
+    alignas(64) std::uint32_t lane_i[kLaneWidth], lane_j[kLaneWidth];
+    // The pairs in contact are found with positions and radii alone, written to the next lane whether they
+    // touch or not: no branch to mispredict, and little work for a listed pair apart (a third of them in a
+    // settled pile). One loop over the listed pairs, each pair's row read from rows_ (a loop per row
+    // mispredicted its end at nearly every row: a settled pile's rows have 3 or 4 pairs).
     const std::uint32_t* __restrict row = rows_;
-    for (std::uint32_t e = off[0]; e < off[n]; ++e) {
+    const auto find = [&](const std::uint32_t e, const int l) {
       const std::uint32_t i = row[e];
       const auto j = static_cast<std::uint32_t>(nb[e]);
       const Real dx = x[i] - x[j], dy = y[i] - y[j], dz = z[i] - z[j];
@@ -525,29 +476,34 @@ class PairDriver final : public ContactDriver<Real, Model, PairDriver<Real, Mode
       const Real rsum = rad[i] + rad[j];
       bool touch = r2 < rsum * rsum;
       if constexpr (Marked) touch = touch && bonded[e] == 0;  // (a bonded pair acts by its bond)
-      const int l = filled;
-      lane_i[l] = i, lane_j[l] = j, lane_e[l] = e;
-      if constexpr (kHistory && Advance) {
-        const double lost = Model::parting_energy(c, hist[e]);
-        parted += !touch && (Newton || id[i] < id[j]) ? lost : 0.0;
+      lane_i[l] = i, lane_j[l] = j;
+      return LaneFound{touch, Newton || id[i] < id[j]};
+    };
+    const auto load = [&](const int filled) {
+      Pass::pad(lane_i, filled), Pass::pad(lane_j, filled);
+      gather<Rot>(p, lane_i, lane_j, L);
+    };
+    const auto add = [&](const int l) {
+      const std::size_t i = lane_i[l], j = lane_j[l];
+      const Real gx = L.fx[l], gy = L.fy[l], gz = L.fz[l];
+      fx[i] += gx, fy[i] += gy, fz[i] += gz;
+      if constexpr (Newton) fx[j] -= gx, fy[j] -= gy, fz[j] -= gz;
+      if constexpr (Rot) {
+        tx[i] += L.tix[l], ty[i] += L.tiy[l], tz[i] += L.tiz[l];
+        if constexpr (Newton) tx[j] += L.tjx[l], ty[j] += L.tjy[l], tz[j] += L.tjz[l];
       }
-      filled += touch;
-      if (filled == kLaneWidth) {
-        complete(filled, std::size_t(e) + 1);
-        run(filled);
-        filled = 0;
-      }
-    }
-    if (filled > 0) {
-      complete(filled, off[n]);
-      run(filled);
-    } else if constexpr (kHistory && Advance) {
-      for (std::size_t e = cleared; e < off[n]; ++e) Model::apart(hist[e]);
-    }
-    dissipated += parted;
-    dissipated_ += dissipated;
-    sliding_ += sliding;
-    return energy;
+      return Newton || id[i] < id[j];
+    };
+    const auto kinematics = [&](const int l) {
+      ContactKinematics<Real> k{};
+      k.dx = L.dx[l], k.dy = L.dy[l], k.dz = L.dz[l], k.r = L.r[l], k.ri = L.ri[l], k.rj = L.rj[l];
+      return k;
+    };
+    LaneTally t;
+    Pass::template run<Energy, Advance>(c, L, hist, off[0], off[n], t, find, load, add, kinematics);
+    dissipated_ += t.dissipated + t.parted;
+    sliding_ += t.sliding;
+    return t.energy;
   }
 
   /// The lanes' particle inputs of pairs (i[l], j[l]), loaded in vector registers. The lanes take
@@ -706,6 +662,7 @@ class PairDriver final : public ContactDriver<Real, Model, PairDriver<Real, Mode
   static constexpr bool kLanes = requires(const Coeffs& c, ContactLanes<Real, kLaneWidth, History>& b) {
     Model::template contact_lanes<true>(c, b);
   };
+  using Pass = LanePass<Real, Model, ContactLanes<Real, kLaneWidth, History>>;
   struct NoLanes {};
   [[no_unique_address]] std::conditional_t<kLanes, ContactLanes<Real, kLaneWidth, History>, NoLanes> lanes_{};
   std::vector<TagFilter> tags_;

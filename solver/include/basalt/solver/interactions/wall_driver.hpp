@@ -16,6 +16,7 @@
 
 #include "basalt/solver/interactions/driver_base.hpp"
 #include "basalt/solver/interactions/history_records.hpp"
+#include "basalt/solver/interactions/lane_pass.hpp"
 
 namespace basalt::solver {
 
@@ -138,17 +139,12 @@ class WallDriver final : public ContactDriver<Real, Model, WallDriver<Real, Mode
                              : loop_kinematic<Energy, Advance, false>(p, walls);
   }
 
-  /// loop_kinematic() for a model with contact_lanes: each wall's candidates in contact are found with
-  /// positions and radii alone (their data asked for kAhead candidates ahead), gathered kLaneWidth at a time
-  /// in candidate order, evaluated side by side, and their forces added in that order (a short last batch
-  /// repeats its last contact and drops it). Every contact goes through the lanes, so a contact's force does
-  /// not depend on the rank or on its place in a batch. The histories of the candidates apart are cleared
-  /// batch by batch (the contacts get theirs back at the scatter).
+  /// loop_kinematic() for a model with contact_lanes: each wall's candidates in candidate order through the
+  /// lane pass (lane_pass.hpp), their particle data asked for kAhead candidates ahead, their forces added in
+  /// that order.
   template <bool Energy, bool Advance, bool Rot>
   double lanes(Particles<Real>& p, Walls& walls) {
     walls_ = &walls;
-    double energy = 0, dissipated = 0, parted = 0;
-    std::size_t sliding = 0;
     const Real* __restrict x = p.x.data();
     const Real* __restrict y = p.y.data();
     const Real* __restrict z = p.z.data();
@@ -161,8 +157,9 @@ class WallDriver final : public ContactDriver<Real, Model, WallDriver<Real, Mode
     [[maybe_unused]] Real* __restrict tz = Rot ? p.tz.data() : nullptr;
     auto& L = lanes_;
     L.dt = dt_;
-    alignas(64) std::uint32_t lane_i[kLaneWidth], lane_c[kLaneWidth];
+    alignas(64) std::uint32_t lane_i[kLaneWidth];
     const auto ahead = lane_arrays<Rot>(p);
+    LaneTally t;  // (over all walls: the sums run on from wall to wall)
     for (std::size_t k = 0; k < index_.size(); ++k) {
       const std::size_t w = index_[k];
       const auto c = coeffs_[k];
@@ -170,71 +167,45 @@ class WallDriver final : public ContactDriver<Real, Model, WallDriver<Real, Mode
       L.nx = nx, L.ny = ny, L.nz = nz;
       double wfx = 0, wfy = 0, wfz = 0;
       const auto& cand = walls.candidates(w);
-      History* __restrict hs = histories(k, cand.size());
       const auto* __restrict ci_of = cand.data();
       const std::size_t nc = cand.size();
-      std::size_t cleared = 0;  // histories before this candidate are cleared
-      const auto complete = [&](const int filled, const std::size_t last) {
-        for (int l = filled; l < kLaneWidth; ++l)
-          lane_i[l] = lane_i[filled - 1], lane_c[l] = lane_c[filled - 1], L.d[l] = L.d[filled - 1];
-        gather<Rot>(p, lane_i, vwx, vwy, vwz, L);
-        for (int l = 0; l < kLaneWidth; ++l) L.h[l] = hs[lane_c[l]];
-        if constexpr (Advance) {
-          for (std::size_t e = cleared; e < last; ++e) hs[e] = History{};
-          cleared = last;
-        }
-      };
-      const auto run = [&](const int filled) {
-        Model::template contact_lanes<Advance>(c, L);
-        for (int l = 0; l < filled; ++l) {
-          const std::size_t i = lane_i[l];
-          const Real gx = L.fx[l], gy = L.fy[l], gz = L.fz[l];
-          fx[i] += gx, fy[i] += gy, fz[i] += gz;
-          if constexpr (Rot) tx[i] += L.tx[l], ty[i] += L.ty[l], tz[i] += L.tz[l];
-          wfx -= double(gx);
-          wfy -= double(gy);
-          wfz -= double(gz);
-          if constexpr (Advance) {
-            hs[lane_c[l]] = L.h[l];
-            dissipated += L.dissipated[l];
-            sliding += L.sliding[l] != Real(0);
-          }
-          if constexpr (Energy) {
-            WallKinematics<Real> kin{};
-            kin.d = L.d[l], kin.r = L.r[l];
-            energy += double(Model::energy(c, L.h[l], kin));
-          }
-        }
-      };
-      int filled = 0;
-      for (std::size_t ci = 0; ci < nc; ++ci) {
+      // The contacts are found with positions and radii alone; the lanes see the distance that found them.
+      const auto find = [&](const std::uint32_t ci, const int l) {
         if (ci + kAhead < nc) {
           const auto a = static_cast<std::size_t>(ci_of[ci + kAhead]);
           for (const Real* f : ahead) __builtin_prefetch(f + a);
         }
         const auto i = static_cast<std::uint32_t>(ci_of[ci]);
         const Real d = (x[i] - px) * nx + (y[i] - py) * ny + (z[i] - pz) * nz;
-        const bool touch = d < rad[i];
-        lane_i[filled] = i, lane_c[filled] = static_cast<std::uint32_t>(ci), L.d[filled] = d;
-        if constexpr (Advance) parted += touch ? 0.0 : Model::parting_energy(c, hs[ci]);
-        filled += touch;
-        if (filled == kLaneWidth) {
-          complete(filled, ci + 1);
-          run(filled);
-          filled = 0;
-        }
-      }
-      if (filled > 0) {
-        complete(filled, nc);
-        run(filled);
-      } else if constexpr (Advance) {
-        for (std::size_t e = cleared; e < nc; ++e) hs[e] = History{};
-      }
+        lane_i[l] = i, L.d[l] = d;
+        return LaneFound{d < rad[i], true};
+      };
+      const auto load = [&](const int filled) {
+        Pass::pad(lane_i, filled), Pass::pad(L.d, filled);
+        gather<Rot>(p, lane_i, vwx, vwy, vwz, L);
+      };
+      const auto add = [&](const int l) {
+        const std::size_t i = lane_i[l];
+        const Real gx = L.fx[l], gy = L.fy[l], gz = L.fz[l];
+        fx[i] += gx, fy[i] += gy, fz[i] += gz;
+        if constexpr (Rot) tx[i] += L.tx[l], ty[i] += L.ty[l], tz[i] += L.tz[l];
+        wfx -= double(gx);
+        wfy -= double(gy);
+        wfz -= double(gz);
+        return true;
+      };
+      const auto kinematics = [&](const int l) {
+        WallKinematics<Real> kin{};
+        kin.d = L.d[l], kin.r = L.r[l];
+        return kin;
+      };
+      Pass::template run<Energy, Advance>(c, L, histories(k, nc), 0, static_cast<std::uint32_t>(nc), t, find,
+                                          load, add, kinematics);
       walls.force(w) = {wfx, wfy, wfz};
     }
-    dissipated_ += dissipated + parted;
-    if (Advance) sliding_ += sliding;
-    return energy;
+    dissipated_ += t.dissipated + t.parted;
+    if (Advance) sliding_ += t.sliding;
+    return t.energy;
   }
 
   /// Candidates ahead whose particle data the finding loop asks for (lanes(): the candidates are spread
@@ -356,6 +327,7 @@ class WallDriver final : public ContactDriver<Real, Model, WallDriver<Real, Mode
     return energy;
   }
 
+  using Pass = LanePass<Real, Model, Lanes>;
   struct NoLanes {};
   [[no_unique_address]] std::conditional_t<kLanes, Lanes, NoLanes> lanes_{};  ///< (with contact_lanes)
   using Base::coeffs_, Base::pending_, Base::dissipated_, Base::sliding_, Base::dt_;
