@@ -413,3 +413,95 @@ TEST(ContactStiffness, TimesTenThousandthAtAQuarterOfTheCriticalStepStops) {
   EXPECT_NE(msg.find("particle id 1 (radius 0.5) and wall \"floor\""), std::string::npos) << msg;
   EXPECT_LT(number_after(msg, "of the smaller radius), "), 10.0) << msg;
 }
+
+// ---------------------------------------------------------------------------------------------------
+// 3. Friction mu = 0, 1, 10: a sphere launched sliding at v0 = 0.5 along x, without spin, on a hertz_mindlin
+// floor under gravity 1, placed at Hertz's static overlap (e = 0.5, dt = 0.1 x critical). While it slips,
+// Coulomb's force decelerates it at mu g and spins it up at 5 mu g / (2 r); the slip ends at
+// t* = 2 v0 / (7 mu g), then it rolls at 5/7 v0 (a solid sphere). mu = 0: it slides at v0 for ever.
+namespace {
+
+struct Slide {
+  double v_half = 0, t_half = 0;  ///< speed at t* / 2 (mu > 0), and that time
+  double v_end = 0;               ///< speed after 3 t* (mu > 0) or 200 steps
+  bool finite = true;
+};
+
+Slide slide(double mu) {
+  const double g = 1, v0 = 0.5, m = mass_of(kR), Es = kE / (2 * (1 - kNu * kNu));
+  const double d = std::pow(3 * m * g / (4 * Es * std::sqrt(kR)), 2.0 / 3);
+  Geometry geo;
+  geo.add_particle(1, {0, 0, kR - d}, kR);
+  const auto scene = fmt::format(R"([run]
+dt_fraction = 0.1
+steps = 0
+skin = 0.05
+[[interactions]]
+type = "hertz_mindlin"
+E = {0}
+nu = {1}
+e = 0.5
+mu = {2}
+[[body_forces]]
+type = "gravity"
+acceleration = [0.0, 0.0, {3}]
+[[walls]]
+name = "floor"
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
+interaction = "hertz_mindlin"
+E = {0}
+nu = {1}
+e = 0.5
+mu = {2}
+)",
+                                 kE, kNu, mu, -g);
+  const auto opt = basalt::test::quiet();
+  Simulation<double> sim(basalt::test::scene_from(scene), geo, basalt::test::world(), opt);
+  set_velocity_of(sim, 1, {v0, 0, 0});
+  Slide out;
+  const double t_star = mu > 0 ? 2 * v0 / (7 * mu * g) : 0;
+  const auto half = static_cast<std::int64_t>(std::round(0.5 * t_star / sim.dt()));
+  const auto end = mu > 0 ? static_cast<std::int64_t>(3 * t_star / sim.dt()) + 200 : 200;
+  for (std::int64_t s = 1; s <= end; ++s) {
+    sim.run(1);
+    const auto st = basalt::test::gather_state(sim, 1, 1);
+    for (int c = 0; c < 3; ++c)
+      out.finite = out.finite && std::isfinite(st.x[0][c]) && std::isfinite(st.v[0][c]);
+    if (s == half) out.v_half = st.v[0][0], out.t_half = sim.time();
+    out.v_end = st.v[0][0];
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST(Friction, MuZeroSlidesAtItsSpeed) {
+  const auto r = slide(0);
+  EXPECT_TRUE(r.finite);
+  EXPECT_NEAR(r.v_end, 0.5, 1e-12);
+}
+
+// mu = 1: v(t* / 2) = v0 - mu g t within 1e-4 of v0 (measured 1e-6), then rolling at 5/7 v0 within 1e-3
+// (measured 4e-4 below: the tangential spring's oscillation as the slip stops).
+TEST(Friction, MuOneDeceleratesAtMuGThenRolls) {
+  const auto r = slide(1);
+  if (basalt::test::rank() == 0)
+    std::printf("mu 1: v(%.4g) = %.6f (mu g: %.6f), end %.6f (5/7 v0 %.6f)\n", r.t_half, r.v_half,
+                0.5 - r.t_half, r.v_end, 2.5 / 7);
+  EXPECT_TRUE(r.finite);
+  EXPECT_NEAR(r.v_half, 0.5 - 1.0 * r.t_half, 1e-4 * 0.5);
+  EXPECT_NEAR(r.v_end, 2.5 / 7, 1e-3 * 0.5);
+}
+
+// mu = 10: the slip lasts t* = 0.0143 (17 steps), decelerating at mu g = 10 (within 1e-4 of v0 at t* / 2);
+// then it sticks and rolls at 5/7 v0 within 1e-3.
+TEST(Friction, MuTenSticksAndRolls) {
+  const auto r = slide(10);
+  if (basalt::test::rank() == 0)
+    std::printf("mu 10: v(%.4g) = %.6f (mu g: %.6f), end %.6f (5/7 v0 %.6f)\n", r.t_half, r.v_half,
+                0.5 - 10 * r.t_half, r.v_end, 2.5 / 7);
+  EXPECT_NEAR(r.v_half, 0.5 - 10.0 * r.t_half, 1e-4 * 0.5);
+  EXPECT_TRUE(r.finite);
+  EXPECT_NEAR(r.v_end, 2.5 / 7, 1e-3 * 0.5);
+}
