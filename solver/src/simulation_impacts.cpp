@@ -18,7 +18,7 @@ void Simulation<Real>::check_impacts() {
   bool sees = false;  // (the same on every rank: the scene's models)
   for (const auto& c : forces_.computes()) sees = sees || c->sees_impacts();
   if (!sees) return;
-  Impact mine;
+  CollisionSeen mine;
   for (const auto& c : forces_.computes())
     if (c->sees_impacts())
       mine.merge(c->shortest_collision(p_, forces_.walls(), scene_.dt, scene_.fixed_tags));
@@ -55,7 +55,7 @@ void Simulation<Real>::check_impacts() {
     for (auto& x : v) x = comm().rank() == who ? x : 0.0;
     comm().sum_all(v);
   }
-  Impact s;
+  CollisionSeen s;
   s.steps = v[0], s.speed = v[1], s.overlap = v[2], s.duration = v[3], s.ra = v[4], s.rb = v[5];
   s.a = static_cast<std::int64_t>(v[6]), s.b = static_cast<std::int64_t>(v[7]),
   s.wall = static_cast<int>(v[8]);

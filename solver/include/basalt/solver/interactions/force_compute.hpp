@@ -94,8 +94,8 @@ class ForceCompute {
   /// that lasts the fewest steps of dt, with the counts of large overlaps (particles of the `fixed` tags
   /// count with an infinite mass).
   virtual bool sees_impacts() const { return false; }
-  virtual Impact shortest_collision(const Particles<Real>& /*p*/, const Walls& /*walls*/, double /*dt*/,
-                                    const std::vector<std::int64_t>& /*fixed*/) const {
+  virtual CollisionSeen shortest_collision(const Particles<Real>& /*p*/, const Walls& /*walls*/,
+                                           double /*dt*/, const std::vector<std::int64_t>& /*fixed*/) const {
     return {};
   }
   /// Adds forces of one part; returns the potential energy when `energy`. `advance`: a real step, so

@@ -141,9 +141,9 @@ class PairDriver final : public ContactDriver<Real, Model, PairDriver<Real, Mode
   /// Every listed unbonded pair of an owned particle, touching or meeting along straight paths: the
   /// collision of fewest steps, and the counts of collisions whose overlap passes 5 % and 20 % of the
   /// smaller radius (a pair across ranks counted by the rank owning the lower id).
-  Impact shortest_collision(const Particles<Real>& p, const Walls&, double dt,
-                            const std::vector<std::int64_t>& fixed) const override {
-    Impact worst;
+  CollisionSeen shortest_collision(const Particles<Real>& p, const Walls&, double dt,
+                                   const std::vector<std::int64_t>& fixed) const override {
+    CollisionSeen worst;
     if constexpr (kCollides) {
       if (own_ == nullptr) return worst;
       for (const PairList* list : {own_, ghost_})

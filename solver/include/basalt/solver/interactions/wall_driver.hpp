@@ -82,9 +82,9 @@ class WallDriver final : public ContactDriver<Real, Model, WallDriver<Real, Mode
   bool sees_impacts() const override { return kCollides; }
   /// Each wall's candidates touching it or moving towards it (relative to the wall): the collision of fewest
   /// steps, and the counts of collisions whose overlap passes 5 % and 20 % of the radius.
-  Impact shortest_collision(const Particles<Real>& p, const Walls& walls, double dt,
-                            const std::vector<std::int64_t>& fixed) const override {
-    Impact worst;
+  CollisionSeen shortest_collision(const Particles<Real>& p, const Walls& walls, double dt,
+                                   const std::vector<std::int64_t>& fixed) const override {
+    CollisionSeen worst;
     if constexpr (kCollides) {
       for (std::size_t k = 0; k < index_.size(); ++k) {
         const std::size_t w = index_[k];

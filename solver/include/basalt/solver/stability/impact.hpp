@@ -26,7 +26,7 @@ struct Collision {
 
 /// One collision, by the closed form of its model: of particles id a and b (b = -1 against wall number
 /// `wall`).
-struct Impact {
+struct CollisionSeen {
   double steps = std::numeric_limits<double>::infinity();  ///< duration / dt
   double speed = 0;    ///< normal impact speed (for a contact already touching: the speed of the same energy)
   double overlap = 0;  ///< largest overlap the collision reaches
@@ -40,7 +40,7 @@ struct Impact {
   double deepest = 0;
 
   /// Keeps the shorter collision, and counts the overlaps of `o`.
-  void merge(const Impact& o) {
+  void merge(const CollisionSeen& o) {
     above5 += o.above5;
     above20 += o.above20;
     deepest = deepest > o.deepest ? deepest : o.deepest;
@@ -96,7 +96,7 @@ inline bool approach(const double d[3], const double u[3], double rsum, double& 
 /// What the run has seen (Simulation::impacts()): the collision of fewest steps at any rebuild, the most
 /// collisions at one rebuild above 5 % and 20 % of a radius, and the deepest (overlap / smaller radius).
 struct ImpactReport {
-  Impact shortest;
+  CollisionSeen shortest;
   std::int64_t above5 = 0, above20 = 0;
   double deepest = 0;
   std::int64_t checks = 0;  ///< rebuilds at which it looked
