@@ -142,6 +142,7 @@ void Simulation<Real>::rebuild() {
   rebuild_step_ = step_;
   bond_broke_ = false;
   ++rebuilds_;
+  check_impacts();  // simulation_impacts.cpp: only scenes with a closed-form collision (hertz_mindlin)
   if constexpr (std::is_same_v<Real, float>)
     warn_far_positions();
   else

@@ -161,6 +161,8 @@ class Simulation {
   const Comm& comm() const { return dec_->comm(); }
   const PhaseTimes& times() const { return times_; }
   const StabilityReport& stability() const { return stability_; }
+  /// The collisions seen at the rebuilds (contact models with a closed form: check_impacts()).
+  const ImpactReport& impacts() const { return impacts_; }
   std::int64_t rebuilds() const { return rebuilds_; }
   /// Step of the last neighbour-list rebuild.
   std::int64_t last_rebuild_step() const { return rebuild_step_; }
@@ -342,6 +344,12 @@ class Simulation {
   /// worse than that (docs/stability.md, "Coordinates far from the origin"). Reads positions, bonds and pair
   /// lists; where the resolution is below 1e-12 (near the origin) only the positions.
   void warn_lost_strain();
+  /// Collective, at rebuilds, for scenes with a contact model that has a closed-form collision
+  /// (hertz_mindlin; simulation_impacts.cpp): stops the run when a collision, touching or ahead along
+  /// straight paths, lasts fewer than kImpactSteps steps of dt, naming the pair, the impact speed, the
+  /// overlap and the dt it needs (forced: a warning, once); warns once when a collision's overlap passes
+  /// 20 % of the smaller radius.
+  void check_impacts();
   /// The fraction of the scene's largest bond strain that rounding may take before warn_lost_strain warns.
   static constexpr double kStrainLossWarn = 1e-3;
   /// What the balancer reads and moves at this point of the run (LoadBalancer::Run).
@@ -507,6 +515,7 @@ class Simulation {
   bool strain_warned_ = false;   ///< warn_lost_strain() has warned
   double strain_max_ = 0;        ///< the largest bond or contact strain warn_lost_strain has seen (all ranks)
   bool far_warned_ = false;      ///< warn_far_positions() has warned (or the load check did at the start)
+  ImpactReport impacts_;         ///< check_impacts(): what the rebuilds saw
   LoadBalancer<Real> balancer_;  ///< run.balance: its state between rebuilds (parallel/load_balancer.hpp)
   bool mixed_ = false;           ///< run.precision = "mixed" (set by configure_particles())
   Origin origin_{};              ///< the frame's origin (mixed; zero otherwise)

@@ -15,6 +15,7 @@
 #include "basalt/solver/interactions/walls.hpp"
 #include "basalt/solver/models/model.hpp"
 #include "basalt/solver/neighbor/verlet_list.hpp"
+#include "basalt/solver/stability/impact.hpp"
 
 namespace basalt::solver {
 
@@ -88,6 +89,15 @@ class ForceCompute {
   /// Pair models: how far beyond ri + rj a pair of particles up to radius rmax can interact (0: only
   /// overlapping pairs; a cohesive neck reaches further, models/contract.hpp).
   virtual double reach(double /*rmax*/) const { return 0; }
+  /// Contact models with a closed-form collision (stability/impact.hpp): whether this one has it, and, at a
+  /// rebuild, the collision of this rank's owned particles (touching now, or meeting along straight paths)
+  /// that lasts the fewest steps of dt, with the counts of large overlaps (particles of the `fixed` tags
+  /// count with an infinite mass).
+  virtual bool sees_impacts() const { return false; }
+  virtual CollisionSeen shortest_collision(const Particles<Real>& /*p*/, const Walls& /*walls*/,
+                                           double /*dt*/, const std::vector<std::int64_t>& /*fixed*/) const {
+    return {};
+  }
   /// Adds forces of one part; returns the potential energy when `energy`. `advance`: a real step, so
   /// contact history moves on (a force evaluation outside the step, e.g. at start or restart, reads it).
   virtual double compute(ForceState<Real>& s, Part part, bool energy, bool advance) = 0;

@@ -8,6 +8,7 @@
 // listed pairs that do not interact, and Model::force reads it. A pair interacts when the model's
 // touching() says so (default: the spheres overlap); the model contract is models/contract.hpp.
 #include <cmath>
+#include <concepts>
 #include <cstdint>
 #include <cstring>
 #include <initializer_list>
@@ -132,6 +133,45 @@ class PairDriver final : public ContactDriver<Real, Model, PairDriver<Real, Mode
     if (own_ == nullptr) return;
     collect_pairs<Model>(p, *own_, hist_own_, out);
     collect_pairs<Model>(p, *ghost_, hist_ghost_, out);
+  }
+  /// The model has a closed-form collision (Model::collision, stability/impact.hpp).
+  static constexpr bool kCollides = requires(const typename Base::Params& q) {
+    { Model::collision(q, 1.0, 1.0, 1.0, 0.0) } -> std::same_as<Collision>;
+  };
+  bool sees_impacts() const override { return kCollides; }
+  /// Every listed unbonded pair of an owned particle, touching or meeting along straight paths: the
+  /// collision of fewest steps, and the counts of collisions whose overlap passes 5 % and 20 % of the
+  /// smaller radius (a pair across ranks counted by the rank owning the lower id).
+  CollisionSeen shortest_collision(const Particles<Real>& p, const Walls&, double dt,
+                                   const std::vector<std::int64_t>& fixed) const override {
+    CollisionSeen worst;
+    if constexpr (kCollides) {
+      if (own_ == nullptr) return worst;
+      for (const PairList* list : {own_, ghost_})
+        for (std::size_t i = 0; i + 1 < list->offset.size() && i < p.n_owned; ++i)
+          for (auto e = list->offset[i]; e < list->offset[i + 1]; ++e) {
+            if (list->is_bonded(e)) continue;
+            const auto j = static_cast<std::size_t>(list->neigh[e]);
+            const double d[3] = {double(p.x[i]) - double(p.x[j]), double(p.y[i]) - double(p.y[j]),
+                                 double(p.z[i]) - double(p.z[j])};
+            const double u[3] = {double(p.vx[i]) - double(p.vx[j]), double(p.vy[i]) - double(p.vy[j]),
+                                 double(p.vz[i]) - double(p.vz[j])};
+            const double ri = double(p.radius[i]), rj = double(p.radius[j]);
+            double vn = 0, overlap = 0;
+            if (!approach(d, u, ri + rj, vn, overlap)) continue;
+            const auto g = uniform_ ? 0 : group_of(p.tag[i], p.tag[j]);
+            if (g < 0) continue;
+            const double m = 1 / ((fixed_tag(fixed, p.tag[i]) ? 0.0 : double(p.inv_mass[i])) +
+                                  (fixed_tag(fixed, p.tag[j]) ? 0.0 : double(p.inv_mass[j])));
+            const Collision c = Model::collision(this->params_[static_cast<std::size_t>(g)],
+                                                 ri * rj / (ri + rj), m, vn, overlap);
+            if (!(c.duration > 0)) continue;
+            if (list == own_ || p.id[i] < p.id[j]) worst.count(c.overlap, std::min(ri, rj));  // once per pair
+            if (!(c.duration / dt < worst.steps)) continue;
+            worst.set(c, dt, ri, rj, p.id[i], p.id[j], -1);
+          }
+    }
+    return worst;
   }
   std::size_t contacts() const override { return own_ ? own_->pairs() + ghost_->pairs() : 0; }
   std::size_t memory_bytes() const override {

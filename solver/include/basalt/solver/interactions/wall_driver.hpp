@@ -8,6 +8,7 @@
 // contact whose second id is -1 - wall index (docs/formats.md).
 #include <array>
 #include <cmath>
+#include <concepts>
 #include <cstdint>
 #include <cstring>
 #include <string_view>
@@ -74,6 +75,41 @@ class WallDriver final : public ContactDriver<Real, Model, WallDriver<Real, Mode
     if (!walls_) return;
     for (std::size_t k = 0; k < index_.size(); ++k)
       collect_candidates(p, walls_->candidates(index_[k]), hist_[k], wall_id(k), out);
+  }
+  /// The model has a closed-form collision (Model::collision, stability/impact.hpp).
+  static constexpr bool kCollides = requires(const typename Base::Params& q) {
+    { Model::collision(q, 1.0, 1.0, 1.0, 0.0) } -> std::same_as<Collision>;
+  };
+  bool sees_impacts() const override { return kCollides; }
+  /// Each wall's candidates touching it or moving towards it (relative to the wall): the collision of fewest
+  /// steps, and the counts of collisions whose overlap passes 5 % and 20 % of the radius.
+  CollisionSeen shortest_collision(const Particles<Real>& p, const Walls& walls, double dt,
+                                   const std::vector<std::int64_t>& fixed) const override {
+    CollisionSeen worst;
+    if constexpr (kCollides) {
+      for (std::size_t k = 0; k < index_.size(); ++k) {
+        const std::size_t w = index_[k];
+        const auto& n = walls.spec(w).normal;
+        const auto& at = walls.point(w);
+        const auto& vw = walls.velocity(w);
+        for (const auto ci : walls.candidates(w)) {
+          const auto i = static_cast<std::size_t>(ci);
+          const double r = double(p.radius[i]);
+          const double s = (double(p.x[i]) - at[0]) * n[0] + (double(p.y[i]) - at[1]) * n[1] +
+                           (double(p.z[i]) - at[2]) * n[2];
+          const double un = (double(p.vx[i]) - vw[0]) * n[0] + (double(p.vy[i]) - vw[1]) * n[1] +
+                            (double(p.vz[i]) - vw[2]) * n[2];
+          if ((!(s < r) && !(un < 0)) || fixed_tag(fixed, p.tag[i])) continue;  // apart and not coming closer
+          const Collision c =
+              Model::collision(this->params_[k], r, 1 / double(p.inv_mass[i]), -un, s < r ? r - s : 0.0);
+          if (!(c.duration > 0)) continue;
+          worst.count(c.overlap, r);
+          if (!(c.duration / dt < worst.steps)) continue;
+          worst.set(c, dt, r, 0.0, p.id[i], -1, int(w));
+        }
+      }
+    }
+    return worst;
   }
   std::size_t memory_bytes() const override {
     std::size_t b = 0;

@@ -20,6 +20,7 @@
 
 #include "basalt/solver/models/model.hpp"
 #include "basalt/solver/scene/table_reader.hpp"
+#include "basalt/solver/stability/impact.hpp"
 
 namespace basalt::solver {
 
@@ -55,6 +56,22 @@ inline double restitution(TableReader& t) {
   const double e = t.number_or("e", 1.0);
   if (!(e > 0 && e <= 1)) t.fail("e", "must be in (0, 1]");
   return e;
+}
+
+/// Hertz's head-on collision, undamped (the check of steps per collision, stability/impact.hpp): with
+/// F = K d^{3/2}, K = 4/3 E* sqrt(R*), a contact of effective mass m with overlap d >= 0 and normal speed
+/// of approach vn holds the energy W = m vn^2 / 2 + 2/5 K d^{5/2}; its collision came in at v = sqrt(2 W /
+/// m), reaches d_max = (5 W / 2 K)^{2/5} and lasts t_c = 2.943275 d_max / v (2 int_0^1 dx / sqrt(1 - x^{5/2})
+/// = 2 sqrt(pi) Gamma(7/5) / Gamma(9/10)), i.e. 2.87 (m^2 / (R* E*^2 v))^{1/5}.
+inline Collision collision(const Constants& c, double R, double m, double vn, double d) {
+  const double K = 4.0 / 3.0 * c.E_star * std::sqrt(R);
+  const double W = 0.5 * m * vn * vn + 0.4 * K * d * d * std::sqrt(d);
+  Collision out;
+  if (!(W > 0) || !std::isfinite(W)) return out;  // (nothing moving, or a fixed particle on a wall)
+  out.speed = std::sqrt(2 * W / m);
+  out.overlap = std::pow(2.5 * W / K, 0.4);
+  out.duration = 2.943275184324706 * out.overlap / out.speed;
+  return out;
 }
 
 /// The loop's constants: E*, G*, beta, mu, and the dashpot factors -2 sqrt(5/6) beta sqrt(2 E*) and
@@ -295,6 +312,11 @@ struct HertzMindlin {
            2 * c.E_star * std::sqrt(0.5 * rmax * 0.05 * rmax);
   }
 
+  /// The collision of a pair of effective radius R and mass m (hertz::collision).
+  static Collision collision(const Params& p, double R, double m, double vn, double d) {
+    return hertz::collision(hertz::constants(p.material, p.material, p.e, p.mu), R, m, vn, d);
+  }
+
   static void apart(History& h) { h = History{}; }
   static History flip(const History& h) { return {-h.x, -h.y, -h.z}; }
   template <class Real>
@@ -412,6 +434,10 @@ struct HertzMindlinWall {
   static double max_stiffness(const Params& p, double rmax) {
     const auto c = hertz::constants(p.particle, p.wall, p.e, p.mu);
     return (8 * c.G_star + 2 * c.E_star) * std::sqrt(rmax * 0.05 * rmax);
+  }
+  /// The collision of a particle of radius R and mass m with the wall (hertz::collision).
+  static Collision collision(const Params& p, double R, double m, double vn, double d) {
+    return hertz::collision(hertz::constants(p.particle, p.wall, p.e, p.mu), R, m, vn, d);
   }
   template <class Real>
   static double parting_energy(const Coeffs<Real>&, const History&) {
