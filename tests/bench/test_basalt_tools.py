@@ -14,12 +14,12 @@ import math
 import os
 import sys
 import tempfile
-import traceback
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.join(ROOT, "tools"))
 import basalt_tools as bt  # noqa: E402
+from script_tests import run_tests  # noqa: E402  (tests/bench/script_tests.py)
 
 SAMPLES = os.path.join(HERE, "samples")
 CUBE = os.path.join(ROOT, "tests", "data", "cube1.geo")
@@ -230,20 +230,7 @@ def live_run(exe):
 
 
 def main():
-    tests = [(name, f) for name, f in globals().items() if name.startswith("test_")]
-    if len(sys.argv) > 1:
-        tests.append(("live_run", lambda: live_run(sys.argv[1])))
-    failed = 0
-    for name, f in tests:
-        try:
-            f()
-            print(f"ok   {name}")
-        except Exception:
-            failed += 1
-            print(f"FAIL {name}")
-            traceback.print_exc()
-    print(f"{len(tests) - failed} passed, {failed} failed")
-    return 1 if failed else 0
+    return run_tests(globals(), [("live_run", lambda: live_run(sys.argv[1]))] if len(sys.argv) > 1 else [])
 
 
 if __name__ == "__main__":

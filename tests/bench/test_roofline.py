@@ -14,12 +14,12 @@ import math
 import os
 import subprocess
 import sys
-import traceback
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.join(ROOT, "tools", "bench"))
 import roofline as rl  # noqa: E402
+from script_tests import run_tests  # noqa: E402  (tests/bench/script_tests.py)
 
 # The wave scene's shape (scenes/wave.toml): linear bonds, linear elastic contacts, one elastic wall at z = 0,
 # velocity Verlet, the kinetic energy saved every step.
@@ -122,21 +122,21 @@ def machine_limits(exe):
     assert {row["threads"] for row in r["stream"]} == {1, 2}, r["stream"]
 
 
+def test_near_pairs_equal_all_pairs():
+    """The cell-grid pair search against every pair, on random points (some exactly a cell apart)."""
+    import numpy as np
+    rng = np.random.default_rng(7)
+    pos = np.vstack([rng.random((300, 3)) * [6.0, 3.0, 4.0], [[0, 0, 0], [1.0, 0, 0], [2.0, 0, 0]]])
+    for cutoff in (0.4, 1.0, 2.5):
+        got = rl.near_pairs(pos, cutoff)
+        d2 = ((pos[:, None, :] - pos[None, :, :]) ** 2).sum(axis=2)
+        i, j = np.nonzero(np.triu(d2 < cutoff * cutoff, k=1))
+        want = set(zip(i.tolist(), j.tolist()))
+        assert len(got) == len(want) and set(map(tuple, got.tolist())) == want, (cutoff, len(got), len(want))
+
+
 def main():
-    tests = [(name, f) for name, f in globals().items() if name.startswith("test_")]
-    if len(sys.argv) > 1:
-        tests.append(("machine_limits", lambda: machine_limits(sys.argv[1])))
-    failed = 0
-    for name, f in tests:
-        try:
-            f()
-            print(f"ok   {name}")
-        except Exception:
-            failed += 1
-            print(f"FAIL {name}")
-            traceback.print_exc()
-    print(f"{len(tests) - failed} passed, {failed} failed")
-    return 1 if failed else 0
+    return run_tests(globals(), [("machine_limits", lambda: machine_limits(sys.argv[1]))] if len(sys.argv) > 1 else [])
 
 
 if __name__ == "__main__":

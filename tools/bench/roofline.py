@@ -3,7 +3,7 @@
 this machine's memory bandwidth and peak flops set for the bytes and flops the phase must move and compute.
 
     source scripts/mpi-env.sh
-    /usr/bin/python3 tools/bench/roofline.py [--work /tmp/roofline] [--repeats 3] [--bin build/bin]
+    /usr/bin/python3 tools/bench/roofline.py [--work out/roofline] [--repeats 3] [--bin build/bin]
         [--output docs/bench/roofline.md] [--plot docs/img/roofline.png] [--quick]
 
 What it does:
@@ -171,16 +171,40 @@ def cost_model(scene, counts, S=8):
 # ---------------------------------------------------------------------------------------------- counts
 
 
+def near_pairs(pos, cutoff):
+    """(P, 2) index pairs i < j of the points `pos` (N, 3) closer than `cutoff`, each once: a cell grid of
+    cutoff-wide cells, every point against the points of its cell and the 26 around it (numpy only)."""
+    import numpy as np
+    c = np.floor((pos - pos.min(axis=0)) / cutoff).astype(np.int64) + 1  # a margin of empty cells
+    dims = c.max(axis=0) + 2
+    key = (c[:, 0] * dims[1] + c[:, 1]) * dims[2] + c[:, 2]
+    order = np.argsort(key, kind="stable")
+    sorted_key = key[order]
+    found = [np.zeros((0, 2), np.int64)]
+    for dx in (-1, 0, 1):
+        for dy in (-1, 0, 1):
+            for dz in (-1, 0, 1):
+                other = key + (dx * dims[1] + dy) * dims[2] + dz
+                start = np.searchsorted(sorted_key, other, "left")
+                count = np.searchsorted(sorted_key, other, "right") - start
+                i = np.repeat(np.arange(len(pos)), count)
+                first = np.repeat(start - (np.cumsum(count) - count), count)
+                j = order[first + np.arange(count.sum())]
+                keep = i < j
+                i, j = i[keep], j[keep]
+                near = ((pos[i] - pos[j]) ** 2).sum(axis=1) < cutoff * cutoff
+                found.append(np.stack([i[near], j[near]], axis=1))
+    return np.concatenate(found)
+
+
 def scene_counts(pos, rad, bonds, ids, scene, skin):
     """Per particle: bonds, listed pairs (closer than ri + rj + skin; bonded pairs are not listed unless
     bonds can break, as the solver's lists do), loose (listed and not bonded: what the pair loop evaluates),
     touching (overlapping, not bonded), wall_candidates (particles within r + skin of a wall plane).
     pos: (N, 3) array, rad: (N,), bonds: (B, 2) ids, ids: (N,)."""
     import numpy as np
-    from scipy.spatial import cKDTree
     N = len(rad)
-    tree = cKDTree(pos)
-    pairs = tree.query_pairs(2 * float(rad.max()) + skin, output_type="ndarray")
+    pairs = near_pairs(pos, 2 * float(rad.max()) + skin)
     d = np.linalg.norm(pos[pairs[:, 0]] - pos[pairs[:, 1]], axis=1)
     rs = rad[pairs[:, 0]] + rad[pairs[:, 1]]
     near = pairs[d < rs + skin]
@@ -307,7 +331,7 @@ def fmt_ns(v):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--work", default="/tmp/basalt-roofline")
+    ap.add_argument("--work", default="out/roofline")
     ap.add_argument("--bin", default=bt.bin_dir())
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--steps-wave", type=int, default=2000)
@@ -320,6 +344,7 @@ def main():
     ap.add_argument("--plot", default="", help="the roofline plot (PNG)")
     ap.add_argument("--label", default="", help="a name for this build in the report (e.g. 'scalar build')")
     a = ap.parse_args()
+    a.work = os.path.abspath(a.work)  # the benchmarks run in other folders
     os.makedirs(a.work, exist_ok=True)
     if a.limits:
         limits = json.load(open(a.limits))
