@@ -348,7 +348,7 @@ def _no_rendering():
     """Why pictures cannot be drawn here, or None: VTK's Python module and an X display (DISPLAY, or Xvfb for
     the front end's own virtual server) are needed."""
     try:
-        import vtkmodules.vtkRenderingOpenGL2  # noqa: F401
+        import vtkmodules.vtkRenderingOpenGL2  # noqa: F401  (the OpenGL back end)
     except ImportError as e:
         return f"VTK's Python module (python3-vtk9) is not installed ({e})"
     if not os.environ.get("DISPLAY") and not shutil.which("Xvfb"):
@@ -474,6 +474,20 @@ def test_povray_render_names_and_formats(tmp_path):
     assert (img[128, 128, 1] > 100) and img[128, 128, 0] < 30 and (img[0, 0] == 255).all()
     green = (img[:, :, 1] > 12) & (3 * img[:, :, 0] < img[:, :, 1])
     assert green.sum() == pytest.approx(math.pi * (256 / 2.05) ** 2, rel=0.08)
+
+
+def test_povray_render_with_a_dead_display_says_so(tmp_path):
+    """DISPLAY naming a display nobody serves: a NoDisplayError saying so (VTK itself would abort the process)."""
+    pytest.importorskip("vtkmodules.vtkRenderingOpenGL2", reason="VTK's Python module (python3-vtk9) is not installed")
+    script = tmp_path / "vis.py"
+    script.write_text("from esys.lsm.vis import povray\n"
+                      "povray.Scene().render(offScreen=True, interactive=False, fileName='a.png')\n")
+    env = {k: v for k, v in os.environ.items() if not k.startswith("OMPI_COMM_WORLD")}
+    env.update(PYTHONPATH=PACKAGE_DIR, DISPLAY=":7919")
+    p = subprocess.run([sys.executable, "-m", "basalt.esys", str(script)], cwd=tmp_path, capture_output=True,
+                       text=True, env=env, timeout=300)
+    assert p.returncode == 1 and "NoDisplayError: cannot open the X display DISPLAY=:7919" in p.stderr
+    assert not (tmp_path / "a.png").exists()
 
 
 def test_script_sees_its_arguments_and_folder(tmp_path):

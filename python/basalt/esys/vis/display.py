@@ -6,12 +6,15 @@ next number when one is taken, `-noreset` (a server resets when its last client 
 killed with the process (setpriv --pdeathsig)."""
 
 import atexit
+import ctypes
+import ctypes.util
 import os
 import select
 import shutil
 import subprocess
 
 _server = None  # the Xvfb process this process started
+_connection = None  # an Xlib connection to DISPLAY, kept open (_check)
 
 
 class NoDisplayError(RuntimeError):
@@ -66,10 +69,33 @@ def _start(number, timeout=20.0):
     return True
 
 
+def _check(display):
+    """Raises NoDisplayError when `display` does not answer (VTK would abort the process instead). The
+    connection stays open until the process ends: an X server started without -noreset (xvfb-run's) resets
+    when its last client leaves and refuses clients during the reset, and VTK opens and closes connections."""
+    global _connection
+    if _connection is not None:
+        return
+    lib = ctypes.util.find_library("X11")
+    if lib is None:
+        return  # let VTK try
+    x11 = ctypes.CDLL(lib)
+    x11.XOpenDisplay.restype = ctypes.c_void_p
+    x11.XOpenDisplay.argtypes = [ctypes.c_char_p]
+    d = x11.XOpenDisplay(display.encode())
+    if not d:
+        raise NoDisplayError(f"cannot open the X display DISPLAY={display}: unset DISPLAY to draw on a virtual X "
+                             "server (Xvfb) of the process's own")
+    _connection = d
+
+
 def ensure_display():
     """Makes sure VTK finds an X display: DISPLAY as set, or a virtual X server of this process's own
     (BASALT_VIEW_NO_XVFB=1 switches that off, as for basalt-view). Returns the display's name."""
+    if _server is not None:  # ours, started with -noreset
+        return os.environ["DISPLAY"]
     if os.environ.get("DISPLAY"):
+        _check(os.environ["DISPLAY"])
         return os.environ["DISPLAY"]
     if os.environ.get("BASALT_VIEW_NO_XVFB"):
         raise NoDisplayError("no X display: DISPLAY is unset and BASALT_VIEW_NO_XVFB is set")
