@@ -4,6 +4,8 @@ import importlib
 
 from basalt.esys.errors import refuse
 
+__all__ = ["povray"]
+
 
 def __getattr__(name):
     if name.startswith("__"):
