@@ -443,7 +443,8 @@ def test_povray_snapshots_drawn_where_the_camera_puts_them(tmp_path, view):
 
 def test_povray_render_names_and_formats(tmp_path):
     """Scene.render's file: the name given (a PNM from .pnm), ESyS's defaults (256 x 256, white); a name
-    without an image extension is ESyS's ValueError. The script's own `from esys.lsm.vis import povray`."""
+    without an image extension is ESyS's ValueError; a sphere behind the camera is not drawn (an orthographic
+    POV-Ray ray starts at the camera)."""
     why = _no_rendering()
     if why:
         pytest.skip(why)
@@ -460,9 +461,17 @@ def test_povray_render_names_and_formats(tmp_path):
         "try:\n"
         "    scene.render(offScreen=True, interactive=False, fileName='d.jpg')\n"
         "except ValueError as e:\n"
-        "    print('refused:', e)\n")
+        "    print('refused:', e)\n"
+        "behind = povray.Sphere([0, 0, 12], 3.0)\n"  # behind a camera at (0, 0, 5): not drawn, as POV-Ray's
+        "behind.apply(povray.Colors.Red)\n"
+        "scene.add(behind)\n"
+        "scene.getCamera().setPosn([0, 0, 5])\n"
+        "scene.render(offScreen=True, interactive=False, fileName='e.png', size=[100, 100])\n")
     p = front(script, tmp_path)
-    assert sorted(os.listdir(tmp_path)) == ["a.png", "b.pnm", "c.png", "vis.py"]
+    assert sorted(os.listdir(tmp_path)) == ["a.png", "b.pnm", "c.png", "e.png", "vis.py"]
+    img = png_pixels(tmp_path / "e.png")
+    assert ((img[:, :, 0] > 12) & (3 * img[:, :, 1] < img[:, :, 0])).sum() == 0  # no red: behind the camera
+    assert img[50, 50, 1] > 100 and img[50, 50, 0] < 30  # the green sphere, seen from +z now
     assert png_size(tmp_path / "a.png") == (256, 256) and png_size(tmp_path / "c.png") == (40, 30)
     pnm = (tmp_path / "b.pnm").read_bytes()  # binary PPM: P6, a comment, width height, 255, the pixels
     assert pnm.startswith(b"P6\n") and re.search(rb"\n64 48\n255\n", pnm) and len(pnm) >= 64 * 48 * 3
