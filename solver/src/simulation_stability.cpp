@@ -36,15 +36,17 @@ double Simulation<Real>::contact_critical_step(double m_min, double rmax) const 
   // A contact that forms later, between two of the lightest particles (omega^2 = 2 k / m_min) or one
   // and a wall (k / m_min): the network at the start does not have it. A tangential spring of rotating
   // particles acts at the contact point, whose compliance 1/m + r^2/I is 3.5/m for a solid sphere (I = 2/5
-  // m r^2): omega^2 = 7 ks / m_min between two of them, 3.5 ks / m_min on a wall (docs/stability.md, "The
-  // rotational step limit"). The power iterations do not see it: they move positions, not the springs'
-  // history.
-  constexpr double kPointCompliance = 1 + 1 / 0.4;  // (1/m + r^2/I) m
-  const double turning = scene_.rotation ? kPointCompliance : 0.0;
+  // m r^2): omega^2 = 7 ks / m_min between two of them, 3.5 ks / m_min on a wall. A rolling couple k_r <= kr
+  // r^2 turns the lightest sphere at up to 2.5 kr / m_min more (on a much heavier one; bounded here by the
+  // sum). docs/stability.md, "The rotational step limit"; the power iterations do not see these modes: they
+  // move positions, not the springs' history.
+  constexpr double kTurn = 1 / 0.4;  // r^2 m / I of a solid sphere
   double future2 = 0;
   for (const auto& c : forces_.computes()) {
-    const double k = c->max_stiffness(rmax), ks = turning * c->shear_stiffness(rmax);
-    if (c->kind() == ModelKind::pair) future2 = std::max(future2, 2 * std::max(k, ks) / m_min);
+    const double k = c->max_stiffness(rmax);
+    const double ks = scene_.rotation ? (1 + kTurn) * c->shear_stiffness(rmax) : 0.0;
+    const double kr = scene_.rotation ? kTurn * c->rolling_stiffness() : 0.0;
+    if (c->kind() == ModelKind::pair) future2 = std::max(future2, std::max(2 * k, 2 * ks + kr) / m_min);
     if (c->kind() == ModelKind::wall) future2 = std::max(future2, std::max(k, ks) / m_min);
   }
   return stability::critical_step(future2);

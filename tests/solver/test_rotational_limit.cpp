@@ -41,8 +41,9 @@ double apart_critical_step(const std::string& pair_model, double ks, bool rotati
 TEST(RotationalLimit, TwoRotatingSpheresStuckTogetherAt7KsOverM) {
   const double m = mass_of(0.5);
   EXPECT_NEAR(apart_critical_step("rot_friction", 1000, true), 2 / std::sqrt(7 * 1000 / m), 1e-12);
+  // The rolling couple adds 2.5 k_r / R*^2 = 2.5 x 2.25 K mu_r^2.
   EXPECT_NEAR(apart_critical_step("rolling_friction", 1000, true, "mu_roll = 0.1\n"),
-              2 / std::sqrt(7 * 1000 / m), 1e-12);
+              2 / std::sqrt((7 * 1000 + 2.5 * 2.25 * 1000 * 0.01) / m), 1e-12);
   // A soft shear spring (7 ks < 2 K) leaves the normal spring's limit.
   EXPECT_NEAR(apart_critical_step("rot_friction", 200, true), 2 / std::sqrt(2 * 1000 / m), 1e-12);
   // ESyS's NRotFriction: the shear force pulls the centres only, as the normal spring does.
@@ -102,4 +103,76 @@ acceleration = [0.0, 0.0, -1.0]
 TEST(RotationalLimit, SphereOnAFrictionalFloorStableBelowUnstableAbove) {
   EXPECT_LT(largest_spin(0.95), 1.5e-3) << "stable at 0.95 of the critical step";
   EXPECT_GT(largest_spin(1.05), 1e-2) << "the tangential mode grows at 1.05 of it";
+}
+
+namespace {
+
+/// A sphere of radius 0.01 resting under gravity 1 on top of a fixed sphere of radius 1 (a 1:100 radius
+/// ratio), rolling_friction (K = 1000, Ks, mu = 0.5, mu_roll), spun by 1e-3 about x, dt = `fraction` of the
+/// critical step (forced above it). Returns the critical step, the largest spin over 5,000 steps and how far
+/// the small sphere's centre moved.
+struct RollingRun {
+  double dt_critical = 0, spin = 0, moved = 0;
+};
+RollingRun small_on_large(double ks, double mu_roll, double fraction) {
+  const std::string body = R"([particles]
+fixed_tags = [1]
+[run]
+dt_fraction = )" + std::to_string(fraction) +
+                           R"(
+force_dt = true
+steps = 5000
+skin = 0.002
+[[interactions]]
+type = "rolling_friction"
+K = 1000.0
+Ks = )" + std::to_string(ks) +
+                           R"(
+mu = 0.5
+mu_roll = )" + std::to_string(mu_roll) +
+                           R"(
+[[body_forces]]
+type = "gravity"
+acceleration = [0.0, 0.0, -1.0]
+)";
+  const double r = 0.01, m = mass_of(r);
+  Geometry g;
+  g.add_particle(1, {0, 0, 0}, 1.0, 1);
+  g.add_particle(2, {0, 0, 1 + r - m / 1000}, r, 0);  // at the static overlap m g / K
+  g.sort_by_id();
+  Simulation<double> sim(basalt::test::scene_from(body), g, MPI_COMM_SELF);
+  RollingRun out;
+  out.dt_critical = sim.stability().dt_critical;
+  const auto small = [&] { return sim.particles().id[0] == 2 ? std::size_t{0} : std::size_t{1}; };
+  const std::array<double, 3> x0{double(sim.particles().x[small()]), double(sim.particles().y[small()]),
+                                 double(sim.particles().z[small()])};
+  sim.particles().wx[small()] = 1e-3;
+  sim.state_changed();
+  for (int s = 0; s < 5000; ++s) {
+    sim.step();
+    const auto& p = sim.particles();
+    const auto i = small();
+    out.spin = std::max(out.spin, std::hypot(double(p.wx[i]), double(p.wy[i]), double(p.wz[i])));
+    out.moved = std::max(out.moved,
+                         std::hypot(double(p.x[i]) - x0[0], double(p.y[i]) - x0[1], double(p.z[i]) - x0[2]));
+    if (!std::isfinite(out.spin)) break;
+  }
+  return out;
+}
+
+}  // namespace
+
+// Rolling resistance on the smallest particle of a 1:100 radius ratio: the rolling spring k_r = 2.25 K mu_r^2
+// R*^2 against I = 0.4 m r^2 turns the small sphere at w^2 = 5.6 mu_r^2 K / m (R* -> r), below the stick
+// mode's 7 Ks / m for mu_r up to 1.1 sqrt(Ks / K). The critical step is the small sphere's; at 0.95 of it the
+// sphere stays on top, its spin bounded.
+TEST(RotationalLimit, RollingResistanceOnTheSmallestOfA1To100Ratio) {
+  const double m = mass_of(0.01);
+  for (const double mu_roll : {0.1, 0.3, 1.0}) {
+    const auto run = small_on_large(1000, mu_roll, 0.95);
+    EXPECT_NEAR(run.dt_critical, 2 / std::sqrt((7 * 1000 + 2.5 * 2.25 * 1000 * mu_roll * mu_roll) / m),
+                1e-12 * run.dt_critical);
+    EXPECT_LT(run.spin, 1.5e-3) << "mu_roll " << mu_roll;
+    EXPECT_LT(run.moved, 1e-4) << "mu_roll " << mu_roll << ": the small sphere stays on top";
+  }
 }

@@ -37,6 +37,11 @@ class ModelDriver : public ForceCompute<Real> {
     for (const auto& p : params_) m = std::max(m, basalt::solver::shear_stiffness<Model>(p, rmax));
     return m;
   }
+  double rolling_stiffness() const override {
+    double m = 0;
+    for (const auto& p : params_) m = std::max(m, basalt::solver::rolling_stiffness<Model>(p));
+    return m;
+  }
 
  protected:
   /// One more group of the model (the next index in params_ and coeffs_).

@@ -11,6 +11,8 @@
 //     at the contact point of rotating particles (default: none). The critical step counts it with the
 //     contact point's compliance 1/m + r^2/I = 3.5/m of a solid sphere (simulation_stability.cpp); a model
 //     whose tangential force does not turn the particles (ESyS's NRotFriction) declares none.
+//   Optional: rolling_stiffness(Params), a rolling couple's stiffness per R*^2 (k_r / R*^2, default none):
+//     it turns a sphere of radius r >= R* at w^2 <= 2.5 rolling_stiffness / m (I = 2/5 m r^2).
 //
 // Pair models (PairDriver, interactions/pair_driver.hpp), one of two laws:
 //   scalar:    force(c, h, rsum, r) and energy(c, h, rsum, r), the force along the line of centres,
@@ -169,6 +171,15 @@ template <class M>
 inline double pair_reach(const typename M::Params& p, double rmax) {
   if constexpr (contract::HasReach<M>)
     return M::reach(p, rmax);
+  else
+    return 0.0;
+}
+
+/// The stiffness of model M's rolling couple per R*^2 (0 without rolling_stiffness()).
+template <class M>
+inline double rolling_stiffness(const typename M::Params& p) {
+  if constexpr (requires { M::rolling_stiffness(p); })
+    return M::rolling_stiffness(p);
   else
     return 0.0;
 }

@@ -62,6 +62,8 @@ struct RollingFriction {
   }
   static double max_stiffness(const Params& p, double rmax) { return Base::max_stiffness(p.base, rmax); }
   static double shear_stiffness(const Params& p, double rmax) { return Base::shear_stiffness(p.base, rmax); }
+  /// k_r / R*^2 (models/contract.hpp): the rolling couple turns the lightest sphere at w^2 <= 2.5 of it / m.
+  static double rolling_stiffness(const Params& p) { return 2.25 * p.base.K * p.mu_roll * p.mu_roll; }
 
   static void apart(History& h) { h = History{}; }
   static History flip(const History& h) { return {Base::flip(h.base), -h.mx, -h.my, -h.mz}; }
