@@ -251,10 +251,10 @@ class Simulation:
         dt as a fraction of it, as run.dt_fraction does."""
         return self._core.critical_dt
 
-    def gather(self, name):
+    def gather(self, name, everywhere=False):
         """Collective: one particle array (a name of sim.particles) of every rank, on rank 0 as (ids, values)
-        sorted by id (float64 values); None on the other ranks."""
-        return self._core.gather(name)
+        sorted by id (float64 values); None on the other ranks, or the same on every rank with everywhere=True."""
+        return self._core.gather(name, bool(everywhere))
 
     def kinetic_energy(self):
         """Collective: the total kinetic energy (translation and rotation)."""

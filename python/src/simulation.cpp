@@ -102,7 +102,7 @@ class Run {
   virtual py::list run_stages() = 0;
   virtual py::dict state() = 0;
   virtual py::array array(const std::string& name, py::handle owner) = 0;
-  virtual py::object gather(const std::string& name, py::handle owner) = 0;
+  virtual py::object gather(const std::string& name, py::handle owner, bool everywhere) = 0;
   virtual const solver::Comm& comm() const = 0;
   virtual std::int64_t step() const = 0;
   virtual double time() const = 0;
@@ -316,8 +316,9 @@ class RunOf final : public Run {
                         "rotation; qw, qx, qy, qz with particles.orientation)");
   }
 
-  py::object gather(const std::string& name, py::handle owner) override {
-    // Collective: (id, value) of every owned particle, all ranks', to rank 0 sorted by id (as float64).
+  py::object gather(const std::string& name, py::handle owner, bool everywhere) override {
+    // Collective: (id, value) of every owned particle, all ranks', to rank 0 (every rank when everywhere)
+    // sorted by id (as float64).
     const py::array local = array(name, owner);  // validates the name
     const auto& p = sim_->particles();
     std::vector<double> mine;
@@ -329,7 +330,7 @@ class RunOf final : public Run {
       mine.push_back(v(static_cast<py::ssize_t>(i)));
     }
     const std::vector<double> all = comm_.size() > 1 ? comm_.all_gather(mine) : mine;
-    if (comm_.rank() != 0) return py::none();
+    if (comm_.rank() != 0 && !everywhere) return py::none();
     const std::size_t n = all.size() / 2;
     std::vector<std::size_t> order(n);
     for (std::size_t k = 0; k < n; ++k) order[k] = k;
@@ -588,10 +589,12 @@ void bind_simulation(py::module_& m) {
            [](py::object self, const std::string& name) {
              return self.cast<PySimulation&>().run().array(name, self);
            })
-      .def("gather",
-           [](py::object self, const std::string& name) {
-             return self.cast<PySimulation&>().run().gather(name, self);
-           })
+      .def(
+          "gather",
+          [](py::object self, const std::string& name, bool everywhere) {
+            return self.cast<PySimulation&>().run().gather(name, self, everywhere);
+          },
+          py::arg("name"), py::arg("everywhere") = false)
       .def("kinetic_energy", [](PySimulation& s) { return s.run().kinetic_energy(); })
       .def("energies", [](PySimulation& s) { return s.run().energies(); })
       .def("walls", [](PySimulation& s) { return s.run().walls(); })

@@ -224,7 +224,10 @@ def test_mpi_two_compute_ranks_and_an_io_rank(tmp_path):
                 assert len(ids) == 8948 and (ids[1:] > ids[:-1]).all(), len(ids)
             else:
                 assert g is None
+            ids, z = sim.gather("z", everywhere=True)  # every rank's particles on every rank
+            assert len(ids) == 8948 and (ids[1:] > ids[:-1]).all(), len(ids)
             if sim.rank == 0:
+                assert (ids == g[0]).all() and (z == g[1]).all()
                 print("ranks", sim.ranks, "ke", repr(ke))
         sim.close()
     """))
