@@ -620,3 +620,104 @@ def test_scaled_nrot_bonds_of_several_sizes_each_have_their_k(tmp_path):
     # the hanging bond (unscaled K = 20, rest 0.6, length 0.62) pulls 3 down and 4 up
     assert rows[4][3] == pytest.approx(dt * 20 * 0.02 / m[4], rel=1e-9)
     assert rows[3][3] == pytest.approx(-dt * 20 * 0.02 / m[3], rel=1e-9)
+
+
+# -- several ranks (mpirun -np 2) --------------------------------------------------------------------------------
+def front_mpi(script, cwd, ranks, *args, launcher=None):
+    """mpirun -np RANKS python3 -m basalt.esys SCRIPT (or the basalt-esys launcher) in cwd."""
+    import basalt_tools
+
+    env = basalt_tools.mpi_env(PYTHONPATH=PACKAGE_DIR)
+    cmd = [*basalt_tools.mpirun(ranks), *([str(launcher)] if launcher else [sys.executable, "-m", "basalt.esys"]),
+           str(script), *args]
+    p = subprocess.run(cmd, cwd=cwd, capture_output=True, text=True, env=env, timeout=300)
+    if p.returncode != 0:
+        pytest.fail(f"{' '.join(cmd)} exited {p.returncode}:\n{p.stdout}\n{p.stderr}")
+    return p
+
+
+# Files whose numbers are sums over the ranks (a wall's force: each rank's particles' share, added in another
+# order on two ranks): equal to rounding; every other file and printed line is the same bytes.
+SUMMED_OVER_RANKS = {"cube_drop.py": {"floor_force.dat"}}
+
+
+@pytest.mark.skipif(subprocess.run(["which", "mpirun"], capture_output=True).returncode != 0, reason="needs mpirun")
+@pytest.mark.parametrize("script", ["collide.py", "press.py", "cube_drop.py"])
+def test_two_ranks_write_what_one_rank_writes(tmp_path, script):
+    """mpirun -np 2: every saver file, checkpoint and printed line once and as on one rank (the same bytes; wall
+    forces, summed over the ranks, to 1e-10). Each rank writing its own copy doubles the appended savers and the
+    prints; a rank's particles missing changes the checkpoints, the particle savers and the Runnables' prints."""
+    one, two = tmp_path / "one", tmp_path / "two"
+    one.mkdir()
+    two.mkdir()
+    a = front(SCRIPTS / script, one).stdout
+    launcher = (pathlib.Path(os.environ.get("BASALT_BIN") or ROOT / "build" / "bin") / "basalt-esys").resolve()
+    b = front_mpi(SCRIPTS / script, two, 2, launcher=launcher if script == "press.py" and launcher.exists()
+                  else None).stdout
+    assert a and b == a
+    files = sorted(f.name for f in one.iterdir())
+    assert files and sorted(f.name for f in two.iterdir()) == files
+    for name in files:
+        x, y = (one / name).read_text(), (two / name).read_text()
+        if name not in SUMMED_OVER_RANKS.get(script, ()):
+            assert x == y, name
+            continue
+        rx, ry = ([[float(w) for w in line.split()] for line in t.splitlines()] for t in (x, y))
+        assert len(rx) == len(ry) and all(len(u) == len(v) for u, v in zip(rx, ry)), name
+        for u, v in zip(rx, ry):
+            assert v == pytest.approx(u, rel=1e-10, abs=1e-12), name
+
+
+SEEN = """import os, sys
+from esys.lsm import *
+from esys.lsm.util import Vec3, BoundingBox
+
+rank = os.environ.get("OMPI_COMM_WORLD_RANK", "0")
+sim = LsmMpi(numWorkerProcesses=1, mpiDimList=[1, 1, 1])
+sim.initNeighbourSearch(particleType="NRotSphere", gridSpacing=2.5, verletDist=0.2)
+sim.setNumTimeSteps(10)
+sim.setTimeStepSize(1.0e-3)
+sim.setSpatialDomain(BoundingBox(Vec3(-20, -5, -5), Vec3(20, 5, 5)))
+for k in range(16):
+    p = NRotSphere(id=100 + k, posn=Vec3(-15.0 + 2.0 * k, 0.1 * k, 0.0), radius=0.5, mass=1.0)
+    p.setLinearVelocity(Vec3(0.5 * (k % 3 - 1), 0.0, 0.0))
+    sim.createParticle(p)
+
+
+class Seen(Runnable):
+    def __init__(self, sim, when):
+        Runnable.__init__(self)
+        self.sim, self.when = sim, when
+
+    def run(self):
+        ps = self.sim.getParticleList()
+        owned = len(self.sim._sim.particles)  # this rank's own particles (the test's view of the decomposition)
+        sys.stderr.write("seen %s %s %d %d %d %s\\n" % (rank, self.when, self.sim.getTimeStep(), owned, len(ps),
+                                                       ",".join(str(p.getId()) for p in ps)))
+        print("%s %d %.17g" % (self.when, self.sim.getTimeStep(), sum(p.getPosn()[0] for p in ps)))
+
+
+sim.addPreTimeStepRunnable(Seen(sim, "pre"))
+sim.addPostTimeStepRunnable(Seen(sim, "post"))
+sim.run()
+"""
+
+
+@pytest.mark.skipif(subprocess.run(["which", "mpirun"], capture_output=True).returncode != 0, reason="needs mpirun")
+def test_runnables_see_every_ranks_particles(tmp_path):
+    """mpirun -np 2: 16 spheres in a row split between the ranks (each owns some); the pre- and post-time-step
+    Runnables on each rank see all 16 (ids 100-115, in order) at every step, and print once, as on one rank."""
+    script = tmp_path / "seen.py"
+    script.write_text(SEEN)
+    one = front(script, tmp_path).stdout
+    p = front_mpi(script, tmp_path, 2)
+    assert p.stdout == one and len(one.splitlines()) == 20
+    rows = [line.split()[1:] for line in p.stderr.splitlines() if line.startswith("seen ")]
+    assert len(rows) == 2 * 2 * 10  # two ranks, two runnables, ten steps
+    ids = ",".join(str(100 + k) for k in range(16))
+    owned = {}
+    for rank, when, step, mine, seen, listed in rows:
+        assert (int(seen), listed) == (16, ids), (rank, when, step)
+        owned.setdefault((when, step), {})[rank] = int(mine)
+    for counts in owned.values():
+        assert sorted(counts) == ["0", "1"] and sum(counts.values()) == 16 and min(counts.values()) > 0, counts

@@ -54,13 +54,13 @@ class CheckPointer(_Schedule):
             if "quat" in state:  # RotSphere (ESyS 2.3.5, measured): orientation w x y z, angular velocity
                 tail += " " + " ".join(_g9(v) for v in (*state["quat"][i], *state["angvel"][i]))
             rows.append(f"{head} {int(state['id'][i])} {int(state['tag'][i])} {tail}\n")
-        rows.append(self._bond_section())
+        rows.append(self._bond_section(state))
         rows.append("TMIG 0\n")
         with open(data, "w") as f:
             f.write("".join(rows))
 
 
-    def _bond_section(self):
+    def _bond_section(self, state):
         """ESyS's bonded groups: their count, then per group 'Bonded', the bond count and 'id1 id2 tag' lines
         (sorted, as ESyS writes them after createConnections)."""
         lsm = self.lsm
@@ -69,7 +69,7 @@ class CheckPointer(_Schedule):
         if len(lsm._bond_groups) > 1:
             refuse("LsmMpi.createCheckPointer with several bond groups", "one bond group is written so "
                    "far; basalt.Simulation.checkpoint() writes Basalt's checkpoints")
-        if lsm._sim.broken_bonds() > 0:
+        if state.get("broken_bonds", 0) > 0:
             refuse("LsmMpi.createCheckPointer after a bond broke", "the front end writes the bonds of an "
                    "intact run so far; Basalt's checkpoints list every bond and its state")
         from .prms import NRotBondPrms
