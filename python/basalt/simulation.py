@@ -355,6 +355,11 @@ class Simulation:
         """Collective: the bonds now."""
         return self._core.bond_count()
 
+    def broken_bond_pairs(self):
+        """Collective: the bonds broken so far as an (n, 3) int64 array, on every rank: their particles' ids
+        (the smaller first) and the step each broke at, sorted."""
+        return self._core.broken_bond_pairs()
+
     def broken_bonds(self):
         """Collective: the bonds broken so far."""
         return self._core.broken_bonds()

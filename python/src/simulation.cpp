@@ -130,6 +130,9 @@ class Run {
   /// Collective: bonds now, bonds broken so far (every rank's), particles inserted and removed so far.
   virtual std::int64_t bond_count() = 0;
   virtual std::int64_t broken_bonds() = 0;
+  /// Collective: the bonds broken so far, every rank's, on every rank: rows (id, id, step it broke at), the
+  /// smaller id first, sorted.
+  virtual py::array broken_bond_pairs() = 0;
   virtual std::array<std::int64_t, 2> flow_totals() const = 0;
   /// Collective: a checkpoint of the current step now.
   virtual void checkpoint() = 0;
@@ -235,6 +238,26 @@ class RunOf final : public Run {
         parse_keys(keys, "delete", [](solver::TableReader& t) { return solver::parse_delete(t); }));
   }
   std::int64_t bond_count() override { return sim_->bond_count(); }
+  py::array broken_bond_pairs() override {
+    std::vector<double> mine;  // each break is recorded by one rank
+    for (const auto& b : sim_->broken_bonds()) {
+      mine.push_back(double(std::min(b.a, b.b)));
+      mine.push_back(double(std::max(b.a, b.b)));
+      mine.push_back(double(b.step));
+    }
+    const std::vector<double> all = comm_.size() > 1 ? comm_.all_gather(mine) : mine;
+    std::vector<std::array<std::int64_t, 3>> rows;
+    for (std::size_t k = 0; k + 2 < all.size(); k += 3)
+      rows.push_back({static_cast<std::int64_t>(all[k]), static_cast<std::int64_t>(all[k + 1]),
+                      static_cast<std::int64_t>(all[k + 2])});
+    std::sort(rows.begin(), rows.end());
+    py::array_t<std::int64_t> out({static_cast<py::ssize_t>(rows.size()), py::ssize_t{3}});
+    auto w = out.mutable_unchecked<2>();
+    for (std::size_t k = 0; k < rows.size(); ++k)
+      for (py::ssize_t c = 0; c < 3; ++c)
+        w(static_cast<py::ssize_t>(k), c) = rows[k][static_cast<std::size_t>(c)];
+    return out;
+  }
   std::int64_t broken_bonds() override {
     return comm_.sum(static_cast<long long>(sim_->broken_bonds().size()));
   }
@@ -622,6 +645,7 @@ void bind_simulation(py::module_& m) {
       .def("delete", [](PySimulation& s, const std::string& keys) { return s.run().remove(keys); })
       .def("bond_count", [](PySimulation& s) { return s.run().bond_count(); })
       .def("broken_bonds", [](PySimulation& s) { return s.run().broken_bonds(); })
+      .def("broken_bond_pairs", [](PySimulation& s) { return s.run().broken_bond_pairs(); })
       .def("flow_totals", [](PySimulation& s) { return s.run().flow_totals(); })
       .def_property_readonly("critical_dt", [](PySimulation& s) { return s.run().critical_dt(); })
       .def("checkpoint", [](PySimulation& s) { s.run().checkpoint(); })
