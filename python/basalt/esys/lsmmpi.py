@@ -460,7 +460,7 @@ class LsmMpi:
             if self._checkpointers:
                 state["quat"] = np.column_stack([c["qw"], c["qx"], c["qy"], c["qz"]])
         if self._checkpointers and self._bond_groups:  # collective: read on every rank, written by rank 0
-            state["broken_bonds"] = self._sim.broken_bonds()
+            state["broken_bonds"] = {(int(i), int(j)): int(s) for i, j, s in self._sim.broken_bond_pairs().tolist()}
         return state
 
     def getParticleList(self):
