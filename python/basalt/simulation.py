@@ -253,7 +253,10 @@ class Simulation:
 
     def gather(self, name, everywhere=False):
         """Collective: one particle array (a name of sim.particles) of every rank, on rank 0 as (ids, values)
-        sorted by id (float64 values); None on the other ranks, or the same on every rank with everywhere=True."""
+        sorted by id (float64 values); None on the other ranks, or the same on every rank with everywhere=True.
+        A list of names gathers them in one exchange: values is then an (n, len(names)) array."""
+        if isinstance(name, (list, tuple)):
+            return self._core.gather_table([str(n) for n in name], bool(everywhere))
         return self._core.gather(name, bool(everywhere))
 
     def kinetic_energy(self):

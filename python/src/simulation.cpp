@@ -102,7 +102,8 @@ class Run {
   virtual py::list run_stages() = 0;
   virtual py::dict state() = 0;
   virtual py::array array(const std::string& name, py::handle owner) = 0;
-  virtual py::object gather(const std::string& name, py::handle owner, bool everywhere) = 0;
+  virtual py::object gather(const std::vector<std::string>& names, py::handle owner, bool everywhere,
+                            bool table) = 0;
   virtual const solver::Comm& comm() const = 0;
   virtual std::int64_t step() const = 0;
   virtual double time() const = 0;
@@ -339,34 +340,43 @@ class RunOf final : public Run {
                         "rotation; qw, qx, qy, qz with particles.orientation)");
   }
 
-  py::object gather(const std::string& name, py::handle owner, bool everywhere) override {
-    // Collective: (id, value) of every owned particle, all ranks', to rank 0 (every rank when everywhere)
-    // sorted by id (as float64).
-    const py::array local = array(name, owner);  // validates the name
+  py::object gather(const std::vector<std::string>& names, py::handle owner, bool everywhere,
+                    bool table) override {
+    // Collective: (id, values) of every owned particle, all ranks', to rank 0 (every rank when everywhere)
+    // sorted by id (as float64): one column per name, a 1-D array unless table.
+    const std::size_t w = names.size() + 1;  // a row: the id, then the values
+    std::vector<py::array_t<double>> columns;
+    for (const auto& name : names)  // array() validates the name
+      columns.push_back(array(name, owner).attr("astype")("float64").template cast<py::array_t<double>>());
     const auto& p = sim_->particles();
     std::vector<double> mine;
-    mine.reserve(2 * p.n_owned);
-    const py::array_t<double> values = local.attr("astype")("float64");
-    const auto v = values.unchecked<1>();
+    mine.reserve(w * p.n_owned);
     for (std::size_t i = 0; i < p.n_owned; ++i) {
       mine.push_back(double(p.id[i]));
-      mine.push_back(v(static_cast<py::ssize_t>(i)));
+      for (const auto& c : columns) mine.push_back(c.at(static_cast<py::ssize_t>(i)));
     }
     const std::vector<double> all = comm_.size() > 1 ? comm_.all_gather(mine) : mine;
     if (comm_.rank() != 0 && !everywhere) return py::none();
-    const std::size_t n = all.size() / 2;
+    const std::size_t n = all.size() / w;
     std::vector<std::size_t> order(n);
     for (std::size_t k = 0; k < n; ++k) order[k] = k;
     std::sort(order.begin(), order.end(),
-              [&](std::size_t a, std::size_t b) { return all[2 * a] < all[2 * b]; });
+              [&](std::size_t a, std::size_t b) { return all[w * a] < all[w * b]; });
     py::array_t<std::int64_t> ids(static_cast<py::ssize_t>(n));
-    py::array_t<double> out(static_cast<py::ssize_t>(n));
     auto wi = ids.mutable_unchecked<1>();
-    auto wo = out.mutable_unchecked<1>();
-    for (std::size_t k = 0; k < n; ++k) {
-      wi(static_cast<py::ssize_t>(k)) = static_cast<std::int64_t>(all[2 * order[k]]);
-      wo(static_cast<py::ssize_t>(k)) = all[2 * order[k] + 1];
+    for (std::size_t k = 0; k < n; ++k)
+      wi(static_cast<py::ssize_t>(k)) = static_cast<std::int64_t>(all[w * order[k]]);
+    if (!table) {
+      py::array_t<double> out(static_cast<py::ssize_t>(n));
+      auto wo = out.mutable_unchecked<1>();
+      for (std::size_t k = 0; k < n; ++k) wo(static_cast<py::ssize_t>(k)) = all[w * order[k] + 1];
+      return py::make_tuple(ids, out);
     }
+    py::array_t<double> out({static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(names.size())});
+    auto wo = out.mutable_unchecked<2>();
+    for (std::size_t k = 0; k < n; ++k)
+      for (std::size_t c = 0; c < names.size(); ++c)
+        wo(static_cast<py::ssize_t>(k), static_cast<py::ssize_t>(c)) = all[w * order[k] + 1 + c];
     return py::make_tuple(ids, out);
   }
 
@@ -615,9 +625,15 @@ void bind_simulation(py::module_& m) {
       .def(
           "gather",
           [](py::object self, const std::string& name, bool everywhere) {
-            return self.cast<PySimulation&>().run().gather(name, self, everywhere);
+            return self.cast<PySimulation&>().run().gather({name}, self, everywhere, false);
           },
           py::arg("name"), py::arg("everywhere") = false)
+      .def(
+          "gather_table",
+          [](py::object self, const std::vector<std::string>& names, bool everywhere) {
+            return self.cast<PySimulation&>().run().gather(names, self, everywhere, true);
+          },
+          py::arg("names"), py::arg("everywhere") = false)
       .def("kinetic_energy", [](PySimulation& s) { return s.run().kinetic_energy(); })
       .def("energies", [](PySimulation& s) { return s.run().energies(); })
       .def("walls", [](PySimulation& s) { return s.run().walls(); })

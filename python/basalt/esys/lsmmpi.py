@@ -383,9 +383,8 @@ class LsmMpi:
             p = sim.particles
             order = np.argsort(p.id, kind="stable")
             return (np.asarray(p.id)[order].astype(np.int64), *(np.asarray(getattr(p, n))[order] for n in names))
-        out = [sim.gather(n, everywhere=True) for n in names]
-        ids = out[0][0] if out else sim.gather("id", everywhere=True)[0]
-        return (ids, *(v for _, v in out))
+        ids, table = sim.gather(list(names) or ["id"], everywhere=True)  # one exchange for all the arrays
+        return (ids, *(table[:, k] for k in range(len(names))))
 
     def _positions(self):
         import numpy as np
