@@ -7,6 +7,8 @@ import math
 import os
 import pathlib
 import re
+import shutil
+import struct
 import subprocess
 import sys
 
@@ -314,6 +316,18 @@ REFUSED = {
     "sim.createFieldSaver(ParticleScalarFieldSaverPrms(fieldName='sigma_xx_2d', fileName='s', fileFormat='SUM', "
     "beginTimeStep=0, endTimeStep=1, timeStepIncr=1))": ("fieldName='sigma_xx_2d'", "e_kin"),
     "from esys.lsm import SomethingElse": ("esys.lsm.SomethingElse", "not provided"),
+    # esys.lsm.vis: povray's Scene of spheres only (docs/esys.md, "POV-Ray snapshots")
+    "from esys.lsm.vis import vtk": ("esys.lsm.vis.vtk", "esys.lsm.vis.povray"),
+    "from esys.lsm.vis import povray\npovray.Box(Vec3(0, 0, 0), Vec3(1, 1, 1))": ("esys.lsm.vis.povray.Box", "Sphere"),
+    "from esys.lsm.vis import povray\npovray.Scene().render(offScreen=True, interactive=False)":
+        ("Scene.render(fileName=None)", "files only"),
+    "from esys.lsm.vis import povray\n"
+    "povray.Sphere(Vec3(0, 0, 0), 1.0).apply(povray.Pigment(povray.Colors.Red, 0.5))":
+        ("Pigment(transmit=0.5)", "opaque"),
+    "from esys.lsm.vis import povray\nc = povray.Colors.Aquamarine":
+        ("Colors.Aquamarine", "RgbColor(red, green, blue)"),
+    "from esys.lsm.vis import povray\npovray.Scene().getCamera().setLightSource(None)":
+        ("LightedCamera.setLightSource", "at the camera's position"),
 }
 
 
@@ -329,11 +343,160 @@ def test_unsupported_call_is_refused_with_a_message(tmp_path, call):
         assert word in p.stderr
 
 
-def test_povray_import_names_basalt_view(tmp_path):
+# -- POV-Ray snapshots: esys.lsm.vis.povray drawn with VTK (snap_pair.py, snaps.py) ---------------------------
+def _no_rendering():
+    """Why pictures cannot be drawn here, or None: VTK's Python module and an X display (DISPLAY, or Xvfb for
+    the front end's own virtual server) are needed."""
+    try:
+        import vtkmodules.vtkRenderingOpenGL2  # noqa: F401  (the OpenGL back end)
+    except ImportError as e:
+        return f"VTK's Python module (python3-vtk9) is not installed ({e})"
+    if not os.environ.get("DISPLAY") and not shutil.which("Xvfb"):
+        return "no X display: DISPLAY is unset and Xvfb (package xvfb) is not installed"
+    return None
+
+
+def png_size(path):
+    """(width, height) from a PNG file's header."""
+    head = pathlib.Path(path).read_bytes()[:24]
+    assert head[:8] == b"\x89PNG\r\n\x1a\n" and head[12:16] == b"IHDR", f"{path} is not a PNG file"
+    return struct.unpack(">II", head[16:24])
+
+
+def png_pixels(path):
+    """The picture as rows of (r, g, b), top row first (numpy array height x width x 3)."""
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    from vtkmodules.vtkIOImage import vtkPNGReader
+    reader = vtkPNGReader()
+    reader.SetFileName(str(path))
+    reader.Update()
+    w, h, _ = reader.GetOutput().GetDimensions()
+    a = vtk_to_numpy(reader.GetOutput().GetPointData().GetScalars()).reshape(h, w, -1)[:, :, :3]
+    return a[::-1].astype(int)  # VTK's first row is the bottom one
+
+
+def pov_projection(camera, look_at, zoom, size, point):
+    """Where POV-Ray puts `point` in ESyS's orthographic camera, in pixels from the top left (column, row):
+    the picture is 2.05/zoom high; its up is +y (POV-Ray's sky) made square to the line of sight d, its right
+    d x up (ESyS flips POV-Ray's left-handed right vector); looking along y, right is +x and up is (+x) x d."""
+    import numpy as np
+    d = np.subtract(look_at, camera, dtype=float)
+    d /= np.linalg.norm(d)
+    sky = np.array([0.0, 1.0, 0.0])
+    if np.linalg.norm(np.cross(sky, d)) < 1e-10:
+        right = np.array([1.0, 0.0, 0.0])
+        up = np.cross(right, d)
+    else:
+        up = sky - sky.dot(d) * d
+        up /= np.linalg.norm(up)
+        right = np.cross(d, up)
+    w, h = size
+    scale = h * zoom / 2.05  # pixels per length unit
+    rel = np.subtract(point, look_at, dtype=float)
+    return w / 2 + rel.dot(right) * scale, h / 2 - rel.dot(up) * scale, scale
+
+
+SNAP_CAMERAS = {  # camera, look-at, zoom, size, background
+    "front": ((0, 0, 20), (0, 0, 0), 0.1, (320, 240), "white"),
+    "moved_and_zoomed": ((2, 1, 20), (2, 1, 0), 0.2, (320, 240), "white"),
+    "behind_black": ((0, 0, -20), (0, 0, 0), 0.2, (300, 200), "black"),
+    "side": ((20, 0, 0), (0, 0, 0), 0.1, (256, 256), "white"),
+    "above": ((0, 20, 0), (0, 0, 0), 0.1, (240, 320), "white"),
+}
+
+
+@pytest.mark.parametrize("view", list(SNAP_CAMERAS))
+def test_povray_snapshots_drawn_where_the_camera_puts_them(tmp_path, view):
+    """snap_pair.py's Snaps Runnable (POVsnaps-style) renders a red sphere (tag 1) and a blue one (tag 2) at
+    steps 10 and 20: each snapshot is a PNG of the requested size under ESyS's file name, and each sphere's
+    pixels are a disc of its radius centred where POV-Ray's camera puts its centre (within half a pixel):
+    the camera's position, look-at point and zoom all move them; the background is the scene's."""
+    why = _no_rendering()
+    if why:
+        pytest.skip(why)
+    import numpy as np
+    cam, look, zoom, size, bg = SNAP_CAMERAS[view]
+    args = [str(v) for v in (*cam, *look, zoom, *size)] + ([bg] if bg == "black" else [])
+    out = front(SCRIPTS / "snap_pair.py", tmp_path, *args).stdout
+    assert sorted(os.listdir(tmp_path)) == ["snap_0000.png", "snap_0001.png"]  # nothing else (no temporaries)
+    rows = [line.split()[1:] for line in out.splitlines() if line.startswith("snap ")]
+    assert [(r[0], r[1], r[2]) for r in rows] == [("snap_0000.png", "10", "1"), ("snap_0000.png", "10", "2"),
+                                                  ("snap_0001.png", "20", "1"), ("snap_0001.png", "20", "2")]
+    reds = [float(r[3]) for r in rows if r[2] == "1"]
+    assert reds[1] - reds[0] == pytest.approx(1.0, abs=1e-9)  # the red sphere moved between the snapshots
+    for r in rows:
+        name, tag, centre, radius = r[0], int(r[2]), [float(v) for v in r[3:6]], float(r[6])
+        assert png_size(tmp_path / name) == size
+        img = png_pixels(tmp_path / name)
+        assert img.shape == (size[1], size[0], 3)
+        corner = 0 if bg == "black" else 255
+        assert (img[0, 0] == corner).all() and (img[-1, -1] == corner).all()
+        red, green, blue = img[:, :, 0], img[:, :, 1], img[:, :, 2]
+        main, other = (red, blue) if tag == 1 else (blue, red)
+        mask = (main > 12) & (3 * other < main) & (3 * green < main)
+        col, row, scale = pov_projection(cam, look, zoom, size, centre)
+        ys, xs = np.nonzero(mask)
+        assert len(xs) > 0, f"{name}: no pixels of the {'red' if tag == 1 else 'blue'} sphere"
+        assert xs.mean() + 0.5 == pytest.approx(col, abs=0.5) and ys.mean() + 0.5 == pytest.approx(row, abs=0.5)
+        assert len(xs) == pytest.approx(math.pi * (radius * scale) ** 2, rel=0.08)
+
+
+def test_povray_render_names_and_formats(tmp_path):
+    """Scene.render's file: the name given (a PNM from .pnm), ESyS's defaults (256 x 256, white); a name
+    without an image extension is ESyS's ValueError; a sphere behind the camera is not drawn (an orthographic
+    POV-Ray ray starts at the camera)."""
+    why = _no_rendering()
+    if why:
+        pytest.skip(why)
     script = tmp_path / "vis.py"
-    script.write_text("from esys.lsm.vis import povray\n")
-    p = front(script, tmp_path, check=False)
-    assert p.returncode != 0 and "basalt-view" in p.stderr
+    script.write_text(
+        "from esys.lsm.vis import povray\n"
+        "scene = povray.Scene()\n"
+        "s = povray.Sphere([0, 0, 0], 1.0)\n"
+        "s.apply(povray.RgbColor(0.0, 1.0, 0.0))\n"
+        "scene.add(s)\n"
+        "scene.render(offScreen=True, interactive=False, fileName='a.png')\n"
+        "scene.render(offScreen=True, interactive=False, fileName='b.pnm', size=[64, 48])\n"
+        "scene.render(fileName='c.png', size=[40, 30])\n"
+        "try:\n"
+        "    scene.render(offScreen=True, interactive=False, fileName='d.jpg')\n"
+        "except ValueError as e:\n"
+        "    print('refused:', e)\n"
+        "behind = povray.Sphere([0, 0, 12], 3.0)\n"  # behind a camera at (0, 0, 5): not drawn, as POV-Ray's
+        "behind.apply(povray.Colors.Red)\n"
+        "scene.add(behind)\n"
+        "scene.getCamera().setPosn([0, 0, 5])\n"
+        "scene.render(offScreen=True, interactive=False, fileName='e.png', size=[100, 100])\n")
+    p = front(script, tmp_path)
+    assert sorted(os.listdir(tmp_path)) == ["a.png", "b.pnm", "c.png", "e.png", "vis.py"]
+    img = png_pixels(tmp_path / "e.png")
+    assert ((img[:, :, 0] > 12) & (3 * img[:, :, 1] < img[:, :, 0])).sum() == 0  # no red: behind the camera
+    assert img[50, 50, 1] > 100 and img[50, 50, 0] < 30  # the green sphere, seen from +z now
+    assert png_size(tmp_path / "a.png") == (256, 256) and png_size(tmp_path / "c.png") == (40, 30)
+    pnm = (tmp_path / "b.pnm").read_bytes()  # binary PPM: P6, a comment, width height, 255, the pixels
+    assert pnm.startswith(b"P6\n") and re.search(rb"\n64 48\n255\n", pnm) and len(pnm) >= 64 * 48 * 3
+    assert "refused: No image format found which matched extension 'jpg'" in p.stdout
+    # ESyS's default render (offScreen=False, interactive=True) opens POV-Ray's window: said once
+    assert p.stderr.count("no window is opened") == 1
+    img = png_pixels(tmp_path / "a.png")
+    # the default camera (zoom 1: 2.05 units high) at (0, 0, -10): the green sphere of radius 1 in the middle
+    assert (img[128, 128, 1] > 100) and img[128, 128, 0] < 30 and (img[0, 0] == 255).all()
+    green = (img[:, :, 1] > 12) & (3 * img[:, :, 0] < img[:, :, 1])
+    assert green.sum() == pytest.approx(math.pi * (256 / 2.05) ** 2, rel=0.08)
+
+
+def test_povray_render_with_a_dead_display_says_so(tmp_path):
+    """DISPLAY naming a display nobody serves: a NoDisplayError saying so (VTK itself would abort the process)."""
+    pytest.importorskip("vtkmodules.vtkRenderingOpenGL2", reason="VTK's Python module (python3-vtk9) is not installed")
+    script = tmp_path / "vis.py"
+    script.write_text("from esys.lsm.vis import povray\n"
+                      "povray.Scene().render(offScreen=True, interactive=False, fileName='a.png')\n")
+    env = {k: v for k, v in os.environ.items() if not k.startswith("OMPI_COMM_WORLD")}
+    env.update(PYTHONPATH=PACKAGE_DIR, DISPLAY=":7919")
+    p = subprocess.run([sys.executable, "-m", "basalt.esys", str(script)], cwd=tmp_path, capture_output=True,
+                       text=True, env=env, timeout=300)
+    assert p.returncode == 1 and "NoDisplayError: cannot open the X display DISPLAY=:7919" in p.stderr
+    assert not (tmp_path / "a.png").exists()
 
 
 def test_script_sees_its_arguments_and_folder(tmp_path):

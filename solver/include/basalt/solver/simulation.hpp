@@ -59,8 +59,9 @@ struct StabilityReport {
   double dt_pair = 0;   ///< the former estimate 2 sqrt(m_min / k_max) (one spring, one particle)
   double dt_bound = 0;  ///< 2 / omega from the bound omega^2 <= max_i (2 sum_j k_ij + sum_walls k) / m_i
   double dt_power = 0;  ///< 2 / omega from power iterations on M^-1 K (the real network)
-  double dt_contact =
-      0;  ///< one new contact of a lightest particle: 2 / sqrt(2 k_pair / m_min) or (wall) k_wall
+  /// One new contact of a lightest particle: 2 / sqrt(2 k_pair / m_min) or (wall) k_wall / m_min; with
+  /// rotation a tangential spring ks counts as 3.5 ks (the contact point's compliance 1/m + r^2/I = 3.5/m).
+  double dt_contact = 0;
   int iterations = 0;       ///< power iterations done
   double perturbation = 0;  ///< the largest displacement of the products K u the estimate took
   int retries = 0;          ///< times the perturbation was made 8x smaller because it broke bonds

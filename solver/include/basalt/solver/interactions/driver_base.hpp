@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "basalt/solver/interactions/force_compute.hpp"
+#include "basalt/solver/models/contract.hpp"
 
 namespace basalt::solver {
 
@@ -29,6 +30,11 @@ class ModelDriver : public ForceCompute<Real> {
   double max_stiffness(double rmax) const override {
     double m = 0;
     for (const auto& p : params_) m = std::max(m, Model::max_stiffness(p, rmax));
+    return m;
+  }
+  double shear_stiffness(double rmax) const override {
+    double m = 0;
+    for (const auto& p : params_) m = std::max(m, basalt::solver::shear_stiffness<Model>(p, rmax));
     return m;
   }
 

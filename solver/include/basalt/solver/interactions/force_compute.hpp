@@ -86,6 +86,9 @@ class ForceCompute {
   virtual bool reconfigure(const InteractionSpec& /*g*/) { return false; }
   /// Largest spring constant for particles up to radius rmax (critical time step).
   virtual double max_stiffness(double rmax) const = 0;
+  /// Pair and wall models: the stiffest tangential spring acting at the contact point of rotating particles
+  /// for radii up to rmax (0: none; models/contract.hpp, shear_stiffness).
+  virtual double shear_stiffness(double /*rmax*/) const { return 0; }
   /// Pair models: how far beyond ri + rj a pair of particles up to radius rmax can interact (0: only
   /// overlapping pairs; a cohesive neck reaches further, models/contract.hpp).
   virtual double reach(double /*rmax*/) const { return 0; }

@@ -7,6 +7,10 @@
 //   name, kind, summary, keys, reads, writes; Params, parse(TableReader&), coeffs<Real>(Params),
 //   Coeffs<Real> for double and float, max_stiffness(Params, rmax); History (empty when none).
 //   History rules: trivially copyable, made of doubles only (checkpoints save it as float64 values).
+//   Optional: shear_stiffness(Params, rmax), the stiffest tangential spring a pair or wall contact applies
+//     at the contact point of rotating particles (default: none). The critical step counts it with the
+//     contact point's compliance 1/m + r^2/I = 3.5/m of a solid sphere (simulation_stability.cpp); a model
+//     whose tangential force does not turn the particles (ESyS's NRotFriction) declares none.
 //
 // Pair models (PairDriver, interactions/pair_driver.hpp), one of two laws:
 //   scalar:    force(c, h, rsum, r) and energy(c, h, rsum, r), the force along the line of centres,
@@ -134,6 +138,12 @@ concept HasReach = requires(const typename M::Params& p) {
   { M::reach(p, 1.0) } -> std::convertible_to<double>;
 };
 
+/// The optional shear_stiffness(): the stiffest tangential spring at the contact point of rotating particles.
+template <class M>
+concept HasShearStiffness = requires(const typename M::Params& p) {
+  { M::shear_stiffness(p, 1.0) } -> std::convertible_to<double>;
+};
+
 template <class M, class Real>
 concept HasContactLanes = requires(const typename M::template Coeffs<Real>& c,
                                    ContactLanes<Real, kContactLaneWidth, typename M::History>& b) {
@@ -159,6 +169,16 @@ template <class M>
 inline double pair_reach(const typename M::Params& p, double rmax) {
   if constexpr (contract::HasReach<M>)
     return M::reach(p, rmax);
+  else
+    return 0.0;
+}
+
+/// The stiffest tangential spring model M applies at the contact point of rotating particles (0 without
+/// shear_stiffness()).
+template <class M>
+inline double shear_stiffness(const typename M::Params& p, double rmax) {
+  if constexpr (contract::HasShearStiffness<M>)
+    return M::shear_stiffness(p, rmax);
   else
     return 0.0;
 }

@@ -79,6 +79,12 @@ struct CoulombFriction {
   static double max_stiffness(const Params& p, double rmax) {
     return std::max(p.K, p.Ks) * (p.scaling ? scale_factor(rmax, rmax) : 1.0);
   }
+  /// The shear spring acts at the contact point, which a sphere's rotation makes lighter
+  /// (models/contract.hpp); without rotation (ESyS's NRotFriction) it only pulls the centres, as
+  /// max_stiffness counts.
+  static double shear_stiffness(const Params& p, double rmax) requires Rotating {
+    return p.Ks * (p.scaling ? scale_factor(rmax, rmax) : 1.0);
+  }
   /// ESyS's stiffness scaling (RotFricInteraction.cpp: R^2 / (ri + rj) with R = (ri + rj) / 2;
   /// FrictionInteraction.cpp: (ri + rj) / 2).
   static double scale_factor(double ri, double rj) { return Rotating ? (ri + rj) / 4 : (ri + rj) / 2; }
@@ -236,6 +242,8 @@ struct FrictionWall {
     return CoulombFriction<true>::coeffs<Real>(p);
   }
   static double max_stiffness(const Params& p, double) { return std::max(p.K, p.Ks); }
+  /// The shear spring acts at the contact point, k.d from the centre (models/contract.hpp).
+  static double shear_stiffness(const Params& p, double) { return p.Ks; }
 
   template <bool Advance, class Real>
   static void contact(const Coeffs<Real>& c, History& h, const WallKinematics<Real>& k,

@@ -311,6 +311,12 @@ struct HertzMindlin {
     return 8 * c.G_star * std::sqrt(0.5 * rmax * 0.05 * rmax) +
            2 * c.E_star * std::sqrt(0.5 * rmax * 0.05 * rmax);
   }
+  /// Mindlin's tangential stiffness 8 G* a at the same overlap: it acts at the contact point
+  /// (models/contract.hpp).
+  static double shear_stiffness(const Params& p, double rmax) {
+    return 8 * hertz::constants(p.material, p.material, p.e, p.mu).G_star *
+           std::sqrt(0.5 * rmax * 0.05 * rmax);
+  }
 
   /// The collision of a pair of effective radius R and mass m (hertz::collision).
   static Collision collision(const Params& p, double R, double m, double vn, double d) {
@@ -434,6 +440,9 @@ struct HertzMindlinWall {
   static double max_stiffness(const Params& p, double rmax) {
     const auto c = hertz::constants(p.particle, p.wall, p.e, p.mu);
     return (8 * c.G_star + 2 * c.E_star) * std::sqrt(rmax * 0.05 * rmax);
+  }
+  static double shear_stiffness(const Params& p, double rmax) {
+    return 8 * hertz::constants(p.particle, p.wall, p.e, p.mu).G_star * std::sqrt(rmax * 0.05 * rmax);
   }
   /// The collision of a particle of radius R and mass m with the wall (hertz::collision).
   static Collision collision(const Params& p, double R, double m, double vn, double d) {

@@ -61,6 +61,7 @@ struct RollingFriction {
     return {Base::coeffs<Real>(p.base), Real(p.mu_roll)};
   }
   static double max_stiffness(const Params& p, double rmax) { return Base::max_stiffness(p.base, rmax); }
+  static double shear_stiffness(const Params& p, double rmax) { return Base::shear_stiffness(p.base, rmax); }
 
   static void apart(History& h) { h = History{}; }
   static History flip(const History& h) { return {Base::flip(h.base), -h.mx, -h.my, -h.mz}; }
