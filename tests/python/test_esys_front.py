@@ -805,11 +805,13 @@ SUMMED_OVER_RANKS = {"cube_drop.py": {"floor_force.dat"}}
 
 
 @pytest.mark.skipif(subprocess.run(["which", "mpirun"], capture_output=True).returncode != 0, reason="needs mpirun")
-@pytest.mark.parametrize("script", ["collide.py", "press.py", "cube_drop.py", "pull.py"])
+@pytest.mark.parametrize("script", ["collide.py", "press.py", "cube_drop.py", "pull.py", "snap_pair.py"])
 def test_two_ranks_write_what_one_rank_writes(tmp_path, script):
     """mpirun -np 2: every saver file, checkpoint and printed line once and as on one rank (the same bytes; wall
     forces, summed over the ranks, to 1e-10). Each rank writing its own copy doubles the appended savers and the
     prints; a rank's particles missing changes the checkpoints, the particle savers and the Runnables' prints."""
+    if script == "snap_pair.py" and _no_rendering():  # POV-Ray snapshots: drawn by rank 0
+        pytest.skip(_no_rendering())
     one, two = tmp_path / "one", tmp_path / "two"
     one.mkdir()
     two.mkdir()
@@ -821,10 +823,10 @@ def test_two_ranks_write_what_one_rank_writes(tmp_path, script):
     files = sorted(f.name for f in one.iterdir())
     assert files and sorted(f.name for f in two.iterdir()) == files
     for name in files:
-        x, y = (one / name).read_text(), (two / name).read_text()
         if name not in SUMMED_OVER_RANKS.get(script, ()):
-            assert x == y, name
+            assert (one / name).read_bytes() == (two / name).read_bytes(), name
             continue
+        x, y = (one / name).read_text(), (two / name).read_text()
         rx, ry = ([[float(w) for w in line.split()] for line in t.splitlines()] for t in (x, y))
         assert len(rx) == len(ry) and all(len(u) == len(v) for u, v in zip(rx, ry)), name
         for u, v in zip(rx, ry):
