@@ -23,7 +23,7 @@ PACKAGE_DIR = os.path.dirname(os.path.dirname(os.path.abspath(basalt.__file__)))
 
 def front(script, cwd, *args, check=True):
     """python3 -m basalt.esys SCRIPT in cwd; returns the CompletedProcess."""
-    env = {k: v for k, v in os.environ.items() if not k.startswith("OMPI_COMM_WORLD")}
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_COMM_WORLD", "PMI_RANK", "PMI_SIZE"))}
     env["PYTHONPATH"] = PACKAGE_DIR
     p = subprocess.run([sys.executable, "-m", "basalt.esys", str(script), *args], cwd=cwd, capture_output=True,
                        text=True, env=env, timeout=300)
@@ -491,7 +491,7 @@ def test_povray_render_with_a_dead_display_says_so(tmp_path):
     script = tmp_path / "vis.py"
     script.write_text("from esys.lsm.vis import povray\n"
                       "povray.Scene().render(offScreen=True, interactive=False, fileName='a.png')\n")
-    env = {k: v for k, v in os.environ.items() if not k.startswith("OMPI_COMM_WORLD")}
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_COMM_WORLD", "PMI_RANK", "PMI_SIZE"))}
     env.update(PYTHONPATH=PACKAGE_DIR, DISPLAY=":7919")
     p = subprocess.run([sys.executable, "-m", "basalt.esys", str(script)], cwd=tmp_path, capture_output=True,
                        text=True, env=env, timeout=300)
