@@ -7,7 +7,6 @@ Runnables, field savers and checkpointers run at ESyS's points of the step (docs
 
 import atexit
 import math
-import os
 import shutil
 import tempfile
 
