@@ -251,10 +251,13 @@ class Simulation:
         dt as a fraction of it, as run.dt_fraction does."""
         return self._core.critical_dt
 
-    def gather(self, name):
+    def gather(self, name, everywhere=False):
         """Collective: one particle array (a name of sim.particles) of every rank, on rank 0 as (ids, values)
-        sorted by id (float64 values); None on the other ranks."""
-        return self._core.gather(name)
+        sorted by id (float64 values); None on the other ranks, or the same on every rank with everywhere=True.
+        A list of names gathers them in one exchange: values is then an (n, len(names)) array."""
+        if isinstance(name, (list, tuple)):
+            return self._core.gather_table([str(n) for n in name], bool(everywhere))
+        return self._core.gather(name, bool(everywhere))
 
     def kinetic_energy(self):
         """Collective: the total kinetic energy (translation and rotation)."""
@@ -354,6 +357,11 @@ class Simulation:
     def bond_count(self):
         """Collective: the bonds now."""
         return self._core.bond_count()
+
+    def broken_bond_pairs(self):
+        """Collective: the bonds broken so far as an (n, 3) int64 array, on every rank: their particles' ids
+        (the smaller first) and the step each broke at, sorted."""
+        return self._core.broken_bond_pairs()
 
     def broken_bonds(self):
         """Collective: the bonds broken so far."""

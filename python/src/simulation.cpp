@@ -102,7 +102,8 @@ class Run {
   virtual py::list run_stages() = 0;
   virtual py::dict state() = 0;
   virtual py::array array(const std::string& name, py::handle owner) = 0;
-  virtual py::object gather(const std::string& name, py::handle owner) = 0;
+  virtual py::object gather(const std::vector<std::string>& names, py::handle owner, bool everywhere,
+                            bool table) = 0;
   virtual const solver::Comm& comm() const = 0;
   virtual std::int64_t step() const = 0;
   virtual double time() const = 0;
@@ -130,6 +131,9 @@ class Run {
   /// Collective: bonds now, bonds broken so far (every rank's), particles inserted and removed so far.
   virtual std::int64_t bond_count() = 0;
   virtual std::int64_t broken_bonds() = 0;
+  /// Collective: the bonds broken so far, every rank's, on every rank: rows (id, id, step it broke at), the
+  /// smaller id first, sorted.
+  virtual py::array broken_bond_pairs() = 0;
   virtual std::array<std::int64_t, 2> flow_totals() const = 0;
   /// Collective: a checkpoint of the current step now.
   virtual void checkpoint() = 0;
@@ -235,6 +239,26 @@ class RunOf final : public Run {
         parse_keys(keys, "delete", [](solver::TableReader& t) { return solver::parse_delete(t); }));
   }
   std::int64_t bond_count() override { return sim_->bond_count(); }
+  py::array broken_bond_pairs() override {
+    std::vector<double> mine;  // each break is recorded by one rank
+    for (const auto& b : sim_->broken_bonds()) {
+      mine.push_back(double(std::min(b.a, b.b)));
+      mine.push_back(double(std::max(b.a, b.b)));
+      mine.push_back(double(b.step));
+    }
+    const std::vector<double> all = comm_.size() > 1 ? comm_.all_gather(mine) : mine;
+    std::vector<std::array<std::int64_t, 3>> rows;
+    for (std::size_t k = 0; k + 2 < all.size(); k += 3)
+      rows.push_back({static_cast<std::int64_t>(all[k]), static_cast<std::int64_t>(all[k + 1]),
+                      static_cast<std::int64_t>(all[k + 2])});
+    std::sort(rows.begin(), rows.end());
+    py::array_t<std::int64_t> out({static_cast<py::ssize_t>(rows.size()), py::ssize_t{3}});
+    auto w = out.mutable_unchecked<2>();
+    for (std::size_t k = 0; k < rows.size(); ++k)
+      for (py::ssize_t c = 0; c < 3; ++c)
+        w(static_cast<py::ssize_t>(k), c) = rows[k][static_cast<std::size_t>(c)];
+    return out;
+  }
   std::int64_t broken_bonds() override {
     return comm_.sum(static_cast<long long>(sim_->broken_bonds().size()));
   }
@@ -316,33 +340,43 @@ class RunOf final : public Run {
                         "rotation; qw, qx, qy, qz with particles.orientation)");
   }
 
-  py::object gather(const std::string& name, py::handle owner) override {
-    // Collective: (id, value) of every owned particle, all ranks', to rank 0 sorted by id (as float64).
-    const py::array local = array(name, owner);  // validates the name
+  py::object gather(const std::vector<std::string>& names, py::handle owner, bool everywhere,
+                    bool table) override {
+    // Collective: (id, values) of every owned particle, all ranks', to rank 0 (every rank when everywhere)
+    // sorted by id (as float64): one column per name, a 1-D array unless table.
+    const std::size_t w = names.size() + 1;  // a row: the id, then the values
+    std::vector<py::array_t<double>> columns;
+    for (const auto& name : names)  // array() validates the name
+      columns.push_back(array(name, owner).attr("astype")("float64").template cast<py::array_t<double>>());
     const auto& p = sim_->particles();
     std::vector<double> mine;
-    mine.reserve(2 * p.n_owned);
-    const py::array_t<double> values = local.attr("astype")("float64");
-    const auto v = values.unchecked<1>();
+    mine.reserve(w * p.n_owned);
     for (std::size_t i = 0; i < p.n_owned; ++i) {
       mine.push_back(double(p.id[i]));
-      mine.push_back(v(static_cast<py::ssize_t>(i)));
+      for (const auto& c : columns) mine.push_back(c.at(static_cast<py::ssize_t>(i)));
     }
     const std::vector<double> all = comm_.size() > 1 ? comm_.all_gather(mine) : mine;
-    if (comm_.rank() != 0) return py::none();
-    const std::size_t n = all.size() / 2;
+    if (comm_.rank() != 0 && !everywhere) return py::none();
+    const std::size_t n = all.size() / w;
     std::vector<std::size_t> order(n);
     for (std::size_t k = 0; k < n; ++k) order[k] = k;
     std::sort(order.begin(), order.end(),
-              [&](std::size_t a, std::size_t b) { return all[2 * a] < all[2 * b]; });
+              [&](std::size_t a, std::size_t b) { return all[w * a] < all[w * b]; });
     py::array_t<std::int64_t> ids(static_cast<py::ssize_t>(n));
-    py::array_t<double> out(static_cast<py::ssize_t>(n));
     auto wi = ids.mutable_unchecked<1>();
-    auto wo = out.mutable_unchecked<1>();
-    for (std::size_t k = 0; k < n; ++k) {
-      wi(static_cast<py::ssize_t>(k)) = static_cast<std::int64_t>(all[2 * order[k]]);
-      wo(static_cast<py::ssize_t>(k)) = all[2 * order[k] + 1];
+    for (std::size_t k = 0; k < n; ++k)
+      wi(static_cast<py::ssize_t>(k)) = static_cast<std::int64_t>(all[w * order[k]]);
+    if (!table) {
+      py::array_t<double> out(static_cast<py::ssize_t>(n));
+      auto wo = out.mutable_unchecked<1>();
+      for (std::size_t k = 0; k < n; ++k) wo(static_cast<py::ssize_t>(k)) = all[w * order[k] + 1];
+      return py::make_tuple(ids, out);
     }
+    py::array_t<double> out({static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(names.size())});
+    auto wo = out.mutable_unchecked<2>();
+    for (std::size_t k = 0; k < n; ++k)
+      for (std::size_t c = 0; c < names.size(); ++c)
+        wo(static_cast<py::ssize_t>(k), static_cast<py::ssize_t>(c)) = all[w * order[k] + 1 + c];
     return py::make_tuple(ids, out);
   }
 
@@ -588,10 +622,18 @@ void bind_simulation(py::module_& m) {
            [](py::object self, const std::string& name) {
              return self.cast<PySimulation&>().run().array(name, self);
            })
-      .def("gather",
-           [](py::object self, const std::string& name) {
-             return self.cast<PySimulation&>().run().gather(name, self);
-           })
+      .def(
+          "gather",
+          [](py::object self, const std::string& name, bool everywhere) {
+            return self.cast<PySimulation&>().run().gather({name}, self, everywhere, false);
+          },
+          py::arg("name"), py::arg("everywhere") = false)
+      .def(
+          "gather_table",
+          [](py::object self, const std::vector<std::string>& names, bool everywhere) {
+            return self.cast<PySimulation&>().run().gather(names, self, everywhere, true);
+          },
+          py::arg("names"), py::arg("everywhere") = false)
       .def("kinetic_energy", [](PySimulation& s) { return s.run().kinetic_energy(); })
       .def("energies", [](PySimulation& s) { return s.run().energies(); })
       .def("walls", [](PySimulation& s) { return s.run().walls(); })
@@ -619,6 +661,7 @@ void bind_simulation(py::module_& m) {
       .def("delete", [](PySimulation& s, const std::string& keys) { return s.run().remove(keys); })
       .def("bond_count", [](PySimulation& s) { return s.run().bond_count(); })
       .def("broken_bonds", [](PySimulation& s) { return s.run().broken_bonds(); })
+      .def("broken_bond_pairs", [](PySimulation& s) { return s.run().broken_bond_pairs(); })
       .def("flow_totals", [](PySimulation& s) { return s.run().flow_totals(); })
       .def_property_readonly("critical_dt", [](PySimulation& s) { return s.run().critical_dt(); })
       .def("checkpoint", [](PySimulation& s) { s.run().checkpoint(); })

@@ -23,7 +23,7 @@ PACKAGE_DIR = os.path.dirname(os.path.dirname(os.path.abspath(basalt.__file__)))
 
 def front(script, cwd, *args, check=True):
     """python3 -m basalt.esys SCRIPT in cwd; returns the CompletedProcess."""
-    env = {k: v for k, v in os.environ.items() if not k.startswith("OMPI_COMM_WORLD")}
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_COMM_WORLD", "PMI_RANK", "PMI_SIZE"))}
     env["PYTHONPATH"] = PACKAGE_DIR
     p = subprocess.run([sys.executable, "-m", "basalt.esys", str(script), *args], cwd=cwd, capture_output=True,
                        text=True, env=env, timeout=300)
@@ -491,7 +491,7 @@ def test_povray_render_with_a_dead_display_says_so(tmp_path):
     script = tmp_path / "vis.py"
     script.write_text("from esys.lsm.vis import povray\n"
                       "povray.Scene().render(offScreen=True, interactive=False, fileName='a.png')\n")
-    env = {k: v for k, v in os.environ.items() if not k.startswith("OMPI_COMM_WORLD")}
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_COMM_WORLD", "PMI_RANK", "PMI_SIZE"))}
     env.update(PYTHONPATH=PACKAGE_DIR, DISPLAY=":7919")
     p = subprocess.run([sys.executable, "-m", "basalt.esys", str(script)], cwd=tmp_path, capture_output=True,
                        text=True, env=env, timeout=300)
@@ -783,3 +783,126 @@ def test_scaled_nrot_bonds_of_several_sizes_each_have_their_k(tmp_path):
     # the hanging bond (unscaled K = 20, rest 0.6, length 0.62) pulls 3 down and 4 up
     assert rows[4][3] == pytest.approx(dt * 20 * 0.02 / m[4], rel=1e-9)
     assert rows[3][3] == pytest.approx(-dt * 20 * 0.02 / m[3], rel=1e-9)
+
+
+# -- several ranks (mpirun -np 2) --------------------------------------------------------------------------------
+def front_mpi(script, cwd, ranks, *args, launcher=None):
+    """mpirun -np RANKS python3 -m basalt.esys SCRIPT (or the basalt-esys launcher) in cwd."""
+    import basalt_tools
+
+    env = basalt_tools.mpi_env(PYTHONPATH=PACKAGE_DIR)
+    cmd = [*basalt_tools.mpirun(ranks), *([str(launcher)] if launcher else [sys.executable, "-m", "basalt.esys"]),
+           str(script), *args]
+    p = subprocess.run(cmd, cwd=cwd, capture_output=True, text=True, env=env, timeout=300)
+    if p.returncode != 0:
+        pytest.fail(f"{' '.join(cmd)} exited {p.returncode}:\n{p.stdout}\n{p.stderr}")
+    return p
+
+
+# Files whose numbers are sums over the ranks (a wall's force: each rank's particles' share, added in another
+# order on two ranks): equal to rounding; every other file and printed line is the same bytes.
+SUMMED_OVER_RANKS = {"cube_drop.py": {"floor_force.dat"}}
+
+
+@pytest.mark.skipif(subprocess.run(["which", "mpirun"], capture_output=True).returncode != 0, reason="needs mpirun")
+@pytest.mark.parametrize("script", ["collide.py", "press.py", "cube_drop.py", "pull.py", "snap_pair.py"])
+def test_two_ranks_write_what_one_rank_writes(tmp_path, script):
+    """mpirun -np 2: every saver file, checkpoint and printed line once and as on one rank (the same bytes; wall
+    forces, summed over the ranks, to 1e-10). Each rank writing its own copy doubles the appended savers and the
+    prints; a rank's particles missing changes the checkpoints, the particle savers and the Runnables' prints."""
+    if script == "snap_pair.py" and _no_rendering():  # POV-Ray snapshots: drawn by rank 0
+        pytest.skip(_no_rendering())
+    one, two = tmp_path / "one", tmp_path / "two"
+    one.mkdir()
+    two.mkdir()
+    a = front(SCRIPTS / script, one).stdout
+    launcher = (pathlib.Path(os.environ.get("BASALT_BIN") or ROOT / "build" / "bin") / "basalt-esys").resolve()
+    b = front_mpi(SCRIPTS / script, two, 2, launcher=launcher if script == "press.py" and launcher.exists()
+                  else None).stdout
+    assert b == a
+    files = sorted(f.name for f in one.iterdir())
+    assert files and sorted(f.name for f in two.iterdir()) == files
+    for name in files:
+        if name not in SUMMED_OVER_RANKS.get(script, ()):
+            assert (one / name).read_bytes() == (two / name).read_bytes(), name
+            continue
+        x, y = (one / name).read_text(), (two / name).read_text()
+        rx, ry = ([[float(w) for w in line.split()] for line in t.splitlines()] for t in (x, y))
+        assert len(rx) == len(ry) and all(len(u) == len(v) for u, v in zip(rx, ry)), name
+        for u, v in zip(rx, ry):
+            assert v == pytest.approx(u, rel=1e-10, abs=1e-12), name
+
+
+SEEN = """import os, sys
+from esys.lsm import *
+from esys.lsm.util import Vec3, BoundingBox
+
+rank = os.environ.get("OMPI_COMM_WORLD_RANK", "0")
+sim = LsmMpi(numWorkerProcesses=1, mpiDimList=[1, 1, 1])
+sim.initNeighbourSearch(particleType="NRotSphere", gridSpacing=2.5, verletDist=0.2)
+sim.setNumTimeSteps(10)
+sim.setTimeStepSize(1.0e-3)
+sim.setSpatialDomain(BoundingBox(Vec3(-20, -5, -5), Vec3(20, 5, 5)))
+for k in range(16):
+    p = NRotSphere(id=100 + k, posn=Vec3(-15.0 + 2.0 * k, 0.1 * k, 0.0), radius=0.5, mass=1.0)
+    p.setLinearVelocity(Vec3(0.5 * (k % 3 - 1), 0.0, 0.0))
+    sim.createParticle(p)
+
+
+class Seen(Runnable):
+    def __init__(self, sim, when):
+        Runnable.__init__(self)
+        self.sim, self.when = sim, when
+
+    def run(self):
+        ps = self.sim.getParticleList()
+        owned = len(self.sim._sim.particles)  # this rank's own particles (the test's view of the decomposition)
+        sys.stderr.write("seen %s %s %d %d %d %s\\n" % (rank, self.when, self.sim.getTimeStep(), owned, len(ps),
+                                                       ",".join(str(p.getId()) for p in ps)))
+        print("%s %d %.17g" % (self.when, self.sim.getTimeStep(), sum(p.getPosn()[0] for p in ps)))
+
+
+sim.addPreTimeStepRunnable(Seen(sim, "pre"))
+sim.addPostTimeStepRunnable(Seen(sim, "post"))
+sim.run()
+"""
+
+
+@pytest.mark.skipif(subprocess.run(["which", "mpirun"], capture_output=True).returncode != 0, reason="needs mpirun")
+def test_runnables_see_every_ranks_particles(tmp_path):
+    """mpirun -np 2: 16 spheres in a row split between the ranks (each owns some); the pre- and post-time-step
+    Runnables on each rank see all 16 (ids 100-115, in order) at every step, and print once, as on one rank."""
+    script = tmp_path / "seen.py"
+    script.write_text(SEEN)
+    one = front(script, tmp_path).stdout
+    p = front_mpi(script, tmp_path, 2)
+    assert p.stdout == one and len(one.splitlines()) == 20
+    rows = [line.split()[1:] for line in p.stderr.splitlines() if line.startswith("seen ")]
+    assert len(rows) == 2 * 2 * 10  # two ranks, two runnables, ten steps
+    ids = ",".join(str(100 + k) for k in range(16))
+    owned = {}
+    for rank, when, step, mine, seen, listed in rows:
+        assert (int(seen), listed) == (16, ids), (rank, when, step)
+        owned.setdefault((when, step), {})[rank] = int(mine)
+    for counts in owned.values():
+        assert sorted(counts) == ["0", "1"] and sum(counts.values()) == 16 and min(counts.values()) > 0, counts
+
+
+# -- checkpoints after a bond broke -------------------------------------------------------------------------------
+# pull.py MODE on ESyS-Particle 2.3.5 (mpirun -np 2 esysparticle pull.py MODE, measured): the last checkpoint
+# whose bonds' section lists the broken bond 0-1. Basalt's front end wrote the same section at every step, and
+# with rot and beam every checkpoint file is ESyS's byte for byte (nrot's particle rows part from step 7 on:
+# ESyS's NRotBond still pulls in the step it finds the bond broken, docs/esys.md).
+ESYS_LAST_LISTED = {"nrot": 7, "rot": 5, "beam": 7}
+
+
+@pytest.mark.parametrize("mode", sorted(ESYS_LAST_LISTED))
+def test_checkpoint_after_a_bond_broke_lists_the_bonds_left(tmp_path, mode):
+    """pull.py: bond 0-1 breaks, 1-2 holds; each step's checkpoint lists 0-1 up to ESyS's last step for it and
+    then only 1-2, with the count and the group kind (Bonded for NRotBondPrms, RotBonded otherwise)."""
+    front(SCRIPTS / "pull.py", tmp_path, mode)
+    kind = "Bonded" if mode == "nrot" else "RotBonded"
+    for t in range(21):
+        section = (tmp_path / f"pull_t={t}_1.txt").read_text().splitlines()[4:]
+        bonds = ["0 1 3", "1 2 3"] if t <= ESYS_LAST_LISTED[mode] else ["1 2 3"]
+        assert section == ["1", kind, str(len(bonds)), *bonds, "TMIG 0"], (t, section)

@@ -224,7 +224,13 @@ def test_mpi_two_compute_ranks_and_an_io_rank(tmp_path):
                 assert len(ids) == 8948 and (ids[1:] > ids[:-1]).all(), len(ids)
             else:
                 assert g is None
+            ids, z = sim.gather("z", everywhere=True)  # every rank's particles on every rank
+            assert len(ids) == 8948 and (ids[1:] > ids[:-1]).all(), len(ids)
+            ids2, table = sim.gather(["x", "z"], everywhere=True)  # several arrays in one exchange
+            assert (ids2 == ids).all() and table.shape == (8948, 2) and (table[:, 1] == z).all()
+            assert (table[:, 0] == sim.gather("x", everywhere=True)[1]).all()
             if sim.rank == 0:
+                assert (ids == g[0]).all() and (z == g[1]).all()
                 print("ranks", sim.ranks, "ke", repr(ke))
         sim.close()
     """))

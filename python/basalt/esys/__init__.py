@@ -15,7 +15,7 @@ from .errors import NotSupportedError
 
 SHIM_ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "_shim")
 
-__all__ = ["NotSupportedError", "run_script", "activate", "SHIM_ROOT"]
+__all__ = ["NotSupportedError", "run_script", "activate", "world", "SHIM_ROOT"]
 
 
 def activate():
@@ -28,13 +28,31 @@ def activate():
     sys.path.insert(0, SHIM_ROOT)
 
 
+def world():
+    """(rank, size) of this process in mpirun's world, from the launcher's environment (Open MPI's
+    OMPI_COMM_WORLD_RANK/SIZE, MPICH's PMI_RANK/SIZE), read before MPI starts; (0, 1) without mpirun."""
+    for rank, size in (("OMPI_COMM_WORLD_RANK", "OMPI_COMM_WORLD_SIZE"), ("PMI_RANK", "PMI_SIZE")):
+        if rank in os.environ and size in os.environ:
+            return int(os.environ[rank]), int(os.environ[size])
+    return 0, 1
+
+
 def run_script(path, args=()):
     """Runs the ESyS script `path` as __main__ with sys.argv = [path, *args], its folder on sys.path (after
-    the shim), as `python3 path` would."""
+    the shim), as `python3 path` would. Under mpirun every rank runs it (Basalt's calls are collective); the
+    script's prints appear once: ranks other than 0 print to os.devnull (their stderr is kept)."""
     path = os.fspath(path)
     if not os.path.isfile(path):
         raise FileNotFoundError(f"basalt.esys: no script {path!r}")
     sys.argv = [path, *args]
     activate()
     sys.path.insert(1, os.path.dirname(os.path.abspath(path)))
-    return runpy.run_path(path, run_name="__main__")
+    rank, size = world()
+    if size == 1 or rank == 0:
+        return runpy.run_path(path, run_name="__main__")
+    stdout, sys.stdout = sys.stdout, open(os.devnull, "w")
+    try:
+        return runpy.run_path(path, run_name="__main__")
+    finally:
+        sys.stdout.close()
+        sys.stdout = stdout

@@ -7,7 +7,6 @@ Runnables, field savers and checkpointers run at ESyS's points of the step (docs
 
 import atexit
 import math
-import os
 import shutil
 import tempfile
 
@@ -35,14 +34,15 @@ _HINTS = {
 
 
 class LsmMpi:
-    """LsmMpi(numWorkerProcesses, mpiDimList): the simulation. Basalt runs it in this one process (its own
-    decomposition); numWorkerProcesses and mpiDimList are accepted and not needed."""
+    """LsmMpi(numWorkerProcesses, mpiDimList): the simulation. Basalt runs it on the ranks mpirun starts (one
+    without mpirun), every one a compute rank with Basalt's own decomposition; numWorkerProcesses and mpiDimList
+    are accepted and not needed. Every rank runs the script; the particles the script sees (getParticleList)
+    are every rank's, gathered on each; rank 0 alone writes the savers' and checkpoints' files."""
 
     def __init__(self, numWorkerProcesses=1, mpiDimList=None):
-        if int(os.environ.get("OMPI_COMM_WORLD_SIZE", "1")) > 1:
-            refuse("LsmMpi under mpirun with several ranks",
-                   "Basalt's ESyS front end runs the script in one process: `python3 -m basalt.esys script.py` "
-                   "(basalt.Simulation scripts run on several ranks)")
+        from . import world
+
+        self._root = world()[0] == 0
         self.numWorkerProcesses, self.mpiDimList = int(numWorkerProcesses), list(mpiDimList or [1, 1, 1])
         self._particle_type = None
         self._verlet = None
@@ -343,10 +343,8 @@ class LsmMpi:
                     r.run()
             if track:
                 self._rebuild_check()
-                order = self._order()
-                self._prev_force = (np.asarray(self._sim.particles.id)[order].copy(),
-                                    np.column_stack([self._sim.particles.fx, self._sim.particles.fy,
-                                                     self._sim.particles.fz])[order])
+                ids, fx, fy, fz = self._columns("fx", "fy", "fz")
+                self._prev_force = (ids, np.column_stack([fx, fy, fz]))
             if n == 1:  # the walls' push on the particles (+ 0.0: no "-0" where nothing touches, as ESyS prints)
                 self._prev_wall_force = {w: 0.0 - np.asarray(self._sim.walls[w].force) for w in self._walls}
             else:  # a chunk: savers and getWallForce fall back to the current forces
@@ -368,21 +366,29 @@ class LsmMpi:
         self._saved = self._t
         due = [s for s in (*self._savers, *self._checkpointers) if s.due(self._t)]
         if due:
-            state = self._state()
-            for s in due:
-                s.write(self._t, state)
+            state = self._state()  # collective: every rank gathers it, rank 0 writes
+            if self._root:
+                for s in due:
+                    s.write(self._t, state)
 
     # -- state ----------------------------------------------------------------------------------------------
-    def _order(self):
+    def _columns(self, *names):
+        """Collective: (ids, one array per name) of every rank's particles, in id order, on every rank (this
+        rank's arrays when it is the only one)."""
         import numpy as np
 
-        return np.argsort(self._sim.particles.id, kind="stable")
+        sim = self._sim
+        if sim.ranks == 1:
+            p = sim.particles
+            order = np.argsort(p.id, kind="stable")
+            return (np.asarray(p.id)[order].astype(np.int64), *(np.asarray(getattr(p, n))[order] for n in names))
+        ids, table = sim.gather(list(names) or ["id"], everywhere=True)  # one exchange for all the arrays
+        return (ids, *(table[:, k] for k in range(len(names))))
 
     def _positions(self):
         import numpy as np
 
-        p = self._sim.particles
-        return np.column_stack([p.x, p.y, p.z])[self._order()]
+        return np.column_stack(self._columns("x", "y", "z")[1:])
 
     def _rebuild_check(self):
         """ESyS's neighbour-list rule (TSubLattice::checkNeighbors), checked as a step begins: when a particle has
@@ -408,9 +414,8 @@ class LsmMpi:
 
     def _leave_domain(self):
         """Deletes the particles outside the (grown) spatial domain, as ESyS does at its neighbour updates."""
-        p = self._sim.particles
         (lo, hi), big = self._grid_domain(), 1e30
-        for k, c in enumerate((p.x, p.y, p.z)):
+        for k, c in enumerate(self._columns("x", "y", "z")[1:]):
             if len(c) and (c.min() < lo[k] or c.max() > hi[k]):
                 for side in (0, 1):
                     a, b = [-big] * 3, [big] * 3
@@ -423,13 +428,17 @@ class LsmMpi:
     def _state(self):
         import numpy as np
 
-        p, order = self._sim.particles, self._order()
-        ids = np.asarray(p.id)[order]
+        names = ["tag", "radius", "inv_mass", "x", "y", "z", "vx", "vy", "vz", "fx", "fy", "fz"]
+        if self._rotational:
+            names += ["wx", "wy", "wz"]
+            if self._checkpointers:  # the scene keeps orientations then (scene.py)
+                names += ["qw", "qx", "qy", "qz"]
+        ids, *cols = self._columns(*names)
+        c = dict(zip(names, cols))
         where = np.searchsorted(self._ids, ids)
         state = {
-            "id": ids, "tag": np.asarray(p.tag)[order], "radius": np.asarray(p.radius)[order],
-            "mass": 1.0 / np.asarray(p.inv_mass)[order],
-            "pos": np.column_stack([p.x, p.y, p.z])[order], "vel": np.column_stack([p.vx, p.vy, p.vz])[order],
+            "id": ids, "tag": c["tag"].astype(np.int64), "radius": c["radius"], "mass": 1.0 / c["inv_mass"],
+            "pos": np.column_stack([c["x"], c["y"], c["z"]]), "vel": np.column_stack([c["vx"], c["vy"], c["vz"]]),
             "init": self._init[where],
             "walls": {n: (np.asarray(w.position), np.asarray(w.force)) for n, w in
                       ((n, self._sim.walls[n]) for n in self._walls)},
@@ -438,16 +447,18 @@ class LsmMpi:
             prev_ids, prev = self._prev_force
             state["force"] = prev[np.searchsorted(prev_ids, ids)]
         else:
-            state["force"] = np.column_stack([p.fx, p.fy, p.fz])[order]
+            state["force"] = np.column_stack([c["fx"], c["fy"], c["fz"]])
         state["walls"] = {n: (pos, self._prev_wall_force.get(n, -f)) for n, (pos, f) in state["walls"].items()}
         if self._t == 0:  # before the first step ESyS holds no forces
             state["force"] = np.zeros_like(state["pos"])
             state["walls"] = {n: (pos, np.zeros(3)) for n, (pos, f) in state["walls"].items()}
         state["old"] = self._old if self._old is not None and len(self._old) == len(ids) else state["pos"]
         if self._rotational:
-            state["angvel"] = np.column_stack([p.wx, p.wy, p.wz])[order]
-            if self._checkpointers:  # the scene keeps orientations then (scene.py)
-                state["quat"] = np.column_stack([p.qw, p.qx, p.qy, p.qz])[order]
+            state["angvel"] = np.column_stack([c["wx"], c["wy"], c["wz"]])
+            if self._checkpointers:
+                state["quat"] = np.column_stack([c["qw"], c["qx"], c["qy"], c["qz"]])
+        if self._checkpointers and self._bond_groups:  # collective: read on every rank, written by rank 0
+            state["broken_bonds"] = {(int(i), int(j)): int(s) for i, j, s in self._sim.broken_bond_pairs().tolist()}
         return state
 
     def getParticleList(self):

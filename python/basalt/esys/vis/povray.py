@@ -293,6 +293,10 @@ class Scene:
             if not (radius > 0 and math.isfinite(radius)):
                 raise ValueError(f"{_MODULE}.Sphere: radius {s.getRadius()!r} is not a positive number")
             spheres.append((_vec(s.getCenter(), "a sphere's centre"), radius, s._colour()))
+        from .. import world
+
+        if world()[0] != 0:  # several ranks: each builds the same scene, rank 0 draws it (the file appears once)
+            return
         from .draw import draw
         cam = self.camera
         draw(str(fileName), fmt, (width, height), tuple(self.background), spheres,
