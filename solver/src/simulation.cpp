@@ -64,7 +64,7 @@ Simulation<Real>::Simulation(const Scene& scene, io::Geometry g, MPI_Comm comm, 
   rebuild();
   check_start(true);
   estimate_critical_step(true);  // simulation_stability.cpp; may set dt (run.dt_fraction)
-  start_ledger(compute_forces<true>());
+  guard_.start(forces_.ledger(), ledger_totals(compute_forces<true>()));
 }
 
 template <class Real>
@@ -95,7 +95,7 @@ Simulation<Real>::Simulation(const Scene& scene, const io::GeometryFile& file, M
   rebuild();
   check_start(true);
   estimate_critical_step(true);
-  start_ledger(compute_forces<true>());
+  guard_.start(forces_.ledger(), ledger_totals(compute_forces<true>()));
 }
 
 template <class Real>
@@ -279,27 +279,6 @@ void Simulation<Real>::hold_fixed() {
     p_.fx[i] = p_.fy[i] = p_.fz[i] = 0;
     if (p_.with_rotation) p_.tx[i] = p_.ty[i] = p_.tz[i] = 0;
   }
-}
-
-template <class Real>
-bool Simulation<Real>::energy_due(std::int64_t s) const {
-  for (const auto& f : scene_.fields)
-    if (s % f.every == 0 &&
-        (f.type == FieldSpec::Type::total_energy ||
-         (f.type == FieldSpec::Type::energy &&
-          forces_.ledger()[static_cast<std::size_t>(forces_.ledger().find(f.term))].kind ==
-              Ledger::Kind::potential)))
-      return true;
-  return scene_.energy_check_every > 0 && s % scene_.energy_check_every == 0;
-}
-
-template <class Real>
-bool Simulation<Real>::kinetic_due(std::int64_t s) const {
-  for (const auto& f : scene_.fields)
-    if (s % f.every == 0 && (f.type == FieldSpec::Type::total_energy ||
-                             (f.type == FieldSpec::Type::energy && f.term == "kinetic_energy")))
-      return true;
-  return scene_.energy_check_every > 0 && s % scene_.energy_check_every == 0;
 }
 
 template <class Real>
@@ -525,8 +504,8 @@ void Simulation<Real>::set_contact(std::string_view name, const std::string& key
 template <class Real>
 void Simulation<Real>::state_changed(bool advance_history) {
   integrator_.forget_energy();
-  wall_work_in_ = 0;
-  start_ledger(compute_forces<true>(false, advance_history));
+  guard_.clear_wall_work();
+  guard_.start(forces_.ledger(), ledger_totals(compute_forces<true>(false, advance_history)));
 }
 
 template <class Real>

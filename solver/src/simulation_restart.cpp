@@ -112,7 +112,7 @@ void Simulation<Real>::finish_restart(const io::Checkpoint& c, bool replay) {
   balancer_.set_paused(false);
   check_start(false);
   estimate_critical_step(false);  // simulation_stability.cpp
-  start_ledger(compute_forces<true>());
+  guard_.start(forces_.ledger(), ledger_totals(compute_forces<true>()));
   restore_kick_forces(c);  // simulation_kick_forces.cpp
 }
 

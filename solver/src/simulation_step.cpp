@@ -84,8 +84,8 @@ template <class Real>
 const std::vector<double>& Simulation<Real>::step_forces(bool in_flight) {
   Stopwatch sw;
   ghost_wait_ = 0;
-  const auto& pe = energy_due(step_) || flow_changed_ ? compute_forces<true>(in_flight, true)
-                                                      : compute_forces<false>(in_flight, true);
+  const auto& pe = guard_.energy_due(step_) || flow_changed_ ? compute_forces<true>(in_flight, true)
+                                                             : compute_forces<false>(in_flight, true);
   times_.forces += sw.lap() - ghost_wait_;
   times_.communication += ghost_wait_;
   return pe;
@@ -94,7 +94,7 @@ const std::vector<double>& Simulation<Real>::step_forces(bool in_flight) {
 template <class Real>
 void Simulation<Real>::second_kick(bool defer) {
   Stopwatch sw;
-  integrator_.second_half(p_, defer, kinetic_due(step_));
+  integrator_.second_half(p_, defer, guard_.kinetic_due(step_));
   times_.integration += sw.lap();
 }
 
@@ -102,7 +102,7 @@ template <class Real>
 void Simulation<Real>::wall_work() {
   if (forces_.walls().empty()) return;
   Stopwatch sw;
-  wall_work_in_ += std::max(0.0, forces_.walls().power()) * scene_.dt;
+  guard_.add_wall_work(forces_.walls().power(), scene_.dt);
   steer_servos();
   times_.output += sw.lap();
 }
@@ -113,14 +113,14 @@ void Simulation<Real>::observe(const std::vector<double>& pe) {
   output_fields(pe);
   times_.output += sw.lap();
   if (flow_changed_) rebase_ledger(pe);  // particles came or went: the ledger balances from here
-  if (scene_.energy_check_every > 0 && step_ % scene_.energy_check_every == 0) guard_energy(pe);
+  if (guard_.due(step_)) guard_energy(pe);
 }
 
 template <class Real>
 bool Simulation<Real>::observed(std::int64_t s) const {
   for (const auto& f : scene_.fields)
     if (s % f.every == 0) return true;
-  return scene_.energy_check_every > 0 && s % scene_.energy_check_every == 0;
+  return guard_.due(s);
 }
 
 template <class Real>

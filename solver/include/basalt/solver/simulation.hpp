@@ -38,6 +38,8 @@
 #include "basalt/solver/scene/frame_origin.hpp"
 #include "basalt/solver/scene/load_checks.hpp"
 #include "basalt/solver/scene/scene.hpp"
+#include "basalt/solver/stability/energy_guard.hpp"
+#include "basalt/solver/stability/rebuild_checks.hpp"
 #include "basalt/solver/timers.hpp"
 
 namespace basalt::solver {
@@ -161,8 +163,8 @@ class Simulation {
   const Comm& comm() const { return dec_->comm(); }
   const PhaseTimes& times() const { return times_; }
   const StabilityReport& stability() const { return stability_; }
-  /// The collisions seen at the rebuilds (contact models with a closed form: check_impacts()).
-  const ImpactReport& impacts() const { return impacts_; }
+  /// The collisions seen at the rebuilds (contact models with a closed form: RebuildChecks::impacts).
+  const ImpactReport& impacts() const { return checks_.impact_report(); }
   std::int64_t rebuilds() const { return rebuilds_; }
   /// Step of the last neighbour-list rebuild.
   std::int64_t last_rebuild_step() const { return rebuild_step_; }
@@ -334,24 +336,8 @@ class Simulation {
   /// between unbonded particles or into a wall; warns (rank 0) of the deepest overlap above 10 %.
   void check_start(bool fresh);
   void rebuild();
-  /// Float only, collective, at rebuilds until it warned: warns (rank 0, once) when the particles have moved
-  /// so far from the origin that float rounds a distance between two of the smallest to a strain above
-  /// kResolutionWarn (the load check sees only the start; docs/stability.md, "Energy drift over 1e7 steps").
-  void warn_far_positions();
-  /// Double only, collective, at rebuilds until it warned: warns (rank 0, once) when the rounding of
-  /// positions, epsilon |x|max / (2 r_min), exceeds kStrainLossWarn of the largest strain seen so far, of a
-  /// bond (|r - r0| / r0) or a contact (overlap / (ri + rj)): the scene's own strains are then resolved to
-  /// worse than that (docs/stability.md, "Coordinates far from the origin"). Reads positions, bonds and pair
-  /// lists; where the resolution is below 1e-12 (near the origin) only the positions.
-  void warn_lost_strain();
-  /// Collective, at rebuilds, for scenes with a contact model that has a closed-form collision
-  /// (hertz_mindlin; simulation_impacts.cpp): stops the run when a collision, touching or ahead along
-  /// straight paths, lasts fewer than kImpactSteps steps of dt, naming the pair, the impact speed, the
-  /// overlap and the dt it needs (forced: a warning, once); warns once when a collision's overlap passes
-  /// 20 % of the smaller radius.
-  void check_impacts();
-  /// The fraction of the scene's largest bond strain that rounding may take before warn_lost_strain warns.
-  static constexpr double kStrainLossWarn = 1e-3;
+  /// Collective, at the end of every rebuild: the collision and rounding checks (RebuildChecks).
+  void check_rebuild();
   /// What the balancer reads and moves at this point of the run (LoadBalancer::Run).
   typename LoadBalancer<Real>::Run balance_run() {
     return {scene_, *dec_, *halo_, p_, bonds_, forces_, times_, n_global_, step_, rebuilds_, ghost_width_};
@@ -434,8 +420,7 @@ class Simulation {
   void exchange_flow();
   /// The queued flow now, between steps: a rebuild, the forces, the ledger's new reference.
   void flow_now();
-  /// The energy guard's reference after particles came or went: the ledger now balances (mechanical +
-  /// dissipated - work in is the new reference).
+  /// The energy guard's reference after particles came or went (EnergyGuard::rebase).
   void rebase_ledger(const std::vector<double>& pe);
   /// Restart: next_id_ from the checkpoint's attribute next_particle_id (else the largest id + 1) and the
   /// lists' reach from the largest radius.
@@ -467,12 +452,9 @@ class Simulation {
   void restore_servos(const io::Checkpoint& c, bool at_rebuild);
   /// Collective: delivers pending output, then throws RunError(message).
   [[noreturn]] void stop(const std::string& message);
+  /// Collective: stops the run (naming the fastest particle) when the ledger of this rank's potentials pe
+  /// breaks the energy guard's balance.
   void guard_energy(const std::vector<double>& pe);
-  /// The ledger's balance at the start (global): set by start_ledger().
-  void start_ledger(const std::vector<double>& pe);
-  bool energy_due(std::int64_t s) const;
-  /// Whether step s needs the kinetic energy (a saver or the energy guard).
-  bool kinetic_due(std::int64_t s) const;
 
   Scene scene_;
   RunOptions options_;
@@ -482,7 +464,8 @@ class Simulation {
   Particles<Real> p_;
   Bonds<Real> bonds_;
   IdMap ids_;
-  ForceField<Real> forces_;  ///< the models, their lists and the energy ledger
+  ForceField<Real> forces_;                      ///< the models, their lists and the energy ledger
+  EnergyGuard guard_{scene_, forces_.ledger()};  ///< the ledger's reference and balance
   std::vector<BrokenBond> broken_;
   /// This rank's field-saver partials and due mask at step fields_step_ (output_fields; saved_field).
   std::vector<double> fields_local_;
@@ -502,9 +485,6 @@ class Simulation {
   double time_base_ = 0;        ///< time_ at the last set_dt() (time_at)
   std::int64_t step_base_ = 0;  ///< step_ at the last set_dt()
   std::int64_t rebuilds_ = 0;
-  double energy0_ = 0;
-  std::vector<double> ledger0_;  ///< the ledger's global values at the start (the guard's reference)
-  double wall_work_in_ = 0;      ///< this rank's share of the positive work done by walls
   PhaseTimes times_;
   LoadStats load_stats_;
   double ghost_wait_ = 0;
@@ -512,10 +492,7 @@ class Simulation {
   OutputSink* output_ = nullptr;   ///< the output of the step being made (run(), step())
   std::int64_t rebuild_step_ = 0;  ///< step of the last rebuild (checkpoints store it with p_.xr, yr, zr)
   bool far_moves_ = false;  ///< check_blowup let fast particles go on: the next migration goes any distance
-  bool strain_warned_ = false;   ///< warn_lost_strain() has warned
-  double strain_max_ = 0;        ///< the largest bond or contact strain warn_lost_strain has seen (all ranks)
-  bool far_warned_ = false;      ///< warn_far_positions() has warned (or the load check did at the start)
-  ImpactReport impacts_;         ///< check_impacts(): what the rebuilds saw
+  RebuildChecks<Real> checks_;   ///< what the rebuilds' collision and rounding checks saw and said
   LoadBalancer<Real> balancer_;  ///< run.balance: its state between rebuilds (parallel/load_balancer.hpp)
   bool mixed_ = false;           ///< run.precision = "mixed" (set by configure_particles())
   Origin origin_{};              ///< the frame's origin (mixed; zero otherwise)
