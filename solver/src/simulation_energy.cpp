@@ -30,7 +30,7 @@ std::vector<double> Simulation<Real>::ledger_totals(const std::vector<double>& p
 template <class Real>
 void Simulation<Real>::rebase_ledger(const std::vector<double>& pe) {
   guard_.rebase(forces_.ledger(), ledger_totals(pe));
-  flow_changed_ = false;
+  flow_.settled();
 }
 
 template <class Real>

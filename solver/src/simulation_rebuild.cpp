@@ -108,8 +108,8 @@ void Simulation<Real>::rebuild() {
     balancer_.weigh_pairs(balance_run());
   times_.communication += sw.lap();
   forces_.save_history(p_);  // before the ghosts (and the pairs' ids) go
-  const bool flow = !flow_.inserts.empty() || !flow_.deletes.empty();
-  if (flow) plan_arrivals();  // (simulation_flow.cpp: reads the ghosts)
+  const bool flow = flow_.pending();
+  if (flow) flow_.plan_arrivals(p_, *dec_, step_);  // (reads the ghosts)
   p_.drop_ghosts();
   if (flow) exchange_flow();
   times_.neighbor += sw.lap();
