@@ -57,14 +57,14 @@ Simulation<Real>::Simulation(const Scene& scene, io::Geometry g, MPI_Comm comm, 
   const auto summary = summarize_geometry(scene_, g, scene.geometry.string());
   run_load_checks(scene_, summary, scene.geometry.string(), comm, kEpsilon, precision_name());
   GeometryExtent extent = extent_of(g);
-  include_flow(extent);
+  flow_.include(scene_, extent);
   check_stability(summary);
   decompose(extent, comm);
   distribute(g, extent);
   rebuild();
   check_start(true);
   estimate_critical_step(true);  // simulation_stability.cpp; may set dt (run.dt_fraction)
-  start_ledger(compute_forces<true>());
+  guard_.start(forces_.ledger(), ledger_totals(compute_forces<true>()));
 }
 
 template <class Real>
@@ -86,7 +86,7 @@ Simulation<Real>::Simulation(const Scene& scene, const io::GeometryFile& file, M
       merge_summaries(summarize_geometry(scene_, loader.slice(), scene.geometry.string()), comm);
   run_load_checks(scene_, summary, scene.geometry.string(), comm, kEpsilon, precision_name());
   GeometryExtent extent = loader.extent();
-  include_flow(extent);
+  flow_.include(scene_, extent);
   check_stability(summary);
   decompose(extent, comm);
   io::Geometry part = loader.local_part(*dec_);
@@ -95,7 +95,7 @@ Simulation<Real>::Simulation(const Scene& scene, const io::GeometryFile& file, M
   rebuild();
   check_start(true);
   estimate_critical_step(true);
-  start_ledger(compute_forces<true>());
+  guard_.start(forces_.ledger(), ledger_totals(compute_forces<true>()));
 }
 
 template <class Real>
@@ -279,27 +279,6 @@ void Simulation<Real>::hold_fixed() {
     p_.fx[i] = p_.fy[i] = p_.fz[i] = 0;
     if (p_.with_rotation) p_.tx[i] = p_.ty[i] = p_.tz[i] = 0;
   }
-}
-
-template <class Real>
-bool Simulation<Real>::energy_due(std::int64_t s) const {
-  for (const auto& f : scene_.fields)
-    if (s % f.every == 0 &&
-        (f.type == FieldSpec::Type::total_energy ||
-         (f.type == FieldSpec::Type::energy &&
-          forces_.ledger()[static_cast<std::size_t>(forces_.ledger().find(f.term))].kind ==
-              Ledger::Kind::potential)))
-      return true;
-  return scene_.energy_check_every > 0 && s % scene_.energy_check_every == 0;
-}
-
-template <class Real>
-bool Simulation<Real>::kinetic_due(std::int64_t s) const {
-  for (const auto& f : scene_.fields)
-    if (s % f.every == 0 && (f.type == FieldSpec::Type::total_energy ||
-                             (f.type == FieldSpec::Type::energy && f.term == "kinetic_energy")))
-      return true;
-  return scene_.energy_check_every > 0 && s % scene_.energy_check_every == 0;
 }
 
 template <class Real>
@@ -498,19 +477,19 @@ void Simulation<Real>::set_contact(std::string_view name, const std::string& key
   };
   take(spec);
   // The lists were built for the reach the scene's models had at the start (contact_cutoff_).
-  const double reach = forces_.pair_reach(rmax_run_);
-  if (2 * rmax_run_ + reach + scene_.skin > contact_cutoff_ * (1 + 1e-12)) {
+  const double reach = forces_.pair_reach(flow_.rmax());
+  if (2 * flow_.rmax() + reach + scene_.skin > contact_cutoff_ * (1 + 1e-12)) {
     take(before);
     throw InputError(
         fmt::format("{}: the new parameters reach {:.6g} beyond touching, further than the lists were built "
                     "for ({:.6g}): "
                     "give the scene the far-reaching parameters from the start and weaken them here instead",
-                    label, reach, contact_cutoff_ - 2 * rmax_run_ - scene_.skin));
+                    label, reach, contact_cutoff_ - 2 * flow_.rmax() - scene_.skin));
   }
   // A stiffer contact shortens the critical step: the network's estimate again, refused as at the start.
   try {
-    stability_.dt_contact = contact_critical_step(stability_.m_min, rmax_run_);
-    stability_.k_max = forces_.max_stiffness(rmax_run_);
+    stability_.dt_contact = contact_critical_step(stability_.m_min, flow_.rmax());
+    stability_.k_max = forces_.max_stiffness(flow_.rmax());
     estimate_critical_step(false);
   } catch (const InputError& e) {
     take(before);
@@ -525,8 +504,8 @@ void Simulation<Real>::set_contact(std::string_view name, const std::string& key
 template <class Real>
 void Simulation<Real>::state_changed(bool advance_history) {
   integrator_.forget_energy();
-  wall_work_in_ = 0;
-  start_ledger(compute_forces<true>(false, advance_history));
+  guard_.clear_wall_work();
+  guard_.start(forces_.ledger(), ledger_totals(compute_forces<true>(false, advance_history)));
 }
 
 template <class Real>

@@ -146,21 +146,8 @@ double Simulation<Real>::runout(const FieldSpec& f) const {
 }
 
 template <class Real>
-void Simulation<Real>::output_fields(const std::vector<double>& pe) {
-  // No reduction here: the sink sums the ranks' partials (on an I/O rank, or reduced with Q = 0).
-  if (!field_partials(pe, fields_local_, fields_due_)) return;
-  fields_step_ = step_;
-  // The due mask travels beside the values: a NaN sum stays a NaN ("nan" in fields.csv), never a saver
-  // that was not due (an empty cell).
-  output_->fields(step_, time_, fields_local_, fields_due_);
-}
-
-template <class Real>
 std::optional<double> Simulation<Real>::saved_field(std::size_t column) const {
-  // The due mask is the same on every rank (the savers' every), so every rank returns alike.
-  if (fields_step_ != step_ || column >= fields_due_.size() || !fields_due_[column]) return std::nullopt;
-  const double v = fields_local_[column];
-  return comm().size() > 1 ? comm().sum(v) : v;
+  return fields_.saved(column, step_, comm());
 }
 
 template <class Real>
@@ -191,7 +178,6 @@ void Simulation<Real>::report_frame_times(std::vector<double> seconds) const {
 #define BASALT_INSTANTIATE(R)                                                                   \
   template bool Simulation<R>::field_partials(const std::vector<double>&, std::vector<double>&, \
                                               std::vector<char>&) const;                        \
-  template void Simulation<R>::output_fields(const std::vector<double>&);                       \
   template std::optional<double> Simulation<R>::saved_field(std::size_t) const;                 \
   template double Simulation<R>::runout(const FieldSpec&) const;                                \
   template RestartLayout Simulation<R>::restart_layout() const;                                 \

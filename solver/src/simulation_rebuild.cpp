@@ -108,8 +108,8 @@ void Simulation<Real>::rebuild() {
     balancer_.weigh_pairs(balance_run());
   times_.communication += sw.lap();
   forces_.save_history(p_);  // before the ghosts (and the pairs' ids) go
-  const bool flow = !flow_.inserts.empty() || !flow_.deletes.empty();
-  if (flow) plan_arrivals();  // (simulation_flow.cpp: reads the ghosts)
+  const bool flow = flow_.pending();
+  if (flow) flow_.plan_arrivals(p_, *dec_, step_);  // (reads the ghosts)
   p_.drop_ghosts();
   if (flow) exchange_flow();
   times_.neighbor += sw.lap();
@@ -142,12 +142,7 @@ void Simulation<Real>::rebuild() {
   rebuild_step_ = step_;
   bond_broke_ = false;
   ++rebuilds_;
-  check_impacts();  // simulation_impacts.cpp: only scenes with a closed-form collision (hertz_mindlin)
-  if constexpr (std::is_same_v<Real, float>)
-    warn_far_positions();
-  else
-    warn_lost_strain();  // (float's and mixed's own rounding of the wave's strains is ~1e-3 of them at the
-                         // origin)
+  check_rebuild();
   if (std::getenv("BASALT_DEBUG_REBUILD"))
     fmt::print(stderr, "rank {} rebuild at step {} owned {} ghosts {} bonds {} (both owned {}) pairs {}+{}\n",
                comm().rank(), step_, p_.n_owned, p_.n_ghost(), bonds_.size(), bonds_.n_both_owned,
@@ -156,79 +151,18 @@ void Simulation<Real>::rebuild() {
 }
 
 template <class Real>
-void Simulation<Real>::warn_far_positions() {
-  if (far_warned_) return;
-  double xmax = 0;
-  for (std::size_t i = 0; i < p_.n_owned; ++i)
-    xmax = std::max({xmax, std::abs(double(p_.x[i])), std::abs(double(p_.y[i])), std::abs(double(p_.z[i]))});
-  xmax = comm().max(xmax);
-  const double resolution = kEpsilon * xmax / (2 * stability_.rmin);
-  if (!(resolution > kResolutionWarn)) return;
-  far_warned_ = true;
-  if (step_ == 0) return;  // at the start: the load check has warned (or refused) already
-  if (comm().rank() == 0)
-    fmt::print(
-        stderr,
-        "basalt-run: warning: step {}: particles have reached |x| = {:.4g} with a smallest radius of {:.4g}: "
-        "in {} a distance between particles there is rounded to a strain of {:.2g} (epsilon |x| / 2 "
-        "r_min), above {:g}: expect the energy to drift (docs/stability.md, \"Energy drift over 1e7 "
-        "steps\"); run in double (--precision double)\n",
-        step_, xmax, stability_.rmin, precision_name(), resolution, kResolutionWarn);
-}
-
-template <class Real>
-void Simulation<Real>::warn_lost_strain() {
-  if (strain_warned_ || !(stability_.rmin > 0)) return;
-  double xmax = 0, smax = 0;
-  for (std::size_t i = 0; i < p_.n_owned; ++i)
-    xmax = std::max({xmax, std::abs(double(p_.x[i])), std::abs(double(p_.y[i])), std::abs(double(p_.z[i]))});
-  if (comm().size() > 1) xmax = comm().max(xmax);
-  const double resolution = kEpsilon * xmax / (2 * stability_.rmin);
-  // Below this no strain a scene can resolve (>= 1e-9) is at risk: near the origin the strain passes are
-  // skipped (the same on every rank: xmax is global).
-  if (!(resolution > kStrainLossWarn * 1e-9)) return;
-  for (std::size_t k = 0; k < bonds_.ia.size(); ++k) {
-    const auto i = static_cast<std::size_t>(bonds_.ia[k]), j = static_cast<std::size_t>(bonds_.ib[k]);
-    const double r0 = double(bonds_.r0[k]);
-    if (!(r0 > 0)) continue;
-    const double dx = double(p_.x[i]) - double(p_.x[j]), dy = double(p_.y[i]) - double(p_.y[j]),
-                 dz = double(p_.z[i]) - double(p_.z[j]);
-    smax = std::max(smax, std::abs(std::sqrt(dx * dx + dy * dy + dz * dz) - r0) / r0);
-  }
-  // Contacts: a listed pair's overlap over the sum of radii (a granular scene's strains).
-  for (const PairList* l : {&forces_.own_pairs(), &forces_.ghost_pairs()}) {
-    if (l->offset.size() < p_.n_owned + 1) continue;
-    for (std::size_t i = 0; i < p_.n_owned; ++i)
-      for (auto e = l->offset[i]; e < l->offset[i + 1]; ++e) {
-        const auto j = static_cast<std::size_t>(l->neigh[e]);
-        const double rsum = double(p_.radius[i]) + double(p_.radius[j]);
-        const double dx = double(p_.x[i]) - double(p_.x[j]), dy = double(p_.y[i]) - double(p_.y[j]),
-                     dz = double(p_.z[i]) - double(p_.z[j]);
-        const double r = std::sqrt(dx * dx + dy * dy + dz * dz);
-        if (r < rsum) smax = std::max(smax, (rsum - r) / rsum);
-      }
-  }
-  if (comm().size() > 1) smax = comm().max(smax);
-  strain_max_ = std::max(strain_max_, smax);
-  if (std::getenv("BASALT_DEBUG_STRAIN") && comm().rank() == 0)
-    fmt::print(stderr, "strain: step {} |x|max {:.4g} resolution {:.3g} largest strain {:.3g} ratio {:.3g}\n",
-               step_, xmax, resolution, strain_max_, resolution / strain_max_);
-  if (!(strain_max_ > 0) || !(resolution > kStrainLossWarn * strain_max_)) return;
-  strain_warned_ = true;
-  if (comm().rank() == 0)
-    fmt::print(
-        stderr,
-        "basalt-run: warning: step {}: positions reach |x| = {:.4g} with a smallest radius of {:.4g}: in "
-        "{} a distance between particles there is rounded to a strain of {:.2g} (epsilon |x| / 2 r_min), "
-        "{:.2g} % of the largest bond or contact strain of this run so far ({:.2g}), above {:g} %: "
-        "expect results off by about that fraction (docs/stability.md, \"Coordinates far from the "
-        "origin\"); {}\n",
-        step_, xmax, stability_.rmin, precision_name(), resolution, 100 * resolution / strain_max_,
-        strain_max_, 100 * kStrainLossWarn,
-        precision_name() == std::string_view("double")
-            ? "run in mixed precision (--precision mixed: positions as offsets from the geometry's "
-              "centre), or move the geometry nearer the origin"
-            : "move the geometry nearer the origin of its frame, or run in double");
+void Simulation<Real>::check_rebuild() {
+  const typename RebuildChecks<Real>::State state{p_,    bonds_,          forces_,         comm(),
+                                                  step_, stability_.rmin, precision_name()};
+  // Only scenes with a closed-form collision (hertz_mindlin) look at collisions.
+  if (auto error = checks_.impacts(state, scene_.dt, scene_.fixed_tags, scene_.force_dt || options_.force_dt,
+                                   stability_.dt_critical))
+    stop(*error);
+  if constexpr (std::is_same_v<Real, float>)
+    checks_.far_positions(state);
+  else
+    checks_.lost_strain(state);  // (float's and mixed's own rounding of the wave's strains is ~1e-3 of them
+                                 // at the origin)
 }
 
 template <class Real>
@@ -324,8 +258,7 @@ void Simulation<Real>::check_start(bool fresh) {
   template std::vector<std::uint32_t> Simulation<R>::resolve_bonds();      \
   template void Simulation<R>::rebuild();                                  \
   template void Simulation<R>::set_skin_reference();                       \
-  template void Simulation<R>::warn_far_positions();                       \
-  template void Simulation<R>::warn_lost_strain();                         \
+  template void Simulation<R>::check_rebuild();                            \
   template void Simulation<R>::check_start(bool);
 BASALT_INSTANTIATE(double)
 BASALT_INSTANTIATE(float)

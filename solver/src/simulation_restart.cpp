@@ -52,7 +52,7 @@ Simulation<Real>::Simulation(const Scene& scene, const io::Checkpoint& c, const 
   restore_decomposition(layout, comm);
   n_global_ = static_cast<std::int64_t>(c.size());
   ids_.configure(c.geometry.id.front(), c.geometry.id.back(), c.size());
-  restore_flow(c.geometry.attributes, c.geometry.id.back(), summary.rmax);
+  flow_.restore(scene_, c.geometry.attributes, c.geometry.id.back(), summary.rmax);
   distribute_checkpoint(c, nullptr, replay);
   finish_restart(c, replay);
 }
@@ -86,7 +86,7 @@ Simulation<Real>::Simulation(const Scene& scene, const io::CheckpointFile& file,
   load_stats_.bond_rows = loader.slice().geometry.bonds.size();
   n_global_ = static_cast<std::int64_t>(h.particles);
   ids_.configure(loader.first_id(), loader.last_id(), h.particles);
-  restore_flow(h.run.geometry.attributes, loader.last_id(), summary.rmax);
+  flow_.restore(scene_, h.run.geometry.attributes, loader.last_id(), summary.rmax);
   CheckpointPart part = loader.local_part(*dec_, origin_);
   load_stats_.owned = part.c.size();
   load_stats_.bonds = part.c.geometry.bonds.size();
@@ -112,7 +112,7 @@ void Simulation<Real>::finish_restart(const io::Checkpoint& c, bool replay) {
   balancer_.set_paused(false);
   check_start(false);
   estimate_critical_step(false);  // simulation_stability.cpp
-  start_ledger(compute_forces<true>());
+  guard_.start(forces_.ledger(), ledger_totals(compute_forces<true>()));
   restore_kick_forces(c);  // simulation_kick_forces.cpp
 }
 

@@ -30,7 +30,7 @@ void Simulation<Real>::advance(bool may_defer) {
   ++step_;
   time_ = time_at(step_);
   const auto& pe = step_forces(in_flight);
-  second_kick(may_defer && !observed(step_) && !flow_changed_);
+  second_kick(may_defer && !observed(step_) && !flow_.changed());
   wall_work();
   observe(pe);
 }
@@ -61,7 +61,7 @@ bool Simulation<Real>::refresh_neighbours(double moved2) {
                            scene_.balance == "time" && !balancer_.paused() &&
                            balancer_.time_balance_due(balance_run());
   // Particles entering or leaving as this step begins (the scene's [[insert]], [[delete]]): at a rebuild.
-  const bool flow = (!scene_.inserts.empty() || !scene_.deletes.empty()) && queue_flow(step_);
+  const bool flow = (!scene_.inserts.empty() || !scene_.deletes.empty()) && flow_.queue(scene_, step_);
   double need =
       bond_broke_ || balance_due || flow
           ? std::numeric_limits<double>::infinity()
@@ -84,8 +84,8 @@ template <class Real>
 const std::vector<double>& Simulation<Real>::step_forces(bool in_flight) {
   Stopwatch sw;
   ghost_wait_ = 0;
-  const auto& pe = energy_due(step_) || flow_changed_ ? compute_forces<true>(in_flight, true)
-                                                      : compute_forces<false>(in_flight, true);
+  const auto& pe = guard_.energy_due(step_) || flow_.changed() ? compute_forces<true>(in_flight, true)
+                                                               : compute_forces<false>(in_flight, true);
   times_.forces += sw.lap() - ghost_wait_;
   times_.communication += ghost_wait_;
   return pe;
@@ -94,7 +94,7 @@ const std::vector<double>& Simulation<Real>::step_forces(bool in_flight) {
 template <class Real>
 void Simulation<Real>::second_kick(bool defer) {
   Stopwatch sw;
-  integrator_.second_half(p_, defer, kinetic_due(step_));
+  integrator_.second_half(p_, defer, guard_.kinetic_due(step_));
   times_.integration += sw.lap();
 }
 
@@ -102,7 +102,7 @@ template <class Real>
 void Simulation<Real>::wall_work() {
   if (forces_.walls().empty()) return;
   Stopwatch sw;
-  wall_work_in_ += std::max(0.0, forces_.walls().power()) * scene_.dt;
+  guard_.add_wall_work(forces_.walls().power(), scene_.dt);
   steer_servos();
   times_.output += sw.lap();
 }
@@ -110,17 +110,20 @@ void Simulation<Real>::wall_work() {
 template <class Real>
 void Simulation<Real>::observe(const std::vector<double>& pe) {
   Stopwatch sw;
-  output_fields(pe);
+  // No reduction here: the sink sums the ranks' partials (on an I/O rank, or reduced with Q = 0).
+  fields_.observe(step_, time_, *output_, [&](std::vector<double>& local, std::vector<char>& due) {
+    return field_partials(pe, local, due);
+  });
   times_.output += sw.lap();
-  if (flow_changed_) rebase_ledger(pe);  // particles came or went: the ledger balances from here
-  if (scene_.energy_check_every > 0 && step_ % scene_.energy_check_every == 0) guard_energy(pe);
+  if (flow_.changed()) rebase_ledger(pe);  // particles came or went: the ledger balances from here
+  if (guard_.due(step_)) guard_energy(pe);
 }
 
 template <class Real>
 bool Simulation<Real>::observed(std::int64_t s) const {
   for (const auto& f : scene_.fields)
     if (s % f.every == 0) return true;
-  return scene_.energy_check_every > 0 && s % scene_.energy_check_every == 0;
+  return guard_.due(s);
 }
 
 template <class Real>
@@ -258,22 +261,13 @@ std::int64_t Simulation<Real>::run(std::int64_t steps, OutputSink& out, std::spa
 }
 
 template <class Real>
-FieldRows& Simulation<Real>::field_rows(FieldSink* sink) {
-  if (!rows_)
-    rows_ = std::make_unique<FieldRows>(comm(), sink);
-  else
-    rows_->retarget(sink);
-  return *rows_;
-}
-
-template <class Real>
 void Simulation<Real>::run(std::int64_t steps, FieldSink* sink) {
-  run(steps, field_rows(sink));
+  run(steps, fields_.rows(comm(), sink));
 }
 
 template <class Real>
 void Simulation<Real>::step(FieldSink* sink) {
-  output_ = &field_rows(sink);
+  output_ = &fields_.rows(comm(), sink);
   struct Reset {
     OutputSink*& p;
     ~Reset() { p = nullptr; }
@@ -283,7 +277,7 @@ void Simulation<Real>::step(FieldSink* sink) {
 
 template <class Real>
 void Simulation<Real>::flush_fields(FieldSink* sink) {
-  field_rows(sink).finish();
+  fields_.rows(comm(), sink).finish();
 }
 
 template <class Real>
@@ -291,8 +285,8 @@ void Simulation<Real>::stop(const std::string& message) {
   // Collective (every caller has agreed on the error): deliver what output is held back, then stop.
   if (output_)
     output_->deliver_pending();
-  else if (rows_)
-    rows_->deliver_pending();
+  else
+    fields_.deliver_pending();
   throw RunError(message);
 }
 
@@ -313,7 +307,6 @@ void Simulation<Real>::stop(const std::string& message) {
   template void Simulation<R>::checkpoint_now(OutputSink&);                                       \
   template bool Simulation<R>::agree_on_output(OutputSink&, bool&);                               \
   template std::int64_t Simulation<R>::run(std::int64_t, OutputSink&, std::span<const StepHook>); \
-  template FieldRows& Simulation<R>::field_rows(FieldSink*);                                      \
   template void Simulation<R>::run(std::int64_t, FieldSink*);                                     \
   template void Simulation<R>::step(FieldSink*);                                                  \
   template void Simulation<R>::flush_fields(FieldSink*);                                          \

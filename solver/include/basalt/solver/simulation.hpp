@@ -22,11 +22,13 @@
 #include "basalt/solver/core/bonds.hpp"
 #include "basalt/solver/core/id_map.hpp"
 #include "basalt/solver/core/ledger.hpp"
+#include "basalt/solver/core/particle_flow.hpp"
 #include "basalt/solver/core/particle_source.hpp"
 #include "basalt/solver/core/particles.hpp"
 #include "basalt/solver/integrate/verlet.hpp"
 #include "basalt/solver/interactions/force_field.hpp"
 #include "basalt/solver/neighbor/verlet_list.hpp"
+#include "basalt/solver/output/field_observer.hpp"
 #include "basalt/solver/output/field_rows.hpp"
 #include "basalt/solver/output/field_sink.hpp"
 #include "basalt/solver/output/output_sink.hpp"
@@ -38,6 +40,8 @@
 #include "basalt/solver/scene/frame_origin.hpp"
 #include "basalt/solver/scene/load_checks.hpp"
 #include "basalt/solver/scene/scene.hpp"
+#include "basalt/solver/stability/energy_guard.hpp"
+#include "basalt/solver/stability/rebuild_checks.hpp"
 #include "basalt/solver/timers.hpp"
 
 namespace basalt::solver {
@@ -162,8 +166,8 @@ class Simulation {
   const Comm& comm() const { return dec_->comm(); }
   const PhaseTimes& times() const { return times_; }
   const StabilityReport& stability() const { return stability_; }
-  /// The collisions seen at the rebuilds (contact models with a closed form: check_impacts()).
-  const ImpactReport& impacts() const { return impacts_; }
+  /// The collisions seen at the rebuilds (contact models with a closed form: RebuildChecks::impacts).
+  const ImpactReport& impacts() const { return checks_.impact_report(); }
   std::int64_t rebuilds() const { return rebuilds_; }
   /// Step of the last neighbour-list rebuild.
   std::int64_t last_rebuild_step() const { return rebuild_step_; }
@@ -240,17 +244,17 @@ class Simulation {
   /// bonds; returns how many.
   std::int64_t remove_particles(DeleteSpec spec);
   /// Particles inserted and removed since the start of this process's run (restarts count from there).
-  const std::array<std::int64_t, 2>& flow_totals() const { return flow_totals_; }
+  const std::array<std::int64_t, 2>& flow_totals() const { return flow_.totals(); }
   /// The id the next inserted particle gets (checkpoints keep it: attribute next_particle_id).
-  std::int64_t next_particle_id() const { return next_id_; }
+  std::int64_t next_particle_id() const { return flow_.next_id(); }
   /// Every checkpoint from now on carries this root attribute (text), e.g. the stages' progress (stages.hpp).
   void set_checkpoint_attribute(const std::string& key, const std::string& value) {
     checkpoint_attributes_[key] = value;
   }
   /// Whether checkpoints store next_particle_id (a scene with [[insert]], or ids were issued).
-  bool keeps_next_id() const { return ids_issued_ || !scene_.inserts.empty(); }
+  bool keeps_next_id() const { return flow_.ids_issued() || !scene_.inserts.empty(); }
   /// The largest radius the lists reach (the geometry's and the scene's [[insert]]s').
-  double largest_radius() const { return rmax_run_; }
+  double largest_radius() const { return flow_.rmax(); }
   /// Collective: the busiest rank's owned particles over the mean (1 = perfectly balanced).
   double imbalance() const { return LoadBalancer<Real>::imbalance(p_, comm(), n_global_); }
   /// run.balance = "pairs"'s estimate of each owned particle's work in a step, a whole number (units of
@@ -335,24 +339,8 @@ class Simulation {
   /// between unbonded particles or into a wall; warns (rank 0) of the deepest overlap above 10 %.
   void check_start(bool fresh);
   void rebuild();
-  /// Float only, collective, at rebuilds until it warned: warns (rank 0, once) when the particles have moved
-  /// so far from the origin that float rounds a distance between two of the smallest to a strain above
-  /// kResolutionWarn (the load check sees only the start; docs/stability.md, "Energy drift over 1e7 steps").
-  void warn_far_positions();
-  /// Double only, collective, at rebuilds until it warned: warns (rank 0, once) when the rounding of
-  /// positions, epsilon |x|max / (2 r_min), exceeds kStrainLossWarn of the largest strain seen so far, of a
-  /// bond (|r - r0| / r0) or a contact (overlap / (ri + rj)): the scene's own strains are then resolved to
-  /// worse than that (docs/stability.md, "Coordinates far from the origin"). Reads positions, bonds and pair
-  /// lists; where the resolution is below 1e-12 (near the origin) only the positions.
-  void warn_lost_strain();
-  /// Collective, at rebuilds, for scenes with a contact model that has a closed-form collision
-  /// (hertz_mindlin; simulation_impacts.cpp): stops the run when a collision, touching or ahead along
-  /// straight paths, lasts fewer than kImpactSteps steps of dt, naming the pair, the impact speed, the
-  /// overlap and the dt it needs (forced: a warning, once); warns once when a collision's overlap passes
-  /// 20 % of the smaller radius.
-  void check_impacts();
-  /// The fraction of the scene's largest bond strain that rounding may take before warn_lost_strain warns.
-  static constexpr double kStrainLossWarn = 1e-3;
+  /// Collective, at the end of every rebuild: the collision and rounding checks (RebuildChecks).
+  void check_rebuild();
   /// What the balancer reads and moves at this point of the run (LoadBalancer::Run).
   typename LoadBalancer<Real>::Run balance_run() {
     return {scene_, *dec_, *halo_, p_, bonds_, forces_, times_, n_global_, step_, rebuilds_, ghost_width_};
@@ -403,8 +391,6 @@ class Simulation {
   /// Collective: a stop signal or an output error on any rank stops every rank here (RunError), unless the
   /// output may fail (on_error = "continue": warned once, `reported`).
   bool agree_on_output(OutputSink& out, bool& reported);
-  /// The FieldRows adapter of step()/run() given a FieldSink (kept across calls: a row may be in flight).
-  FieldRows& field_rows(FieldSink* sink);
   /// Makes a deferred second half-kick now (run() on its way out, whatever the way).
   void settle_kick();
   /// run()'s guard: settle_kick() when it leaves scope (the last step, an error, a stop signal).
@@ -416,31 +402,17 @@ class Simulation {
   bool observed(std::int64_t s) const;
   bool field_partials(const std::vector<double>& pe, std::vector<double>& local,
                       std::vector<char>& due) const;
-  void output_fields(const std::vector<double>& pe);
   /// Collective: the runout saver's value (FieldSpec::percentile of the distances along its direction).
   double runout(const FieldSpec& f) const;
-  /// The scene's [[insert]] regions and radii into the decomposition's box and the lists' reach; sets
-  /// rmax_run_ and next_id_ (fresh starts).
-  void include_flow(GeometryExtent& e);
   /// The scene's [[insert]] radii and masses into the stability estimate's (future contacts).
   void include_flow(GeometrySummary& s) const;
-  /// Queues the scene's insert and delete events of step s (the one about to be made); whether any is.
-  bool queue_flow(std::int64_t s);
-  /// InputError when spec's particles do not fit the run (radius beyond the lists' reach, too light for dt).
-  void check_insert(const InsertSpec& spec) const;
-  /// At a rebuild, before the ghosts go: the queued inserts' chosen particles (flow_.arriving), agreed.
-  void plan_arrivals();
-  /// At a rebuild, after the ghosts went: removes the queued deletions' particles and bonds, appends the
-  /// arrivals this rank owns, counts.
+  /// At a rebuild, after the ghosts went: the queued flow's particles leave and arrive (ParticleFlow), the
+  /// count and the id map follow.
   void exchange_flow();
   /// The queued flow now, between steps: a rebuild, the forces, the ledger's new reference.
   void flow_now();
-  /// The energy guard's reference after particles came or went: the ledger now balances (mechanical +
-  /// dissipated - work in is the new reference).
+  /// The energy guard's reference after particles came or went (EnergyGuard::rebase).
   void rebase_ledger(const std::vector<double>& pe);
-  /// Restart: next_id_ from the checkpoint's attribute next_particle_id (else the largest id + 1) and the
-  /// lists' reach from the largest radius.
-  void restore_flow(const std::map<std::string, std::string>& attributes, std::int64_t last_id, double rmax);
   /// Restart: what both restart constructors check first (particles, bond groups, dt) and set.
   void begin_restart(std::size_t particles, double dt, const RestartLayout& layout);
   /// Restart: the checkpoint's bonds belong to the scene's bond groups, its contact histories to its
@@ -468,27 +440,21 @@ class Simulation {
   void restore_servos(const io::Checkpoint& c, bool at_rebuild);
   /// Collective: delivers pending output, then throws RunError(message).
   [[noreturn]] void stop(const std::string& message);
+  /// Collective: stops the run (naming the fastest particle) when the ledger of this rank's potentials pe
+  /// breaks the energy guard's balance.
   void guard_energy(const std::vector<double>& pe);
-  /// The ledger's balance at the start (global): set by start_ledger().
-  void start_ledger(const std::vector<double>& pe);
-  bool energy_due(std::int64_t s) const;
-  /// Whether step s needs the kinetic energy (a saver or the energy guard).
-  bool kinetic_due(std::int64_t s) const;
 
   Scene scene_;
   RunOptions options_;
   std::unique_ptr<Decomposition> dec_;
   std::unique_ptr<Halo<Real>> halo_;
-  std::unique_ptr<FieldRows> rows_;  ///< field rows of step()/run() given a FieldSink
   Particles<Real> p_;
   Bonds<Real> bonds_;
   IdMap ids_;
-  ForceField<Real> forces_;  ///< the models, their lists and the energy ledger
+  ForceField<Real> forces_;                      ///< the models, their lists and the energy ledger
+  EnergyGuard guard_{scene_, forces_.ledger()};  ///< the ledger's reference and balance
   std::vector<BrokenBond> broken_;
-  /// This rank's field-saver partials and due mask at step fields_step_ (output_fields; saved_field).
-  std::vector<double> fields_local_;
-  std::vector<char> fields_due_;
-  std::int64_t fields_step_ = -1;
+  FieldObserver fields_;  ///< the field savers' last row, and the FieldRows of step()/run() given a FieldSink
   std::vector<std::uint32_t> fixed_;  ///< owned particles of a fixed tag (from the last rebuild)
   bool bond_broke_ = false;
 
@@ -503,9 +469,6 @@ class Simulation {
   double time_base_ = 0;        ///< time_ at the last set_dt() (time_at)
   std::int64_t step_base_ = 0;  ///< step_ at the last set_dt()
   std::int64_t rebuilds_ = 0;
-  double energy0_ = 0;
-  std::vector<double> ledger0_;  ///< the ledger's global values at the start (the guard's reference)
-  double wall_work_in_ = 0;      ///< this rank's share of the positive work done by walls
   PhaseTimes times_;
   LoadStats load_stats_;
   double ghost_wait_ = 0;
@@ -513,29 +476,13 @@ class Simulation {
   OutputSink* output_ = nullptr;   ///< the output of the step being made (run(), step())
   std::int64_t rebuild_step_ = 0;  ///< step of the last rebuild (checkpoints store it with p_.xr, yr, zr)
   bool far_moves_ = false;  ///< check_blowup let fast particles go on: the next migration goes any distance
-  bool strain_warned_ = false;   ///< warn_lost_strain() has warned
-  double strain_max_ = 0;        ///< the largest bond or contact strain warn_lost_strain has seen (all ranks)
-  bool far_warned_ = false;      ///< warn_far_positions() has warned (or the load check did at the start)
-  ImpactReport impacts_;         ///< check_impacts(): what the rebuilds saw
+  RebuildChecks<Real> checks_;   ///< what the rebuilds' collision and rounding checks saw and said
   LoadBalancer<Real> balancer_;  ///< run.balance: its state between rebuilds (parallel/load_balancer.hpp)
   bool mixed_ = false;           ///< run.precision = "mixed" (set by configure_particles())
   Origin origin_{};              ///< the frame's origin (mixed; zero otherwise)
-  /// Particles to insert and remove at the next rebuild (the scene's events due, or a caller's), and the
-  /// inserts' chosen particles.
-  struct FlowQueue {
-    std::vector<InsertSpec> inserts;
-    std::vector<DeleteSpec> deletes;
-    std::vector<NewParticle> arriving;
-  } flow_;
-  std::int64_t next_id_ = 0;  ///< the id of the next inserted particle (alike on every rank)
-  double rmax_run_ = 0;       ///< the largest radius the lists reach
-  std::array<std::int64_t, 2> last_flow_{0, 0};    ///< inserted, removed by the last event
-  std::array<std::int64_t, 2> flow_totals_{0, 0};  ///< inserted, removed in all
-  bool flow_changed_ = false;  ///< particles came or went at this step's rebuild: the guard rebases
+  ParticleFlow<Real> flow_;      ///< particles entering and leaving: the queue, the id counter, the counts
   std::map<std::string, std::string> checkpoint_attributes_;  ///< set_checkpoint_attribute()
   std::int64_t checkpoint_step_ = -1;                         ///< the step of the last checkpoint written
-  /// Inserted ids were issued (or the checkpoint kept the counter): checkpoints keep next_id_.
-  bool ids_issued_ = false;
 };
 
 /// The last step's force and (with rotation) torque in checkpoints, /particles/<name> float64 (N): what a
