@@ -139,6 +139,8 @@ class Run {
   virtual void checkpoint() = 0;
   /// The critical time step the run estimated at its start (docs/stability.md).
   virtual double critical_dt() const = 0;
+  /// What the time step risks now, one sentence each (Simulation::step_warnings).
+  virtual std::vector<std::string> step_warnings() const = 0;
   virtual std::string close() = 0;
 };
 
@@ -264,6 +266,7 @@ class RunOf final : public Run {
   }
   std::array<std::int64_t, 2> flow_totals() const override { return sim_->flow_totals(); }
   double critical_dt() const override { return sim_->stability().dt_critical; }
+  std::vector<std::string> step_warnings() const override { return sim_->step_warnings(); }
   void checkpoint() override { sim_->checkpoint_now(*sink_); }
 
   py::dict energies() override {
@@ -664,6 +667,7 @@ void bind_simulation(py::module_& m) {
       .def("broken_bond_pairs", [](PySimulation& s) { return s.run().broken_bond_pairs(); })
       .def("flow_totals", [](PySimulation& s) { return s.run().flow_totals(); })
       .def_property_readonly("critical_dt", [](PySimulation& s) { return s.run().critical_dt(); })
+      .def_property_readonly("step_warnings", [](PySimulation& s) { return s.run().step_warnings(); })
       .def("checkpoint", [](PySimulation& s) { s.run().checkpoint(); })
       .def("allreduce", [](PySimulation& s, double v, const std::string& op) {
         const auto& c = s.run().comm();
