@@ -890,9 +890,9 @@ def test_runnables_see_every_ranks_particles(tmp_path):
 
 # -- checkpoints after a bond broke -------------------------------------------------------------------------------
 # pull.py MODE on ESyS-Particle 2.3.5 (mpirun -np 2 esysparticle pull.py MODE, measured): the last checkpoint
-# whose bonds' section lists the broken bond 0-1. Basalt's front end wrote the same section at every step, and
-# with rot and beam every checkpoint file is ESyS's byte for byte (nrot's particle rows part from step 7 on:
-# ESyS's NRotBond still pulls in the step it finds the bond broken, docs/esys.md).
+# whose bonds' section lists the broken bond 0-1. Basalt's front end writes the same section at every step, and
+# every checkpoint file is ESyS's byte for byte (nrot too, since NRotBondPrms maps to linear_bond's ESyS
+# convention: the bond still pulls in the step whose forces find it broken, docs/esys.md).
 ESYS_LAST_LISTED = {"nrot": 7, "rot": 5, "beam": 7}
 
 
@@ -906,3 +906,15 @@ def test_checkpoint_after_a_bond_broke_lists_the_bonds_left(tmp_path, mode):
         section = (tmp_path / f"pull_t={t}_1.txt").read_text().splitlines()[4:]
         bonds = ["0 1 3", "1 2 3"] if t <= ESYS_LAST_LISTED[mode] else ["1 2 3"]
         assert section == ["1", kind, str(len(bonds)), *bonds, "TMIG 0"], (t, section)
+    if mode == "nrot":
+        # the step whose forces find 0-1 broken (stretch 0.00599 > breakDistance 0.005, from the positions they
+        # were computed at: the checkpoint before's, ESyS's order): sphere 0 still feels its pull, K (r - r0)
+        # towards sphere 1 (ESyS: 0.59930028); from the next step on, nothing
+        def rows(t):
+            lines = (tmp_path / f"pull_t={t}_1.txt").read_text().splitlines()
+            return {int(r.split()[4]): [float(v) for v in r.split()] for r in lines[1:1 + int(lines[0])]}
+        before, at, after = rows(6), rows(7), rows(8)
+        stretch = (before[1][0] - before[0][0]) - 1.0
+        assert stretch > 0.005
+        assert at[0][16] == pytest.approx(100.0 * stretch, rel=1e-6)
+        assert after[0][16] == 0.0
