@@ -597,6 +597,13 @@ void close_live_simulations() {
 }  // namespace
 
 void bind_simulation(py::module_& m) {
+  // Every process of mpirun's world waits here until all have come (MPI started if it was not): the ESyS
+  // front end's scripts run on every rank, and a file rank 0 wrote is read by all only after it is written.
+  m.def("world_barrier", [] {
+    ensure_mpi();
+    py::gil_scoped_release release;
+    MPI_Barrier(MPI_COMM_WORLD);
+  });
   py::class_<PySimulation>(m, "Simulation")
       .def(py::init([](const std::string& scene, bool text, const std::string& geometry,
                        const std::string& output, int io_ranks, const std::string& precision,

@@ -805,7 +805,8 @@ SUMMED_OVER_RANKS = {"cube_drop.py": {"floor_force.dat"}}
 
 
 @pytest.mark.skipif(subprocess.run(["which", "mpirun"], capture_output=True).returncode != 0, reason="needs mpirun")
-@pytest.mark.parametrize("script", ["collide.py", "press.py", "cube_drop.py", "pull.py", "snap_pair.py"])
+@pytest.mark.parametrize("script", ["collide.py", "press.py", "cube_drop.py", "pull.py", "snap_pair.py",
+                                    "geo_read.py", "own_files.py"])
 def test_two_ranks_write_what_one_rank_writes(tmp_path, script):
     """mpirun -np 2: every saver file, checkpoint and printed line once and as on one rank (the same bytes; wall
     forces, summed over the ranks, to 1e-10). Each rank writing its own copy doubles the appended savers and the
@@ -815,10 +816,13 @@ def test_two_ranks_write_what_one_rank_writes(tmp_path, script):
     one, two = tmp_path / "one", tmp_path / "two"
     one.mkdir()
     two.mkdir()
-    a = front(SCRIPTS / script, one).stdout
+    if script == "own_files.py":  # the script's own files: written once, read back by every rank
+        for d in (one, two):
+            (d / script).write_text(OWN_FILES)
+    a = front(SCRIPTS / script if script != "own_files.py" else one / script, one).stdout
     launcher = (pathlib.Path(os.environ.get("BASALT_BIN") or ROOT / "build" / "bin") / "basalt-esys").resolve()
-    b = front_mpi(SCRIPTS / script, two, 2, launcher=launcher if script == "press.py" and launcher.exists()
-                  else None).stdout
+    b = front_mpi(SCRIPTS / script if script != "own_files.py" else two / script, two, 2,
+                  launcher=launcher if script == "press.py" and launcher.exists() else None).stdout
     assert b == a
     files = sorted(f.name for f in one.iterdir())
     assert files and sorted(f.name for f in two.iterdir()) == files
@@ -832,6 +836,47 @@ def test_two_ranks_write_what_one_rank_writes(tmp_path, script):
         for u, v in zip(rx, ry):
             assert v == pytest.approx(u, rel=1e-10, abs=1e-12), name
 
+
+# A script writing its own files (ESyS runs it once, on its master): a log appended by a Runnable, a table
+# written with numpy and read back by every rank, a file written in two goes.
+OWN_FILES = """import numpy as np
+from esys.lsm import *
+from esys.lsm.util import Vec3, BoundingBox
+
+with open("notes.txt", "w") as f:
+    f.write("start\\n")
+np.savetxt("table.txt", np.arange(6.0).reshape(3, 2))
+speeds = np.loadtxt("table.txt")[:, 1]  # every rank reads what rank 0 wrote
+sim = LsmMpi(numWorkerProcesses=1, mpiDimList=[1, 1, 1])
+sim.initNeighbourSearch(particleType="NRotSphere", gridSpacing=2.5, verletDist=0.2)
+sim.setNumTimeSteps(30)
+sim.setTimeStepSize(1.0e-3)
+sim.setSpatialDomain(BoundingBox(Vec3(-20, -5, -5), Vec3(20, 5, 5)))
+for k in range(8):
+    p = NRotSphere(id=k, posn=Vec3(-14.0 + 4.0 * k, 0.0, 0.0), radius=0.5, mass=1.0)
+    p.setLinearVelocity(Vec3(speeds[k % 3], 0.0, 0.0))
+    sim.createParticle(p)
+
+
+class Log(Runnable):
+    def __init__(self, sim):
+        Runnable.__init__(self)
+        self.sim = sim
+
+    def run(self):
+        if self.sim.getTimeStep() % 10 == 0:
+            x = sum(p.getPosn()[0] for p in self.sim.getParticleList())
+            with open("log.txt", "a") as f:
+                f.write("%d %.12g\\n" % (self.sim.getTimeStep(), x))
+
+
+log = Log(sim)
+sim.addPostTimeStepRunnable(log)
+sim.run()
+with open("notes.txt", "a") as f:
+    f.write("done\\n")
+print(open("notes.txt").read().split())
+"""
 
 SEEN = """import os, sys
 from esys.lsm import *

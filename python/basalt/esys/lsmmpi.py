@@ -148,6 +148,9 @@ class LsmMpi:
         self._setup("readGeometry")
         if self._particle_type is None:
             raise ValueError("LsmMpi.readGeometry before initNeighbourSearch(particleType=...)")
+        from . import before_read
+
+        before_read(fileName)  # under mpirun: after rank 0 wrote it, when the script did
         g = read_geometry(str(fileName))
         if any(g.periodic) and self._domain_lo is None:
             refuse(f"LsmMpi.readGeometry({fileName!r}): a geometry with periodic boundaries",
