@@ -310,8 +310,12 @@ REFUSED = {
     "sim.createParticle(NRotSphere(id=0, posn=Vec3(0, 0, 0), radius=0.5, mass=1.0))\nsim.run()":
         ("contact group 'e' together with the bond group 'b' without createExclusion('b', 'e')",),
     "sim.setParticleDensity(tag=0, mask=-1, Density=2.0)": ("LsmMpi.setParticleDensity", "mass="),
-    "from esys.lsm.geometry import RandomBoxPacker\nRandomBoxPacker(minRadius=0.2, maxRadius=0.5)":
-        ("esys.lsm.geometry.RandomBoxPacker", "not reproduced", "basalt.pack.box"),
+    "from esys.lsm.geometry import RandomBoxPacker\nRandomBoxPacker(minRadius=0.2, maxRadius=0.5, "
+    "cubicPackRadius=1.1, maxInsertFails=100, bBox=BoundingBox(Vec3(0, 0, 0), Vec3(4, 4, 4)), "
+    "circDimList=[True, False, False])": ("RandomBoxPacker(circDimList=[True, False, False])", "basalt.pack.box"),
+    "from esys.lsm.geometry import RandomBoxPacker\nRandomBoxPacker(minRadius=0.2, maxRadius=0.5, "
+    "cubicPackRadius=1.1, maxInsertFails=100, bBox=BoundingBox(Vec3(0, 0, 0), Vec3(4, 4, 0)))":
+        ("RandomBoxPacker with a 2-D box", "basalt.pack"),
     "sim.setVelocityOfWall('w', Vec3(0, 1, 0))": ("LsmMpi.setVelocityOfWall", "ViscWallPrms", "moveWallBy"),
     "sim.createFieldSaver(ParticleScalarFieldSaverPrms(fieldName='sigma_xx_2d', fileName='s', fileFormat='SUM', "
     "beginTimeStep=0, endTimeStep=1, timeStepIncr=1))": ("fieldName='sigma_xx_2d'", "e_kin"),

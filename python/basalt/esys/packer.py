@@ -242,7 +242,8 @@ class RandomBoxPacker:
         self._cell = 8.0 * self._rmin
         self._dims = [max(int(math.floor((self._hi[a] - self._lo[a]) / self._cell)), 1) for a in range(3)]
         self._cells = [[] for _ in range(self._dims[0] * self._dims[1] * self._dims[2])]
-        self._x, self._y, self._z, self._r = [], [], [], []
+        self._x, self._y, self._z, self._r = [], [], [], []  # the spheres, by id
+        self._xa, self._ya, self._za, self._ra = (np.zeros(0) for _ in range(4))  # the same, for numpy
 
     # -- ESyS's Python methods
     def generate(self):
@@ -289,6 +290,12 @@ class RandomBoxPacker:
 
     def _insert(self, x, y, z, r):
         n = len(self._x)
+        if n == len(self._xa):
+            for name in ("_xa", "_ya", "_za", "_ra"):
+                a = np.zeros(max(2 * n, 1024))
+                a[:n] = getattr(self, name)
+                setattr(self, name, a)
+        self._xa[n], self._ya[n], self._za[n], self._ra[n] = x, y, z, r
         self._x.append(x)
         self._y.append(y)
         self._z.append(z)
@@ -342,20 +349,28 @@ class RandomBoxPacker:
                     if self._fits_box(x, y, z, r) and self._fits_neighbours(x, y, z, r):
                         self._insert(x, y, z, r)
 
+    def _unique(self, x, y, z, radius):
+        """The ids of the spheres in the cells within radius of (x, y, z), each once, ascending (ESyS sorts its
+        list by address, which follows the ids)."""
+        cells = list(self._cell_range(x, y, z, radius))
+        if len(cells) == 1:
+            return cells[0]  # ids are appended in ascending order
+        return sorted(set().union(*cells))
+
     def _closest(self, x, y, z, r):
+        """The (up to) four closest spheres, by distance minus radius, among those ESyS's table offers."""
         t = self._tol
-        ids = set(self._neighbours(x, y, z, t))
+        ids = self._unique(x, y, z, t)
         if len(ids) < 4:
-            ids = set(self._neighbours(x, y, z, r + t))
+            ids = self._unique(x, y, z, r + t)
             if len(ids) < 4:
-                ids = set(self._neighbours(x, y, z, self._rmax + t))
-        X, Y, Z, R = self._x, self._y, self._z, self._r
-        keyed = []
-        for n in sorted(ids):
-            dx, dy, dz = X[n] - x, Y[n] - y, Z[n] - z
-            keyed.append((math.sqrt(dx * dx + dy * dy + dz * dz) - R[n], n))
-        keyed.sort()
-        return [n for _, n in keyed[:4]]
+                ids = self._unique(x, y, z, self._rmax + t)
+        if len(ids) <= 1:
+            return list(ids)
+        a = np.array(ids)
+        dx, dy, dz = self._xa[a] - x, self._ya[a] - y, self._za[a] - z
+        key = np.sqrt(dx * dx + dy * dy + dz * dz) - self._ra[a]
+        return a[np.argsort(key, kind="stable")[:4]].tolist()  # ties: the lower id first
 
     def _closest_wall(self, x, y, z):
         """(origin, normal, distance, axis) of the closest wall; on ties the first in ESyS's order y, x, z (min
