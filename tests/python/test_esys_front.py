@@ -3,6 +3,7 @@
 and checkpoints' text formats line by line, refused calls, and no shadowing of a real `esys` elsewhere.
 ESyS-Particle itself is not needed (tools/esys/compare_tutorial.py compares with it when installed)."""
 
+import hashlib
 import math
 import os
 import pathlib
@@ -275,6 +276,33 @@ def test_hexag_block_is_hexagonal_close_packed():
         if period == 3:
             assert not np.allclose(xz[2 * layer:3 * layer], xz[:layer], atol=1e-3)
 
+
+
+# -- RandomBoxPacker: ESyS's packing, reproduced ----------------------------------------------------------------
+def sphere_lines(text):
+    return [line for line in text.splitlines() if line.startswith("sphere ")]
+
+
+def test_random_box_packer_is_esys_packing(tmp_path):
+    """RandomBoxPacker packs as ESyS-Particle 2.3.5 does, to the 17 digits printed: pack_box.py packs two boxes
+    one after the other (the second goes on with the first's random stream; minRadius = maxRadius / 4 in the
+    first, the default tolerance in the second); data/pack_box_small_wide.txt is what ESyS printed."""
+    ref = sphere_lines((SCRIPTS / "data" / "pack_box_small_wide.txt").read_text())
+    got = sphere_lines(front(SCRIPTS / "pack_box.py", tmp_path, "small", "wide").stdout)
+    assert len(ref) == 196 + 176
+    first = next((i for i, (a, b) in enumerate(zip(got, ref)) if a != b), None)
+    assert first is None, f"sphere line {first} differs from ESyS's:\n{got[first]}\n{ref[first]}"
+    assert len(got) == len(ref)
+
+
+def test_random_box_packer_slope_fail_box_is_esys_packing(tmp_path):
+    """slope_fail.py's box (10 x 10 x 10, radii 0.2-0.5): the 5,167 spheres ESyS-Particle 2.3.5 printed with
+    pack_box.py slope, compared through the SHA-256 of the printed lines (17 digits)."""
+    got = sphere_lines(front(SCRIPTS / "pack_box.py", tmp_path, "slope").stdout)
+    assert len(got) == 5167
+    assert got[0] == "sphere 0 -2.7999999999999998 2.2000000000000002 -2.7999999999999998 0.4444171075709164 0"
+    digest = hashlib.sha256(("\n".join(got) + "\n").encode()).hexdigest()
+    assert digest == "21b8273227e68885e1d6da65f1b5c09c54802b70a156ac206fd58ed5f211c8ba"
 
 def test_bonded_block_falls_and_bounces(tmp_path):
     out = front(SCRIPTS / "cube_drop.py", tmp_path).stdout
