@@ -30,3 +30,4 @@ for case in sys.argv[1:] or ["small"]:
         c = s.getPosn()
         print("sphere %d %.17g %.17g %.17g %.17g %d" % (s.getId(), c[0], c[1], c[2], s.getRadius(), s.getTag()))
 sys.stdout.flush()
+sim.exit()  # ends ESyS's worker processes (no run() here)
