@@ -247,8 +247,8 @@ class RandomBoxPacker:
 
     # -- ESyS's Python methods
     def generate(self):
-        if self._spheres is not None:
-            return
+        """Packs the box; called again, packs again around the spheres already there (as ESyS: the grid, then
+        random insertion), the ids going on."""
         self._cubic_packing()
         self._random_fill()
         self._spheres = [SimpleSphere(i, Vec3(x, y, z), r)
