@@ -304,6 +304,25 @@ def test_random_box_packer_slope_fail_box_is_esys_packing(tmp_path):
     digest = hashlib.sha256(("\n".join(got) + "\n").encode()).hexdigest()
     assert digest == "21b8273227e68885e1d6da65f1b5c09c54802b70a156ac206fd58ed5f211c8ba"
 
+
+def test_random_box_packer_block_slumps_on_the_floor(tmp_path):
+    """slope_collapse.py (slope_fail in small): the 600 packed spheres become particles with their ids, radii and
+    masses r^3 (the checkpoint at step 0), fall onto the floor and spread: the front moves out, the top comes down,
+    no sphere sinks into the floor by more than a small overlap."""
+    out = front(SCRIPTS / "slope_collapse.py", tmp_path).stdout
+    assert lines(out, "spheres") == [[600.0]]
+    shape = lines(out, "shape")
+    assert [row[0] for row in shape] == [500.0 * i for i in range(1, 11)]
+    front_x, top, bottom = zip(*[row[1:] for row in shape])
+    assert front_x[0] < 3.05 and front_x[-1] > front_x[0] + 0.5
+    assert top[0] > 4.9 and top[-1] < top[0] - 0.5
+    assert min(bottom) > -0.05
+    rows = (tmp_path / "slope_t=0_1.txt").read_text().splitlines()
+    assert int(rows[0]) == 600
+    first = [float(w) for w in rows[1].split()[:7]]  # position, radius, id, tag, mass (ESyS's 9 digits)
+    r = 0.4444171075709164
+    assert first == pytest.approx([-1.9, 1.1, -0.9, r, 0, 0, r * r * r], rel=1e-8)
+
 def test_bonded_block_falls_and_bounces(tmp_path):
     out = front(SCRIPTS / "cube_drop.py", tmp_path).stdout
     assert lines(out, "mass") == [[0, 0.125], [1, 0.125], [2, 0.125]]  # ESyS: a block's spheres get r^3
