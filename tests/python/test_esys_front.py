@@ -306,9 +306,10 @@ def test_random_box_packer_slope_fail_box_is_esys_packing(tmp_path):
 
 
 def test_random_box_packer_block_slumps_on_the_floor(tmp_path):
-    """slope_collapse.py (slope_fail in small): the 600 packed spheres become particles with their ids, radii and
-    masses r^3 (the checkpoint at step 0), fall onto the floor and spread: the front moves out, the top comes down,
-    no sphere sinks into the floor by more than a small overlap."""
+    """slope_collapse.py (slope_fail in small): the 600 packed spheres, given to createParticle one by one, become
+    particles with their ids, radii, tags (2 near the floor) and masses r^3 (the checkpoint at step 0), fall onto
+    the floor and spread: the front moves out, the top comes down, no sphere sinks into the floor by more than a
+    small overlap."""
     out = front(SCRIPTS / "slope_collapse.py", tmp_path).stdout
     assert lines(out, "spheres") == [[600.0]]
     shape = lines(out, "shape")
@@ -322,6 +323,10 @@ def test_random_box_packer_block_slumps_on_the_floor(tmp_path):
     first = [float(w) for w in rows[1].split()[:7]]  # position, radius, id, tag, mass (ESyS's 9 digits)
     r = 0.4444171075709164
     assert first == pytest.approx([-1.9, 1.1, -0.9, r, 0, 0, r * r * r], rel=1e-8)
+    table = [[float(w) for w in row.split()[:7]] for row in rows[1:601]]
+    low = [row for row in table if row[5] == 2]
+    assert len(low) > 10 and all(row[1] < 1.1 * row[3] + 1e-8 for row in low)
+    assert all(row[5] == 0 for row in table if row[1] > 1.1 * row[3] + 1e-8)
 
 def test_bonded_block_falls_and_bounces(tmp_path):
     out = front(SCRIPTS / "cube_drop.py", tmp_path).stdout

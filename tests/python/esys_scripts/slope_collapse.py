@@ -1,7 +1,7 @@
 # slope_collapse.py: a block of spheres packed by RandomBoxPacker collapses on the floor under gravity
 # (ESyS-Particle tutorial style, as its slope_fail.py, own numbers and a smaller block).
 #   python3 -m basalt.esys slope_collapse.py      (or: mpirun -np 2 esysparticle slope_collapse.py)
-# Prints the number of spheres, then every 500 steps the block's front (largest x + radius), top (largest
+# The spheres nearest the floor get tag 2. Prints the number of spheres, then every 500 steps the block's front (largest x + radius), top (largest
 # y + radius) and lowest bottom (smallest y - radius); checkpoints every 1000 steps.
 from esys.lsm import *
 from esys.lsm.util import Vec3, BoundingBox
@@ -18,7 +18,10 @@ packer = RandomBoxPacker(minRadius=0.2, maxRadius=0.5, cubicPackRadius=1.1, maxI
                          circDimList=[False, False, False], tolerance=1.0e-5)
 packer.generate()
 spheres = packer.getSimpleSphereCollection()
-sim.createParticles(spheres)
+for s in spheres:  # one at a time, those nearest the floor tagged (as the tutorial's slope_friction_floor)
+    if s.getPosn()[1] < 1.1 * s.getRadius():
+        s.setTag(2)
+    sim.createParticle(s)
 print("spheres %d" % spheres.getNumSpheres())
 
 sim.createWall(name="floor", posn=Vec3(0.0, 0.0, 0.0), normal=Vec3(0.0, 1.0, 0.0))
