@@ -295,6 +295,17 @@ def test_random_box_packer_is_esys_packing(tmp_path):
     assert len(got) == len(ref)
 
 
+
+def test_random_box_packer_generate_twice_adds_as_esys(tmp_path):
+    """generate() a second time packs again around the first spheres, the ids going on: ESyS-Particle printed
+    `pack_box.py small+` as the 196 spheres of `small` and these four."""
+    ref = sphere_lines((SCRIPTS / "data" / "pack_box_small_wide.txt").read_text())[:196] + [
+        "sphere 196 3.9674195330978872 3.6503172691271728 4.6946834598791565 0.28046340402215719 0",
+        "sphere 197 1.3446440905431101 0.27261494457061097 2.836420394859239 0.27261494457061097 0",
+        "sphere 198 0.35871598143558525 2.1992211626841804 0.2560226976275144 0.2560226976275144 0",
+        "sphere 199 0.52079825113695932 3.732837831432918 3.3103809053682913 0.26716216856708197 0"]
+    assert sphere_lines(front(SCRIPTS / "pack_box.py", tmp_path, "small+").stdout) == ref
+
 def test_random_box_packer_slope_fail_box_is_esys_packing(tmp_path):
     """slope_fail.py's box (10 x 10 x 10, radii 0.2-0.5): the 5,167 spheres ESyS-Particle 2.3.5 printed with
     pack_box.py slope, compared through the SHA-256 of the printed lines (17 digits)."""

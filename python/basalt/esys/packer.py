@@ -251,8 +251,10 @@ class RandomBoxPacker:
         random insertion), the ids going on."""
         self._cubic_packing()
         self._random_fill()
-        self._spheres = [SimpleSphere(i, Vec3(x, y, z), r)
-                         for i, (x, y, z, r) in enumerate(zip(self._x, self._y, self._z, self._r))]
+        spheres = self._spheres or []  # the spheres of an earlier generate() stay the same objects
+        for i in range(len(spheres), len(self._x)):
+            spheres.append(SimpleSphere(i, Vec3(self._x[i], self._y[i], self._z[i]), self._r[i]))
+        self._spheres = spheres
 
     def getSimpleSphereCollection(self):
         return SphereCollection(list(self._spheres or []))
@@ -281,12 +283,6 @@ class RandomBoxPacker:
                 base = (i * dy + j) * dz
                 for k in range(k0, k1 + 1):
                     yield cells[base + k]
-
-    def _neighbours(self, x, y, z, radius):
-        out = []
-        for c in self._cell_range(x, y, z, radius):
-            out.extend(c)
-        return out
 
     def _insert(self, x, y, z, r):
         n = len(self._x)

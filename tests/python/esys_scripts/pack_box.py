@@ -1,8 +1,9 @@
 # pack_box.py: RandomBoxPacker fills a box (ESyS-Particle tutorial style, own numbers) and the script prints
 # every sphere: "sphere id x y z radius tag" at 17 digits, in the packing's order.
 #   python3 -m basalt.esys pack_box.py [CASE...]     (or: mpirun -np 2 esysparticle pack_box.py [CASE...])
-# CASE is small (default), wide (minRadius = maxRadius / 4 is small's too; wide has the default tolerance) or
-# slope (slope_fail's box, 5,167 spheres); several cases pack one after the other in the same run (ESyS's
+# CASE is small (default; minRadius = maxRadius / 4), wide (the default tolerance) or
+# slope (slope_fail's box, 5,167 spheres); CASE+ calls generate() twice (the second adds spheres around the
+# first ones) and prints after the second; several cases pack one after the other in the same run (ESyS's
 # random stream goes on from one packer to the next). tests/python/esys_scripts/data/pack_box_*.txt hold what
 # ESyS-Particle 2.3.5 printed.
 import sys
@@ -24,8 +25,10 @@ CASES = {
 
 sim = LsmMpi(numWorkerProcesses=1, mpiDimList=[1, 1, 1])
 for case in sys.argv[1:] or ["small"]:
-    packer = RandomBoxPacker(**CASES[case])
+    packer = RandomBoxPacker(**CASES[case.rstrip("+")])
     packer.generate()
+    if case.endswith("+"):
+        packer.generate()
     for s in packer.getSimpleSphereCollection():
         c = s.getPosn()
         print("sphere %d %.17g %.17g %.17g %.17g %d" % (s.getId(), c[0], c[1], c[2], s.getRadius(), s.getTag()))
