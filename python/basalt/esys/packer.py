@@ -385,13 +385,13 @@ class RandomBoxPacker:
     def _random_fill(self):
         rng = _stream()
         lo, hi = self._lo, self._hi
-        X, Y, Z, R = self._x, self._y, self._z, self._r
         rmin, rmax, max_fails = self._rmin, self._rmax, self._max_fails
         last_fails = 0
         while last_fails < max_fails:
             fails = 0
             fit = None
             while fit is None and fails < max_fails:
+                # z first: ESyS's compiled Vec3(random, random, random) evaluates its arguments right to left
                 z = lo[2] + (hi[2] - lo[2]) * rng.uniform()
                 y = lo[1] + (hi[1] - lo[1]) * rng.uniform()
                 x = lo[0] + (hi[0] - lo[0]) * rng.uniform()
