@@ -112,7 +112,16 @@ class LsmMpi:
                    "steers walls between runs")
 
     def createParticle(self, particle):
+        """An NRotSphere/RotSphere, or a generated SimpleSphere (CubicBlock, RandomBoxPacker: ESyS's createParticle
+        is createParticles of one): a particle of the run's type with the sphere's id, tag, radius and mass."""
+        from .blocks import SimpleSphere
+
         self._setup("createParticle")
+        if isinstance(particle, SimpleSphere) and self._particle_type is not None:
+            kind = RotSphere if self._particle_type == "RotSphere" else NRotSphere
+            q = kind(particle.getId(), particle.getPosn(), particle.getRadius(), particle.getMass())
+            q.setTag(particle.getTag())
+            particle = q
         if not isinstance(particle, NRotSphere):
             raise TypeError(f"LsmMpi.createParticle: an NRotSphere or RotSphere, got {type(particle).__name__}")
         want = RotSphere if self._particle_type == "RotSphere" else NRotSphere
@@ -128,14 +137,7 @@ class LsmMpi:
     def createParticles(self, particles):
         """NRotSphere/RotSphere objects, or a generated block's SimpleSpheres (CubicBlock): each becomes a
         particle of the run's type with the sphere's id, tag, radius and mass (r^3, as ESyS)."""
-        from .blocks import SimpleSphere
-
-        kind = RotSphere if self._particle_type == "RotSphere" else NRotSphere
         for p in particles:
-            if isinstance(p, SimpleSphere):
-                q = kind(p.getId(), p.getPosn(), p.getRadius(), p.getMass())
-                q.setTag(p.getTag())
-                p = q
             self.createParticle(p)
 
     def readGeometry(self, fileName):
