@@ -57,6 +57,10 @@ class _RankFiles:
         if any(c in mode for c in "wax+"):
             self.written.add(key)
             if self.rank != 0:
+                # the file exists afterwards on every rank, as after rank 0's open (numpy.savetxt creates a file,
+                # then opens it again and finds it): made if missing, never truncated, rank 0 alone writes it
+                if "x" not in mode:
+                    self.open(file, "ab").close()
                 return self.open(os.devnull, mode.replace("x", "w"), *args, **kwargs)
         else:
             self.before_read(key)

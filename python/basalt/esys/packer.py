@@ -9,7 +9,8 @@ Sphere3d, NeighbourTable, GridIterator; Foundation/Rng), not from its code:
   stream, as in ESyS;
 - first a regular close packing on a grid of spacing cubicPackRadius (its points in ESyS's order), each sphere of a
   random radius, kept where it lies inside the box and overlaps no sphere already kept;
-- then random insertion: a random point (x, y, z drawn in that order) and a random radius; its four closest
+- then random insertion: a random point (z, y, x drawn in that order: ESyS's compiler evaluates its
+  Vec3(random, random, random) right to left) and a random radius; its four closest
   spheres found through ESyS's cell table (cells 8 minRadius wide; closest = smallest distance minus radius among
   the spheres of the cells searched); the closest of the six walls; three fitters tried in turn (move the sphere
   onto the surface of its closest neighbour; the sphere touching four neighbours; the sphere touching three
