@@ -346,9 +346,9 @@ class LsmMpi:
                 self._clock = self._t + 1
                 for r in self._pre:
                     r.run()
-            if track:
-                self._rebuild_check()
-                ids, fx, fy, fz = self._columns("fx", "fy", "fz")
+            if track:  # one gather for both (an argsort or an exchange each)
+                ids, x, y, z, fx, fy, fz = self._columns("x", "y", "z", "fx", "fy", "fz")
+                self._rebuild_check(np.column_stack([x, y, z]))
                 self._prev_force = (ids, np.column_stack([fx, fy, fz]))
             if n == 1:  # the walls' push on the particles (+ 0.0: no "-0" where nothing touches, as ESyS prints)
                 self._prev_wall_force = {w: 0.0 - np.asarray(self._sim.walls[w].force) for w in self._walls}
@@ -395,11 +395,11 @@ class LsmMpi:
 
         return np.column_stack(self._columns("x", "y", "z")[1:])
 
-    def _rebuild_check(self):
-        """ESyS's neighbour-list rule (TSubLattice::checkNeighbors), checked as a step begins: when a particle has
-        moved more than verletDist/2 since the last rebuild, all 'old positions' become the current ones
-        (measured: a checkpoint of step n shows the rebuild of the positions after step n - 1, not n)."""
-        x = self._positions()
+    def _rebuild_check(self, x):
+        """ESyS's neighbour-list rule (TSubLattice::checkNeighbors), checked as a step begins on the positions x (in
+        id order): when a particle has moved more than verletDist/2 since the last rebuild, all 'old positions'
+        become the current ones (measured: a checkpoint of step n shows the rebuild of the positions after step
+        n - 1, not n)."""
         if len(x) != len(self._old):
             self._old = x
             return
@@ -420,7 +420,11 @@ class LsmMpi:
     def _leave_domain(self):
         """Deletes the particles outside the (grown) spatial domain, as ESyS does at its neighbour updates."""
         (lo, hi), big = self._grid_domain(), 1e30
-        for k, c in enumerate(self._columns("x", "y", "z")[1:]):
+        sim = self._sim
+        # the extremes need no id order: on one rank the particles' own arrays
+        columns = (sim.particles.x, sim.particles.y, sim.particles.z) if sim.ranks == 1 else \
+            self._columns("x", "y", "z")[1:]
+        for k, c in enumerate(columns):
             if len(c) and (c.min() < lo[k] or c.max() > hi[k]):
                 for side in (0, 1):
                     a, b = [-big] * 3, [big] * 3
