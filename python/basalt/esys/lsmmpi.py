@@ -15,9 +15,6 @@ from .output import CheckPointer, FieldSaver
 from .particles import NRotSphere, RotSphere
 from .vec3 import Vec3
 
-# Without runnables or a checkpointer the run goes in chunks up to the next saver's step, at most this many
-# steps (particles that left the spatial domain are deleted at each chunk's end).
-CHUNK = 100
 
 _HINTS = {
     "setParticleDensity": "give each NRotSphere/RotSphere its mass (mass=...), as the tutorial's scripts do",
@@ -65,7 +62,7 @@ class LsmMpi:
         self._t = 0                     # steps completed
         self._clock = 0                 # what getTimeStep() returns (t + 1 inside pre-time-step runnables)
         self._saved = -1                # the last step whose savers ran
-        self._old = None                # positions at the last (emulated) neighbour-list rebuild
+        self._watching = False          # ESyS's neighbour-list rule and domain watched (esys_watch.hpp)
         self._prev_force = None         # (ids, forces) the last step used (ESyS's stored force)
         self._prev_wall_force = {}      # wall name -> the force the last step's particles got from it
         self._rotational = False
@@ -332,30 +329,36 @@ class LsmMpi:
             self._start()
         import numpy as np
 
-        # per step: the forces a step used (checkpoints, force savers) and the neighbour-list rule (checkpoints)
+        # ESyS's neighbour-list rule (the checkpoints' 'position at the last rebuild') and its spatial domain,
+        # checked after every step in C++ (python/src/esys_watch.hpp): a run goes in chunks between the steps
+        # Python must see (savers, Runnables), and stops early at a step a particle left the domain
+        core = self._sim._core
+        if not self._watching:
+            lo, hi = self._grid_domain()
+            core.esys_watch((0.5 * self._verlet) ** 2, lo, hi)
+            self._watching = True
+        # the forces a step used (checkpoints, force savers): kept for the step into a save
         track = bool(self._checkpointers) or any(s.prms.fieldName.lower() == "force" for s in self._savers)
-        if track and self._old is None:
-            self._old = self._positions()
         self._save_due()
         while self._t < target:
-            if self._pre or self._post or track:
+            if self._pre or self._post:
                 n = 1
             else:
-                n = min([target, self._t + CHUNK] + [s for s in self._next_saves() if s is not None]) - self._t
+                n = min([target] + [s for s in self._next_saves() if s is not None]) - self._t
+                if track and n > 1:
+                    n -= 1  # the step into the save goes alone
             if self._pre:
                 self._clock = self._t + 1
                 for r in self._pre:
                     r.run()
-            if track:  # one gather for both (an argsort or an exchange each)
-                ids, x, y, z, fx, fy, fz = self._columns("x", "y", "z", "fx", "fy", "fz")
-                self._rebuild_check(np.column_stack([x, y, z]))
+            if track and n == 1:
+                ids, fx, fy, fz = self._columns("fx", "fy", "fz")
                 self._prev_force = (ids, np.column_stack([fx, fy, fz]))
             if n == 1:  # the walls' push on the particles (+ 0.0: no "-0" where nothing touches, as ESyS prints)
                 self._prev_wall_force = {w: 0.0 - np.asarray(self._sim.walls[w].force) for w in self._walls}
             else:  # a chunk: savers and getWallForce fall back to the current forces
                 self._prev_wall_force = {}
-            self._sim.run(n)
-            self._t += n
+            self._t += self._sim.run(n)  # (fewer when a particle left the domain)
             self._clock = self._t
             self._leave_domain()
             self._save_due()
@@ -390,23 +393,6 @@ class LsmMpi:
         ids, table = sim.gather(list(names) or ["id"], everywhere=True)  # one exchange for all the arrays
         return (ids, *(table[:, k] for k in range(len(names))))
 
-    def _positions(self):
-        import numpy as np
-
-        return np.column_stack(self._columns("x", "y", "z")[1:])
-
-    def _rebuild_check(self, x):
-        """ESyS's neighbour-list rule (TSubLattice::checkNeighbors), checked as a step begins on the positions x (in
-        id order): when a particle has moved more than verletDist/2 since the last rebuild, all 'old positions'
-        become the current ones (measured: a checkpoint of step n shows the rebuild of the positions after step
-        n - 1, not n)."""
-        if len(x) != len(self._old):
-            self._old = x
-            return
-        d = x - self._old
-        if (d * d).sum(axis=1).max(initial=0.0) > (0.5 * self._verlet) ** 2:
-            self._old = x
-
     def _grid_domain(self):
         """ESyS removes a particle once its centre leaves the spatial domain grown to whole cells of gridSpacing,
         centred (measured: [-8, 8] with gridSpacing 2.5 keeps particles up to |x| = 8.75, with 3.0 up to 9)."""
@@ -430,8 +416,7 @@ class LsmMpi:
                     a, b = [-big] * 3, [big] * 3
                     (b if side == 0 else a)[k] = lo[k] if side == 0 else hi[k]
                     self._sim.delete(box=(a, b))
-                if self._old is not None:  # ESyS removes particles at a neighbour rebuild
-                    self._old = self._positions()
+                self._sim._core.esys_watch_reset()  # ESyS removes particles at a neighbour rebuild
                 return self._leave_domain()
 
     def _state(self):
@@ -461,7 +446,8 @@ class LsmMpi:
         if self._t == 0:  # before the first step ESyS holds no forces
             state["force"] = np.zeros_like(state["pos"])
             state["walls"] = {n: (pos, np.zeros(3)) for n, (pos, f) in state["walls"].items()}
-        state["old"] = self._old if self._old is not None and len(self._old) == len(ids) else state["pos"]
+        old_ids, old = self._sim._core.esys_watch_reference()
+        state["old"] = old if np.array_equal(old_ids, ids) else state["pos"]
         if self._rotational:
             state["angvel"] = np.column_stack([c["wx"], c["wy"], c["wz"]])
             if self._checkpointers:
