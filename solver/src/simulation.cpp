@@ -315,7 +315,7 @@ void Simulation<Real>::set_dt(double dt) {
     const StabilityReport stability = stability_;
     scene_.dt = dt;
     try {
-      judge_step(fmt::format("dt (set at step {})", step_));
+      judge_step(fmt::format("dt (set at step {})", clock_.step()));
     } catch (const InputError&) {
       scene_.dt = before;
       stability_ = stability;
