@@ -6,7 +6,7 @@ from .errors import NotSupportedError, refuse
 from .lsmmpi import LsmMpi  # noqa: F401
 from .particles import NRotSphere, RotSphere  # noqa: F401
 from .prms import (BrittleBeamPrms, CheckPointPrms, FrictionPrms, GravityPrms, LinDampingPrms,  # noqa: F401
-                   NRotBondPrms, NRotElasticPrms, NRotElasticWallPrms, NRotFrictionPrms, RotBondPrms,
+                   NRotBondPrms, NRotBondedWallPrms, NRotElasticPrms, NRotElasticWallPrms, NRotFrictionPrms, RotBondPrms,
                    RotDampingPrms, RotFrictionPrms, ParticleScalarFieldSaverPrms, ParticleVectorFieldSaverPrms,
                    Runnable, WallVectorFieldSaverPrms)
 from .refused import LSM, stubs
@@ -15,7 +15,7 @@ from .vec3 import BoundingBox, Vec3  # noqa: F401
 globals().update(stubs("esys.lsm", LSM))
 
 SUPPORTED = ["LsmMpi", "NRotSphere", "RotSphere", "NRotElasticPrms", "NRotBondPrms", "RotBondPrms",
-             "BrittleBeamPrms", "NRotElasticWallPrms",
+             "BrittleBeamPrms", "NRotElasticWallPrms", "NRotBondedWallPrms",
              "RotFrictionPrms", "FrictionPrms", "NRotFrictionPrms", "RotDampingPrms", "GravityPrms",
              "LinDampingPrms", "CheckPointPrms", "ParticleScalarFieldSaverPrms", "ParticleVectorFieldSaverPrms",
              "WallVectorFieldSaverPrms", "Runnable", "Vec3", "BoundingBox"]

@@ -53,7 +53,8 @@ class LsmMpi:
         self._pair = []                 # NRotElasticPrms
         self._bond_groups = []          # NRotBondPrms
         self._bonds = []                # (id1, id2, tag) from createConnections
-        self._wall_k = {}               # wall name -> NRotElasticWallPrms
+        self._wall_k = {}               # wall name -> NRotElasticWallPrms or NRotBondedWallPrms
+        self._moved_before = set()      # walls moveWallBy moved before the run
         self._walls = {}                # name -> (posn, normal), in creation order
         self._body = []                 # GravityPrms, LinDampingPrms
         self._group_names = set()
@@ -208,7 +209,11 @@ class LsmMpi:
                        "one bond group per tag")
             self._name(prms)
             self._bond_groups.append(prms)
-        elif isinstance(prms, P.NRotElasticWallPrms):
+        elif isinstance(prms, (P.NRotElasticWallPrms, P.NRotBondedWallPrms)):
+            if isinstance(prms, P.NRotBondedWallPrms) and prms.tagMask != -1:
+                refuse(f"LsmMpi.createInteractionGroup(NRotBondedWallPrms(tagMask={prms.tagMask}))",
+                       "Basalt's bonded wall ties the particles whose tag equals particleTag (tagMask=-1, "
+                       "ESyS's default)")
             if prms.wallName not in self._walls:
                 raise ValueError(f"LsmMpi.createInteractionGroup({kind}): no wall named {prms.wallName!r}")
             if prms.wallName in self._wall_k:
@@ -227,6 +232,7 @@ class LsmMpi:
         else:
             refuse(f"LsmMpi.createInteractionGroup({kind})", "the front end maps NRotElasticPrms, RotFrictionPrms, "
                    "FrictionPrms, NRotFrictionPrms, NRotBondPrms, RotBondPrms, BrittleBeamPrms, NRotElasticWallPrms, "
+                   "NRotBondedWallPrms, "
                    "GravityPrms, LinDampingPrms and RotDampingPrms so far")
 
     def createExclusion(self, interactionName1, interactionName2):
@@ -268,6 +274,7 @@ class LsmMpi:
         if self._sim is None:
             posn, normal = self._walls[name]
             self._walls[name] = (posn + d, normal)
+            self._moved_before.add(name)
         else:
             self._sim.walls[name].move_by(d.toList())
 
@@ -318,9 +325,57 @@ class LsmMpi:
             raise ValueError("LsmMpi.run: no spatial domain (setSpatialDomain)")
         if not self._particles:
             raise ValueError("LsmMpi.run: no particles (createParticle)")
+        self._check_bonded_walls()
         self._dir = tempfile.mkdtemp(prefix="basalt-esys-")
         atexit.register(self._cleanup)
         self._sim, self._ids, self._init = build(self, self._dir)
+
+    def _bonded_walls(self):
+        from . import prms as P
+
+        return {w: g for w, g in self._wall_k.items() if isinstance(g, P.NRotBondedWallPrms)}
+
+    def _check_bonded_walls(self):
+        """ESyS ties a tagged particle to the wall only while its centre is within the neighbour table's cell
+        (gridSpacing) of the plane, at each neighbour-list update (ntable's getParticlesAtPlane), with the wall's
+        displacement counted from its creation; Basalt ties every particle of the tag for the whole run, its
+        rest state the start. Refused where the two differ from the start."""
+        for w, g in self._bonded_walls().items():
+            if w in self._moved_before:
+                refuse(f"LsmMpi.moveWallBy({w!r}) before the run, on a wall with NRotBondedWallPrms {g.name!r}",
+                       "ESyS counts that move in the bonds' stretch (the wall's displacement from its creation), "
+                       "Basalt's bonded wall rests where the run starts: create the wall where it starts, or move "
+                       "it from a Runnable")
+            posn, normal = self._walls[w]
+            n = normal * (1.0 / normal.norm())
+            for p in self._particles:
+                if p.getTag() == g.particleTag and abs((p.getPosn() - posn).dot(n)) >= self._grid:
+                    refuse(f"LsmMpi.createInteractionGroup(NRotBondedWallPrms({g.name!r})): particle {p.getId()} "
+                           f"of tag {g.particleTag} is {abs((p.getPosn() - posn).dot(n)):.6g} from wall {w!r}, "
+                           f"not within gridSpacing {self._grid:g}",
+                           "ESyS leaves such a particle free, Basalt's bonded wall (bond_tags) ties every particle "
+                           "of the tag: tag only the particles near the wall")
+
+    def _check_bonds_held(self):
+        """A tied particle now a gridSpacing or more from its wall's plane: ESyS drops its bond at the next
+        neighbour-list update, Basalt keeps it (refused here rather than run on with different physics)."""
+        import numpy as np
+
+        walls = self._bonded_walls()
+        if not walls:
+            return
+        ids, tag, x, y, z = self._columns("tag", "x", "y", "z")
+        for w, g in walls.items():
+            n = np.asarray(self._walls[w][1].toList())
+            n = n / np.linalg.norm(n)
+            d = np.abs((np.column_stack([x, y, z]) - np.asarray(self._sim.walls[w].position)) @ n)
+            far = (tag.astype(np.int64) == g.particleTag) & (d >= self._grid)
+            if far.any():
+                k = int(np.argmax(np.where(far, d, -1.0)))
+                refuse(f"LsmMpi.run: particle {int(ids[k])} tied to wall {w!r} by NRotBondedWallPrms {g.name!r} is "
+                       f"{d[k]:.6g} from it at step {self._t}, not within gridSpacing {self._grid:g}",
+                       "ESyS drops such a bond at its next neighbour-list update, Basalt's bonded wall keeps every "
+                       "bond for the whole run")
 
     def _advance(self, target):
         if self._sim is None:
@@ -356,6 +411,7 @@ class LsmMpi:
             self._save_due()
             for r in self._post:
                 r.run()
+        self._check_bonds_held()
 
     def _next_saves(self):
         return [s.next_after(self._t) for s in (*self._savers, *self._checkpointers)]

@@ -29,6 +29,17 @@ class NRotElasticWallPrms:
         self.name, self.wallName, self.normalK = str(name), str(wallName), float(normalK)
 
 
+class NRotBondedWallPrms:
+    """ESyS's NRotBondedWall: the particles of particleTag near the wall are tied to it by F = -k (u_p - u_w), the
+    particle's displacement since its creation against the wall's since its creation (the full vector), k = pi r
+    normalK (3-D); the group's other particles near the wall get the elastic wall with the same normalK
+    (ESyS's BWallInteraction, BWallInteractionGroup). tagMask: which bits of the tag count (-1: all)."""
+
+    def __init__(self, name, wallName, normalK, particleTag, tagMask=-1):
+        self.name, self.wallName, self.normalK = str(name), str(wallName), float(normalK)
+        self.particleTag, self.tagMask = int(particleTag), int(tagMask)
+
+
 class GravityPrms:
     def __init__(self, name, acceleration):
         self.name, self.acceleration = str(name), Vec3(acceleration)

@@ -14,7 +14,6 @@ LSM = {
     "HertzMindlinPrms": _SCENE + 'type = "hertz_mindlin"',
     "HertzMindlinViscoPrms": _SCENE + 'type = "hertz_mindlin"',
     "LinearDashpotPrms": "Basalt has no dashpot pair model; damping is the linear_damping body force",
-    "NRotBondedWallPrms": _SCENE + '[[walls]] interaction = "bonded"',
     "RotBondedWallPrms": _SCENE + '[[walls]] interaction = "bonded"',
     "ViscWallPrms": "Basalt's walls are elastic, frictional, Hertz-Mindlin or bonded (docs/scenes.md)",
     "InteractionScalarFieldSaverPrms": "Basalt's [[output.fields]] bond_count, broken_bonds and energies "

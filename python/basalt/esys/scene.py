@@ -5,6 +5,7 @@
                                        rot_friction with scaling = true, Ks = 0 and mu = 0 (no shear force,
                                        no moment: the same normal force), particles.rotation on
     NRotElasticWallPrms             -> the wall's K with stiffness = "esys_pi_r" (k = pi r K)
+    NRotBondedWallPrms              -> interaction = "bonded", bond_tags = [particleTag], the same K and stiffness
     a wall without a group          -> K = 0 (ESyS: no force on it)
     RotFrictionPrms, FrictionPrms   -> rot_friction, convention "esys" (FrictionPrms: K = pi E, Ks = pi E/(2(1 + nu)),
                                        scaling); NRotFrictionPrms -> friction, convention "esys", mu = dynamicMu
@@ -55,8 +56,11 @@ def scene_dict(lsm, geometry_file, output_dir):
     walls = []
     for name, (posn, normal) in lsm._walls.items():
         k = lsm._wall_k.get(name)
-        walls.append({"name": name, "point": posn.toList(), "normal": normal.toList(),
-                      "K": k.normalK if k else 0.0, "stiffness": "esys_pi_r"})
+        wall = {"name": name, "point": posn.toList(), "normal": normal.toList(), "K": k.normalK if k else 0.0,
+                "stiffness": "esys_pi_r"}
+        if isinstance(k, P.NRotBondedWallPrms):  # k = pi r K for the bond and the elastic part, ESyS's literals
+            wall.update(interaction="bonded", bond_tags=[k.particleTag])
+        walls.append(wall)
     body = []
     for b in lsm._body:
         if isinstance(b, P.GravityPrms):
