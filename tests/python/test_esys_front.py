@@ -292,6 +292,14 @@ def test_bonded_block_falls_and_bounces(tmp_path):
 
 
 # -- refusals, the runner ----------------------------------------------------------------------------------------
+_GLUE_SETUP = (  # a bonded wall 'w' (y = 0, normal +y) for particles of tag 2 (_tied(id, posn))
+    "sim.initNeighbourSearch(particleType='NRotSphere', gridSpacing=2.5, verletDist=0.5)\n"
+    "sim.setTimeStepSize(0.001)\nsim.setNumTimeSteps(10)\n"
+    "sim.setSpatialDomain(BoundingBox(Vec3(-5, -5, -5), Vec3(5, 5, 5)))\n"
+    "sim.createWall(name='w', posn=Vec3(0, 0, 0), normal=Vec3(0, 1, 0))\n"
+    "sim.createInteractionGroup(NRotBondedWallPrms(name='g', wallName='w', normalK=1000.0, particleTag=2))\n"
+    "def _tied(i, x):\n    p = NRotSphere(id=i, posn=x, radius=0.5, mass=1.0)\n    p.setTag(2)\n    return p\n")
+
 REFUSED = {
     "sim.createInteractionGroup(HertzMindlinPrms(name='h', youngsModulus=1.0, poissonsRatio=0.25, cor=0.5))":
         ("esys.lsm.HertzMindlinPrms", 'hertz_mindlin'),
@@ -310,6 +318,16 @@ REFUSED = {
     "sim.createParticle(NRotSphere(id=0, posn=Vec3(0, 0, 0), radius=0.5, mass=1.0))\nsim.run()":
         ("contact group 'e' together with the bond group 'b' without createExclusion('b', 'e')",),
     "sim.setParticleDensity(tag=0, mask=-1, Density=2.0)": ("LsmMpi.setParticleDensity", "mass="),
+    # NRotBondedWallPrms: what Basalt's bonded wall cannot do as ESyS does
+    "sim.createWall(name='w', posn=Vec3(0, 0, 0), normal=Vec3(0, 1, 0))\n"
+    "sim.createInteractionGroup(NRotBondedWallPrms(name='g', wallName='w', normalK=1.0, particleTag=2, tagMask=1))":
+        ("NRotBondedWallPrms(tagMask=1)", "particleTag"),
+    _GLUE_SETUP + "sim.createParticle(_tied(0, Vec3(0, 2.6, 0)))\nsim.run()":
+        ("particle 0 of tag 2 is 2.6 from wall 'w', not within gridSpacing 2.5", "ties every particle of the tag"),
+    _GLUE_SETUP + "sim.createParticle(_tied(0, Vec3(0, 0.5, 0)))\nsim.moveWallBy('w', Vec3(0, 0.1, 0))\nsim.run()":
+        ("LsmMpi.moveWallBy('w') before the run", "from a Runnable"),
+    _GLUE_SETUP + "p = _tied(0, Vec3(0, 0.5, 0))\np.setLinearVelocity(Vec3(0, 400, 0))\nsim.createParticle(p)\n"
+    "sim.run()": ("particle 0 tied to wall 'w'", "drops such a bond"),
     "from esys.lsm.geometry import RandomBoxPacker\nRandomBoxPacker(minRadius=0.2, maxRadius=0.5)":
         ("esys.lsm.geometry.RandomBoxPacker", "not reproduced", "basalt.pack.box"),
     "sim.setVelocityOfWall('w', Vec3(0, 1, 0))": ("LsmMpi.setVelocityOfWall", "ViscWallPrms", "moveWallBy"),
@@ -594,6 +612,49 @@ def test_move_wall_by_moves_the_platen_before_the_step_forces(tmp_path):
         assert abs(ball_y) < 1e-8  # the heavy ball gives way by ~1e-9
     saved = [line.split() for line in (tmp_path / "platen.dat").read_text().splitlines()]
     assert [float(s[1]) for s in saved] == pytest.approx([r - 50 * k * d for k in range(9)], abs=1e-12)
+
+
+# -- NRotBondedWallPrms: particles glued to a wall -------------------------------------------------------------
+def test_bonded_wall_swings_a_tied_particle_as_esys(tmp_path):
+    """NRotBondedWallPrms(normalK=K, particleTag=2): a tied particle thrown sideways (along the wall) swings on
+    the bond F = -k (u_p - u_w), k = 3.1415926536 r K, ESyS's full-vector spring: symplectic Euler's discrete
+    oscillation x_n = A sin(n theta), cos theta = 1 - dt^2 k/(2m), A = dt v0/sin theta, exactly (1e-10 of A);
+    it never moves along the normal. A particle of another tag overlapping the wall by 0.1 feels the group's
+    elastic part, 3.141592654 r K overlap, in its first step. k = K (no pi r), the normal part only, or every
+    particle tied fails it."""
+    r, K, m, dt, v0, steps = 0.5, 1000.0, 2.0, 1e-3, 0.4, 400
+    script = tmp_path / "swing.py"
+    script.write_text(
+        "from esys.lsm import *\nfrom esys.lsm.util import Vec3, BoundingBox\n"
+        "sim = LsmMpi(numWorkerProcesses=1, mpiDimList=[1, 1, 1])\n"
+        "sim.initNeighbourSearch(particleType='NRotSphere', gridSpacing=2.5, verletDist=0.2)\n"
+        f"sim.setTimeStepSize({dt})\nsim.setNumTimeSteps({steps})\n"
+        "sim.setSpatialDomain(BoundingBox(Vec3(-5, -5, -5), Vec3(5, 5, 5)))\n"
+        f"p = NRotSphere(id=0, posn=Vec3(0, {r}, 0), radius={r}, mass={m})\np.setTag(2)\n"
+        f"p.setLinearVelocity(Vec3({v0}, 0, 0))\nsim.createParticle(p)\n"
+        f"q = NRotSphere(id=1, posn=Vec3(3, {r - 0.1}, 0), radius={r}, mass={m})\nq.setTag(1)\n"
+        "sim.createParticle(q)\n"
+        "sim.createWall(name='w', posn=Vec3(0, 0, 0), normal=Vec3(0, 1, 0))\n"
+        f"sim.createInteractionGroup(NRotBondedWallPrms(name='g', wallName='w', normalK={K}, particleTag=2))\n"
+        "class Watch(Runnable):\n"
+        "    def run(self):\n"
+        "        for p in sim.getParticleList():\n"
+        "            x, v = p.getPosn(), p.getVelocity()\n"
+        "            print('p%d %d %.17g %.17g %.17g %.17g' % (p.getId(), sim.getTimeStep(), x[0], x[1], v[0], v[1]))\n"
+        "w = Watch()\nsim.addPostTimeStepRunnable(w)\nsim.run()\n")
+    out = front(script, tmp_path).stdout
+    k = 3.1415926536 * r * K
+    theta = math.acos(1 - dt * dt * k / (2 * m))
+    amp = dt * v0 / math.sin(theta)
+    rows = lines(out, "p0")
+    assert [int(t) for t, *_ in rows] == list(range(1, steps + 1))
+    assert max(x for _, x, *_ in rows) == pytest.approx(amp, rel=1e-3)  # it swings: several periods
+    for t, x, y, vx, vy in rows:
+        assert x == pytest.approx(amp * math.sin(t * theta), abs=1e-10 * amp)
+        assert y == r and vy == 0.0
+    t, x, y, vx, vy = lines(out, "p1")[0]
+    assert vy == pytest.approx(dt * 3.141592654 * r * K * 0.1 / m, rel=1e-12)
+    assert y == pytest.approx(r - 0.1 + dt * vy, rel=1e-12) and x == 3.0
 
 
 # -- LinDampingPrms and RotDampingPrms on RotSpheres (spin.py) ---------------------------------------------------
