@@ -97,7 +97,7 @@ def quantities(name, esys_dir, basalt_dir, esys_out, basalt_out):
     files = sorted(set(os.listdir(esys_dir)) | set(os.listdir(basalt_dir)))
     groups = collections.defaultdict(lambda: [[], [], 0])
     for f in files:
-        if f == "stdout.txt" or f.endswith(".geo"):  # a .geo is the script's own input (geo_read.py)
+        if f == "stdout.txt" or f.endswith((".geo", ".msh")):  # the script's own input (geo_read, mesh_drop)
             continue
         fe, fb = os.path.join(esys_dir, f), os.path.join(basalt_dir, f)
         if not (os.path.exists(fe) and os.path.exists(fb)):

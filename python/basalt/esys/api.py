@@ -6,7 +6,8 @@ from .errors import NotSupportedError, refuse
 from .lsmmpi import LsmMpi  # noqa: F401
 from .particles import NRotSphere, RotSphere  # noqa: F401
 from .prms import (BrittleBeamPrms, CheckPointPrms, FrictionPrms, GravityPrms, LinDampingPrms,  # noqa: F401
-                   NRotBondPrms, NRotBondedWallPrms, NRotElasticPrms, NRotElasticWallPrms, NRotFrictionPrms, RotBondPrms,
+                   NRotBondPrms, NRotBondedWallPrms, NRotElasticPrms, NRotElasticTriMeshPrms,
+                   NRotElasticWallPrms, NRotFrictionPrms, RotBondPrms,
                    RotDampingPrms, RotFrictionPrms, ParticleScalarFieldSaverPrms, ParticleVectorFieldSaverPrms,
                    Runnable, WallVectorFieldSaverPrms)
 from .refused import LSM, stubs
@@ -16,6 +17,7 @@ globals().update(stubs("esys.lsm", LSM))
 
 SUPPORTED = ["LsmMpi", "NRotSphere", "RotSphere", "NRotElasticPrms", "NRotBondPrms", "RotBondPrms",
              "BrittleBeamPrms", "NRotElasticWallPrms", "NRotBondedWallPrms",
+             "NRotElasticTriMeshPrms",
              "RotFrictionPrms", "FrictionPrms", "NRotFrictionPrms", "RotDampingPrms", "GravityPrms",
              "LinDampingPrms", "CheckPointPrms", "ParticleScalarFieldSaverPrms", "ParticleVectorFieldSaverPrms",
              "WallVectorFieldSaverPrms", "Runnable", "Vec3", "BoundingBox"]

@@ -40,6 +40,15 @@ class NRotBondedWallPrms:
         self.particleTag, self.tagMask = int(particleTag), int(tagMask)
 
 
+class NRotElasticTriMeshPrms:
+    """ESyS's elastic repulsion of a triangle mesh (readMesh): k = pi r normalK (3-D) times the overlap, along the
+    line from the contact point (on a face, an edge or a corner) to the centre (ESyS's ETriangleInteraction,
+    EEdgeInteraction, ECornerInteraction)."""
+
+    def __init__(self, name, meshName, normalK):
+        self.name, self.meshName, self.normalK = str(name), str(meshName), float(normalK)
+
+
 class GravityPrms:
     def __init__(self, name, acceleration):
         self.name, self.acceleration = str(name), Vec3(acceleration)

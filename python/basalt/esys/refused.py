@@ -23,7 +23,6 @@ LSM = {
     "WallScalarFieldSaverPrms": "WallVectorFieldSaverPrms (Position, Force) or Basalt's wall_force field",
     "MeshReader": "Basalt's mesh walls ([[mesh_walls]], docs/mesh-walls.md)",
     "TriMeshPrms": "Basalt's mesh walls ([[mesh_walls]], docs/mesh-walls.md)",
-    "NRotElasticTriMeshPrms": "Basalt's mesh walls ([[mesh_walls]], docs/mesh-walls.md)",
     "NRotBondedTriMeshPrms": "Basalt's mesh walls ([[mesh_walls]], docs/mesh-walls.md)",
 }
 
