@@ -657,6 +657,65 @@ def test_bonded_wall_swings_a_tied_particle_as_esys(tmp_path):
     assert y == pytest.approx(r - 0.1 + dt * vy, rel=1e-12) and x == 3.0
 
 
+# -- readMesh + NRotElasticTriMeshPrms: a triangle-mesh floor ---------------------------------------------------
+_FLAT_MSH = ("Triangle\n3D-Nodes 4\n"  # a 10 x 10 square at y = 0, node ids out of order; ESyS's normal +y
+             "7 0 0 -5 0 -5\n3 0 0 5 0 -5\n9 0 0 5 0 5\n1 0 0 -5 0 5\n\nTri3 2\n0 0 7 3 9\n1 0 7 9 1\n")
+
+
+def _mesh_script(tmp_path, particles, extra=""):
+    (tmp_path / "flat.msh").write_text(_FLAT_MSH)
+    script = tmp_path / "mesh.py"
+    script.write_text(
+        "from esys.lsm import *\nfrom esys.lsm.util import Vec3, BoundingBox\n"
+        "sim = LsmMpi(numWorkerProcesses=1, mpiDimList=[1, 1, 1])\n"
+        "sim.initNeighbourSearch(particleType='NRotSphere', gridSpacing=2.5, verletDist=0.2)\n"
+        "sim.setTimeStepSize(0.001)\nsim.setNumTimeSteps(1)\n"
+        "sim.setSpatialDomain(BoundingBox(Vec3(-8, -3, -8), Vec3(8, 6, 8)))\n"
+        + "".join(f"sim.createParticle(NRotSphere(id={i}, posn=Vec3{tuple(x)}, radius={r}, mass=1.0))\n"
+                  for i, x, r in particles)
+        + "sim.readMesh(fileName='flat.msh', meshName='m')\n" + extra
+        + "class W(Runnable):\n    def run(self):\n"
+          "        for p in sim.getParticleList():\n"
+          "            print('v %d %.17g %.17g %.17g' % ((p.getId(),) + tuple(p.getVelocity().toList())))\n"
+          "w = W()\nsim.addPostTimeStepRunnable(w)\nsim.run()\n")
+    return script
+
+
+def test_mesh_floor_pushes_as_esys_2_3_5(tmp_path):
+    """readMesh of an ESyS .msh (nodes named by id, out of order) + NRotElasticTriMeshPrms(normalK=K): after one
+    step each sphere's velocity is dt k overlap/m along the line from the mesh's nearest point to the centre, with
+    k = r K (ESyS 2.3.5 as Debian builds it, measured: its source's pi r is not in it): on a face (two radii), beyond
+    the square's rim (an edge) and beyond its corner (a vertex); a sphere not touching is left alone. Without the
+    group the mesh pushes nothing. pi r K, or the triangles' node ids taken as positions, fails it."""
+    K, dt = 1000.0, 1e-3
+    spheres = [(0, (-2.3, 0.24, 0.7), 0.25), (1, (2.3, 0.49, 0.7), 0.5), (2, (5.3, 0.3, 1.0), 0.5),
+               (3, (5.2, 0.3, 5.2), 0.5), (4, (0.0, 0.6, 0.0), 0.5)]
+    group = "sim.createInteractionGroup(NRotElasticTriMeshPrms(name='r', meshName='m', normalK=1000.0))\n"
+    out = front(_mesh_script(tmp_path, spheres, group), tmp_path).stdout
+    v = {int(r[0]): r[1:] for r in lines(out, "v")}
+    nearest = {0: (-2.3, 0.0, 0.7), 1: (2.3, 0.0, 0.7), 2: (5.0, 0.0, 1.0), 3: (5.0, 0.0, 5.0)}
+    for i, x, r in spheres[:4]:
+        gap = [a - b for a, b in zip(x, nearest[i])]
+        d = math.sqrt(sum(g * g for g in gap))
+        for c in range(3):
+            assert v[i][c] == pytest.approx(dt * r * K * (r - d) * gap[c] / d, rel=1e-9, abs=1e-15)
+    assert v[4] == [0.0, 0.0, 0.0]
+    out = front(_mesh_script(tmp_path, spheres), tmp_path).stdout
+    assert all(row[1:] == [0.0, 0.0, 0.0] for row in lines(out, "v"))
+
+
+def test_mesh_refusals(tmp_path):
+    """A sphere behind the mesh (ESyS pushes it through the face, Basalt's one-sided mesh leaves it) and readMesh
+    with a tag are refused, naming the call."""
+    group = "sim.createInteractionGroup(NRotElasticTriMeshPrms(name='r', meshName='m', normalK=1000.0))\n"
+    p = front(_mesh_script(tmp_path, [(0, (0.3, -0.49, -2.7), 0.5)], group), tmp_path, check=False)
+    assert p.returncode != 0 and "particle 0 behind triangle" in p.stderr and "pushed through it" in p.stderr
+    script = _mesh_script(tmp_path, [(0, (0.3, 0.6, 0.0), 0.5)])
+    script.write_text(script.read_text().replace("meshName='m')", "meshName='m', tag=3)"))
+    p = front(script, tmp_path, check=False)
+    assert p.returncode != 0 and "NotSupportedError" in p.stderr and "readMesh('flat.msh', 'm', tag)" in p.stderr
+
+
 # -- LinDampingPrms and RotDampingPrms on RotSpheres (spin.py) ---------------------------------------------------
 def _esys_damped(x, nu, dt, steps):
     """ESyS's damping rule (docs/reference-runs.md) on a free particle's v or w: u0 = 0; u <- x - nu dt u while
