@@ -318,6 +318,14 @@ REFUSED = {
     "sim.createParticle(NRotSphere(id=0, posn=Vec3(0, 0, 0), radius=0.5, mass=1.0))\nsim.run()":
         ("contact group 'e' together with the bond group 'b' without createExclusion('b', 'e')",),
     "sim.setParticleDensity(tag=0, mask=-1, Density=2.0)": ("LsmMpi.setParticleDensity", "mass="),
+    # InteractionScalarFieldSaverPrms: the count of a bond group's bonds only
+    "sim.createFieldSaver(InteractionScalarFieldSaverPrms(interactionName='b', fieldName='potential_energy', "
+    "fileName='e', fileFormat='SUM', beginTimeStep=0, endTimeStep=1, timeStepIncr=1))":
+        ("InteractionScalarFieldSaverPrms(fieldName='potential_energy'", "count of a bond group"),
+    "sim.createInteractionGroup(NRotElasticPrms(name='c', normalK=1.0))\n"
+    "sim.createFieldSaver(InteractionScalarFieldSaverPrms(interactionName='c', fieldName='count', "
+    "fileName='e', fileFormat='SUM', beginTimeStep=0, endTimeStep=1, timeStepIncr=1))":
+        ("on 'c'", "a contact group's count is not reproduced"),
     # NRotBondedWallPrms: what Basalt's bonded wall cannot do as ESyS does
     "sim.createWall(name='w', posn=Vec3(0, 0, 0), normal=Vec3(0, 1, 0))\n"
     "sim.createInteractionGroup(NRotBondedWallPrms(name='g', wallName='w', normalK=1.0, particleTag=2, tagMask=1))":
@@ -1019,10 +1027,15 @@ ESYS_LAST_LISTED = {"nrot": 7, "rot": 5, "beam": 7}
 @pytest.mark.parametrize("mode", sorted(ESYS_LAST_LISTED))
 def test_checkpoint_after_a_bond_broke_lists_the_bonds_left(tmp_path, mode):
     """pull.py: bond 0-1 breaks, 1-2 holds; each step's checkpoint lists 0-1 up to ESyS's last step for it and
-    then only 1-2, with the count and the group kind (Bonded for NRotBondPrms, RotBonded otherwise)."""
+    then only 1-2, with the count and the group kind (Bonded for NRotBondPrms, RotBonded otherwise). The
+    InteractionScalarFieldSaverPrms count (SUM) of every step says the same, in ESyS's %.10e (its file is ESyS's
+    byte for byte, measured)."""
     front(SCRIPTS / "pull.py", tmp_path, mode)
     kind = "Bonded" if mode == "nrot" else "RotBonded"
+    counts = (tmp_path / "nbonds.dat").read_text().splitlines()
+    assert len(counts) == 21
     for t in range(21):
         section = (tmp_path / f"pull_t={t}_1.txt").read_text().splitlines()[4:]
         bonds = ["0 1 3", "1 2 3"] if t <= ESYS_LAST_LISTED[mode] else ["1 2 3"]
         assert section == ["1", kind, str(len(bonds)), *bonds, "TMIG 0"], (t, section)
+        assert counts[t] == "%.10e" % len(bonds), (t, counts[t])

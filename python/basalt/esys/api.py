@@ -9,7 +9,7 @@ from .prms import (BrittleBeamPrms, CheckPointPrms, FrictionPrms, GravityPrms, L
                    NRotBondPrms, NRotBondedWallPrms, NRotElasticPrms, NRotElasticTriMeshPrms,
                    NRotElasticWallPrms, NRotFrictionPrms, RotBondPrms,
                    RotDampingPrms, RotFrictionPrms, ParticleScalarFieldSaverPrms, ParticleVectorFieldSaverPrms,
-                   Runnable, WallVectorFieldSaverPrms)
+                   Runnable, WallVectorFieldSaverPrms, InteractionScalarFieldSaverPrms)
 from .refused import LSM, stubs
 from .vec3 import BoundingBox, Vec3  # noqa: F401
 
@@ -20,7 +20,7 @@ SUPPORTED = ["LsmMpi", "NRotSphere", "RotSphere", "NRotElasticPrms", "NRotBondPr
              "NRotElasticTriMeshPrms",
              "RotFrictionPrms", "FrictionPrms", "NRotFrictionPrms", "RotDampingPrms", "GravityPrms",
              "LinDampingPrms", "CheckPointPrms", "ParticleScalarFieldSaverPrms", "ParticleVectorFieldSaverPrms",
-             "WallVectorFieldSaverPrms", "Runnable", "Vec3", "BoundingBox"]
+             "WallVectorFieldSaverPrms", "InteractionScalarFieldSaverPrms", "Runnable", "Vec3", "BoundingBox"]
 REFUSED = sorted(LSM)
 __all__ = SUPPORTED + REFUSED + ["NotSupportedError"]
 

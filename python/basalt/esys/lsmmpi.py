@@ -563,7 +563,8 @@ class LsmMpi:
             state["angvel"] = np.column_stack([c["wx"], c["wy"], c["wz"]])
             if self._checkpointers:
                 state["quat"] = np.column_stack([c["qw"], c["qx"], c["qy"], c["qz"]])
-        if self._checkpointers and self._bond_groups:  # collective: read on every rank, written by rank 0
+        counts = any(s.prms.kind == "InteractionScalarFieldSaverPrms" for s in self._savers)
+        if (self._checkpointers or counts) and self._bond_groups:  # collective: read on every rank, rank 0 writes
             state["broken_bonds"] = {(int(i), int(j)): int(s) for i, j, s in self._sim.broken_bond_pairs().tolist()}
         return state
 

@@ -85,6 +85,14 @@ class ParticleVectorFieldSaverPrms(_SaverPrms):
     kind = "ParticleVectorFieldSaverPrms"
 
 
+class InteractionScalarFieldSaverPrms(_SaverPrms):
+    kind = "InteractionScalarFieldSaverPrms"
+
+    def __init__(self, interactionName, fieldName, fileName, fileFormat, beginTimeStep, endTimeStep, timeStepIncr):
+        super().__init__(fieldName, fileName, fileFormat, beginTimeStep, endTimeStep, timeStepIncr)
+        self.interactionName = str(interactionName)
+
+
 class WallVectorFieldSaverPrms(_SaverPrms):
     kind = "WallVectorFieldSaverPrms"
 

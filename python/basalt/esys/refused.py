@@ -16,8 +16,6 @@ LSM = {
     "LinearDashpotPrms": "Basalt has no dashpot pair model; damping is the linear_damping body force",
     "RotBondedWallPrms": _SCENE + '[[walls]] interaction = "bonded"',
     "ViscWallPrms": "Basalt's walls are elastic, frictional, Hertz-Mindlin or bonded (docs/scenes.md)",
-    "InteractionScalarFieldSaverPrms": "Basalt's [[output.fields]] bond_count, broken_bonds and energies "
-                                       "(basalt.Simulation, docs/scenes.md)",
     "InteractionVectorFieldSaverPrms": "Basalt's checkpoints hold the bonds and contacts (basalt.read_checkpoint)",
     "ParticleTensorFieldSaverPrms": "Basalt's [[output.fields]] stress savers (docs/scenes.md)",
     "WallScalarFieldSaverPrms": "WallVectorFieldSaverPrms (Position, Force) or Basalt's wall_force field",
