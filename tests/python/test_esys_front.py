@@ -929,11 +929,11 @@ def front_mpi(script, cwd, ranks, *args, launcher=None):
 
 # Files whose numbers are sums over the ranks (a wall's force: each rank's particles' share, added in another
 # order on two ranks): equal to rounding; every other file and printed line is the same bytes.
-SUMMED_OVER_RANKS = {"cube_drop.py": {"floor_force.dat"}}
+SUMMED_OVER_RANKS = {"cube_drop.py": {"floor_force.dat"}, "glued.py": {"platen_force.dat"}}
 
 
 @pytest.mark.skipif(subprocess.run(["which", "mpirun"], capture_output=True).returncode != 0, reason="needs mpirun")
-@pytest.mark.parametrize("script", ["collide.py", "press.py", "cube_drop.py", "pull.py", "snap_pair.py"])
+@pytest.mark.parametrize("script", ["collide.py", "press.py", "cube_drop.py", "pull.py", "snap_pair.py", "glued.py"])
 def test_two_ranks_write_what_one_rank_writes(tmp_path, script):
     """mpirun -np 2: every saver file, checkpoint and printed line once and as on one rank (the same bytes; wall
     forces, summed over the ranks, to 1e-10). Each rank writing its own copy doubles the appended savers and the
