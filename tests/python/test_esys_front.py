@@ -713,11 +713,15 @@ def test_mesh_floor_pushes_as_esys_2_3_5(tmp_path):
 
 
 def test_mesh_refusals(tmp_path):
-    """A sphere behind the mesh (ESyS pushes it through the face, Basalt's one-sided mesh leaves it) and readMesh
-    with a tag are refused, naming the call."""
+    """A sphere behind the mesh (ESyS pushes it through the face, Basalt's one-sided mesh leaves it), one exactly
+    over the edge two coplanar triangles share (ESyS pushes it twice), and readMesh with a tag are refused, naming
+    the call."""
     group = "sim.createInteractionGroup(NRotElasticTriMeshPrms(name='r', meshName='m', normalK=1000.0))\n"
     p = front(_mesh_script(tmp_path, [(0, (0.3, -0.49, -2.7), 0.5)], group), tmp_path, check=False)
     assert p.returncode != 0 and "particle 0 behind triangle" in p.stderr and "pushed through it" in p.stderr
+    # exactly over the diagonal the two triangles share: ESyS pushes twice (measured: dt 2 r K overlap/m)
+    p = front(_mesh_script(tmp_path, [(0, (1.0, 0.49, 1.0), 0.5)], group), tmp_path, check=False)
+    assert p.returncode != 0 and "exactly over the shared edge" in p.stderr and "once per triangle" in p.stderr
     script = _mesh_script(tmp_path, [(0, (0.3, 0.6, 0.0), 0.5)])
     script.write_text(script.read_text().replace("meshName='m')", "meshName='m', tag=3)"))
     p = front(script, tmp_path, check=False)

@@ -390,7 +390,7 @@ class LsmMpi:
         a centre whose projection is inside (so one behind a face is pushed through it), and its edges and
         corners from either side; Basalt's one-sided mesh wall leaves a centre behind the surface alone. Refused
         where that happens (a centre behind a face within gridSpacing, or behind it and touching its rim)."""
-        from .mesh import touching_from_behind
+        from .mesh import pushed_twice, touching_from_behind
 
         for name, (vertices, triangles) in self._meshes.items():
             if name not in self._mesh_k or not len(ids):
@@ -404,6 +404,14 @@ class LsmMpi:
                        "through it) and its edges and corners from both sides, Basalt's one-sided mesh wall leaves "
                        "a centre behind the mesh alone: keep the particles on the side the triangles' normals "
                        "(p2 - p0) x (p1 - p0) point to")
+            twice = pushed_twice(vertices, triangles, centres, radii)
+            if twice is not None:
+                m, k, l = twice
+                refuse(f"LsmMpi: particle {int(ids[m])} touches mesh {name!r} exactly over the shared edge or corner "
+                       f"of its coplanar triangles {k} and {l} at step {self._t}",
+                       "ESyS 2.3.5 counts such a centre inside both triangles and pushes it once per triangle, "
+                       "Basalt's mesh wall once: move the particle off the edge (or the mesh's vertices off the "
+                       "particles' lines)")
 
     def _check_bonds_held(self):
         """A tied particle now a gridSpacing or more from its wall's plane: ESyS drops its bond at the next

@@ -119,3 +119,30 @@ def touching_from_behind(vertices, triangles, centres, radii, reach):
             m = int(np.argmax(bad))
             return m, k, float(d[m])
     return None
+
+
+def pushed_twice(vertices, triangles, centres, radii):
+    """(particle index, triangle k, triangle l) of the first particle ESyS 2.3.5 would push twice where Basalt pushes
+    once, or None: its centre projects into two coplanar triangles at once (exactly onto their shared edge or
+    vertex: ESyS's inside test counts the boundary, measured Δv twice a face's) while touching them."""
+    import numpy as np
+
+    v = np.asarray(vertices, dtype=float)
+    c = np.asarray(centres, dtype=float).reshape(-1, 3)
+    r = np.asarray(radii, dtype=float)
+    normals = esys_normals(vertices, triangles)
+    touch = []
+    for k, (i, j, l) in enumerate(triangles):
+        p0, e1, e2 = v[i], v[j] - v[i], v[l] - v[i]
+        d = (c - p0) @ normals[k]
+        g = np.array([[e1 @ e1, e1 @ e2], [e1 @ e2, e2 @ e2]])
+        a = np.linalg.solve(g, np.column_stack([(c - p0) @ e1, (c - p0) @ e2]).T).T
+        touch.append((a[:, 0] >= 0) & (a[:, 1] >= 0) & (a.sum(axis=1) <= 1) & (d >= 0) & (d < r))
+    for k in range(len(triangles)):
+        if not touch[k].any():
+            continue
+        for m in range(k + 1, len(triangles)):
+            both = touch[k] & touch[m]
+            if both.any() and abs(normals[k] @ normals[m]) > 1 - 1e-12:
+                return int(np.argmax(both)), k, m
+    return None
