@@ -138,10 +138,9 @@ def pushed_twice(vertices, triangles, centres, radii):
         g = np.array([[e1 @ e1, e1 @ e2], [e1 @ e2, e2 @ e2]])
         a = np.linalg.solve(g, np.column_stack([(c - p0) @ e1, (c - p0) @ e2]).T).T
         touch.append((a[:, 0] >= 0) & (a[:, 1] >= 0) & (a.sum(axis=1) <= 1) & (d >= 0) & (d < r))
-    for k in range(len(triangles)):
-        if not touch[k].any():
-            continue
-        for m in range(k + 1, len(triangles)):
+    touched = [k for k in range(len(triangles)) if touch[k].any()]
+    for n, k in enumerate(touched):
+        for m in touched[n + 1:]:
             both = touch[k] & touch[m]
             if both.any() and abs(normals[k] @ normals[m]) > 1 - 1e-12:
                 return int(np.argmax(both)), k, m
