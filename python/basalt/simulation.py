@@ -16,6 +16,7 @@ on them the constructor returns when the compute ranks close the run, with ``is_
 
 import numbers
 import os
+import warnings
 
 from ._core_loader import core
 
@@ -189,6 +190,15 @@ class Simulation:
         self._callbacks = []  # (every, fn, reads velocities)
         self.particles = Particles(self)
         self.walls = Walls(self)
+        self._warn_step()
+
+    def _warn_step(self):
+        # What the time step risks (dt above the safe fraction of the critical step, rot_bond networks above
+        # 0.45 of it): basalt-run's warnings, as Python warnings, once per run (rank 0)
+        if self._core.is_io_rank or self._core.rank != 0:
+            return
+        for text in self._core.step_warnings:
+            warnings.warn(f"basalt.Simulation: {text}", RuntimeWarning, stacklevel=3)
 
     # -- running --------------------------------------------------------------------------------------------
     def run(self, steps=None, *, until=None, every=1):
@@ -237,7 +247,10 @@ class Simulation:
 
     @dt.setter
     def dt(self, value):
+        """The time step from now on: refused (basalt.InputError, nothing changed) above the critical step unless
+        the run is forced (force_dt=True, run.force_dt); warned of above the safe fraction."""
         self._core.set_dt(float(value))
+        self._warn_step()
 
     def checkpoint(self):
         """Collective: writes a checkpoint of the current step now (out/ckpt_<step>.h5, as the scheduled ones; none

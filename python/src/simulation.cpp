@@ -139,6 +139,8 @@ class Run {
   virtual void checkpoint() = 0;
   /// The critical time step the run estimated at its start (docs/stability.md).
   virtual double critical_dt() const = 0;
+  /// What the time step risks now, one sentence each (Simulation::step_warnings).
+  virtual std::vector<std::string> step_warnings() const = 0;
   virtual std::string close() = 0;
 };
 
@@ -264,6 +266,7 @@ class RunOf final : public Run {
   }
   std::array<std::int64_t, 2> flow_totals() const override { return sim_->flow_totals(); }
   double critical_dt() const override { return sim_->stability().dt_critical; }
+  std::vector<std::string> step_warnings() const override { return sim_->step_warnings(); }
   void checkpoint() override { sim_->checkpoint_now(*sink_); }
 
   py::dict energies() override {
@@ -594,6 +597,13 @@ void close_live_simulations() {
 }  // namespace
 
 void bind_simulation(py::module_& m) {
+  // Every process of mpirun's world waits here until all have come (MPI started if it was not): the ESyS
+  // front end's scripts run on every rank, and a file rank 0 wrote is read by all only after it is written.
+  m.def("world_barrier", [] {
+    ensure_mpi();
+    py::gil_scoped_release release;
+    MPI_Barrier(MPI_COMM_WORLD);
+  });
   py::class_<PySimulation>(m, "Simulation")
       .def(py::init([](const std::string& scene, bool text, const std::string& geometry,
                        const std::string& output, int io_ranks, const std::string& precision,
@@ -664,6 +674,7 @@ void bind_simulation(py::module_& m) {
       .def("broken_bond_pairs", [](PySimulation& s) { return s.run().broken_bond_pairs(); })
       .def("flow_totals", [](PySimulation& s) { return s.run().flow_totals(); })
       .def_property_readonly("critical_dt", [](PySimulation& s) { return s.run().critical_dt(); })
+      .def_property_readonly("step_warnings", [](PySimulation& s) { return s.run().step_warnings(); })
       .def("checkpoint", [](PySimulation& s) { s.run().checkpoint(); })
       .def("allreduce", [](PySimulation& s, double v, const std::string& op) {
         const auto& c = s.run().comm();

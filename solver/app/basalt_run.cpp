@@ -59,11 +59,6 @@ namespace io = basalt::io;
 
 namespace {
 
-/// The fraction of the critical-step estimate above which basalt-run warns of rot_bond networks: two
-/// bonded spheres were measured unstable from 0.502 of it, a bonded lattice from 0.78 (docs/stability.md,
-/// "Rotational bonds and the critical step"); 0.45 leaves a margin.
-constexpr double kRotBondFraction = 0.45;
-
 struct Cli {
   std::string scene_file, geometry, output, dims_text, restart, precision, preset;
   std::int64_t steps = -1;
@@ -301,22 +296,7 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
                  st.dt_fraction > 0 ? fmt::format(" (run.dt_fraction = {})", st.dt_fraction) : "",
                  scene.dt_safety);
     }
-    if (st.warn)
-      fmt::print(stderr,
-                 "warning: dt = {} is {:.3g} x the critical time step, above the safe fraction {}{}\n",
-                 scene.dt, st.fraction, scene.dt_safety,
-                 st.fraction > 1 ? " (forced): expect the blow-up check to stop the run" : "");
-    // ESyS's rotational bonds are not derived from a potential: the estimate (a symmetric network's) is
-    // above their limit, measured at 0.502 of it for two bonded spheres (kRotBondFraction).
-    const bool rot_bonds = std::any_of(scene.bonds.begin(), scene.bonds.end(),
-                                       [](const auto& g) { return g.model == "rot_bond"; });
-    if (rot_bonds && st.fraction > kRotBondFraction && st.fraction <= 1)
-      fmt::print(
-          stderr,
-          "warning: dt = {:.6g} is {:.3g} x the critical time step: rot_bond networks can be unstable there "
-          "(two bonded spheres from 0.502 of it; docs/stability.md, \"Rotational bonds and the critical "
-          "step\"): use run.dt_fraction <= {}\n",
-          scene.dt, st.fraction, kRotBondFraction);
+    for (const auto& w : sim->step_warnings()) fmt::print(stderr, "warning: {}\n", w);
     fmt::print("{}\n", fields_line(*sim));
     if (comm.size() > 1)
       fmt::print("balance: max/mean particles per rank {:.3f} at start ({})\n", imbalance_start,

@@ -310,6 +310,18 @@ template <class Real>
 void Simulation<Real>::set_dt(double dt) {
   if (!(dt > 0) || !std::isfinite(dt))
     throw InputError(fmt::format("dt = {}: must be positive and finite", dt));
+  if (stability_.dt_critical > 0) {  // refused, nothing changed, as the scene's dt is at the start
+    const double before = scene_.dt;
+    const StabilityReport stability = stability_;
+    scene_.dt = dt;
+    try {
+      judge_step(fmt::format("dt (set at step {})", step_));
+    } catch (const InputError&) {
+      scene_.dt = before;
+      stability_ = stability;
+      throw;
+    }
+  }
   // The clock goes on from now at the new step (a step x dt clock would jump, and the walls' motions with
   // it).
   time_base_ = time_;

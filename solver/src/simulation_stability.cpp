@@ -313,6 +313,25 @@ void Simulation<Real>::estimate_critical_step(bool fresh) {
     apply_dt(scene_.dt_fraction * st.dt_critical);
   }
   if (!(st.dt_critical > 0)) return;
+  judge_step(scene_.dt_fraction > 0 ? fmt::format("dt (run.dt_fraction = {})", scene_.dt_fraction)
+                                    : std::string("run.dt"));
+  // A stage's dt is refused now, not when the run reaches it (after the earlier stages' output).
+  if (!fresh) return;
+  for (std::size_t k = 0; k < scene_.stages.size(); ++k) {
+    const auto& stage = scene_.stages[k];
+    if (stage.dt > 0 && stage.dt > st.dt_critical && !(scene_.force_dt || options_.force_dt))
+      throw InputError(fmt::format(
+          "stages[{}] \"{}\": dt = {:.6g} is {:.3g} times the critical time step {:.6g}: the stage would be "
+          "unstable. Lower it (a safe choice is <= {} x critical), or set run.force_dt = true / --force-dt "
+          "to "
+          "run anyway",
+          k, stage.name, stage.dt, stage.dt / st.dt_critical, st.dt_critical, scene_.dt_safety));
+  }
+}
+
+template <class Real>
+void Simulation<Real>::judge_step(const std::string& what) {
+  auto& st = stability_;
   st.fraction = scene_.dt / st.dt_critical;
   st.warn =
       st.fraction > scene_.dt_safety && !(scene_.dt_fraction > 0 && st.fraction <= 1);  // chosen knowingly
@@ -320,13 +339,32 @@ void Simulation<Real>::estimate_critical_step(bool fresh) {
     throw InputError(fmt::format(
         "{} = {:.6g} is {:.3g} times the critical time step {:.6g} (2 / omega_max of the network, {} power "
         "iterations, {:.6g}; the bound gives {:.6g}; one new contact of the lightest particle {:.6g}): the "
-        "run "
-        "would be unstable. Lower dt (a safe choice is <= {} x "
-        "critical, e.g. run.dt_fraction = {}), or set run.force_dt = true / --force-dt to run anyway",
-        scene_.dt_fraction > 0 ? fmt::format("dt (run.dt_fraction = {})", scene_.dt_fraction)
-                               : std::string("run.dt"),
-        scene_.dt, st.fraction, st.dt_critical, st.iterations, st.dt_power, st.dt_bound, st.dt_contact,
+        "run would be unstable. Lower dt (a safe choice is <= {} x critical, e.g. run.dt_fraction = {}), or "
+        "set run.force_dt = true / --force-dt to run anyway",
+        what, scene_.dt, st.fraction, st.dt_critical, st.iterations, st.dt_power, st.dt_bound, st.dt_contact,
         scene_.dt_safety, scene_.dt_safety));
+}
+
+template <class Real>
+std::vector<std::string> Simulation<Real>::step_warnings() const {
+  const auto& st = stability_;
+  std::vector<std::string> out;
+  if (!(st.dt_critical > 0)) return out;
+  if (st.warn)
+    out.push_back(fmt::format("dt = {} is {:.3g} x the critical time step, above the safe fraction {}{}",
+                              scene_.dt, st.fraction, scene_.dt_safety,
+                              st.fraction > 1 ? " (forced): expect the blow-up check to stop the run" : ""));
+  // ESyS's rotational bonds are not derived from a potential: the estimate (a symmetric network's) is above
+  // their limit, measured at 0.502 of it for two bonded spheres (stability::kRotBondFraction).
+  const bool rot_bonds = std::any_of(scene_.bonds.begin(), scene_.bonds.end(),
+                                     [](const auto& g) { return g.model == "rot_bond"; });
+  if (rot_bonds && st.fraction > stability::kRotBondFraction && st.fraction <= 1)
+    out.push_back(fmt::format(
+        "dt = {:.6g} is {:.3g} x the critical time step: rot_bond networks can be unstable there (two bonded "
+        "spheres from 0.502 of it; docs/stability.md, \"Rotational bonds and the critical step\"): use "
+        "run.dt_fraction <= {}",
+        scene_.dt, st.fraction, stability::kRotBondFraction));
+  return out;
 }
 
 namespace {
@@ -581,6 +619,8 @@ std::optional<std::string> Simulation<Real>::check_frame_state() const {
   template std::optional<std::string> Simulation<R>::check_frame_state() const; \
   template void Simulation<R>::check_stability(const GeometrySummary&);         \
   template void Simulation<R>::estimate_critical_step(bool);                    \
+  template void Simulation<R>::judge_step(const std::string&);                  \
+  template std::vector<std::string> Simulation<R>::step_warnings() const;       \
   template double Simulation<R>::contact_critical_step(double, double) const;   \
   template void Simulation<R>::check_blowup();                                  \
   template std::optional<std::string> Simulation<R>::blocked_path(std::vector<double>&, bool) const;

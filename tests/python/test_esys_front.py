@@ -3,6 +3,7 @@
 and checkpoints' text formats line by line, refused calls, and no shadowing of a real `esys` elsewhere.
 ESyS-Particle itself is not needed (tools/esys/compare_tutorial.py compares with it when installed)."""
 
+import hashlib
 import math
 import os
 import pathlib
@@ -276,6 +277,68 @@ def test_hexag_block_is_hexagonal_close_packed():
             assert not np.allclose(xz[2 * layer:3 * layer], xz[:layer], atol=1e-3)
 
 
+
+# -- RandomBoxPacker: ESyS's packing, reproduced ----------------------------------------------------------------
+def sphere_lines(text):
+    return [line for line in text.splitlines() if line.startswith("sphere ")]
+
+
+def test_random_box_packer_is_esys_packing(tmp_path):
+    """RandomBoxPacker packs as ESyS-Particle 2.3.5 does, to the 17 digits printed: pack_box.py packs two boxes
+    one after the other (the second goes on with the first's random stream; minRadius = maxRadius / 4 in the
+    first, the default tolerance in the second); data/pack_box_small_wide.txt is what ESyS printed."""
+    ref = sphere_lines((SCRIPTS / "data" / "pack_box_small_wide.txt").read_text())
+    got = sphere_lines(front(SCRIPTS / "pack_box.py", tmp_path, "small", "wide").stdout)
+    assert len(ref) == 196 + 176
+    first = next((i for i, (a, b) in enumerate(zip(got, ref)) if a != b), None)
+    assert first is None, f"sphere line {first} differs from ESyS's:\n{got[first]}\n{ref[first]}"
+    assert len(got) == len(ref)
+
+
+
+def test_random_box_packer_generate_twice_adds_as_esys(tmp_path):
+    """generate() a second time packs again around the first spheres, the ids going on: ESyS-Particle printed
+    `pack_box.py small+` as the 196 spheres of `small` and these four."""
+    ref = sphere_lines((SCRIPTS / "data" / "pack_box_small_wide.txt").read_text())[:196] + [
+        "sphere 196 3.9674195330978872 3.6503172691271728 4.6946834598791565 0.28046340402215719 0",
+        "sphere 197 1.3446440905431101 0.27261494457061097 2.836420394859239 0.27261494457061097 0",
+        "sphere 198 0.35871598143558525 2.1992211626841804 0.2560226976275144 0.2560226976275144 0",
+        "sphere 199 0.52079825113695932 3.732837831432918 3.3103809053682913 0.26716216856708197 0"]
+    assert sphere_lines(front(SCRIPTS / "pack_box.py", tmp_path, "small+").stdout) == ref
+
+def test_random_box_packer_slope_fail_box_is_esys_packing(tmp_path):
+    """slope_fail.py's box (10 x 10 x 10, radii 0.2-0.5): the 5,167 spheres ESyS-Particle 2.3.5 printed with
+    pack_box.py slope, compared through the SHA-256 of the printed lines (17 digits)."""
+    got = sphere_lines(front(SCRIPTS / "pack_box.py", tmp_path, "slope").stdout)
+    assert len(got) == 5167
+    assert got[0] == "sphere 0 -2.7999999999999998 2.2000000000000002 -2.7999999999999998 0.4444171075709164 0"
+    digest = hashlib.sha256(("\n".join(got) + "\n").encode()).hexdigest()
+    assert digest == "21b8273227e68885e1d6da65f1b5c09c54802b70a156ac206fd58ed5f211c8ba"
+
+
+def test_random_box_packer_block_slumps_on_the_floor(tmp_path):
+    """slope_collapse.py (slope_fail in small): the 600 packed spheres, given to createParticle one by one, become
+    particles with their ids, radii, tags (2 near the floor) and masses r^3 (the checkpoint at step 0), fall onto
+    the floor and spread: the front moves out, the top comes down, no sphere sinks into the floor by more than a
+    small overlap."""
+    out = front(SCRIPTS / "slope_collapse.py", tmp_path).stdout
+    assert lines(out, "spheres") == [[600.0]]
+    shape = lines(out, "shape")
+    assert [row[0] for row in shape] == [500.0 * i for i in range(1, 11)]
+    front_x, top, bottom = zip(*[row[1:] for row in shape])
+    assert front_x[0] < 3.05 and front_x[-1] > front_x[0] + 0.5
+    assert top[0] > 4.9 and top[-1] < top[0] - 0.5
+    assert min(bottom) > -0.05
+    rows = (tmp_path / "slope_t=0_1.txt").read_text().splitlines()
+    assert int(rows[0]) == 600
+    first = [float(w) for w in rows[1].split()[:7]]  # position, radius, id, tag, mass (ESyS's 9 digits)
+    r = 0.4444171075709164
+    assert first == pytest.approx([-1.9, 1.1, -0.9, r, 0, 0, r * r * r], rel=1e-8)
+    table = [[float(w) for w in row.split()[:7]] for row in rows[1:601]]
+    low = [row for row in table if row[5] == 2]
+    assert len(low) > 10 and all(row[1] < 1.1 * row[3] + 1e-8 for row in low)
+    assert all(row[5] == 0 for row in table if row[1] > 1.1 * row[3] + 1e-8)
+
 def test_bonded_block_falls_and_bounces(tmp_path):
     out = front(SCRIPTS / "cube_drop.py", tmp_path).stdout
     assert lines(out, "mass") == [[0, 0.125], [1, 0.125], [2, 0.125]]  # ESyS: a block's spheres get r^3
@@ -336,8 +399,12 @@ REFUSED = {
         ("LsmMpi.moveWallBy('w') before the run", "from a Runnable"),
     _GLUE_SETUP + "p = _tied(0, Vec3(0, 0.5, 0))\np.setLinearVelocity(Vec3(0, 400, 0))\nsim.createParticle(p)\n"
     "sim.run()": ("particle 0 tied to wall 'w'", "drops such a bond"),
-    "from esys.lsm.geometry import RandomBoxPacker\nRandomBoxPacker(minRadius=0.2, maxRadius=0.5)":
-        ("esys.lsm.geometry.RandomBoxPacker", "not reproduced", "basalt.pack.box"),
+    "from esys.lsm.geometry import RandomBoxPacker\nRandomBoxPacker(minRadius=0.2, maxRadius=0.5, "
+    "cubicPackRadius=1.1, maxInsertFails=100, bBox=BoundingBox(Vec3(0, 0, 0), Vec3(4, 4, 4)), "
+    "circDimList=[True, False, False])": ("RandomBoxPacker(circDimList=[True, False, False])", "basalt.pack.box"),
+    "from esys.lsm.geometry import RandomBoxPacker\nRandomBoxPacker(minRadius=0.2, maxRadius=0.5, "
+    "cubicPackRadius=1.1, maxInsertFails=100, bBox=BoundingBox(Vec3(0, 0, 0), Vec3(4, 4, 0)))":
+        ("RandomBoxPacker with a 2-D box", "basalt.pack"),
     "sim.setVelocityOfWall('w', Vec3(0, 1, 0))": ("LsmMpi.setVelocityOfWall", "ViscWallPrms", "moveWallBy"),
     "sim.createFieldSaver(ParticleScalarFieldSaverPrms(fieldName='sigma_xx_2d', fileName='s', fileFormat='SUM', "
     "beginTimeStep=0, endTimeStep=1, timeStepIncr=1))": ("fieldName='sigma_xx_2d'", "e_kin"),
@@ -937,7 +1004,8 @@ SUMMED_OVER_RANKS = {"cube_drop.py": {"floor_force.dat"}, "glued.py": {"platen_f
 
 
 @pytest.mark.skipif(subprocess.run(["which", "mpirun"], capture_output=True).returncode != 0, reason="needs mpirun")
-@pytest.mark.parametrize("script", ["collide.py", "press.py", "cube_drop.py", "pull.py", "snap_pair.py", "glued.py"])
+@pytest.mark.parametrize("script", ["collide.py", "press.py", "cube_drop.py", "pull.py", "snap_pair.py",
+                                    "geo_read.py", "own_files.py", "glued.py"])
 def test_two_ranks_write_what_one_rank_writes(tmp_path, script):
     """mpirun -np 2: every saver file, checkpoint and printed line once and as on one rank (the same bytes; wall
     forces, summed over the ranks, to 1e-10). Each rank writing its own copy doubles the appended savers and the
@@ -947,10 +1015,13 @@ def test_two_ranks_write_what_one_rank_writes(tmp_path, script):
     one, two = tmp_path / "one", tmp_path / "two"
     one.mkdir()
     two.mkdir()
-    a = front(SCRIPTS / script, one).stdout
+    if script == "own_files.py":  # the script's own files: written once, read back by every rank
+        for d in (one, two):
+            (d / script).write_text(OWN_FILES)
+    a = front(SCRIPTS / script if script != "own_files.py" else one / script, one).stdout
     launcher = (pathlib.Path(os.environ.get("BASALT_BIN") or ROOT / "build" / "bin") / "basalt-esys").resolve()
-    b = front_mpi(SCRIPTS / script, two, 2, launcher=launcher if script == "press.py" and launcher.exists()
-                  else None).stdout
+    b = front_mpi(SCRIPTS / script if script != "own_files.py" else two / script, two, 2,
+                  launcher=launcher if script == "press.py" and launcher.exists() else None).stdout
     assert b == a
     files = sorted(f.name for f in one.iterdir())
     assert files and sorted(f.name for f in two.iterdir()) == files
@@ -963,6 +1034,67 @@ def test_two_ranks_write_what_one_rank_writes(tmp_path, script):
         assert len(rx) == len(ry) and all(len(u) == len(v) for u, v in zip(rx, ry)), name
         for u, v in zip(rx, ry):
             assert v == pytest.approx(u, rel=1e-10, abs=1e-12), name
+
+
+# A script writing its own files (ESyS runs it once, on its master): a log appended by a Runnable, a table
+# written with numpy and read back by every rank, a file written in two goes.
+OWN_FILES = """import numpy as np
+from esys.lsm import *
+from esys.lsm.util import Vec3, BoundingBox
+
+with open("notes.txt", "w") as f:
+    f.write("start\\n")
+np.savetxt("table.txt", np.arange(6.0).reshape(3, 2))
+speeds = np.loadtxt("table.txt")[:, 1]  # every rank reads what rank 0 wrote
+sim = LsmMpi(numWorkerProcesses=1, mpiDimList=[1, 1, 1])
+sim.initNeighbourSearch(particleType="NRotSphere", gridSpacing=2.5, verletDist=0.2)
+sim.setNumTimeSteps(30)
+sim.setTimeStepSize(1.0e-3)
+sim.setSpatialDomain(BoundingBox(Vec3(-20, -5, -5), Vec3(20, 5, 5)))
+for k in range(8):
+    p = NRotSphere(id=k, posn=Vec3(-14.0 + 4.0 * k, 0.0, 0.0), radius=0.5, mass=1.0)
+    p.setLinearVelocity(Vec3(speeds[k % 3], 0.0, 0.0))
+    sim.createParticle(p)
+
+
+class Log(Runnable):
+    def __init__(self, sim):
+        Runnable.__init__(self)
+        self.sim = sim
+
+    def run(self):
+        if self.sim.getTimeStep() % 10 == 0:
+            x = sum(p.getPosn()[0] for p in self.sim.getParticleList())
+            with open("log.txt", "a") as f:
+                f.write("%d %.12g\\n" % (self.sim.getTimeStep(), x))
+
+
+log = Log(sim)
+sim.addPostTimeStepRunnable(log)
+sim.run()
+with open("notes.txt", "a") as f:
+    f.write("done\\n")
+print(open("notes.txt").read().split())
+"""
+
+
+@pytest.mark.skipif(subprocess.run(["which", "mpirun"], capture_output=True).returncode != 0, reason="needs mpirun")
+def test_random_box_packer_same_on_two_ranks(tmp_path):
+    """mpirun -np 2 slope_collapse.py: every rank runs the script and packs; the step-0 checkpoint is the same
+    bytes as on one rank (the same 600 spheres), later rows and prints equal to rounding (forces summed over the
+    ranks in another order)."""
+    one, two = tmp_path / "one", tmp_path / "two"
+    one.mkdir()
+    two.mkdir()
+    a = front(SCRIPTS / "slope_collapse.py", one).stdout
+    b = front_mpi(SCRIPTS / "slope_collapse.py", two, 2).stdout
+    for name in ("slope_t=0_0.txt", "slope_t=0_1.txt"):
+        assert (one / name).read_bytes() == (two / name).read_bytes(), name
+    rows = [[[float(w) for w in line.split()[1:]] for line in t.splitlines() if line.startswith("shape ")]
+            for t in (a, b)]
+    assert len(rows[0]) == len(rows[1]) == 10
+    for u, v in zip(*rows):
+        assert v == pytest.approx(u, rel=1e-9)
 
 
 SEEN = """import os, sys
@@ -1022,9 +1154,9 @@ def test_runnables_see_every_ranks_particles(tmp_path):
 
 # -- checkpoints after a bond broke -------------------------------------------------------------------------------
 # pull.py MODE on ESyS-Particle 2.3.5 (mpirun -np 2 esysparticle pull.py MODE, measured): the last checkpoint
-# whose bonds' section lists the broken bond 0-1. Basalt's front end wrote the same section at every step, and
-# with rot and beam every checkpoint file is ESyS's byte for byte (nrot's particle rows part from step 7 on:
-# ESyS's NRotBond still pulls in the step it finds the bond broken, docs/esys.md).
+# whose bonds' section lists the broken bond 0-1. Basalt's front end writes the same section at every step, and
+# every checkpoint file is ESyS's byte for byte (nrot too, since NRotBondPrms maps to linear_bond's ESyS
+# convention: the bond still pulls in the step whose forces find it broken, docs/esys.md).
 ESYS_LAST_LISTED = {"nrot": 7, "rot": 5, "beam": 7}
 
 
@@ -1043,3 +1175,15 @@ def test_checkpoint_after_a_bond_broke_lists_the_bonds_left(tmp_path, mode):
         bonds = ["0 1 3", "1 2 3"] if t <= ESYS_LAST_LISTED[mode] else ["1 2 3"]
         assert section == ["1", kind, str(len(bonds)), *bonds, "TMIG 0"], (t, section)
         assert counts[t] == "%.10e" % len(bonds), (t, counts[t])
+    if mode == "nrot":
+        # the step whose forces find 0-1 broken (stretch 0.00599 > breakDistance 0.005, from the positions they
+        # were computed at: the checkpoint before's, ESyS's order): sphere 0 still feels its pull, K (r - r0)
+        # towards sphere 1 (ESyS: 0.59930028); from the next step on, nothing
+        def rows(t):
+            lines = (tmp_path / f"pull_t={t}_1.txt").read_text().splitlines()
+            return {int(r.split()[4]): [float(v) for v in r.split()] for r in lines[1:1 + int(lines[0])]}
+        before, at, after = rows(6), rows(7), rows(8)
+        stretch = (before[1][0] - before[0][0]) - 1.0
+        assert stretch > 0.005
+        assert at[0][16] == pytest.approx(100.0 * stretch, rel=1e-6)
+        assert after[0][16] == 0.0

@@ -159,6 +159,13 @@ def test_views_and_steering(tmp_path):
     assert sim.dt == 1e-3
     with pytest.raises(ValueError, match="positive"):
         sim.dt = -1
+    # above the critical step: refused, nothing changed; just below it: taken with a warning (rank 0)
+    with pytest.raises(basalt.InputError, match="times the critical time step"):
+        sim.dt = 1.05 * sim.critical_dt
+    assert sim.dt == 1e-3
+    with pytest.warns(RuntimeWarning, match="above the safe fraction"):
+        sim.dt = 0.95 * sim.critical_dt
+    sim.dt = 1e-3
     # body forces: the scene's groups by name; gravity changed from now on; bad keys named
     assert sim.body_forces["gravity0"] == "gravity"
     sim.set_gravity((0.0, 0.0, -2.0))
@@ -190,6 +197,19 @@ def test_bad_scene_is_a_python_exception(tmp_path):
         basalt.Simulation(scene)
     with pytest.raises(ValueError, match="does not exist"):
         basalt.Simulation(wave_scene(tmp_path / "bad"), geometry=tmp_path / "missing.h5")
+
+
+def test_a_step_above_the_safe_fraction_is_warned_of(tmp_path):
+    """basalt-run's warnings on the time step reach a script as RuntimeWarnings; none at a safe step."""
+    scene = wave_scene(tmp_path / "a", steps=0)
+    critical = basalt.Simulation(scene).critical_dt
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        basalt.Simulation(scene)  # dt = 1e-3: no warning
+    scene["run"]["dt"] = 0.9 * critical
+    with pytest.warns(RuntimeWarning, match="above the safe fraction"):
+        basalt.Simulation(scene)
 
 
 def test_units_other_than_the_geometrys_are_warned_of(tmp_path, capfd):

@@ -160,6 +160,71 @@ TEST(Steering, SetDtChangesTheStepFromNowOn) {
   EXPECT_THROW(sim.set_dt(-1), InputError);
 }
 
+TEST(Steering, SetDtAboveTheCriticalStepIsRefusedWithNothingChanged) {
+  auto sim = make("dt = 2e-3");
+  const double critical = sim.stability().dt_critical;
+  ASSERT_GT(critical, 4e-3);  // the pile's step is far below it: the test needs room on both sides
+  sim.run(5);
+  const double t0 = sim.time();
+  const auto before = state(sim);
+  try {
+    sim.set_dt(1.05 * critical);
+    FAIL() << "dt above the critical step was taken";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("dt (set at step 5)"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("times the critical time step"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(sim.dt(), 2e-3);
+  EXPECT_EQ(sim.stability().fraction, 2e-3 / critical);
+  EXPECT_TRUE(sim.step_warnings().empty());
+  sim.run(5);
+  EXPECT_NEAR(sim.time(), t0 + 5 * 2e-3, 1e-15);  // the clock went on at the old step
+  EXPECT_NE(state(sim), before);
+
+  // Just below it: taken, and warned of (above the safe fraction); back to a small step: no warning.
+  sim.set_dt(0.95 * critical);
+  EXPECT_EQ(sim.dt(), 0.95 * critical);
+  ASSERT_EQ(sim.step_warnings().size(), 1u);
+  EXPECT_NE(sim.step_warnings()[0].find("above the safe fraction"), std::string::npos);
+  sim.set_dt(2e-3);
+  EXPECT_TRUE(sim.step_warnings().empty());
+}
+
+TEST(Steering, SetDtAboveTheCriticalStepIsTakenWhenForced) {
+  auto sim = make("dt = 2e-3\nforce_dt = true");
+  const double critical = sim.stability().dt_critical;
+  sim.set_dt(1.5 * critical);
+  EXPECT_EQ(sim.dt(), 1.5 * critical);
+  ASSERT_EQ(sim.step_warnings().size(), 1u);
+  EXPECT_NE(sim.step_warnings()[0].find("(forced)"), std::string::npos);
+}
+
+TEST(Steering, AStageDtAboveTheCriticalStepIsRefusedAtTheStart) {
+  // Not when the run reaches the stage, after the earlier stages' output: the scene is refused as it starts.
+  const auto with_stage = [](double dt) {
+    return pile_scene("dt = 2e-3") + fmt::format(R"(
+[[stages]]
+name = "settle"
+steps = 10
+[[stages]]
+name = "fast"
+steps = 10
+dt = {}
+)",
+                                                 dt);
+  };
+  const double critical = make("dt = 2e-3").stability().dt_critical;
+  EXPECT_NO_THROW(Simulation<double>(basalt::test::scene_from(with_stage(0.9 * critical)), pile(),
+                                     MPI_COMM_WORLD, basalt::test::quiet()));
+  try {
+    Simulation<double>(basalt::test::scene_from(with_stage(1.1 * critical)), pile(), MPI_COMM_WORLD,
+                       basalt::test::quiet());
+    FAIL() << "a stage's dt above the critical step was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("stages[1] \"fast\": dt ="), std::string::npos) << e.what();
+  }
+}
+
 TEST(Steering, AWallMovesAtTheVelocityGivenFromWhereItIs) {
   auto sim = make("dt = 2e-3");
   sim.run(20);

@@ -1,6 +1,7 @@
 // Closed-form checks on one or two particles: bonded oscillation (period, amplitude), bond breaking
 // once at its break strain, an elastic collision (momentum, energy, restitution 1), a wall bounce
 // (impulse on the wall, both wall-stiffness conventions), and the time-step guard.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -137,6 +138,57 @@ type = "bond_count"
   const auto counts = sink.column(0);
   EXPECT_EQ(counts[static_cast<std::size_t>(broke_at) - 2], 1.0);
   EXPECT_EQ(counts.back(), 0.0);
+}
+
+TEST(Bond, EsysConventionPullsOnceInTheStepThatFindsItBroken) {
+  // ESyS's NRotBond applies its force, then finds the bond broken at the same distance: its last pull acts
+  // in the step that breaks it. The same pair with both conventions: equal up to that step's forces, then
+  // the ESyS one's velocities differ by exactly that pull's impulse, K (r - r0) dt / m.
+  const auto scene_with = [](const char* convention) {
+    return basalt::test::scene_from(fmt::format(R"(
+[run]
+dt = 1e-4
+steps = 0
+skin = 0.05
+[[interactions]]
+type = "linear_bond"
+K = 10.0
+break_strain = 0.05
+convention = "{}"
+)",
+                                                convention));
+  };
+  const double r0 = 1.0, K = 10.0, dt = 1e-4;
+  Simulation<double> basalt_sim(scene_with("basalt"), pair(0.5, 0.5, r0, true), MPI_COMM_SELF);
+  Simulation<double> esys_sim(scene_with("esys"), pair(0.5, 0.5, r0, true), MPI_COMM_SELF);
+  for (auto* sim : {&basalt_sim, &esys_sim}) {
+    auto& p = sim->particles();
+    p.vx[index_of(p, 1)] = -1.0;
+    p.vx[index_of(p, 2)] = 1.0;
+    sim->state_changed();
+  }
+  auto& a = basalt_sim.particles();
+  auto& b = esys_sim.particles();
+  int k = 0;
+  while (basalt_sim.bond_count() == 1 && k++ < 1500) {
+    basalt_sim.step(nullptr);
+    esys_sim.step(nullptr);
+  }
+  ASSERT_EQ(basalt_sim.bond_count(), 0) << "the bond never broke";
+  EXPECT_EQ(esys_sim.bond_count(), 0);  // found broken in the same step
+  const std::size_t ia = index_of(a, 2), ib = index_of(b, 2);
+  EXPECT_EQ(a.x[ia], b.x[ib]);  // the same positions up to the break
+  const double stretch = separation(b) - r0;
+  ASSERT_GT(stretch, 0.05 * r0);
+  EXPECT_EQ(a.fx[ia], 0.0);                        // Basalt: no force in the step that breaks it
+  EXPECT_NEAR(b.fx[ib], -K * stretch, 1e-12 * K);  // ESyS: the bond's last pull, towards particle 1
+  for (int s = 0; s < 50; ++s) {
+    basalt_sim.step(nullptr);
+    esys_sim.step(nullptr);
+  }
+  const double m = 1 / a.inv_mass[ia];
+  EXPECT_NEAR(b.vx[ib], a.vx[ia] - K * stretch * dt / m, 1e-12);
+  EXPECT_EQ(esys_sim.broken_bonds().size(), 1u);
 }
 
 TEST(Contact, ElasticCollisionConservesMomentumAndEnergy) {

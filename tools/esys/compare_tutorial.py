@@ -152,8 +152,8 @@ def deviation(a, b):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--scripts", nargs="+", default=["collide", "fall", "settle", "cube_drop", "block_large",
-                                                         "slide", "press", "spin", "geo_read", "chain", "glued",
-                                                         "mesh_drop"])
+                                                         "slide", "press", "spin", "geo_read", "chain", "pack_box",
+                                                         "slope_collapse", "glued", "mesh_drop"])
     ap.add_argument("--workdir", default="out/esys-tutorial")
     ap.add_argument("--tolerance", type=float, default=1e-6)
     ap.add_argument("--build", default=os.path.join(bt.ROOT, "build"), help="the build whose python/ to use")

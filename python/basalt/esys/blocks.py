@@ -16,7 +16,7 @@ class SimpleSphere:
 
     def __init__(self, id=0, posn=(0.0, 0.0, 0.0), radius=1.0, mass=None, tag=0):
         self._id, self._posn, self._radius = int(id), Vec3(posn), float(radius)
-        self._mass = self._radius ** 3 if mass is None else float(mass)
+        self._mass = self._radius * self._radius * self._radius if mass is None else float(mass)  # ESyS: r*r*r
         self._tag = int(tag)
 
     def getId(self):

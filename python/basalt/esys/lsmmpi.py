@@ -115,7 +115,16 @@ class LsmMpi:
                    "steers walls between runs")
 
     def createParticle(self, particle):
+        """An NRotSphere/RotSphere, or a generated SimpleSphere (CubicBlock, RandomBoxPacker: ESyS's createParticle
+        is createParticles of one): a particle of the run's type with the sphere's id, tag, radius and mass."""
+        from .blocks import SimpleSphere
+
         self._setup("createParticle")
+        if isinstance(particle, SimpleSphere) and self._particle_type is not None:
+            kind = RotSphere if self._particle_type == "RotSphere" else NRotSphere
+            q = kind(particle.getId(), particle.getPosn(), particle.getRadius(), particle.getMass())
+            q.setTag(particle.getTag())
+            particle = q
         if not isinstance(particle, NRotSphere):
             raise TypeError(f"LsmMpi.createParticle: an NRotSphere or RotSphere, got {type(particle).__name__}")
         want = RotSphere if self._particle_type == "RotSphere" else NRotSphere
@@ -131,14 +140,7 @@ class LsmMpi:
     def createParticles(self, particles):
         """NRotSphere/RotSphere objects, or a generated block's SimpleSpheres (CubicBlock): each becomes a
         particle of the run's type with the sphere's id, tag, radius and mass (r^3, as ESyS)."""
-        from .blocks import SimpleSphere
-
-        kind = RotSphere if self._particle_type == "RotSphere" else NRotSphere
         for p in particles:
-            if isinstance(p, SimpleSphere):
-                q = kind(p.getId(), p.getPosn(), p.getRadius(), p.getMass())
-                q.setTag(p.getTag())
-                p = q
             self.createParticle(p)
 
     def readGeometry(self, fileName):
@@ -151,6 +153,9 @@ class LsmMpi:
         self._setup("readGeometry")
         if self._particle_type is None:
             raise ValueError("LsmMpi.readGeometry before initNeighbourSearch(particleType=...)")
+        from . import before_read
+
+        before_read(fileName)  # under mpirun: after rank 0 wrote it, when the script did
         g = read_geometry(str(fileName))
         if any(g.periodic) and self._domain_lo is None:
             refuse(f"LsmMpi.readGeometry({fileName!r}): a geometry with periodic boundaries",
@@ -454,9 +459,9 @@ class LsmMpi:
                 self._clock = self._t + 1
                 for r in self._pre:
                     r.run()
-            if track:
-                self._rebuild_check()
-                ids, fx, fy, fz = self._columns("fx", "fy", "fz")
+            if track:  # one gather for both (an argsort or an exchange each)
+                ids, x, y, z, fx, fy, fz = self._columns("x", "y", "z", "fx", "fy", "fz")
+                self._rebuild_check(np.column_stack([x, y, z]))
                 self._prev_force = (ids, np.column_stack([fx, fy, fz]))
             if n == 1:  # the walls' push on the particles (+ 0.0: no "-0" where nothing touches, as ESyS prints)
                 self._prev_wall_force = {w: 0.0 - np.asarray(self._sim.walls[w].force) for w in self._walls}
@@ -504,11 +509,11 @@ class LsmMpi:
 
         return np.column_stack(self._columns("x", "y", "z")[1:])
 
-    def _rebuild_check(self):
-        """ESyS's neighbour-list rule (TSubLattice::checkNeighbors), checked as a step begins: when a particle has
-        moved more than verletDist/2 since the last rebuild, all 'old positions' become the current ones
-        (measured: a checkpoint of step n shows the rebuild of the positions after step n - 1, not n)."""
-        x = self._positions()
+    def _rebuild_check(self, x):
+        """ESyS's neighbour-list rule (TSubLattice::checkNeighbors), checked as a step begins on the positions x (in
+        id order): when a particle has moved more than verletDist/2 since the last rebuild, all 'old positions'
+        become the current ones (measured: a checkpoint of step n shows the rebuild of the positions after step
+        n - 1, not n)."""
         if len(x) != len(self._old):
             self._old = x
             return
@@ -529,7 +534,11 @@ class LsmMpi:
     def _leave_domain(self):
         """Deletes the particles outside the (grown) spatial domain, as ESyS does at its neighbour updates."""
         (lo, hi), big = self._grid_domain(), 1e30
-        for k, c in enumerate(self._columns("x", "y", "z")[1:]):
+        sim = self._sim
+        # the extremes need no id order: on one rank the particles' own arrays
+        columns = (sim.particles.x, sim.particles.y, sim.particles.z) if sim.ranks == 1 else \
+            self._columns("x", "y", "z")[1:]
+        for k, c in enumerate(columns):
             if len(c) and (c.min() < lo[k] or c.max() > hi[k]):
                 for side in (0, 1):
                     a, b = [-big] * 3, [big] * 3

@@ -29,11 +29,6 @@ _PACK = "Basalt packs spheres with basalt.pack (box, cylinder, sphere, mesh; lat
 GEOMETRY = {name: _PACK for name in (
     "SimpleBlock", "RandomSpherePacker", "SimpleSphereCollection",
     "ParticleCollection", "GrainCollection")}
-# ESyS's RandomBoxPacker gives the same packing in every run; the front end does not reproduce that packing yet,
-# and a different one would silently change the script's results
-GEOMETRY["RandomBoxPacker"] = ("ESyS's packing (the same in every ESyS run) is not reproduced yet, and another "
-                               "packing would silently change the results; " + _PACK +
-                               ": basalt.pack.box fills the same box, with other spheres")
 
 
 def stub(module, name, offer):

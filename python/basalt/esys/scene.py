@@ -46,7 +46,7 @@ def scene_dict(lsm, geometry_file, output_dir, mesh_files=None):
             rotation = True
             continue
         bond = {"type": "linear_bond", "K": g.normalK, "rest_length": "sum_of_radii",
-                "break_strain": g.breakDistance, "bond_tag": g.tag}
+                "break_strain": g.breakDistance, "convention": "esys", "bond_tag": g.tag}
         sizes = split.get(g.tag)
         if not sizes:
             interactions.append(bond)

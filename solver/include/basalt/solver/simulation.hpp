@@ -166,6 +166,9 @@ class Simulation {
   const Comm& comm() const { return dec_->comm(); }
   const PhaseTimes& times() const { return times_; }
   const StabilityReport& stability() const { return stability_; }
+  /// What the time step risks now (dt above the safe fraction of the critical step; rot_bond networks above
+  /// stability::kRotBondFraction), one sentence each: basalt-run prints them, the Python package warns.
+  std::vector<std::string> step_warnings() const;
   /// The collisions seen at the rebuilds (contact models with a closed form: RebuildChecks::impacts).
   const ImpactReport& impacts() const { return checks_.impact_report(); }
   std::int64_t rebuilds() const { return rebuilds_; }
@@ -202,7 +205,9 @@ class Simulation {
   void force_rebuild();
 
   // Steering between steps (the Python package, docs/python.md): collective, called alike on every rank.
-  /// The time step from now on (velocity-dependent models follow it). InputError unless positive and finite.
+  /// The time step from now on (velocity-dependent models follow it). InputError, nothing changed, unless
+  /// positive and finite, or when above the critical step (the start's estimate, or set_contact's) and the
+  /// run is not forced (run.force_dt, --force-dt).
   void set_dt(double dt);
   /// Particles of these tags are held from now on (stopped; they feel forces but never move or turn);
   /// replaces the scene's particles.fixed_tags.
@@ -322,6 +327,9 @@ class Simulation {
   /// Collective, after the first rebuild (simulation_stability.cpp): the network's critical step, dt
   /// from run.dt_fraction (fresh starts), and the refusal above it unless forced.
   void estimate_critical_step(bool fresh);
+  /// dt against the critical step: stability_.fraction and .warn, and the refusal above it unless forced
+  /// (`what` names the setting in the message).
+  void judge_step(const std::string& what);
   /// Collective, before a rebuild: stops the run when a particle moved more than kBlowupRadii rmin in one
   /// step and its path meets another particle or a wall (or it is bonded), or moved to a non-finite
   /// position; a particle in free flight goes on (the rebuild then migrates it however far it went).

@@ -80,6 +80,7 @@ class BondDriver final : public ModelDriver<Real, Model> {
       const Real r = std::sqrt(dx * dx + dy * dy + dz * dz);
       const Real r0 = r0s[k];
       const Coeffs& c = Uniform ? c0 : coeffs_[bonds.group[k]];
+      bool gone = false;
       if constexpr (Breakable) {
         if (Model::broken(c, r0, r)) [[unlikely]] {
           gone_.push_back(k);
@@ -91,7 +92,8 @@ class BondDriver final : public ModelDriver<Real, Model> {
             s.broken.push_back(broken_bond<Real>(bonds.a[k], bonds.b[k], double(r), double(r0),
                                                  bonds.group_of(k), 0, {x[i], y[i], z[i]}, p.radius[i],
                                                  {x[j], y[j], z[j]}, p.radius[j]));
-          continue;
+          if (!pulls_when_broken(c)) continue;
+          gone = true;  // (its energy is the break's loss, not the network's)
         }
       }
       const Real f = Model::force(c, r0, r) / r;
@@ -104,9 +106,17 @@ class BondDriver final : public ModelDriver<Real, Model> {
         fz[j] -= f * dz;
       }
       if constexpr (Energy)
-        if (BothOwned || p.id[i] < p.id[j]) energy += double(Model::energy(c, r0, r));
+        if (!gone && (BothOwned || p.id[i] < p.id[j])) energy += double(Model::energy(c, r0, r));
     }
     return energy;
+  }
+
+  /// A model may have the forces that find a bond broken still take its pull (LinearBond's ESyS convention).
+  static bool pulls_when_broken(const Coeffs& c) {
+    if constexpr (requires { Model::pulls_when_broken(c); })
+      return Model::pulls_when_broken(c);
+    else
+      return false;
   }
 
   using Base::params_, Base::coeffs_;

@@ -34,7 +34,8 @@
 //     contact_lanes<Advance>(c, ContactLanes&): the kinematic law for kContactLaneWidth pairs at once
 //       (a model with lanes keeps the default touching()).
 // Bond models (BondDriver / RotBondDriver): force and energy of (c, history-free bond geometry), or
-//   evaluate() for rotational bonds; broken() / failure() where bonds break.
+//   evaluate() for rotational bonds; broken() / failure() where bonds break; pulls_when_broken(c) (optional,
+//   default false): the forces that find a bond broken still take its pull once (ESyS's NRotBond).
 // Wall models (WallDriver / BondedWallDriver / MeshWallDriver): force(c, radius, overlap) and energy, or
 //   the kinematic contact<Advance>(c, h, WallKinematics, ContactForce&); a wall History starts with the
 //   tangential vector (the mesh walls turn it with the contact point).

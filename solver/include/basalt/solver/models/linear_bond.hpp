@@ -1,7 +1,9 @@
 #pragma once
 // Linear elastic bond between two particles (ESyS-Particle "NRotBond", non-rotational):
 //   F = K (r - r0) along the line of centres (attractive when stretched), E = K (r - r0)^2 / 2,
-//   broken when (r - r0) > break_strain * r0 (ESyS: relative strain "breakDistance").
+//   broken when (r - r0) > break_strain * r0 (ESyS: relative strain "breakDistance"). The forces that find a
+//   bond broken leave it out (Basalt), or, with convention = "esys", still take its pull once, as ESyS's
+//   NRotBond does (it applies the force, then finds the bond broken from the same distance: docs/esys.md).
 // Units: K in force/length (N/mm in mm-ms-N), r and r0 in length. r0 is the bond's history (kept by the
 // bond store, Bonds::r0), set at start either to the initial distance (Basalt's default) or to r1 + r2
 // (ESyS-Particle's convention).
@@ -24,6 +26,8 @@ struct LinearBond {
       KeyDoc{"K", "stiffness, force/length, >= 0 (required)"},
       KeyDoc{"break_strain", "relative stretch at which the bond breaks, > 0 (default: never)"},
       KeyDoc{"rest_length", "\"initial_distance\" (default) or \"sum_of_radii\" (ESyS)"},
+      KeyDoc{"convention",
+             "\"basalt\" (default) or \"esys\": a bond found broken still pulls in that step's forces"},
       KeyDoc{"tags", "[a, b]: bonds between particles tagged a and b (default: all)"},
       KeyDoc{"bond_tag", "the geometry's bond tag this group takes (default: all)"}};
   static constexpr Fields reads = kPosition | kId;
@@ -34,10 +38,12 @@ struct LinearBond {
     double K = 0;
     double break_strain = std::numeric_limits<double>::infinity();  ///< infinity: never breaks
     RestLength rest_length = RestLength::initial_distance;
+    bool pulls_when_broken = false;  ///< convention = "esys"
   };
   template <class Real>
   struct Coeffs {
     Real K, break_strain;
+    bool pulls_when_broken;
   };
   struct History {};  // the rest length lives in the bond store
 
@@ -49,12 +55,14 @@ struct LinearBond {
         t.choice_or("rest_length", {"initial_distance", "sum_of_radii"}, "initial_distance") == "sum_of_radii"
             ? RestLength::sum_of_radii
             : RestLength::initial_distance;
+    p.pulls_when_broken = t.choice_or("convention", {"basalt", "esys"}, "basalt") == "esys";
     return p;
   }
   template <class Real>
   static Coeffs<Real> coeffs(const Params& p) {
     return {Real(p.K),
-            std::isfinite(p.break_strain) ? Real(p.break_strain) : std::numeric_limits<Real>::infinity()};
+            std::isfinite(p.break_strain) ? Real(p.break_strain) : std::numeric_limits<Real>::infinity(),
+            p.pulls_when_broken};
   }
   static double max_stiffness(const Params& p, double) { return p.K; }
   static bool breakable(const Params& p) { return std::isfinite(p.break_strain); }
@@ -77,6 +85,11 @@ struct LinearBond {
   template <class Real>
   static bool broken(const Coeffs<Real>& c, Real r0, Real r) {
     return (r - r0) > c.break_strain * r0;
+  }
+  /// The forces that find the bond broken still take its pull (once: it is gone from the next step).
+  template <class Real>
+  static bool pulls_when_broken(const Coeffs<Real>& c) {
+    return c.pulls_when_broken;
   }
 };
 

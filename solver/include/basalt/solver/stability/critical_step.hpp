@@ -106,4 +106,9 @@ inline constexpr int kPerturbationRetries = 2;
 /// of the smallest radius in one step.
 inline constexpr double kBlowupRadii = 0.5;
 
+/// The fraction of the critical-step estimate above which a rot_bond scene is warned of: two bonded
+/// spheres were measured unstable from 0.502 of it, a bonded lattice from 0.78 (docs/stability.md,
+/// "Rotational bonds and the critical step"); 0.45 leaves a margin.
+inline constexpr double kRotBondFraction = 0.45;
+
 }  // namespace basalt::solver::stability
