@@ -1,0 +1,570 @@
+"""GenGeo's box packing rebuilt in Python for `from gengeo import *` inside `python3 -m basalt.esys`
+(docs/esys.md, "GenGeo"): Vector3, Plane, Sphere, BoxWithPlanes3D, MNTable3D and InsertGenerator3D.
+
+Written from what Debian's GenGeo 1.4 does (measured on its output and read from its machine code): the same
+random numbers (glibc's rand() from its default seed, as GenGeo never seeds it), the same seeding lattice,
+trial points, simplex fit of each new sphere to its four nearest objects, overlap checks, ids (one global
+counter bumped by every sphere GenGeo constructs, fits that fail included) and .geo file, each floating-point
+operation in GenGeo's order, so that the spheres come out bit for bit.
+"""
+
+import math
+
+from .errors import refuse
+
+_RAND_MAX = 2147483647.0
+_SMALL = 1e-7          # GenGeo's MNTable3D::s_small_value
+
+
+class _GlibcRand:
+    """glibc's rand() (TYPE_3 additive feedback generator), from srand(seed)."""
+
+    def __init__(self, seed=1):
+        r = [0] * 34
+        r[0] = seed if seed else 1
+        for i in range(1, 31):
+            hi, lo = divmod(r[i - 1], 127773)
+            word = 16807 * lo - 2836 * hi
+            if word < 0:
+                word += 2147483647
+            r[i] = word
+        for i in range(31, 34):
+            r[i] = r[i - 31]
+        self.r = r
+        for _ in range(310):
+            self._next()
+
+    def _next(self):
+        r = self.r
+        v = (r[-31] + r[-3]) & 0xFFFFFFFF
+        r.append(v)
+        if len(r) > 4096:
+            del r[:-34]
+        return v >> 1
+
+    def __call__(self):
+        return self._next()
+
+
+_rand = _GlibcRand()
+_next_id = [0]  # GenGeo's Sphere::s_current_id
+
+
+def _new_id():
+    i = _next_id[0]
+    _next_id[0] = i + 1
+    return i
+
+
+def _ceil(x):
+    return int(math.ceil(x))
+
+
+class Vector3:
+    __slots__ = ("x", "y", "z")
+
+    def __init__(self, x=0.0, y=0.0, z=0.0):
+        self.x, self.y, self.z = float(x), float(y), float(z)
+
+    def X(self):
+        return self.x
+
+    def Y(self):
+        return self.y
+
+    def Z(self):
+        return self.z
+
+    def __add__(self, o):
+        return Vector3(self.x + o.x, self.y + o.y, self.z + o.z)
+
+    def __sub__(self, o):
+        return Vector3(self.x - o.x, self.y - o.y, self.z - o.z)
+
+    def __mul__(self, s):
+        return Vector3(self.x * s, self.y * s, self.z * s)
+
+    __rmul__ = __mul__
+
+    def __truediv__(self, s):
+        return Vector3(self.x / s, self.y / s, self.z / s)
+
+    def __neg__(self):
+        return Vector3(-self.x, -self.y, -self.z)
+
+    def __eq__(self, o):
+        return isinstance(o, Vector3) and (self.x, self.y, self.z) == (o.x, o.y, o.z)
+
+    def __getitem__(self, i):
+        return (self.x, self.y, self.z)[i]
+
+    def norm(self):
+        return math.sqrt((self.x * self.x + self.y * self.y) + self.z * self.z)
+
+    def __repr__(self):
+        return f"{self.x:g} {self.y:g} {self.z:g}"
+
+    __str__ = __repr__
+
+
+def _vec(v):
+    return v if isinstance(v, Vector3) else Vector3(*v)
+
+
+class Plane:
+    """A plane through `origin` with normal `normal` (normalised as GenGeo does)."""
+
+    def __init__(self, origin, normal):
+        origin, normal = _vec(origin), _vec(normal)
+        self.p = (origin.x, origin.y, origin.z)
+        n = math.sqrt((normal.x * normal.x + normal.y * normal.y) + normal.z * normal.z)
+        self.n = (normal.x / n, normal.y / n, normal.z / n)
+
+    def getDist(self, q):
+        p, n = self.p, self.n
+        return abs(((q[0] - p[0]) * n[0] + (q[1] - p[1]) * n[1]) + (q[2] - p[2]) * n[2])
+
+
+class Sphere:
+    """A sphere; constructing one takes the next id of GenGeo's global counter, as GenGeo's does."""
+
+    __slots__ = ("c", "r", "id", "tag")
+
+    def __init__(self, centre=None, radius=0.0):
+        if centre is None:  # GenGeo's default constructor: id 0, no counter
+            self.c, self.r, self.id, self.tag = (0.0, 0.0, 0.0), 0.0, 0, 0
+            return
+        centre = _vec(centre)
+        self.c = (centre.x, centre.y, centre.z)
+        self.r = float(radius)
+        self.id = _new_id()
+        self.tag = 0
+
+    def Centre(self):
+        return Vector3(*self.c)
+
+    Center = Centre
+
+    def Radius(self):
+        return self.r
+
+    def Id(self):
+        return self.id
+
+    def Tag(self):
+        return self.tag
+
+    def setTag(self, tag):
+        self.tag = int(tag)
+
+    def setId(self, i):
+        self.id = int(i)
+        if _next_id[0] < self.id:
+            _next_id[0] = self.id
+
+    def getDist(self, q):
+        c = self.c
+        dx, dy, dz = q[0] - c[0], q[1] - c[1], q[2] - c[2]
+        return math.sqrt((dx * dx + dy * dy) + dz * dz) - self.r
+
+
+class BoxWithPlanes3D:
+    """An axis-aligned box to fill; planes added with addPlane also bound the spheres (touching them)."""
+
+    def __init__(self, minPoint, maxPoint):
+        lo, hi = _vec(minPoint), _vec(maxPoint)
+        self.lo = (lo.x, lo.y, lo.z)
+        self.hi = (hi.x, hi.y, hi.z)
+        self.planes = []
+
+    def addPlane(self, plane):
+        self.planes.append(plane)
+
+    def getBoundingBox(self):
+        return Vector3(*self.lo), Vector3(*self.hi)
+
+    def getAPoint(self, ivol=0):
+        lo, hi = self.lo, self.hi
+        x = lo[0] + (_rand() / _RAND_MAX) * (hi[0] - lo[0])
+        y = lo[1] + (_rand() / _RAND_MAX) * (hi[1] - lo[1])
+        z = lo[2] + (_rand() / _RAND_MAX) * (hi[2] - lo[2])
+        return (x, y, z)
+
+    def _is_in(self, c, r):
+        lo, hi = self.lo, self.hi
+        if not (c[0] > lo[0] + r and hi[0] - r > c[0] and c[1] > lo[1] + r and hi[1] - r > c[1]
+                and c[2] > lo[2] + r and hi[2] - r > c[2]):
+            return False
+        d = r + r
+        for p in self.planes:
+            if not d > r:
+                break
+            d = p.getDist(c)
+        return d > r
+
+    def isIn(self, sphere):
+        return self._is_in(sphere.c, sphere.r)
+
+
+class MNTable3D:
+    """GenGeo's neighbour table: cells of gridSize around the box (one layer of empty cells outside), each
+    holding its spheres per group in insertion order; the .geo lists them cell by cell."""
+
+    def __init__(self, minPoint, maxPoint, gridSize, numGroups=1):
+        lo, hi = _vec(minPoint), _vec(maxPoint)
+        g = float(gridSize)
+        self.cell = g
+        self.ngroups = int(numGroups)
+        self.n = (_ceil((hi.x - lo.x) / g) + 2, _ceil((hi.y - lo.y) / g) + 2, _ceil((hi.z - lo.z) / g) + 2)
+        self.origin = (lo.x - g, lo.y - g, lo.z - g)
+        self.lo = (lo.x, lo.y, lo.z)
+        self.hi = (lo.x + g * (self.n[0] - 2), lo.y + g * (self.n[1] - 2), lo.z + g * (self.n[2] - 2))
+        self.cells = {}   # index -> [list of spheres per group]
+        self.bonds = {}   # tag -> set of (id1, id2)
+        print("nx,ny,nz: %d , %d , %d" % self.n)
+
+    # -- cells
+    def _index(self, q):
+        o, g = self.origin, self.cell
+        ix = math.floor((q[0] - o[0]) / g)
+        iy = math.floor((q[1] - o[1]) / g)
+        iz = math.floor((q[2] - o[2]) / g)
+        nx, ny, nz = self.n
+        if 0 < ix < nx - 1 and 0 < iy < ny - 1 and 0 < iz < nz - 1:
+            return (ix * ny + iy) * nz + iz
+        return -1
+
+    def _around(self, q):
+        g = self.cell
+        for i in (-1.0, 0.0, 1.0):
+            x = g * i + q[0]
+            for j in (-1.0, 0.0, 1.0):
+                y = g * j + q[1]
+                for k in (-1.0, 0.0, 1.0):
+                    idx = self._index((x, y, k * g + q[2]))
+                    if idx != -1:
+                        cell = self.cells.get(idx)
+                        if cell is not None:
+                            yield cell
+
+    def _near(self, c, dist, gid):
+        for cell in self._around(c):
+            for s in cell[gid]:
+                if not dist < s.getDist(c):
+                    return True
+        return False
+
+    def _closest(self, q, n):
+        found = []
+        for cell in self._around(q):
+            best = []
+            for group in cell:
+                for s in group:
+                    d = s.getDist(q)
+                    if len(best) < n:
+                        _insert_equal(best, d, s)
+                    elif d < best[-1][0]:
+                        _insert_equal(best, d, s)
+                        best.pop()
+            for d, s in best:
+                _insert_equal(found, d, s)
+        return found
+
+    def _store(self, s, gid):
+        idx = self._index(s.c)
+        cell = self.cells.get(idx)
+        if cell is None:
+            cell = self.cells[idx] = [[] for _ in range(self.ngroups)]
+        cell[gid].append(s)
+
+    def insert(self, sphere, gid=0):
+        if self._index(sphere.c) == -1 or not 0 <= gid < self.ngroups:
+            return False
+        self._store(_copy(sphere), gid)
+        return True
+
+    def insertChecked(self, sphere, gid=0, tol=_SMALL):
+        if self._index(sphere.c) == -1 or not 0 <= gid < self.ngroups:
+            return False
+        if self._near(sphere.c, sphere.r - (_SMALL + tol), gid):
+            return False
+        self._store(_copy(sphere), gid)
+        return True
+
+    def checkInsertable(self, sphere, gid=0):
+        if self._index(sphere.c) == -1 or not 0 <= gid < self.ngroups:
+            return False
+        return not self._near(sphere.c, sphere.r - _SMALL, gid)
+
+    # -- queries
+    def _spheres(self, gid=None):
+        for idx in sorted(self.cells):
+            cell = self.cells[idx]
+            for g, group in enumerate(cell):
+                if gid is None or g == gid:
+                    yield from group
+
+    def getSphereListFromGroup(self, groupID):
+        return list(self._spheres(groupID))
+
+    def getNumParticles(self, groupID=-1):
+        return sum(1 for _ in self._spheres(None if groupID < 0 else groupID))
+
+    def getSumVolume(self, groupID=0):
+        total = 0.0
+        for s in self._spheres(groupID):
+            total += 4.1887902047863905 * s.r * s.r * s.r
+        return total
+
+    # -- bonds
+    def generateBonds(self, groupID=0, tol=1e-5, bondTag=0):
+        print("MNTable3D::generateBonds(", groupID, ",", tol, ",", bondTag, ")")
+        pairs = self.bonds.setdefault(int(bondTag), set())
+        cell_keys = sorted(self.cells)
+        for idx in cell_keys:
+            mine = self.cells[idx][groupID]
+            if not mine:
+                continue
+            for cell in self._around(_cell_point(self, idx)):
+                others = cell[groupID]
+                for a in mine:
+                    for b in others:
+                        if a is b:
+                            continue
+                        dx, dy, dz = a.c[0] - b.c[0], a.c[1] - b.c[1], a.c[2] - b.c[2]
+                        rr = a.r + b.r
+                        if rr * tol > abs(math.sqrt((dx * dx + dy * dy) + dz * dz) - rr):
+                            pairs.add((a.id, b.id) if a.id < b.id else (b.id, a.id))
+
+    # -- output
+    def write(self, fileName, outputStyle=1):
+        if int(outputStyle) != 1:
+            refuse(f"MNTable3D.write(..., {outputStyle})", "only outputStyle 1 (the .geo file ESyS reads) is "
+                   "written; Basalt's own files are written by basalt.pack and basalt-run (docs/formats.md)")
+        spheres = list(self._spheres())
+        bonds = sorted((a, b, t) for t, ps in self.bonds.items() for a, b in ps)
+        lo, hi = self.lo, self.hi
+        out = ["LSMGeometry 1.2",
+               "BoundingBox " + " ".join(_g10(v) for v in lo + hi),
+               "PeriodicBoundaries 0 0 0", "Dimension 3D", "BeginParticles", "Simple", str(len(spheres))]
+        for s in spheres:
+            out.append(" ".join(_g10(v) for v in s.c + (s.r,)) + f" {s.id} {s.tag}")
+        out += ["EndParticles", "BeginConnect", str(len(bonds))]
+        out += [f"{a} {b} {t}" for a, b, t in sorted(bonds)]
+        out.append("EndConnect")
+        with open(fileName, "w") as f:
+            f.write("\n".join(out) + "\n")
+
+
+def _cell_point(table, idx):
+    nx, ny, nz = table.n
+    ix, rest = divmod(idx, ny * nz)
+    iy, iz = divmod(rest, nz)
+    o, g = table.origin, table.cell
+    return (o[0] + (ix + 0.5) * g, o[1] + (iy + 0.5) * g, o[2] + (iz + 0.5) * g)
+
+
+def _g10(v):
+    return "%.10g" % v
+
+
+def _copy(s):
+    c = Sphere.__new__(Sphere)
+    c.c, c.r, c.id, c.tag = s.c, s.r, s.id, s.tag
+    return c
+
+
+def _insert_equal(lst, key, obj):
+    """multimap insert: after the entries with an equal key."""
+    i = len(lst)
+    while i > 0 and lst[i - 1][0] > key:
+        i -= 1
+    lst.insert(i, (key, obj))
+
+
+# -- the simplex fit (GenGeo's simplex_method<double, 3> on the spread of the four distances)
+def _fit(objs, start, max_iter, prec):
+    o1, o2, o3, o4 = objs
+
+    def f(p):
+        d1, d2, d3, d4 = o1.getDist(p), o2.getDist(p), o3.getDist(p), o4.getDist(p)
+        m = (((d1 + d2) + d3) + d4) * 0.25
+        a, b, c, e = m - d1, m - d2, m - d3, m - d4
+        return math.sqrt(((a * a + b * b) + c * c) + e * e)
+
+    V = [None] * 4
+    F = [0.0] * 4
+
+    def insert(v, fv, n):
+        V[n] = v
+        F[n] = fv
+        i = n
+        while i <= 2 and not F[i] > F[i + 1]:
+            V[i], V[i + 1] = V[i + 1], V[i]
+            F[i], F[i + 1] = F[i + 1], F[i]
+            i += 1
+        while i > 0 and not F[i - 1] > F[i]:
+            V[i - 1], V[i] = V[i], V[i - 1]
+            F[i - 1], F[i] = F[i], F[i - 1]
+            i -= 1
+
+    x, y, z = start
+    V[:] = [(0.0, 0.0, 0.0)] * 4
+    insert((x, y, z), f((x, y, z)), 0)
+    for n, v in ((1, (1.0 + x, 0.0 + y, 0.0 + z)), (2, (0.0 + x, 1.0 + y, 0.0 + z)), (3, (0.0 + x, 0.0 + y, 1.0 + z))):
+        insert(v, f(v), n)
+    if F[0] > prec and (max_iter > 0 or max_iter == -1):
+        count = 0
+        while True:
+            for j in range(4):
+                sx = sy = sz = 0.0
+                for k in range(4):
+                    if k != j:
+                        vk = V[k]
+                        sx += vk[0]
+                        sy += vk[1]
+                        sz += vk[2]
+                vj = V[j]
+                p = ((sx + sx) / 3.0 - vj[0], (sy + sy) / 3.0 - vj[1], (sz + sz) / 3.0 - vj[2])
+                fp = f(p)
+                if F[j] > fp:
+                    insert(p, fp, j)
+                    break
+            else:
+                _shrink(V, F, f)
+            count += 1
+            if not F[3] > prec:
+                break
+            if not (count < max_iter or max_iter == -1):
+                break
+    c = V[3]
+    d1, d2, d3, d4 = o1.getDist(c), o2.getDist(c), o3.getDist(c), o4.getDist(c)
+    m = d1 if d1 < d2 else d2
+    m = m if m < d3 else d3
+    m = m if m < d4 else d4
+    return Sphere(Vector3(*c), m - prec * 0.1)
+
+
+def _shrink(V, F, f):
+    v0, v1, v2, v3 = V
+    cx = (((v0[0] + v1[0]) + v2[0]) + v3[0]) * 0.25
+    cy = (((v0[1] + v1[1]) + v2[1]) + v3[1]) * 0.25
+    cz = (((v0[2] + v1[2]) + v2[2]) + v3[2]) * 0.25
+    for k in range(4):
+        v = V[k]
+        V[k] = ((v[0] - cx) * 0.5 + cx, (v[1] - cy) * 0.5 + cy, (v[2] - cz) * 0.5 + cz)
+        F[k] = f(V[k])
+    for start in (0, 1):
+        for a in range(start, 3):
+            if F[a + 1] > F[a]:
+                V[a], V[a + 1] = V[a + 1], V[a]
+                F[a], F[a + 1] = F[a + 1], F[a]
+
+
+class InsertGenerator3D:
+    """GenGeo's insertion packer: a lattice of seed spheres, then spheres fitted to their four nearest
+    neighbours (spheres or the box's planes) at random points until maxTries points in a row found no room."""
+
+    def __init__(self, minRadius, maxRadius, insertFails, maxIterations, tolerance, seed=False):
+        self.rmin = float(minRadius)
+        self.rmax = float(maxRadius)
+        self.max_tries = float(insertFails)
+        self.max_iter = int(maxIterations)
+        self.prec = float(tolerance)
+        self.old_seeding = bool(seed)
+        self.default_tag = 0
+
+    def setOldSeeding(self, old):
+        self.old_seeding = bool(old)
+
+    def generatePacking(self, vol, ntable, gid=0, tag=-1, shapes=None):
+        if shapes is not None:
+            refuse("InsertGenerator3D.generatePacking(..., ShapeList)", "spheres only")
+        if not isinstance(vol, BoxWithPlanes3D):
+            refuse(f"InsertGenerator3D.generatePacking({type(vol).__name__})", "BoxWithPlanes3D only")
+        if tag == -1:
+            tag = self.default_tag
+        self._seed(vol, ntable, gid, tag)
+        self._fill(vol, ntable, gid, tag)
+
+    def _seed(self, vol, table, gid, tag):
+        print("InsertGenerator3D::seedParticles")
+        lo, hi = vol.lo, vol.hi
+        print("bbx: %g %g %g - %g %g %g" % (lo + hi))
+        rmin, rmax = self.rmin, self.rmax
+        imax = int(math.ceil((hi[0] - lo[0]) / (rmax + rmax)))
+        jmax = int(math.ceil((hi[1] - lo[1]) / (rmax * 1.7320508075688772)))
+        kmax = int(math.ceil((hi[2] - lo[2]) / ((rmax + rmax) * 0.816496580927726)))
+        for i in range(imax + 1):
+            for j in range(jmax + 1):
+                fx = float(j & 1) * 0.5 + float(i)
+                for k in range(kmax + 1):
+                    kk = float(k & 1)
+                    px = ((((kk * 0.5 + fx) * rmax) * 2.0 + lo[0]) + rmax) + 1e-5
+                    py = ((((kk / 3.0 + float(j)) * 1.7320508075688772) * rmax + lo[1]) + rmax) + 1e-5
+                    pz = (((float(k) * 2.0 * 0.816496580927726) * rmax + lo[2]) + rmax) + 1e-5
+                    a = hi[0] - px
+                    b = px - lo[0]
+                    dx = a if a < b else b
+                    a = hi[1] - py
+                    b = py - lo[1]
+                    dy = a if a < b else b
+                    a = hi[2] - pz
+                    b = pz - lo[2]
+                    dz = a if a < b else b
+                    de = dx if dx < dy else dy
+                    de = de if de < dz else dz
+                    if not de > rmin:
+                        continue
+                    top = de if rmax > de else rmax
+                    if self.old_seeding:
+                        r = (_rand() / _RAND_MAX) * (top - rmin) + rmin
+                        jitter = 0.0
+                    else:
+                        r = (_rand() / _RAND_MAX) * ((top - rmin) * 0.5) + rmin
+                        jitter = top - r
+                    u1 = _rand()
+                    u2 = _rand()
+                    x = ((u1 / _RAND_MAX) * 2.0 + -1.0) * jitter + px
+                    y = ((u2 / _RAND_MAX) * 2.0 + -1.0) * jitter + py
+                    z = ((_rand() / _RAND_MAX) * 2.0 - 1.0) * jitter + pz
+                    s = Sphere(Vector3(x, y, z), r)
+                    if vol.isIn(s) and table.checkInsertable(s, gid):
+                        s.tag = tag
+                        table.insertChecked(s, gid, _SMALL)
+
+    def _fill(self, vol, table, gid, tag):
+        fails = 0
+        total = 0
+        inserted = 0
+        since = 0
+        rmin, rmax, prec, max_iter = self.rmin, self.rmax, self.prec, self.max_iter
+        while fails < self.max_tries:
+            p = vol.getAPoint(0)
+            found = table._closest(p, 4)
+            objs = {}
+            for d, s in found:
+                objs.setdefault(d, s)
+            for pl in vol.planes:
+                objs.setdefault(pl.getDist(p), pl)
+            if len(objs) >= 4:
+                four = [objs[d] for d in sorted(objs)[:4]]
+                s = _fit(four, p, max_iter, prec)
+                ok = s.r > rmin and rmax > s.r
+                inside = vol.isIn(s)
+                if ok and inside:
+                    s.tag = tag
+                    if table.insertChecked(s, gid, _SMALL):
+                        inserted += 1
+                        total += fails
+                        since += fails
+                        if inserted % 100 == 0:
+                            print("inserted %d at avg. %g" % (inserted, since / 100.0))
+                            since = 0
+                        fails = 0
+                        continue
+            fails += 1
+        print("total tries: ", total)
+
+
+__all__ = ["Vector3", "Plane", "Sphere", "BoxWithPlanes3D", "MNTable3D", "InsertGenerator3D"]
