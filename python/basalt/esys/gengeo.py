@@ -320,12 +320,20 @@ class MNTable3D:
     def generateBonds(self, groupID=0, tol=1e-5, bondTag=0):
         print("MNTable3D::generateBonds(", groupID, ",", tol, ",", bondTag, ")")
         pairs = self.bonds.setdefault(int(bondTag), set())
-        cell_keys = sorted(self.cells)
-        for idx in cell_keys:
+        nx, ny, nz = self.n
+        # GenGeo pairs each cell with itself and with the neighbours whose offset (di, dj, dk) sums to more
+        # than 0: the three offsets summing to 0 ((0, 1, -1), (1, 0, -1), (1, -1, 0) and their opposites) are
+        # never visited, so touching spheres across those cell edges get no bond (as GenGeo's .geo shows)
+        offsets = [0] + [(di * ny + dj) * nz + dk for di in (-1, 0, 1) for dj in (-1, 0, 1) for dk in (-1, 0, 1)
+                         if di + dj + dk > 0]
+        for idx in sorted(self.cells):
             mine = self.cells[idx][groupID]
             if not mine:
                 continue
-            for cell in self._around(_cell_point(self, idx)):
+            for off in offsets:
+                cell = self.cells.get(idx + off)
+                if cell is None:
+                    continue
                 others = cell[groupID]
                 for a in mine:
                     for b in others:
@@ -356,14 +364,6 @@ class MNTable3D:
             f.write("\n".join(out) + "\n")
 
 
-def _cell_point(table, idx):
-    nx, ny, nz = table.n
-    ix, rest = divmod(idx, ny * nz)
-    iy, iz = divmod(rest, nz)
-    o, g = table.origin, table.cell
-    return (o[0] + (ix + 0.5) * g, o[1] + (iy + 0.5) * g, o[2] + (iz + 0.5) * g)
-
-
 def _g10(v):
     return "%.10g" % v
 
@@ -382,83 +382,13 @@ def _insert_equal(lst, key, obj):
     lst.insert(i, (key, obj))
 
 
-# -- the simplex fit (GenGeo's simplex_method<double, 3> on the spread of the four distances)
+# -- the simplex fit (GenGeo's simplex search on the spread of the four distances): basalt._core.gengeo_fit,
+# compiled (python/src/gengeo.cpp), 100 times quicker than the same steps in Python
 def _fit(objs, start, max_iter, prec):
-    o1, o2, o3, o4 = objs
-
-    def f(p):
-        d1, d2, d3, d4 = o1.getDist(p), o2.getDist(p), o3.getDist(p), o4.getDist(p)
-        m = (((d1 + d2) + d3) + d4) * 0.25
-        a, b, c, e = m - d1, m - d2, m - d3, m - d4
-        return math.sqrt(((a * a + b * b) + c * c) + e * e)
-
-    V = [None] * 4
-    F = [0.0] * 4
-
-    def insert(v, fv, n):
-        V[n] = v
-        F[n] = fv
-        i = n
-        while i <= 2 and not F[i] > F[i + 1]:
-            V[i], V[i + 1] = V[i + 1], V[i]
-            F[i], F[i + 1] = F[i + 1], F[i]
-            i += 1
-        while i > 0 and not F[i - 1] > F[i]:
-            V[i - 1], V[i] = V[i], V[i - 1]
-            F[i - 1], F[i] = F[i], F[i - 1]
-            i -= 1
-
-    x, y, z = start
-    V[:] = [(0.0, 0.0, 0.0)] * 4
-    insert((x, y, z), f((x, y, z)), 0)
-    for n, v in ((1, (1.0 + x, 0.0 + y, 0.0 + z)), (2, (0.0 + x, 1.0 + y, 0.0 + z)), (3, (0.0 + x, 0.0 + y, 1.0 + z))):
-        insert(v, f(v), n)
-    if F[0] > prec and (max_iter > 0 or max_iter == -1):
-        count = 0
-        while True:
-            for j in range(4):
-                sx = sy = sz = 0.0
-                for k in range(4):
-                    if k != j:
-                        vk = V[k]
-                        sx += vk[0]
-                        sy += vk[1]
-                        sz += vk[2]
-                vj = V[j]
-                p = ((sx + sx) / 3.0 - vj[0], (sy + sy) / 3.0 - vj[1], (sz + sz) / 3.0 - vj[2])
-                fp = f(p)
-                if F[j] > fp:
-                    insert(p, fp, j)
-                    break
-            else:
-                _shrink(V, F, f)
-            count += 1
-            if not F[3] > prec:
-                break
-            if not (count < max_iter or max_iter == -1):
-                break
-    c = V[3]
-    d1, d2, d3, d4 = o1.getDist(c), o2.getDist(c), o3.getDist(c), o4.getDist(c)
-    m = d1 if d1 < d2 else d2
-    m = m if m < d3 else d3
-    m = m if m < d4 else d4
-    return Sphere(Vector3(*c), m - prec * 0.1)
-
-
-def _shrink(V, F, f):
-    v0, v1, v2, v3 = V
-    cx = (((v0[0] + v1[0]) + v2[0]) + v3[0]) * 0.25
-    cy = (((v0[1] + v1[1]) + v2[1]) + v3[1]) * 0.25
-    cz = (((v0[2] + v1[2]) + v2[2]) + v3[2]) * 0.25
-    for k in range(4):
-        v = V[k]
-        V[k] = ((v[0] - cx) * 0.5 + cx, (v[1] - cy) * 0.5 + cy, (v[2] - cz) * 0.5 + cz)
-        F[k] = f(V[k])
-    for start in (0, 1):
-        for a in range(start, 3):
-            if F[a + 1] > F[a]:
-                V[a], V[a + 1] = V[a + 1], V[a]
-                F[a], F[a + 1] = F[a + 1], F[a]
+    from .._core_loader import core
+    spec = [(True, o.p + o.n) if isinstance(o, Plane) else (False, o.c + (o.r, 0.0, 0.0)) for o in objs]
+    x, y, z, r = core().gengeo_fit(spec, start, max_iter, prec)
+    return Sphere(Vector3(x, y, z), r)
 
 
 class InsertGenerator3D:
