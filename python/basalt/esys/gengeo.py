@@ -10,6 +10,8 @@ operation in GenGeo's order, so that the spheres come out bit for bit.
 
 import math
 
+import numpy as np
+
 from .errors import refuse
 
 _RAND_MAX = 2147483647.0
@@ -220,6 +222,7 @@ class MNTable3D:
         self.lo = (lo.x, lo.y, lo.z)
         self.hi = (lo.x + g * (self.n[0] - 2), lo.y + g * (self.n[1] - 2), lo.z + g * (self.n[2] - 2))
         self.cells = {}   # index -> [list of spheres per group]
+        self._hoods = {}  # the spheres around a point, cached until the next insertion (_closest4)
         self.bonds = {}   # tag -> set of (id1, id2)
         print("nx,ny,nz: %d , %d , %d" % self.n)
 
@@ -254,23 +257,54 @@ class MNTable3D:
                     return True
         return False
 
-    def _closest(self, q, n):
-        found = []
-        for cell in self._around(q):
-            best = []
-            for group in cell:
-                for s in group:
-                    d = s.getDist(q)
-                    if len(best) < n:
-                        _insert_equal(best, d, s)
-                    elif d < best[-1][0]:
-                        _insert_equal(best, d, s)
-                        best.pop()
-            for d, s in best:
-                _insert_equal(found, d, s)
-        return found
+    def _axis_cells(self, q, axis):
+        o, g = self.origin[axis], self.cell
+        return tuple(math.floor(((g * i + q[axis]) - o) / g) for i in (-1.0, 0.0, 1.0))
+
+    def _closest4(self, q):
+        """The spheres nearest to q as GenGeo's getSpheresClosestTo(q, 4) orders them: (distance, sphere) by
+        distance, an equal distance kept once (the first of the cells in GenGeo's order), at most 4."""
+        key = (self._axis_cells(q, 0), self._axis_cells(q, 1), self._axis_cells(q, 2))
+        hood = self._hoods.get(key)
+        if hood is None:
+            hood = self._hoods[key] = self._hood(key)
+        xyzr, spheres = hood
+        if not spheres:
+            return []
+        dx = q[0] - xyzr[0]
+        dy = q[1] - xyzr[1]
+        dz = q[2] - xyzr[2]
+        d = np.sqrt((dx * dx + dy * dy) + dz * dz) - xyzr[3]
+        order = np.argsort(d, kind="stable") if len(spheres) > 1 else (0,)
+        out = []
+        last = None
+        for i in order:
+            di = float(d[i])
+            if di != last:
+                out.append((di, spheres[i]))
+                last = di
+                if len(out) == 4:
+                    break
+        return out
+
+    def _hood(self, key):
+        """The spheres of the 27 cells of `key` (x, y and z cell numbers) in GenGeo's order: cells x, y, z
+        from -1 to 1, then groups, then insertion order."""
+        nx, ny, nz = self.n
+        spheres = []
+        for ix in key[0]:
+            for iy in key[1]:
+                for iz in key[2]:
+                    if 0 < ix < nx - 1 and 0 < iy < ny - 1 and 0 < iz < nz - 1:
+                        cell = self.cells.get((ix * ny + iy) * nz + iz)
+                        if cell is not None:
+                            for group in cell:
+                                spheres.extend(group)
+        xyzr = np.array([s.c + (s.r,) for s in spheres], dtype=np.float64).T.copy() if spheres else None
+        return xyzr, spheres
 
     def _store(self, s, gid):
+        self._hoods.clear()
         idx = self._index(s.c)
         cell = self.cells.get(idx)
         if cell is None:
@@ -374,14 +408,6 @@ def _copy(s):
     return c
 
 
-def _insert_equal(lst, key, obj):
-    """multimap insert: after the entries with an equal key."""
-    i = len(lst)
-    while i > 0 and lst[i - 1][0] > key:
-        i -= 1
-    lst.insert(i, (key, obj))
-
-
 # -- the simplex fit (GenGeo's simplex search on the spread of the four distances): basalt._core.gengeo_fit,
 # compiled (python/src/gengeo.cpp), 100 times quicker than the same steps in Python
 def _fit(objs, start, max_iter, prec):
@@ -471,10 +497,9 @@ class InsertGenerator3D:
         rmin, rmax, prec, max_iter = self.rmin, self.rmax, self.prec, self.max_iter
         while fails < self.max_tries:
             p = vol.getAPoint(0)
-            found = table._closest(p, 4)
             objs = {}
-            for d, s in found:
-                objs.setdefault(d, s)
+            for d, s in table._closest4(p):
+                objs[d] = s
             for pl in vol.planes:
                 objs.setdefault(pl.getDist(p), pl)
             if len(objs) >= 4:
