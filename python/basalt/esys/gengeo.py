@@ -16,6 +16,7 @@ from .errors import refuse
 
 _RAND_MAX = 2147483647.0
 _SMALL = 1e-7          # GenGeo's MNTable3D::s_small_value
+_FOUR_THIRDS_PI = 4.188790133333333  # GenGeo's 4/3 pi, with pi as 3.1415926
 
 
 class _GlibcRand:
@@ -345,9 +346,13 @@ class MNTable3D:
         return sum(1 for _ in self._spheres(None if groupID < 0 else groupID))
 
     def getSumVolume(self, groupID=0):
+        """The spheres' volume, summed per cell, then over the cells (GenGeo's order)."""
         total = 0.0
-        for s in self._spheres(groupID):
-            total += 4.1887902047863905 * s.r * s.r * s.r
+        for idx in sorted(self.cells):
+            cell_sum = 0.0
+            for s in self.cells[idx][groupID]:
+                cell_sum += ((s.r * _FOUR_THIRDS_PI) * s.r) * s.r
+            total += cell_sum
         return total
 
     # -- bonds
@@ -427,11 +432,19 @@ class InsertGenerator3D:
         self.max_tries = float(insertFails)
         self.max_iter = int(maxIterations)
         self.prec = float(tolerance)
-        self.old_seeding = bool(seed)
+        self.old_seeding = False
         self.default_tag = 0
+        if seed:  # GenGeo: srand() from the clock's microseconds, a different packing on every run
+            import time
+            global _rand
+            _rand = _GlibcRand(int(time.time() * 1e6) % 1000000)
 
     def setOldSeeding(self, old):
+        """GenGeo's first seeding: the lattice spheres without their random shift, radii up to the room."""
         self.old_seeding = bool(old)
+
+    def setNextTag(self, tag):
+        self.default_tag = int(tag)
 
     def generatePacking(self, vol, ntable, gid=0, tag=-1, shapes=None):
         if shapes is not None:
@@ -519,7 +532,7 @@ class InsertGenerator3D:
                         fails = 0
                         continue
             fails += 1
-        print("total tries: ", total)
+        print("total tries: %d" % total)
 
 
 __all__ = ["Vector3", "Plane", "Sphere", "BoxWithPlanes3D", "MNTable3D", "InsertGenerator3D"]
