@@ -14,6 +14,32 @@ import numpy as np
 
 from .errors import refuse
 
+OFFER = ("Basalt reproduces GenGeo's BoxWithPlanes3D packing by InsertGenerator3D (docs/esys.md, \"GenGeo\"); "
+         "Basalt packs other shapes with basalt.pack (box, cylinder, sphere, mesh; lattice=True for a regular one; "
+         "bonds between touching spheres), or run the script with GenGeo itself and read its .geo with "
+         "readGeometry")
+# GenGeo 1.4's other public names (its volumes, packers and tables): refused by the shim's gengeo
+REFUSED = [
+    "AGenerator2D", "AGenerator3D", "AVolume", "AVolume2D", "AVolume3D", "BoxWithJointSet", "BoxWithLines2D",
+    "BoxWithLines2DSubVol", "CircMNTable2D", "CircMNTable3D", "CircMNTableXY2D", "CircleVol", "ClippedCircleVol",
+    "ClippedSphereVol", "ConvexPolyWithJointSet", "ConvexPolyhedron", "CylinderVol", "CylinderWithJointSet",
+    "DifferenceVol", "DogBone", "EllipsoidVol", "FullCircMNTable3D", "HGrainGenerator2D",
+    "HexAggregateInsertGenerator2D", "HexAggregateInsertGenerator2DRand", "HexAggregateInsertGenerator3D",
+    "InsertGenerator2D", "IntersectionVol", "Line2D", "LineSegment2D", "LineSet", "MNTable2D",
+    "MeshVolWithJointSet", "MeshVolume", "MeshVolume2D", "PolygonWithLines2D", "Shape", "ShapeList",
+    "SphereSectionVol", "SphereVol", "SphereVolWithJointSet", "TriBox", "TriPatchSet", "TriWithLines2D",
+    "UnionVol"]
+
+
+class _RefuseOthers:
+    """GenGeo's methods this class does not have are refused by name (NotSupportedError), not AttributeError."""
+
+    def __getattr__(self, name):
+        if name.startswith("_"):
+            raise AttributeError(name)
+        refuse(f"{type(self).__name__}.{name}", OFFER)
+
+
 _RAND_MAX = 2147483647.0
 _SMALL = 1e-7          # GenGeo's MNTable3D::s_small_value
 _FOUR_THIRDS_PI = 4.188790133333333  # GenGeo's 4/3 pi, with pi as 3.1415926
@@ -171,7 +197,7 @@ class Sphere:
         return math.sqrt((dx * dx + dy * dy) + dz * dz) - self.r
 
 
-class BoxWithPlanes3D:
+class BoxWithPlanes3D(_RefuseOthers):
     """An axis-aligned box to fill; planes added with addPlane also bound the spheres (touching them)."""
 
     def __init__(self, minPoint, maxPoint):
@@ -209,7 +235,7 @@ class BoxWithPlanes3D:
         return self._is_in(sphere.c, sphere.r)
 
 
-class MNTable3D:
+class MNTable3D(_RefuseOthers):
     """GenGeo's neighbour table: cells of gridSize around the box (one layer of empty cells outside), each
     holding its spheres per group in insertion order; the .geo lists them cell by cell."""
 
@@ -422,7 +448,7 @@ def _fit(objs, start, max_iter, prec):
     return Sphere(Vector3(x, y, z), r)
 
 
-class InsertGenerator3D:
+class InsertGenerator3D(_RefuseOthers):
     """GenGeo's insertion packer: a lattice of seed spheres, then spheres fitted to their four nearest
     neighbours (spheres or the box's planes) at random points until maxTries points in a row found no room."""
 

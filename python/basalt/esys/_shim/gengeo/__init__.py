@@ -4,14 +4,14 @@ InsertGenerator3D give the spheres, ids, tags, bonds and .geo file of Debian's G
 packers and table calls are refused (NotSupportedError naming basalt.pack), never packed differently. Outside the
 runner this folder is not on sys.path: `import gengeo` finds a real GenGeo, or nothing."""
 from basalt.esys.errors import refuse
-from basalt.esys.gengeo import (BoxWithPlanes3D, InsertGenerator3D, MNTable3D, Plane, Sphere,  # noqa: F401
-                                Vector3)
+from basalt.esys.gengeo import (OFFER, REFUSED, BoxWithPlanes3D, InsertGenerator3D, MNTable3D,  # noqa: F401
+                                Plane, Sphere, Vector3)
+from basalt.esys.refused import stub
 
-__all__ = ["Vector3", "Plane", "Sphere", "BoxWithPlanes3D", "MNTable3D", "InsertGenerator3D"]
-
-_OFFER = ("Basalt reproduces GenGeo's BoxWithPlanes3D packing by InsertGenerator3D only; Basalt packs other "
-          "shapes with basalt.pack (box, cylinder, sphere, mesh; lattice=True for a regular one; bonds between "
-          "touching spheres), or run the GenGeo script with GenGeo itself and read its .geo with readGeometry")
+# GenGeo's other names exist, so that `from gengeo import *` brings them, and refuse when used
+globals().update({name: stub("gengeo", name, OFFER) for name in REFUSED})
+__all__ = ["Vector3", "Plane", "Sphere", "BoxWithPlanes3D", "MNTable3D", "InsertGenerator3D"] + REFUSED
+_OFFER = OFFER
 
 
 def __getattr__(name):
