@@ -411,22 +411,51 @@ class MNTable3D(_RefuseOthers):
 
     # -- output
     def write(self, fileName, outputStyle=1):
-        if int(outputStyle) != 1:
-            refuse(f"MNTable3D.write(..., {outputStyle})", "only outputStyle 1 (the .geo file ESyS reads) is "
-                   "written; Basalt's own files are written by basalt.pack and basalt-run (docs/formats.md)")
+        """outputStyle 1: the .geo file ESyS reads (readGeometry); 2: GenGeo's VTK .vtu (spheres as points with
+        radius, id and tag, bonds as lines with their tag), both as GenGeo writes them."""
+        style = int(outputStyle)
+        if style not in (1, 2):
+            refuse(f"MNTable3D.write(..., {outputStyle})", "outputStyle 1 (the .geo file ESyS reads) and 2 (the "
+                   ".vtu) are written; Basalt's own files come from basalt.pack and basalt-run (docs/formats.md)")
         spheres = list(self._spheres())
         bonds = sorted((a, b, t) for t, ps in self.bonds.items() for a, b in ps)
-        lo, hi = self.lo, self.hi
+        text = self._geo(spheres, bonds) if style == 1 else self._vtu(spheres, bonds)
+        with open(fileName, "w") as f:
+            f.write(text)
+
+    def _geo(self, spheres, bonds):
         out = ["LSMGeometry 1.2",
-               "BoundingBox " + " ".join(_g10(v) for v in lo + hi),
+               "BoundingBox " + " ".join(_g10(v) for v in self.lo + self.hi),
                "PeriodicBoundaries 0 0 0", "Dimension 3D", "BeginParticles", "Simple", str(len(spheres))]
         for s in spheres:
             out.append(" ".join(_g10(v) for v in s.c + (s.r,)) + f" {s.id} {s.tag}")
         out += ["EndParticles", "BeginConnect", str(len(bonds))]
-        out += [f"{a} {b} {t}" for a, b, t in sorted(bonds)]
+        out += [f"{a} {b} {t}" for a, b, t in bonds]
         out.append("EndConnect")
-        with open(fileName, "w") as f:
-            f.write("\n".join(out) + "\n")
+        return "\n".join(out) + "\n"
+
+    @staticmethod
+    def _vtu(spheres, bonds):
+        index = {s.id: i for i, s in enumerate(spheres)}
+        head = '<DataArray type="%s" Name="%s" NumberOfComponents="1" format="ascii">'
+        out = ['<VTKFile type="UnstructuredGrid" version="0.1">', "<UnstructuredGrid>",
+               f'<Piece NumberOfPoints="{len(spheres)}" NumberOfCells="{len(bonds)}">', "<Points>",
+               '<DataArray NumberOfComponents="3" type="Float64" format="ascii">',
+               "".join(_g10(v) + " " for s in spheres for v in s.c), "</DataArray>", "</Points>",
+               '<PointData Scalars="radius">', head % ("Float64", "radius"),
+               "".join(_g10(s.r) + " " for s in spheres), "</DataArray>", head % ("Int32", "particleID"),
+               "".join(f"{s.id} " for s in spheres), "</DataArray>", head % ("Int32", "particleTag"),
+               "".join(f"{s.tag} " for s in spheres), "</DataArray>", "</PointData>", "<Cells>",
+               '<DataArray type="Int32" NumberOfComponents="1" Name="connectivity" format="ascii">']
+        out += [f"{index[a]} {index[b]}" for a, b, t in bonds]
+        out += ["</DataArray>", '<DataArray type="Int32" NumberOfComponents="1" Name="offsets" format="ascii">']
+        out += [str(2 * (i + 1)) for i in range(len(bonds))]
+        out += ["</DataArray>", '<DataArray type="UInt8" NumberOfComponents="1" Name="types" format="ascii">']
+        out += ["3"] * len(bonds)
+        out += ["</DataArray>", "</Cells>", "<CellData>", head % ("Int32", "bondTag")]
+        out += [str(t) for a, b, t in bonds]
+        out += ["</DataArray>", "</CellData>", "</Piece>", "</UnstructuredGrid>", "</VTKFile>"]
+        return "\n".join(out) + "\n"
 
 
 def _g10(v):

@@ -1,5 +1,5 @@
 # GenGeo-style geometry script (our own numbers): InsertGenerator3D fills a box, the table bonds the touching
-# spheres and writes a .geo; every sphere is printed at 17 digits. Cases (several run one after the other, as
+# spheres and writes a .geo (and for `planes` a .vtu); every sphere is printed at 17 digits. Cases (several run one after the other, as
 # GenGeo's random stream and sphere ids go on):
 #   plain   a 6 x 5 x 4 box without planes, radii 0.2-1.0, 200 failed tries to stop (tag 0, group 0)
 #   planes  a 5 x 4 x 6 box with its six faces as planes (the spheres touch them), radii 0.25-0.8, tag 2
@@ -33,6 +33,8 @@ def pack(case):
         print("sphere %d %.17g %.17g %.17g %.17g %d" % (s.Id(), c.X(), c.Y(), c.Z(), s.Radius(), s.Tag()))
     print("volume %.17g" % table.getSumVolume(groupID=0))
     table.write("gengeo_box_%s.geo" % case, 1)
+    if case == "planes":
+        table.write("gengeo_box_%s.vtu" % case, 2)
 
 
 for case in sys.argv[1:] or ["plain"]:
