@@ -385,10 +385,15 @@ class MNTable3D(_RefuseOthers):
     def generateBonds(self, groupID=0, tol=1e-5, bondTag=0):
         print("MNTable3D::generateBonds(", groupID, ",", tol, ",", bondTag, ")")
         pairs = self.bonds.setdefault(int(bondTag), set())
+        for a, b in self._touching(groupID, tol):
+            pairs.add((a.id, b.id) if a.id < b.id else (b.id, a.id))
+
+    def _touching(self, groupID, tol):
+        """The pairs of groupID with |d - r1 - r2| < tol (r1 + r2), over the cell pairs GenGeo visits: each cell
+        with itself and with the neighbours whose offset (di, dj, dk) sums to more than 0. The three offsets
+        summing to 0 ((0, 1, -1), (1, 0, -1), (1, -1, 0) and their opposites) are never visited, so touching
+        spheres across those cell edges get no bond (as GenGeo's .geo shows)."""
         nx, ny, nz = self.n
-        # GenGeo pairs each cell with itself and with the neighbours whose offset (di, dj, dk) sums to more
-        # than 0: the three offsets summing to 0 ((0, 1, -1), (1, 0, -1), (1, -1, 0) and their opposites) are
-        # never visited, so touching spheres across those cell edges get no bond (as GenGeo's .geo shows)
         offsets = [0] + [(di * ny + dj) * nz + dk for di in (-1, 0, 1) for dj in (-1, 0, 1) for dk in (-1, 0, 1)
                          if di + dj + dk > 0]
         for idx in sorted(self.cells):
@@ -399,15 +404,40 @@ class MNTable3D(_RefuseOthers):
                 cell = self.cells.get(idx + off)
                 if cell is None:
                     continue
-                others = cell[groupID]
                 for a in mine:
-                    for b in others:
+                    for b in cell[groupID]:
                         if a is b:
                             continue
                         dx, dy, dz = a.c[0] - b.c[0], a.c[1] - b.c[1], a.c[2] - b.c[2]
                         rr = a.r + b.r
                         if rr * tol > abs(math.sqrt((dx * dx + dy * dy) + dz * dz) - rr):
-                            pairs.add((a.id, b.id) if a.id < b.id else (b.id, a.id))
+                            yield a, b
+
+    def tagParticlesToClosest(self, groupID, seedGroupID):
+        """Each sphere of groupID takes the tag of the closest sphere (centre to centre) of seedGroupID."""
+        seeds = list(self._spheres(seedGroupID))
+        if not seeds:
+            return
+        xyz = np.array([s.c for s in seeds])
+        tags = [s.tag for s in seeds]
+        for s in self._spheres(groupID):
+            dx = s.c[0] - xyz[:, 0]
+            dy = s.c[1] - xyz[:, 1]
+            dz = s.c[2] - xyz[:, 2]
+            s.tag = tags[int(np.argmin((dx * dx + dy * dy) + dz * dz))]
+
+    def removeParticlesInGroup(self, groupID):
+        for cell in self.cells.values():
+            cell[groupID] = []
+        self._hoods.clear()
+
+    def generateClusterBonds(self, groupID, tol, bondTag1, bondTag2):
+        """Bonds between touching spheres of groupID: bondTag1 when both carry the same tag, bondTag2 when not."""
+        print("MNTable3D::generateClusterBonds(", groupID, ",", tol, ",", bondTag1, ",", bondTag2, ")")
+        same = self.bonds.setdefault(int(bondTag1), set())
+        diff = self.bonds.setdefault(int(bondTag2), set())
+        for a, b in self._touching(groupID, tol):
+            (same if a.tag == b.tag else diff).add((a.id, b.id) if a.id < b.id else (b.id, a.id))
 
     # -- output
     def write(self, fileName, outputStyle=1):
