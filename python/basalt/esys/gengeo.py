@@ -388,14 +388,15 @@ class MNTable3D(_RefuseOthers):
         for a, b in self._touching(groupID, tol):
             pairs.add((a.id, b.id) if a.id < b.id else (b.id, a.id))
 
-    def _touching(self, groupID, tol):
+    def _touching(self, groupID, tol, every_neighbour=False):
         """The pairs of groupID with |d - r1 - r2| < tol (r1 + r2), over the cell pairs GenGeo visits: each cell
         with itself and with the neighbours whose offset (di, dj, dk) sums to more than 0. The three offsets
         summing to 0 ((0, 1, -1), (1, 0, -1), (1, -1, 0) and their opposites) are never visited, so touching
-        spheres across those cell edges get no bond (as GenGeo's .geo shows)."""
+        spheres across those cell edges get no bond (as GenGeo's .geo shows). generateClusterBonds visits all 26
+        neighbours (every_neighbour)."""
         nx, ny, nz = self.n
         offsets = [0] + [(di * ny + dj) * nz + dk for di in (-1, 0, 1) for dj in (-1, 0, 1) for dk in (-1, 0, 1)
-                         if di + dj + dk > 0]
+                         if di + dj + dk > 0 or (every_neighbour and (di, dj, dk) != (0, 0, 0))]
         for idx in sorted(self.cells):
             mine = self.cells[idx][groupID]
             if not mine:
@@ -433,10 +434,9 @@ class MNTable3D(_RefuseOthers):
 
     def generateClusterBonds(self, groupID, tol, bondTag1, bondTag2):
         """Bonds between touching spheres of groupID: bondTag1 when both carry the same tag, bondTag2 when not."""
-        print("MNTable3D::generateClusterBonds(", groupID, ",", tol, ",", bondTag1, ",", bondTag2, ")")
         same = self.bonds.setdefault(int(bondTag1), set())
         diff = self.bonds.setdefault(int(bondTag2), set())
-        for a, b in self._touching(groupID, tol):
+        for a, b in self._touching(groupID, tol, every_neighbour=True):
             (same if a.tag == b.tag else diff).add((a.id, b.id) if a.id < b.id else (b.id, a.id))
 
     # -- output
@@ -448,7 +448,7 @@ class MNTable3D(_RefuseOthers):
             refuse(f"MNTable3D.write(..., {outputStyle})", "outputStyle 1 (the .geo file ESyS reads) and 2 (the "
                    ".vtu) are written; Basalt's own files come from basalt.pack and basalt-run (docs/formats.md)")
         spheres = list(self._spheres())
-        bonds = sorted((a, b, t) for t, ps in self.bonds.items() for a, b in ps)
+        bonds = [(a, b, t) for t in sorted(self.bonds) for a, b in sorted(self.bonds[t])]  # by tag, then ids
         text = self._geo(spheres, bonds) if style == 1 else self._vtu(spheres, bonds)
         with open(fileName, "w") as f:
             f.write(text)
