@@ -326,14 +326,17 @@ def test_gengeo_box_packing_is_gengeos_byte_for_byte(tmp_path):
     """Our gengeo_box.py (a GenGeo script) through the front end: its whole output (GenGeo's messages, every
     sphere's id, position, radius and tag at 17 digits, the volume) and its .geo files (spheres in GenGeo's order,
     bonds, header) and .vtu are GenGeo 1.4's, byte for byte: a plain box, a box with its faces as planes (spheres fitted
-    to them, tag 2) and the old seeding, packed one after the other (GenGeo's random stream and ids go on)."""
-    out = front(SCRIPTS / "gengeo_box.py", tmp_path, "plain", "planes", "old").stdout
+    to them, tag 2), the old seeding and the planes box clustered (spheres tagged by the closest seed, bonds
+    tagged inside and between clusters), packed one after the other (GenGeo's random stream and ids go on)."""
+    out = front(SCRIPTS / "gengeo_box.py", tmp_path, "plain", "planes", "old", "cluster").stdout
     ref = _gengeo_reference("gengeo_box.txt")
     assert out.splitlines() == ref.splitlines()
-    for case in ("plain", "planes", "old"):
+    for case in ("plain", "planes", "old", "cluster"):
         got = (tmp_path / f"gengeo_box_{case}.geo").read_text()
         assert got == _gengeo_reference(f"gengeo_box_{case}.geo.txt"), case
-    assert (tmp_path / "gengeo_box_planes.vtu").read_text() == _gengeo_reference("gengeo_box_planes.vtu.txt")
+    for case in ("planes", "cluster"):
+        got = (tmp_path / f"gengeo_box_{case}.vtu").read_text()
+        assert got == _gengeo_reference(f"gengeo_box_{case}.vtu.txt"), case
 
 
 def test_random_box_packer_block_slumps_on_the_floor(tmp_path):
@@ -423,8 +426,8 @@ REFUSED = {
         ("gengeo.HexAggregateInsertGenerator3D", "basalt.pack"),
     "from gengeo import *\nt = MNTable3D(Vector3(0, 0, 0), Vector3(2, 2, 2), 2.5, 1)\nt.write('x.txt', 3)":
         ("MNTable3D.write(..., 3)", ".geo", ".vtu"),
-    "from gengeo import *\nt = MNTable3D(Vector3(0, 0, 0), Vector3(2, 2, 2), 2.5, 2)\nt.tagParticlesToClosest(0, 1)":
-        ("MNTable3D.tagParticlesToClosest", "BoxWithPlanes3D", "basalt.pack"),
+    "from gengeo import *\nt = MNTable3D(Vector3(0, 0, 0), Vector3(2, 2, 2), 2.5, 2)\nt.tagParticlesInSphere(0, 1)":
+        ("MNTable3D.tagParticlesInSphere", "BoxWithPlanes3D", "basalt.pack"),
 }
 
 
