@@ -4,8 +4,8 @@
 #   plain   a 6 x 5 x 4 box without planes, radii 0.2-1.0, 200 failed tries to stop (tag 0, group 0)
 #   planes  a 5 x 4 x 6 box with its six faces as planes (the spheres touch them), radii 0.25-0.8, tag 2
 #   old     the plain box with GenGeo's old seeding (setOldSeeding(True): the lattice spheres unshifted)
-#   cluster the planes box in two groups: 2 x 2 x 3 seed points (group 1, radius 0) tag the spheres by the
-#           closest one, bonds tagged 1 inside a cluster and 3 between clusters, the seeds removed
+#   cluster the planes box in two groups: 2 x 2 x 3 skewed seed points (group 1, radius 0) tag the spheres by
+#           the closest one, bonds tagged 1 inside a cluster and 3 between clusters, the seeds removed
 # Runs on GenGeo (python3 gengeo_box.py CASE...) and on Basalt (python3 -m basalt.esys gengeo_box.py CASE...).
 import sys
 
@@ -33,7 +33,8 @@ def pack(case):
         for i in range(2):
             for j in range(2):
                 for k in range(3):
-                    seed = Sphere(Vector3((i + 0.5) * 2.5, (j + 0.5) * 2.0, (k + 0.5) * 2.0), 0.0)
+                    at = Vector3(0.7 + 2.9 * i + 0.3 * k, 0.9 + 2.2 * j + 0.2 * i, 0.8 + 1.9 * k + 0.4 * j)
+                    seed = Sphere(at, 0.0)
                     seed.setTag(i * 6 + j * 3 + k)
                     table.insert(seed, 1)
         table.tagParticlesToClosest(0, 1)
