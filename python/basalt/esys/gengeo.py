@@ -331,8 +331,13 @@ class MNTable3D(_RefuseOthers):
         return xyzr, spheres
 
     def _store(self, s, gid):
-        self._hoods.clear()
         idx = self._index(s.c)
+        nx, ny, nz = self.n
+        ix, rest = divmod(idx, ny * nz)
+        iy, iz = divmod(rest, nz)
+        stale = [key for key in self._hoods if ix in key[0] and iy in key[1] and iz in key[2]]
+        for key in stale:  # the neighbourhoods holding the sphere's cell
+            del self._hoods[key]
         cell = self.cells.get(idx)
         if cell is None:
             cell = self.cells[idx] = [[] for _ in range(self.ngroups)]
