@@ -33,6 +33,7 @@
 #include "basalt/solver/stages.hpp"
 #include "bindings.hpp"
 #include "client_sink.hpp"
+#include "esys_watch.hpp"
 #include "geometry_input.hpp"
 #include "output_folder.hpp"
 #include "process_setup.hpp"
@@ -139,6 +140,13 @@ class Run {
   virtual void checkpoint() = 0;
   /// The critical time step the run estimated at its start (docs/stability.md).
   virtual double critical_dt() const = 0;
+  /// Collective: ESyS's neighbour-list rule and spatial domain checked after every step of every run from
+  /// now on (esys_watch.hpp; the ESyS front end), the references taken now; again after deletions.
+  virtual void esys_watch(double limit2, const std::array<double, 3>& lo,
+                          const std::array<double, 3>& hi) = 0;
+  virtual void esys_watch_reset() = 0;
+  /// The positions at ESyS's last neighbour-list rebuild: (ids, (n, 3) positions) in id order.
+  virtual py::tuple esys_watch_reference() const = 0;
   /// What the time step risks now, one sentence each (Simulation::step_warnings).
   virtual std::vector<std::string> step_warnings() const = 0;
   virtual std::string close() = 0;
@@ -178,7 +186,28 @@ class RunOf final : public Run {
   }
 
   std::int64_t run(std::int64_t steps, const std::vector<solver::StepHook>& hooks) override {
-    return sim_->run(steps, *sink_, hooks);
+    if (!watch_) return sim_->run(steps, *sink_, hooks);
+    std::vector<solver::StepHook> all = hooks;
+    all.push_back({1, [this](std::int64_t) { return watch_->check(sim_->particles(), comm_); }, false});
+    return sim_->run(steps, *sink_, all);
+  }
+  void esys_watch(double limit2, const std::array<double, 3>& lo, const std::array<double, 3>& hi) override {
+    watch_.emplace(limit2, lo, hi);
+    watch_->reset(sim_->particles(), comm_);
+  }
+  void esys_watch_reset() override {
+    if (!watch_) throw RunError("esys_watch_reset before esys_watch");
+    watch_->reset(sim_->particles(), comm_);
+  }
+  py::tuple esys_watch_reference() const override {
+    if (!watch_) throw RunError("esys_watch_reference before esys_watch");
+    const auto& ids = watch_->ids();
+    const auto n = static_cast<py::ssize_t>(ids.size());
+    py::array_t<std::int64_t> out_ids(n);
+    std::copy(ids.begin(), ids.end(), out_ids.mutable_data());
+    py::array_t<double> out({n, py::ssize_t(3)});
+    std::copy(watch_->reference().begin(), watch_->reference().end(), out.mutable_data());
+    return py::make_tuple(out_ids, out);
   }
   py::list run_stages() override {
     py::list out;
@@ -396,6 +425,7 @@ class RunOf final : public Run {
   std::unique_ptr<solver::Simulation<Real>> sim_;
   std::unique_ptr<io::OutputClient> client_;
   std::unique_ptr<basalt::run::ClientSink> sink_;
+  std::optional<EsysWatch<Real>> watch_;  ///< the ESyS front end's rule and domain, once asked for
 };
 
 /// The Python object: the world's layout, and a Run on compute ranks.
@@ -674,6 +704,10 @@ void bind_simulation(py::module_& m) {
       .def("broken_bond_pairs", [](PySimulation& s) { return s.run().broken_bond_pairs(); })
       .def("flow_totals", [](PySimulation& s) { return s.run().flow_totals(); })
       .def_property_readonly("critical_dt", [](PySimulation& s) { return s.run().critical_dt(); })
+      .def("esys_watch", [](PySimulation& s, double limit2, const std::array<double, 3>& lo,
+                            const std::array<double, 3>& hi) { s.run().esys_watch(limit2, lo, hi); })
+      .def("esys_watch_reset", [](PySimulation& s) { s.run().esys_watch_reset(); })
+      .def("esys_watch_reference", [](PySimulation& s) { return s.run().esys_watch_reference(); })
       .def_property_readonly("step_warnings", [](PySimulation& s) { return s.run().step_warnings(); })
       .def("checkpoint", [](PySimulation& s) { s.run().checkpoint(); })
       .def("allreduce", [](PySimulation& s, double v, const std::string& op) {

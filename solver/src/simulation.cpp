@@ -38,8 +38,7 @@ void Simulation<Real>::start(const Scene& scene) {
   configure_particles();
   if (scene.bonds.size() > 254) throw InputError("interactions: at most 254 bond groups");
   apply_dt(scene_.dt);
-  time_base_ = scene_.clock_base.time;
-  step_base_ = scene_.clock_base.step;
+  clock_.set_base(scene_.clock_base.step, scene_.clock_base.time);
   rebuild_limit2_ = 0.25 * scene.skin * scene.skin;
 }
 
@@ -245,7 +244,7 @@ const std::vector<double>& Simulation<Real>::compute_forces(bool ghosts_in_fligh
   if (!integrator_.take_zeroed()) zero_forces(p_);
   if (Energy) forces_.zero_energies();
   const std::size_t before = broken_.size();
-  if (!forces_.walls().empty()) forces_.walls().move_to(time_);
+  if (!forces_.walls().empty()) forces_.walls().move_to(clock_.time());
   ForceState<Real> state{p_, bonds_, broken_, forces_.walls()};
   // Bond models come first: by the time the others start, the neighbours' ghost posts have arrived
   // and one poke moves them along.
@@ -268,7 +267,7 @@ const std::vector<double>& Simulation<Real>::compute_forces(bool ghosts_in_fligh
       bond_broke_ = true;
     bonds_.parted.clear();
   }
-  for (std::size_t k = before; k < broken_.size(); ++k) broken_[k].step = step_;
+  for (std::size_t k = before; k < broken_.size(); ++k) broken_[k].step = clock_.step();
   return forces_.potentials();
 }
 
@@ -302,6 +301,7 @@ void Simulation<Real>::steer_servos() {
 template <class Real>
 void Simulation<Real>::apply_dt(double dt) {
   scene_.dt = dt;
+  clock_.set_dt(dt);
   integrator_.configure(dt, scene_.integrator == Integrator::symplectic_euler);
   for (const auto& c : forces_.computes()) c->set_time_step(dt);  // velocity-dependent models' increments
 }
@@ -315,7 +315,7 @@ void Simulation<Real>::set_dt(double dt) {
     const StabilityReport stability = stability_;
     scene_.dt = dt;
     try {
-      judge_step(fmt::format("dt (set at step {})", step_));
+      judge_step(fmt::format("dt (set at step {})", clock_.step()));
     } catch (const InputError&) {
       scene_.dt = before;
       stability_ = stability;
@@ -324,8 +324,7 @@ void Simulation<Real>::set_dt(double dt) {
   }
   // The clock goes on from now at the new step (a step x dt clock would jump, and the walls' motions with
   // it).
-  time_base_ = time_;
-  step_base_ = step_;
+  clock_.rebase();
   apply_dt(dt);
 }
 
@@ -365,7 +364,7 @@ template <class Real>
 void Simulation<Real>::set_wall_velocity(std::string_view name, const std::array<double, 3>& v) {
   for (double c : v)
     if (!std::isfinite(c)) throw InputError(fmt::format("wall \"{}\": the velocity must be finite", name));
-  forces_.walls().set_velocity(wall_index(name), v, time_);
+  forces_.walls().set_velocity(wall_index(name), v, clock_.time());
 }
 
 namespace {
@@ -391,7 +390,7 @@ void Simulation<Real>::set_wall_motion(std::string_view name, const std::string&
   TableReader t(table, label, std::string(name) + ".motion");
   const WallMotion m = parse_motion(t, walls.spec(w).normal);
   t.finish();
-  walls.set_motion(w, m, time_);
+  walls.set_motion(w, m, clock_.time());
 }
 
 template <class Real>

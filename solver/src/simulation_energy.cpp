@@ -79,9 +79,9 @@ void Simulation<Real>::guard_energy(const std::vector<double>& pe) {
         "id {} with kinetic energy {:.6g}, velocity ({:.6g}, {:.6g}, {:.6g}) at ({:.6g}, {:.6g}, {:.6g}). dt "
         "= {} "
         "is {:.3g} x the critical time step {:.6g}",
-        step_, breach->mechanical, breach->dissipated, breach->work, breach->energy0, breach->imbalance,
-        breach->allowed, terms, p_.id[bi], best, p_.vx[bi], p_.vy[bi], p_.vz[bi], p_.x[bi], p_.y[bi],
-        p_.z[bi], scene_.dt, stability_.fraction, stability_.dt_critical);
+        clock_.step(), breach->mechanical, breach->dissipated, breach->work, breach->energy0,
+        breach->imbalance, breach->allowed, terms, p_.id[bi], best, p_.vx[bi], p_.vy[bi], p_.vz[bi], p_.x[bi],
+        p_.y[bi], p_.z[bi], scene_.dt, stability_.fraction, stability_.dt_critical);
   }
   stop(comm().broadcast(msg, who));
 }

@@ -16,8 +16,8 @@ SimulationFrame<Real>::SimulationFrame(const Simulation<Real>& sim, std::uint32_
   const auto& bonds = sim.bonds_;
   auto& h = header_;
   h.kinds = kinds;
-  h.step = sim.step_;
-  h.time = sim.time_;
+  h.step = sim.clock_.step();
+  h.time = sim.clock_.time();
   h.source_rank = sim.comm().rank();
   h.particles = p.n_owned;
   // Owned particles now are those of the last rebuild (only a rebuild migrates or reorders them).
@@ -91,7 +91,7 @@ SimulationFrame<Real>::SimulationFrame(const Simulation<Real>& sim, std::uint32_
       }
       for (std::size_t k = 0; k < wd.meshes(); ++k) {
         const auto& s = wd.mesh_spec(k);
-        const auto v = s.motion.velocity_at(sim.time_);
+        const auto v = s.motion.velocity_at(sim.clock_.time());
         const std::size_t at = 3 * (wd.size() + k);
         walls_.push_back({s.name,
                           absolute(wd.mesh_axis_point(k)),
@@ -179,7 +179,8 @@ void SimulationFrame<Real>::write(io::FrameWriter& w) const {
     w.set(Column::bond_b, at, broken.b);
     w.set(Column::bond_rest_length, at, broken.rest_length);
     w.set(Column::bond_group, at, broken.group);
-    w.set(Column::bond_broken, at, std::uint8_t((broken.step == sim_.step_ ? 2 : 1) | (broken.mode << 2)));
+    w.set(Column::bond_broken, at,
+          std::uint8_t((broken.step == sim_.clock_.step() ? 2 : 1) | (broken.mode << 2)));
     w.set(Column::break_x, k, o[0] + broken.x);
     w.set(Column::break_y, k, o[1] + broken.y);
     w.set(Column::break_z, k, o[2] + broken.z);

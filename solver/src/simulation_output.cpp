@@ -23,7 +23,7 @@ bool Simulation<Real>::field_partials(const std::vector<double>& pe, std::vector
   due.clear();
   bool any = false;
   for (const auto& f : scene_.fields) {
-    const bool d = step_ % f.every == 0;
+    const bool d = clock_.step() % f.every == 0;
     any = any || d;
     const std::size_t width = f.width();
     for (std::size_t c = 0; c < width; ++c) due.push_back(d);
@@ -147,7 +147,7 @@ double Simulation<Real>::runout(const FieldSpec& f) const {
 
 template <class Real>
 std::optional<double> Simulation<Real>::saved_field(std::size_t column) const {
-  return fields_.saved(column, step_, comm());
+  return fields_.saved(column, clock_.step(), comm());
 }
 
 template <class Real>

@@ -26,8 +26,8 @@ std::optional<std::string> Simulation<Real>::check_finite() const {
           "step {}: particle id {} went non-finite: position ({}, {}, {}), velocity ({}, {}, {}), force ({}, "
           "{}, "
           "{}); dt = {} is {:.3g} x the critical time step",
-          step_, p_.id[i], p_.x[i], p_.y[i], p_.z[i], p_.vx[i], p_.vy[i], p_.vz[i], p_.fx[i], p_.fy[i],
-          p_.fz[i], scene_.dt, stability_.fraction);
+          clock_.step(), p_.id[i], p_.x[i], p_.y[i], p_.z[i], p_.vx[i], p_.vy[i], p_.vz[i], p_.fx[i],
+          p_.fy[i], p_.fz[i], scene_.dt, stability_.fraction);
   }
   return std::nullopt;
 }
@@ -63,7 +63,8 @@ std::vector<std::uint32_t> Simulation<Real>::resolve_bonds() {
           "step {}: the bond between particle ids {} and {} is longer than the ghost width {:.6g} (particle "
           "{} "
           "is not within reach of rank {}): bonds must not stretch beyond the longest initial bond + skin",
-          step_, bonds_.a[k], bonds_.b[k], ghost_width_, ia < 0 ? bonds_.a[k] : bonds_.b[k], comm().rank());
+          clock_.step(), bonds_.a[k], bonds_.b[k], ghost_width_, ia < 0 ? bonds_.a[k] : bonds_.b[k],
+          comm().rank());
       if (stability_.warn)
         *error += fmt::format(" (dt is {:.3g} x the critical time step: the run is probably unstable)",
                               stability_.fraction);
@@ -109,7 +110,7 @@ void Simulation<Real>::rebuild() {
   times_.communication += sw.lap();
   forces_.save_history(p_);  // before the ghosts (and the pairs' ids) go
   const bool flow = flow_.pending();
-  if (flow) flow_.plan_arrivals(p_, *dec_, step_);  // (reads the ghosts)
+  if (flow) flow_.plan_arrivals(p_, *dec_, clock_.step());  // (reads the ghosts)
   p_.drop_ghosts();
   if (flow) exchange_flow();
   times_.neighbor += sw.lap();
@@ -120,8 +121,8 @@ void Simulation<Real>::rebuild() {
     if (error) stop(*error);
     const long long total = comm().sum(static_cast<long long>(p_.n_owned));
     if (total != n_global_)
-      stop(fmt::format("step {}: {} particles on the ranks, {} expected: particles were lost", step_, total,
-                       n_global_));
+      stop(fmt::format("step {}: {} particles on the ranks, {} expected: particles were lost", clock_.step(),
+                       total, n_global_));
     if (scene_.balance != "none" && !balancer_.paused())
       if (auto balance_error = balancer_.at_rebuild(balance_run())) stop(*balance_error);
   }
@@ -139,21 +140,21 @@ void Simulation<Real>::rebuild() {
     p_.zr.assign(p_.z.begin(), p_.z.begin() + static_cast<std::ptrdiff_t>(p_.n_owned));
   }
   find_fixed();
-  rebuild_step_ = step_;
+  rebuild_step_ = clock_.step();
   bond_broke_ = false;
   ++rebuilds_;
   check_rebuild();
   if (std::getenv("BASALT_DEBUG_REBUILD"))
     fmt::print(stderr, "rank {} rebuild at step {} owned {} ghosts {} bonds {} (both owned {}) pairs {}+{}\n",
-               comm().rank(), step_, p_.n_owned, p_.n_ghost(), bonds_.size(), bonds_.n_both_owned,
+               comm().rank(), clock_.step(), p_.n_owned, p_.n_ghost(), bonds_.size(), bonds_.n_both_owned,
                forces_.own_pairs().pairs(), forces_.ghost_pairs().pairs());
   times_.neighbor += sw.lap();
 }
 
 template <class Real>
 void Simulation<Real>::check_rebuild() {
-  const typename RebuildChecks<Real>::State state{p_,    bonds_,          forces_,         comm(),
-                                                  step_, stability_.rmin, precision_name()};
+  const typename RebuildChecks<Real>::State state{
+      p_, bonds_, forces_, comm(), clock_.step(), stability_.rmin, precision_name()};
   // Only scenes with a closed-form collision (hertz_mindlin) look at collisions.
   if (auto error = checks_.impacts(state, scene_.dt, scene_.fixed_tags, scene_.force_dt || options_.force_dt,
                                    stability_.dt_critical))

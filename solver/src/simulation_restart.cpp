@@ -33,8 +33,8 @@ void Simulation<Real>::begin_restart(std::size_t particles, double dt, const Res
     throw InputError(
         fmt::format("the checkpoint was written with dt = {}, the scene has run.dt = {}", dt, scene_dt));
   apply_dt(scene_.clock_base.dt > 0 ? scene_.clock_base.dt : scene_.dt);
-  time_base_ = scene_.clock_base.time;  // (a staged run's dt change, replayed: stages.hpp)
-  step_base_ = scene_.clock_base.step;
+  // (a staged run's dt change, replayed: stages.hpp)
+  clock_.set_base(scene_.clock_base.step, scene_.clock_base.time);
   rebuild_limit2_ = 0.25 * scene_.skin * scene_.skin;
 }
 
@@ -105,8 +105,8 @@ void Simulation<Real>::finish_restart(const io::Checkpoint& c, bool replay) {
                  "basalt-run: warning: the checkpoint has no /particles/position_at_rebuild (written by an "
                  "older basalt-run): the lists are rebuilt at step {}, so the continuation agrees with the "
                  "uninterrupted run to rounding only\n",
-                 step_);
-    if (!forces_.walls().empty()) forces_.walls().move_to(time_at(step_));
+                 clock_.step());
+    if (!forces_.walls().empty()) forces_.walls().move_to(time_at(clock_.step()));
     rebuild();
   }
   balancer_.set_paused(false);
@@ -243,8 +243,7 @@ void Simulation<Real>::distribute_checkpoint(const io::Checkpoint& c, const std:
     if (is_owned(a) || (b >= 0 && is_owned(b)))  // a wall's id (< 0) has no index
       history[model]->push(a, b, c.contact_history.data() + k * c.contact_width);
   }
-  step_ = c.step;
-  time_ = c.time;
+  clock_.set(c.step, c.time);
 }
 
 template <class Real>
@@ -299,11 +298,11 @@ void Simulation<Real>::replay_rebuild(const io::Checkpoint& c) {
   // everything the uninterrupted run's did: ownership, order, ghosts, bond order, pair and wall
   // lists, the cell grid, x0 for the skin criterion.
   const auto& g = c.geometry;
-  const std::int64_t now = step_;
-  step_ = c.rebuild_step;
+  const std::int64_t now = clock_.step();
+  clock_.set_step(c.rebuild_step);
   if (!forces_.walls().empty()) forces_.walls().move_to(time_at(c.rebuild_step));
   rebuild();
-  step_ = now;
+  clock_.set_step(now);
   restore_servos(c, false);  // from where the rebuild saw them to where the checkpoint has them
   // Back to the checkpoint's positions; the ghosts follow as after any step without a rebuild. A rank
   // holding a part of the checkpoint asks the others for particles a re-balance moved to it during the

@@ -514,7 +514,7 @@ void Simulation<Real>::check_blowup() {
         "step {}: blow-up: particle id {} moved {} in one step (more than {} x the smallest radius {:.4g}; "
         "{:.4g} since the last rebuild, limit skin/2 + that = {:.4g}){}: position ({:.6g}, {:.6g}, {:.6g}), "
         "velocity ({:.6g}, {:.6g}, {:.6g}). dt = {:.6g} is {:.3g} x the critical time step {:.6g}{}",
-        step_ + 1, p_.id[i],
+        clock_.step() + 1, p_.id[i],
         far >= std::numeric_limits<double>::max() ? "to a non-finite position" : "too far",
         stability::kBlowupRadii, stability_.rmin, far, limit, what, double(p_.x[i]), double(p_.y[i]),
         double(p_.z[i]), double(p_.vx[i]), double(p_.vy[i]), double(p_.vz[i]), scene_.dt, stability_.fraction,
@@ -610,9 +610,10 @@ std::optional<std::string> Simulation<Real>::check_frame_state() const {
       "(more than skin + {} x the smallest radius = {:.4g}), and {}: position {}, next step at {}. dt is "
       "{:.3g} x "
       "the critical time step {:.6g}{}",
-      step_, static_cast<std::int64_t>(v[0]), v[10], v[10] * scene_.dt, scene_.dt, stability::kBlowupRadii,
-      limit, hit->substr(colon + 2), xyz({v[2], v[3], v[4]}), xyz({v[5], v[6], v[7]}), stability_.fraction,
-      stability_.dt_critical, stability_.fraction > 1 ? " (forced): lower dt" : "");
+      clock_.step(), static_cast<std::int64_t>(v[0]), v[10], v[10] * scene_.dt, scene_.dt,
+      stability::kBlowupRadii, limit, hit->substr(colon + 2), xyz({v[2], v[3], v[4]}),
+      xyz({v[5], v[6], v[7]}), stability_.fraction, stability_.dt_critical,
+      stability_.fraction > 1 ? " (forced): lower dt" : "");
 }
 
 #define BASALT_INSTANTIATE(R)                                                   \

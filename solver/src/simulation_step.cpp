@@ -25,12 +25,11 @@ namespace basalt::solver {
 template <class Real>
 void Simulation<Real>::advance(bool may_defer) {
   const double moved2 = drift();
-  move_walls(step_ + 1);
+  move_walls(clock_.step() + 1);
   const bool in_flight = refresh_neighbours(moved2);
-  ++step_;
-  time_ = time_at(step_);
+  clock_.tick();
   const auto& pe = step_forces(in_flight);
-  second_kick(may_defer && !observed(step_) && !flow_.changed());
+  second_kick(may_defer && !observed(clock_.step()) && !flow_.changed());
   wall_work();
   observe(pe);
 }
@@ -57,11 +56,12 @@ bool Simulation<Real>::refresh_neighbours(double moved2) {
   Stopwatch sw;
   const bool parallel = comm().size() > 1;
   // (the scene's string is compared once per balance_every steps, not at every step)
-  const bool balance_due = parallel && step_ > 0 && step_ % scene_.balance_every == 0 &&
+  const bool balance_due = parallel && clock_.step() > 0 && clock_.step() % scene_.balance_every == 0 &&
                            scene_.balance == "time" && !balancer_.paused() &&
                            balancer_.time_balance_due(balance_run());
   // Particles entering or leaving as this step begins (the scene's [[insert]], [[delete]]): at a rebuild.
-  const bool flow = (!scene_.inserts.empty() || !scene_.deletes.empty()) && flow_.queue(scene_, step_);
+  const bool flow =
+      (!scene_.inserts.empty() || !scene_.deletes.empty()) && flow_.queue(scene_, clock_.step());
   double need =
       bond_broke_ || balance_due || flow
           ? std::numeric_limits<double>::infinity()
@@ -69,9 +69,9 @@ bool Simulation<Real>::refresh_neighbours(double moved2) {
   if (parallel) need = comm().max(need);
   times_.communication += sw.lap();
   if (!(need <= rebuild_limit2_)) {
-    check_blowup();             // simulation_stability.cpp: stops a run that moved absurdly far in this step
-    rebuild();                  // times itself
-    rebuild_step_ = step_ + 1;  // the positions it used are those of the step being completed
+    check_blowup();  // simulation_stability.cpp: stops a run that moved absurdly far in this step
+    rebuild();       // times itself
+    rebuild_step_ = clock_.step() + 1;  // the positions it used are those of the step being completed
     return false;
   }
   if (!parallel) return false;
@@ -84,8 +84,9 @@ template <class Real>
 const std::vector<double>& Simulation<Real>::step_forces(bool in_flight) {
   Stopwatch sw;
   ghost_wait_ = 0;
-  const auto& pe = guard_.energy_due(step_) || flow_.changed() ? compute_forces<true>(in_flight, true)
-                                                               : compute_forces<false>(in_flight, true);
+  const auto& pe = guard_.energy_due(clock_.step()) || flow_.changed()
+                       ? compute_forces<true>(in_flight, true)
+                       : compute_forces<false>(in_flight, true);
   times_.forces += sw.lap() - ghost_wait_;
   times_.communication += ghost_wait_;
   return pe;
@@ -94,7 +95,7 @@ const std::vector<double>& Simulation<Real>::step_forces(bool in_flight) {
 template <class Real>
 void Simulation<Real>::second_kick(bool defer) {
   Stopwatch sw;
-  integrator_.second_half(p_, defer, guard_.kinetic_due(step_));
+  integrator_.second_half(p_, defer, guard_.kinetic_due(clock_.step()));
   times_.integration += sw.lap();
 }
 
@@ -111,12 +112,12 @@ template <class Real>
 void Simulation<Real>::observe(const std::vector<double>& pe) {
   Stopwatch sw;
   // No reduction here: the sink sums the ranks' partials (on an I/O rank, or reduced with Q = 0).
-  fields_.observe(step_, time_, *output_, [&](std::vector<double>& local, std::vector<char>& due) {
-    return field_partials(pe, local, due);
-  });
+  fields_.observe(
+      clock_.step(), clock_.time(), *output_,
+      [&](std::vector<double>& local, std::vector<char>& due) { return field_partials(pe, local, due); });
   times_.output += sw.lap();
   if (flow_.changed()) rebase_ledger(pe);  // particles came or went: the ledger balances from here
-  if (guard_.due(step_)) guard_energy(pe);
+  if (guard_.due(clock_.step())) guard_energy(pe);
 }
 
 template <class Real>
@@ -159,8 +160,8 @@ class ProgressLine {
 template <class Real>
 void Simulation<Real>::progress(std::int64_t done, std::int64_t total, double seconds) const {
   const double sps = done / std::max(seconds, 1e-9);
-  fmt::print("step {:>8}/{}  {:8.1f} steps/s  {:6.2f} M particle-steps/s  ETA {:.1f} s\n", step_,
-             step_ + (total - done), sps, sps * double(n_global_) * 1e-6,
+  fmt::print("step {:>8}/{}  {:8.1f} steps/s  {:6.2f} M particle-steps/s  ETA {:.1f} s\n", clock_.step(),
+             clock_.step() + (total - done), sps, sps * double(n_global_) * 1e-6,
              (total - done) / std::max(sps, 1e-9));
   std::fflush(stdout);
 }
@@ -179,16 +180,16 @@ void Simulation<Real>::write_frame(OutputSink& out, std::uint32_t kinds, std::ve
   if (comm().size() > 1) bad = comm().agree_error(bad);
   if (bad)
     throw RunError(fmt::format("{}; the {} of step {} is not written (the checkpoints written before stay)",
-                               *bad, (kinds & io::kFrameCheckpoint) ? "checkpoint" : "frame", step_));
+                               *bad, (kinds & io::kFrameCheckpoint) ? "checkpoint" : "frame", clock_.step()));
   Stopwatch frame_clock;
   out.frame(SimulationFrame<Real>(*this, kinds));
   seconds.push_back(frame_clock.lap());
-  if (kinds & io::kFrameCheckpoint) checkpoint_step_ = step_;
+  if (kinds & io::kFrameCheckpoint) checkpoint_step_ = clock_.step();
 }
 
 template <class Real>
 void Simulation<Real>::checkpoint_now(OutputSink& out) {
-  if (checkpoint_step_ == step_) return;
+  if (checkpoint_step_ == clock_.step()) return;
   settle_kick();
   std::vector<double> seconds;
   write_frame(out, io::kFrameCheckpoint, seconds);
@@ -206,18 +207,19 @@ bool Simulation<Real>::agree_on_output(OutputSink& out, bool& reported) {
   if (sig != 0)
     throw StopRequested(fmt::format("stopped by {} at step {}: the output due up to this step is written; "
                                     "--restart from the last checkpoint continues the run",
-                                    signal_name(sig), step_),
-                        sig, step_);
+                                    signal_name(sig), clock_.step()),
+                        sig, clock_.step());
   auto error = out.poll();
   if (parallel) error = comm().agree_error(error);
   if (!error || reported) return true;
-  if (!out.continue_on_error()) throw RunError(fmt::format("output failed at step {}: {}", step_, *error));
+  if (!out.continue_on_error())
+    throw RunError(fmt::format("output failed at step {}: {}", clock_.step(), *error));
   if (comm().rank() == 0)
     fmt::print(
         stderr,
         "basalt-run: warning: output failed at step {} (on_error = \"continue\"; the run goes on without "
         "it): {}\n",
-        step_, *error);
+        clock_.step(), *error);
   reported = true;
   return true;
 }
@@ -240,13 +242,13 @@ std::int64_t Simulation<Real>::run(std::int64_t steps, OutputSink& out, std::spa
   std::int64_t k = 0;
   for (bool go = true; go && k < steps;) {
     // Frames and hooks read the velocities: the step before one makes its second half-kick.
-    advance(k + 1 < steps && out.frame_kinds(step_ + 1) == 0 && !hooks_due(hooks, step_ + 1));
+    advance(k + 1 < steps && out.frame_kinds(clock_.step() + 1) == 0 && !hooks_due(hooks, clock_.step() + 1));
     ++k;
     Stopwatch sw;
-    const std::uint32_t kinds = out.frame_kinds(step_);
+    const std::uint32_t kinds = out.frame_kinds(clock_.step());
     if (kinds != 0) write_frame(out, kinds, frame_seconds);
     for (const auto& h : hooks)
-      if (step_ % h.every == 0 && !h.call(step_)) go = false;
+      if (clock_.step() % h.every == 0 && !h.call(clock_.step())) go = false;
     // Completed sends and errors from the I/O ranks are picked up at output steps and every 32 steps,
     // where the ranks also agree on errors so that all stop at the same step (one small reduction, not
     // one per step; polling every step costs more than it gains: MPI's progress engine yields the core

@@ -378,6 +378,14 @@ def test_bonded_block_falls_and_bounces(tmp_path):
 
 
 # -- refusals, the runner ----------------------------------------------------------------------------------------
+_GLUE_SETUP = (  # a bonded wall 'w' (y = 0, normal +y) for particles of tag 2 (_tied(id, posn))
+    "sim.initNeighbourSearch(particleType='NRotSphere', gridSpacing=2.5, verletDist=0.5)\n"
+    "sim.setTimeStepSize(0.001)\nsim.setNumTimeSteps(10)\n"
+    "sim.setSpatialDomain(BoundingBox(Vec3(-5, -5, -5), Vec3(5, 5, 5)))\n"
+    "sim.createWall(name='w', posn=Vec3(0, 0, 0), normal=Vec3(0, 1, 0))\n"
+    "sim.createInteractionGroup(NRotBondedWallPrms(name='g', wallName='w', normalK=1000.0, particleTag=2))\n"
+    "def _tied(i, x):\n    p = NRotSphere(id=i, posn=x, radius=0.5, mass=1.0)\n    p.setTag(2)\n    return p\n")
+
 REFUSED = {
     "sim.createInteractionGroup(HertzMindlinPrms(name='h', youngsModulus=1.0, poissonsRatio=0.25, cor=0.5))":
         ("esys.lsm.HertzMindlinPrms", 'hertz_mindlin'),
@@ -396,6 +404,24 @@ REFUSED = {
     "sim.createParticle(NRotSphere(id=0, posn=Vec3(0, 0, 0), radius=0.5, mass=1.0))\nsim.run()":
         ("contact group 'e' together with the bond group 'b' without createExclusion('b', 'e')",),
     "sim.setParticleDensity(tag=0, mask=-1, Density=2.0)": ("LsmMpi.setParticleDensity", "mass="),
+    # InteractionScalarFieldSaverPrms: the count of a bond group's bonds only
+    "sim.createFieldSaver(InteractionScalarFieldSaverPrms(interactionName='b', fieldName='potential_energy', "
+    "fileName='e', fileFormat='SUM', beginTimeStep=0, endTimeStep=1, timeStepIncr=1))":
+        ("InteractionScalarFieldSaverPrms(fieldName='potential_energy'", "count of a bond group"),
+    "sim.createInteractionGroup(NRotElasticPrms(name='c', normalK=1.0))\n"
+    "sim.createFieldSaver(InteractionScalarFieldSaverPrms(interactionName='c', fieldName='count', "
+    "fileName='e', fileFormat='SUM', beginTimeStep=0, endTimeStep=1, timeStepIncr=1))":
+        ("on 'c'", "a contact group's count is not reproduced"),
+    # NRotBondedWallPrms: what Basalt's bonded wall cannot do as ESyS does
+    "sim.createWall(name='w', posn=Vec3(0, 0, 0), normal=Vec3(0, 1, 0))\n"
+    "sim.createInteractionGroup(NRotBondedWallPrms(name='g', wallName='w', normalK=1.0, particleTag=2, tagMask=1))":
+        ("NRotBondedWallPrms(tagMask=1)", "particleTag"),
+    _GLUE_SETUP + "sim.createParticle(_tied(0, Vec3(0, 2.6, 0)))\nsim.run()":
+        ("particle 0 of tag 2 is 2.6 from wall 'w', not within gridSpacing 2.5", "ties every particle of the tag"),
+    _GLUE_SETUP + "sim.createParticle(_tied(0, Vec3(0, 0.5, 0)))\nsim.moveWallBy('w', Vec3(0, 0.1, 0))\nsim.run()":
+        ("LsmMpi.moveWallBy('w') before the run", "from a Runnable"),
+    _GLUE_SETUP + "p = _tied(0, Vec3(0, 0.5, 0))\np.setLinearVelocity(Vec3(0, 400, 0))\nsim.createParticle(p)\n"
+    "sim.run()": ("particle 0 tied to wall 'w'", "drops such a bond"),
     "from esys.lsm.geometry import RandomBoxPacker\nRandomBoxPacker(minRadius=0.2, maxRadius=0.5, "
     "cubicPackRadius=1.1, maxInsertFails=100, bBox=BoundingBox(Vec3(0, 0, 0), Vec3(4, 4, 4)), "
     "circDimList=[True, False, False])": ("RandomBoxPacker(circDimList=[True, False, False])", "basalt.pack.box"),
@@ -708,6 +734,112 @@ def test_move_wall_by_moves_the_platen_before_the_step_forces(tmp_path):
     assert [float(s[1]) for s in saved] == pytest.approx([r - 50 * k * d for k in range(9)], abs=1e-12)
 
 
+# -- NRotBondedWallPrms: particles glued to a wall -------------------------------------------------------------
+def test_bonded_wall_swings_a_tied_particle_as_esys(tmp_path):
+    """NRotBondedWallPrms(normalK=K, particleTag=2): a tied particle thrown sideways (along the wall) swings on
+    the bond F = -k (u_p - u_w), k = 3.1415926536 r K, ESyS's full-vector spring: symplectic Euler's discrete
+    oscillation x_n = A sin(n theta), cos theta = 1 - dt^2 k/(2m), A = dt v0/sin theta, exactly (1e-10 of A);
+    it never moves along the normal. A particle of another tag overlapping the wall by 0.1 feels the group's
+    elastic part, 3.141592654 r K overlap, in its first step. k = K (no pi r), the normal part only, or every
+    particle tied fails it."""
+    r, K, m, dt, v0, steps = 0.5, 1000.0, 2.0, 1e-3, 0.4, 400
+    script = tmp_path / "swing.py"
+    script.write_text(
+        "from esys.lsm import *\nfrom esys.lsm.util import Vec3, BoundingBox\n"
+        "sim = LsmMpi(numWorkerProcesses=1, mpiDimList=[1, 1, 1])\n"
+        "sim.initNeighbourSearch(particleType='NRotSphere', gridSpacing=2.5, verletDist=0.2)\n"
+        f"sim.setTimeStepSize({dt})\nsim.setNumTimeSteps({steps})\n"
+        "sim.setSpatialDomain(BoundingBox(Vec3(-5, -5, -5), Vec3(5, 5, 5)))\n"
+        f"p = NRotSphere(id=0, posn=Vec3(0, {r}, 0), radius={r}, mass={m})\np.setTag(2)\n"
+        f"p.setLinearVelocity(Vec3({v0}, 0, 0))\nsim.createParticle(p)\n"
+        f"q = NRotSphere(id=1, posn=Vec3(3, {r - 0.1}, 0), radius={r}, mass={m})\nq.setTag(1)\n"
+        "sim.createParticle(q)\n"
+        "sim.createWall(name='w', posn=Vec3(0, 0, 0), normal=Vec3(0, 1, 0))\n"
+        f"sim.createInteractionGroup(NRotBondedWallPrms(name='g', wallName='w', normalK={K}, particleTag=2))\n"
+        "class Watch(Runnable):\n"
+        "    def run(self):\n"
+        "        for p in sim.getParticleList():\n"
+        "            x, v = p.getPosn(), p.getVelocity()\n"
+        "            print('p%d %d %.17g %.17g %.17g %.17g' % (p.getId(), sim.getTimeStep(), x[0], x[1], v[0], v[1]))\n"
+        "w = Watch()\nsim.addPostTimeStepRunnable(w)\nsim.run()\n")
+    out = front(script, tmp_path).stdout
+    k = 3.1415926536 * r * K
+    theta = math.acos(1 - dt * dt * k / (2 * m))
+    amp = dt * v0 / math.sin(theta)
+    rows = lines(out, "p0")
+    assert [int(t) for t, *_ in rows] == list(range(1, steps + 1))
+    assert max(x for _, x, *_ in rows) == pytest.approx(amp, rel=1e-3)  # it swings: several periods
+    for t, x, y, vx, vy in rows:
+        assert x == pytest.approx(amp * math.sin(t * theta), abs=1e-10 * amp)
+        assert y == r and vy == 0.0
+    t, x, y, vx, vy = lines(out, "p1")[0]
+    assert vy == pytest.approx(dt * 3.141592654 * r * K * 0.1 / m, rel=1e-12)
+    assert y == pytest.approx(r - 0.1 + dt * vy, rel=1e-12) and x == 3.0
+
+
+# -- readMesh + NRotElasticTriMeshPrms: a triangle-mesh floor ---------------------------------------------------
+_FLAT_MSH = ("Triangle\n3D-Nodes 4\n"  # a 10 x 10 square at y = 0, node ids out of order; ESyS's normal +y
+             "7 0 0 -5 0 -5\n3 0 0 5 0 -5\n9 0 0 5 0 5\n1 0 0 -5 0 5\n\nTri3 2\n0 0 7 3 9\n1 0 7 9 1\n")
+
+
+def _mesh_script(tmp_path, particles, extra=""):
+    (tmp_path / "flat.msh").write_text(_FLAT_MSH)
+    script = tmp_path / "mesh.py"
+    script.write_text(
+        "from esys.lsm import *\nfrom esys.lsm.util import Vec3, BoundingBox\n"
+        "sim = LsmMpi(numWorkerProcesses=1, mpiDimList=[1, 1, 1])\n"
+        "sim.initNeighbourSearch(particleType='NRotSphere', gridSpacing=2.5, verletDist=0.2)\n"
+        "sim.setTimeStepSize(0.001)\nsim.setNumTimeSteps(1)\n"
+        "sim.setSpatialDomain(BoundingBox(Vec3(-8, -3, -8), Vec3(8, 6, 8)))\n"
+        + "".join(f"sim.createParticle(NRotSphere(id={i}, posn=Vec3{tuple(x)}, radius={r}, mass=1.0))\n"
+                  for i, x, r in particles)
+        + "sim.readMesh(fileName='flat.msh', meshName='m')\n" + extra
+        + "class W(Runnable):\n    def run(self):\n"
+          "        for p in sim.getParticleList():\n"
+          "            print('v %d %.17g %.17g %.17g' % ((p.getId(),) + tuple(p.getVelocity().toList())))\n"
+          "w = W()\nsim.addPostTimeStepRunnable(w)\nsim.run()\n")
+    return script
+
+
+def test_mesh_floor_pushes_as_esys_2_3_5(tmp_path):
+    """readMesh of an ESyS .msh (nodes named by id, out of order) + NRotElasticTriMeshPrms(normalK=K): after one
+    step each sphere's velocity is dt k overlap/m along the line from the mesh's nearest point to the centre, with
+    k = r K (ESyS 2.3.5 as Debian builds it, measured: its source's pi r is not in it): on a face (two radii), beyond
+    the square's rim (an edge) and beyond its corner (a vertex); a sphere not touching is left alone. Without the
+    group the mesh pushes nothing. pi r K, or the triangles' node ids taken as positions, fails it."""
+    K, dt = 1000.0, 1e-3
+    spheres = [(0, (-2.3, 0.24, 0.7), 0.25), (1, (2.3, 0.49, 0.7), 0.5), (2, (5.3, 0.3, 1.0), 0.5),
+               (3, (5.2, 0.3, 5.2), 0.5), (4, (0.0, 0.6, 0.0), 0.5)]
+    group = "sim.createInteractionGroup(NRotElasticTriMeshPrms(name='r', meshName='m', normalK=1000.0))\n"
+    out = front(_mesh_script(tmp_path, spheres, group), tmp_path).stdout
+    v = {int(r[0]): r[1:] for r in lines(out, "v")}
+    nearest = {0: (-2.3, 0.0, 0.7), 1: (2.3, 0.0, 0.7), 2: (5.0, 0.0, 1.0), 3: (5.0, 0.0, 5.0)}
+    for i, x, r in spheres[:4]:
+        gap = [a - b for a, b in zip(x, nearest[i])]
+        d = math.sqrt(sum(g * g for g in gap))
+        for c in range(3):
+            assert v[i][c] == pytest.approx(dt * r * K * (r - d) * gap[c] / d, rel=1e-9, abs=1e-15)
+    assert v[4] == [0.0, 0.0, 0.0]
+    out = front(_mesh_script(tmp_path, spheres), tmp_path).stdout
+    assert all(row[1:] == [0.0, 0.0, 0.0] for row in lines(out, "v"))
+
+
+def test_mesh_refusals(tmp_path):
+    """A sphere behind the mesh (ESyS pushes it through the face, Basalt's one-sided mesh leaves it), one exactly
+    over the edge two coplanar triangles share (ESyS pushes it twice), and readMesh with a tag are refused, naming
+    the call."""
+    group = "sim.createInteractionGroup(NRotElasticTriMeshPrms(name='r', meshName='m', normalK=1000.0))\n"
+    p = front(_mesh_script(tmp_path, [(0, (0.3, -0.49, -2.7), 0.5)], group), tmp_path, check=False)
+    assert p.returncode != 0 and "particle 0 behind triangle" in p.stderr and "pushed through it" in p.stderr
+    # exactly over the diagonal the two triangles share: ESyS pushes twice (measured: dt 2 r K overlap/m)
+    p = front(_mesh_script(tmp_path, [(0, (1.0, 0.49, 1.0), 0.5)], group), tmp_path, check=False)
+    assert p.returncode != 0 and "exactly over the shared edge" in p.stderr and "once per triangle" in p.stderr
+    script = _mesh_script(tmp_path, [(0, (0.3, 0.6, 0.0), 0.5)])
+    script.write_text(script.read_text().replace("meshName='m')", "meshName='m', tag=3)"))
+    p = front(script, tmp_path, check=False)
+    assert p.returncode != 0 and "NotSupportedError" in p.stderr and "readMesh('flat.msh', 'm', tag)" in p.stderr
+
+
 # -- LinDampingPrms and RotDampingPrms on RotSpheres (spin.py) ---------------------------------------------------
 def _esys_damped(x, nu, dt, steps):
     """ESyS's damping rule (docs/reference-runs.md) on a free particle's v or w: u0 = 0; u <- x - nu dt u while
@@ -913,12 +1045,12 @@ def front_mpi(script, cwd, ranks, *args, launcher=None):
 
 # Files whose numbers are sums over the ranks (a wall's force: each rank's particles' share, added in another
 # order on two ranks): equal to rounding; every other file and printed line is the same bytes.
-SUMMED_OVER_RANKS = {"cube_drop.py": {"floor_force.dat"}}
+SUMMED_OVER_RANKS = {"cube_drop.py": {"floor_force.dat"}, "glued.py": {"platen_force.dat"}}
 
 
 @pytest.mark.skipif(subprocess.run(["which", "mpirun"], capture_output=True).returncode != 0, reason="needs mpirun")
 @pytest.mark.parametrize("script", ["collide.py", "press.py", "cube_drop.py", "pull.py", "snap_pair.py",
-                                    "geo_read.py", "own_files.py"])
+                                    "geo_read.py", "own_files.py", "glued.py"])
 def test_two_ranks_write_what_one_rank_writes(tmp_path, script):
     """mpirun -np 2: every saver file, checkpoint and printed line once and as on one rank (the same bytes; wall
     forces, summed over the ranks, to 1e-10). Each rank writing its own copy doubles the appended savers and the
@@ -1076,13 +1208,18 @@ ESYS_LAST_LISTED = {"nrot": 7, "rot": 5, "beam": 7}
 @pytest.mark.parametrize("mode", sorted(ESYS_LAST_LISTED))
 def test_checkpoint_after_a_bond_broke_lists_the_bonds_left(tmp_path, mode):
     """pull.py: bond 0-1 breaks, 1-2 holds; each step's checkpoint lists 0-1 up to ESyS's last step for it and
-    then only 1-2, with the count and the group kind (Bonded for NRotBondPrms, RotBonded otherwise)."""
+    then only 1-2, with the count and the group kind (Bonded for NRotBondPrms, RotBonded otherwise). The
+    InteractionScalarFieldSaverPrms count (SUM) of every step says the same, in ESyS's %.10e (its file is ESyS's
+    byte for byte, measured)."""
     front(SCRIPTS / "pull.py", tmp_path, mode)
     kind = "Bonded" if mode == "nrot" else "RotBonded"
+    counts = (tmp_path / "nbonds.dat").read_text().splitlines()
+    assert len(counts) == 21
     for t in range(21):
         section = (tmp_path / f"pull_t={t}_1.txt").read_text().splitlines()[4:]
         bonds = ["0 1 3", "1 2 3"] if t <= ESYS_LAST_LISTED[mode] else ["1 2 3"]
         assert section == ["1", kind, str(len(bonds)), *bonds, "TMIG 0"], (t, section)
+        assert counts[t] == "%.10e" % len(bonds), (t, counts[t])
     if mode == "nrot":
         # the step whose forces find 0-1 broken (stretch 0.00599 > breakDistance 0.005, from the positions they
         # were computed at: the checkpoint before's, ESyS's order): sphere 0 still feels its pull, K (r - r0)

@@ -97,7 +97,7 @@ def quantities(name, esys_dir, basalt_dir, esys_out, basalt_out):
     files = sorted(set(os.listdir(esys_dir)) | set(os.listdir(basalt_dir)))
     groups = collections.defaultdict(lambda: [[], [], 0])
     for f in files:
-        if f == "stdout.txt" or f.endswith(".geo"):  # a .geo is the script's own input (geo_read.py)
+        if f == "stdout.txt" or f.endswith((".geo", ".msh")):  # the script's own input (geo_read, mesh_drop)
             continue
         fe, fb = os.path.join(esys_dir, f), os.path.join(basalt_dir, f)
         if not (os.path.exists(fe) and os.path.exists(fb)):
@@ -153,7 +153,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--scripts", nargs="+", default=["collide", "fall", "settle", "cube_drop", "block_large",
                                                          "slide", "press", "spin", "geo_read", "chain", "pack_box",
-                                                         "slope_collapse"])
+                                                         "slope_collapse", "glued", "mesh_drop"])
     ap.add_argument("--workdir", default="out/esys-tutorial")
     ap.add_argument("--tolerance", type=float, default=1e-6)
     ap.add_argument("--build", default=os.path.join(bt.ROOT, "build"), help="the build whose python/ to use")

@@ -6,19 +6,21 @@ from .errors import NotSupportedError, refuse
 from .lsmmpi import LsmMpi  # noqa: F401
 from .particles import NRotSphere, RotSphere  # noqa: F401
 from .prms import (BrittleBeamPrms, CheckPointPrms, FrictionPrms, GravityPrms, LinDampingPrms,  # noqa: F401
-                   NRotBondPrms, NRotElasticPrms, NRotElasticWallPrms, NRotFrictionPrms, RotBondPrms,
+                   NRotBondPrms, NRotBondedWallPrms, NRotElasticPrms, NRotElasticTriMeshPrms,
+                   NRotElasticWallPrms, NRotFrictionPrms, RotBondPrms,
                    RotDampingPrms, RotFrictionPrms, ParticleScalarFieldSaverPrms, ParticleVectorFieldSaverPrms,
-                   Runnable, WallVectorFieldSaverPrms)
+                   Runnable, WallVectorFieldSaverPrms, InteractionScalarFieldSaverPrms)
 from .refused import LSM, stubs
 from .vec3 import BoundingBox, Vec3  # noqa: F401
 
 globals().update(stubs("esys.lsm", LSM))
 
 SUPPORTED = ["LsmMpi", "NRotSphere", "RotSphere", "NRotElasticPrms", "NRotBondPrms", "RotBondPrms",
-             "BrittleBeamPrms", "NRotElasticWallPrms",
+             "BrittleBeamPrms", "NRotElasticWallPrms", "NRotBondedWallPrms",
+             "NRotElasticTriMeshPrms",
              "RotFrictionPrms", "FrictionPrms", "NRotFrictionPrms", "RotDampingPrms", "GravityPrms",
              "LinDampingPrms", "CheckPointPrms", "ParticleScalarFieldSaverPrms", "ParticleVectorFieldSaverPrms",
-             "WallVectorFieldSaverPrms", "Runnable", "Vec3", "BoundingBox"]
+             "WallVectorFieldSaverPrms", "InteractionScalarFieldSaverPrms", "Runnable", "Vec3", "BoundingBox"]
 REFUSED = sorted(LSM)
 __all__ = SUPPORTED + REFUSED + ["NotSupportedError"]
 

@@ -15,9 +15,6 @@ from .output import CheckPointer, FieldSaver
 from .particles import NRotSphere, RotSphere
 from .vec3 import Vec3
 
-# Without runnables or a checkpointer the run goes in chunks up to the next saver's step, at most this many
-# steps (particles that left the spatial domain are deleted at each chunk's end).
-CHUNK = 100
 
 _HINTS = {
     "setParticleDensity": "give each NRotSphere/RotSphere its mass (mass=...), as the tutorial's scripts do",
@@ -53,7 +50,10 @@ class LsmMpi:
         self._pair = []                 # NRotElasticPrms
         self._bond_groups = []          # NRotBondPrms
         self._bonds = []                # (id1, id2, tag) from createConnections
-        self._wall_k = {}               # wall name -> NRotElasticWallPrms
+        self._wall_k = {}               # wall name -> NRotElasticWallPrms or NRotBondedWallPrms
+        self._moved_before = set()      # walls moveWallBy moved before the run
+        self._meshes = {}               # mesh name -> (vertices, triangles) from readMesh, in reading order
+        self._mesh_k = {}               # mesh name -> NRotElasticTriMeshPrms
         self._walls = {}                # name -> (posn, normal), in creation order
         self._body = []                 # GravityPrms, LinDampingPrms
         self._group_names = set()
@@ -65,7 +65,7 @@ class LsmMpi:
         self._t = 0                     # steps completed
         self._clock = 0                 # what getTimeStep() returns (t + 1 inside pre-time-step runnables)
         self._saved = -1                # the last step whose savers ran
-        self._old = None                # positions at the last (emulated) neighbour-list rebuild
+        self._watching = False          # ESyS's neighbour-list rule and domain watched (esys_watch.hpp)
         self._prev_force = None         # (ids, forces) the last step used (ESyS's stored force)
         self._prev_wall_force = {}      # wall name -> the force the last step's particles got from it
         self._rotational = False
@@ -213,7 +213,11 @@ class LsmMpi:
                        "one bond group per tag")
             self._name(prms)
             self._bond_groups.append(prms)
-        elif isinstance(prms, P.NRotElasticWallPrms):
+        elif isinstance(prms, (P.NRotElasticWallPrms, P.NRotBondedWallPrms)):
+            if isinstance(prms, P.NRotBondedWallPrms) and prms.tagMask != -1:
+                refuse(f"LsmMpi.createInteractionGroup(NRotBondedWallPrms(tagMask={prms.tagMask}))",
+                       "Basalt's bonded wall ties the particles whose tag equals particleTag (tagMask=-1, "
+                       "ESyS's default)")
             if prms.wallName not in self._walls:
                 raise ValueError(f"LsmMpi.createInteractionGroup({kind}): no wall named {prms.wallName!r}")
             if prms.wallName in self._wall_k:
@@ -221,6 +225,15 @@ class LsmMpi:
                        "a Basalt wall has one interaction")
             self._name(prms)
             self._wall_k[prms.wallName] = prms
+        elif isinstance(prms, P.NRotElasticTriMeshPrms):
+            if prms.meshName not in self._meshes:
+                raise ValueError(f"LsmMpi.createInteractionGroup({kind}): no mesh named {prms.meshName!r} "
+                                 "(readMesh)")
+            if prms.meshName in self._mesh_k:
+                refuse(f"LsmMpi.createInteractionGroup({kind}) on mesh {prms.meshName!r} twice",
+                       "a Basalt mesh wall has one interaction")
+            self._name(prms)
+            self._mesh_k[prms.meshName] = prms
         elif isinstance(prms, (P.GravityPrms, P.LinDampingPrms, P.RotDampingPrms)):
             if isinstance(prms, P.RotDampingPrms) and not self._rotational:
                 raise ValueError(f"LsmMpi.createInteractionGroup({kind}): rotational damping acts on RotSpheres "
@@ -232,6 +245,7 @@ class LsmMpi:
         else:
             refuse(f"LsmMpi.createInteractionGroup({kind})", "the front end maps NRotElasticPrms, RotFrictionPrms, "
                    "FrictionPrms, NRotFrictionPrms, NRotBondPrms, RotBondPrms, BrittleBeamPrms, NRotElasticWallPrms, "
+                   "NRotBondedWallPrms, NRotElasticTriMeshPrms, "
                    "GravityPrms, LinDampingPrms and RotDampingPrms so far")
 
     def createExclusion(self, interactionName1, interactionName2):
@@ -256,12 +270,28 @@ class LsmMpi:
 
     def createWall(self, name, posn, normal):
         self._setup("createWall")
-        if name in self._walls:
-            raise ValueError(f"LsmMpi.createWall: a wall named {name!r} exists")
+        if name in self._walls or name in self._meshes:
+            raise ValueError(f"LsmMpi.createWall: a wall or mesh named {name!r} exists")
         n = Vec3(normal)
         if n.norm() == 0.0:
             raise ValueError(f"LsmMpi.createWall({name!r}): the normal has zero length")
         self._walls[str(name)] = (Vec3(posn), n)
+
+    def readMesh(self, fileName, meshName, *tag, **kwargs):
+        """An ESyS .msh triangle mesh (docs/esys.md, "Mesh walls"), read now (relative to the working folder, as
+        ESyS reads it); it becomes a Basalt mesh wall (written as OFF beside the run's scene) acting through the
+        NRotElasticTriMeshPrms group that names it (none: no force, as in ESyS)."""
+        from .mesh import read_msh
+
+        self._setup("readMesh")
+        if tag or kwargs:
+            refuse(f"LsmMpi.readMesh({fileName!r}, {meshName!r}, tag)",
+                   "the front end reads a mesh without a tag (the tag names it for ESyS's mesh savers, which "
+                   "Basalt's front end does not write); Basalt's wall_force field saves a mesh wall's force")
+        name = str(meshName)
+        if name in self._meshes or name in self._walls:
+            raise ValueError(f"LsmMpi.readMesh: a wall or mesh named {name!r} exists")
+        self._meshes[name] = read_msh(str(fileName))
 
     def moveWallBy(self, wallName, d):
         """Moves the wall by d now, as ESyS does (a Runnable's move before a step is in that step's forces): the
@@ -273,6 +303,7 @@ class LsmMpi:
         if self._sim is None:
             posn, normal = self._walls[name]
             self._walls[name] = (posn + d, normal)
+            self._moved_before.add(name)
         else:
             self._sim.walls[name].move_by(d.toList())
 
@@ -323,44 +354,130 @@ class LsmMpi:
             raise ValueError("LsmMpi.run: no spatial domain (setSpatialDomain)")
         if not self._particles:
             raise ValueError("LsmMpi.run: no particles (createParticle)")
+        self._check_bonded_walls()
+        self._check_meshes([p.getId() for p in self._particles], [p.getPosn().toList() for p in self._particles],
+                           [p.getRadius() for p in self._particles])
         self._dir = tempfile.mkdtemp(prefix="basalt-esys-")
         atexit.register(self._cleanup)
         self._sim, self._ids, self._init = build(self, self._dir)
+
+    def _bonded_walls(self):
+        from . import prms as P
+
+        return {w: g for w, g in self._wall_k.items() if isinstance(g, P.NRotBondedWallPrms)}
+
+    def _check_bonded_walls(self):
+        """ESyS ties a tagged particle to the wall only while its centre is within the neighbour table's cell
+        (gridSpacing) of the plane, at each neighbour-list update (ntable's getParticlesAtPlane), with the wall's
+        displacement counted from its creation; Basalt ties every particle of the tag for the whole run, its
+        rest state the start. Refused where the two differ from the start."""
+        for w, g in self._bonded_walls().items():
+            if w in self._moved_before:
+                refuse(f"LsmMpi.moveWallBy({w!r}) before the run, on a wall with NRotBondedWallPrms {g.name!r}",
+                       "ESyS counts that move in the bonds' stretch (the wall's displacement from its creation), "
+                       "Basalt's bonded wall rests where the run starts: create the wall where it starts, or move "
+                       "it from a Runnable")
+            posn, normal = self._walls[w]
+            n = normal * (1.0 / normal.norm())
+            for p in self._particles:
+                if p.getTag() == g.particleTag and abs((p.getPosn() - posn).dot(n)) >= self._grid:
+                    refuse(f"LsmMpi.createInteractionGroup(NRotBondedWallPrms({g.name!r})): particle {p.getId()} "
+                           f"of tag {g.particleTag} is {abs((p.getPosn() - posn).dot(n)):.6g} from wall {w!r}, "
+                           f"not within gridSpacing {self._grid:g}",
+                           "ESyS leaves such a particle free, Basalt's bonded wall (bond_tags) ties every particle "
+                           "of the tag: tag only the particles near the wall")
+
+    def _check_meshes(self, ids, centres, radii):
+        """ESyS 2.3.5's mesh triangles push along their normal only, with k (r - d) for any signed distance d < r of
+        a centre whose projection is inside (so one behind a face is pushed through it), and its edges and
+        corners from either side; Basalt's one-sided mesh wall leaves a centre behind the surface alone. Refused
+        where that happens (a centre behind a face within gridSpacing, or behind it and touching its rim)."""
+        from .mesh import pushed_twice, touching_from_behind
+
+        for name, (vertices, triangles) in self._meshes.items():
+            if name not in self._mesh_k or not len(ids):
+                continue
+            hit = touching_from_behind(vertices, triangles, centres, radii, self._grid)
+            if hit is not None:
+                m, k, d = hit
+                refuse(f"LsmMpi: particle {int(ids[m])} behind triangle {k} of mesh {name!r} (distance {d:.6g} "
+                       f"along ESyS's normal) at step {self._t}",
+                       "ESyS 2.3.5's mesh faces push along their normal only (a centre behind a face is pushed "
+                       "through it) and its edges and corners from both sides, Basalt's one-sided mesh wall leaves "
+                       "a centre behind the mesh alone: keep the particles on the side the triangles' normals "
+                       "(p2 - p0) x (p1 - p0) point to")
+            twice = pushed_twice(vertices, triangles, centres, radii)
+            if twice is not None:
+                m, k, l = twice
+                refuse(f"LsmMpi: particle {int(ids[m])} touches mesh {name!r} exactly over the shared edge or corner "
+                       f"of its coplanar triangles {k} and {l} at step {self._t}",
+                       "ESyS 2.3.5 counts such a centre inside both triangles and pushes it once per triangle, "
+                       "Basalt's mesh wall once: move the particle off the edge (or the mesh's vertices off the "
+                       "particles' lines)")
+
+    def _check_bonds_held(self):
+        """A tied particle now a gridSpacing or more from its wall's plane: ESyS drops its bond at the next
+        neighbour-list update, Basalt keeps it (refused here rather than run on with different physics)."""
+        import numpy as np
+
+        walls = self._bonded_walls()
+        if not walls and not self._mesh_k:
+            return
+        ids, tag, x, y, z, rad = self._columns("tag", "x", "y", "z", "radius")
+        self._check_meshes(ids, np.column_stack([x, y, z]), rad)
+        for w, g in walls.items():
+            n = np.asarray(self._walls[w][1].toList())
+            n = n / np.linalg.norm(n)
+            d = np.abs((np.column_stack([x, y, z]) - np.asarray(self._sim.walls[w].position)) @ n)
+            far = (tag.astype(np.int64) == g.particleTag) & (d >= self._grid)
+            if far.any():
+                k = int(np.argmax(np.where(far, d, -1.0)))
+                refuse(f"LsmMpi.run: particle {int(ids[k])} tied to wall {w!r} by NRotBondedWallPrms {g.name!r} is "
+                       f"{d[k]:.6g} from it at step {self._t}, not within gridSpacing {self._grid:g}",
+                       "ESyS drops such a bond at its next neighbour-list update, Basalt's bonded wall keeps every "
+                       "bond for the whole run")
 
     def _advance(self, target):
         if self._sim is None:
             self._start()
         import numpy as np
 
-        # per step: the forces a step used (checkpoints, force savers) and the neighbour-list rule (checkpoints)
+        # ESyS's neighbour-list rule (the checkpoints' 'position at the last rebuild') and its spatial domain,
+        # checked after every step in C++ (python/src/esys_watch.hpp): a run goes in chunks between the steps
+        # Python must see (savers, Runnables), and stops early at a step a particle left the domain
+        core = self._sim._core
+        if not self._watching:
+            lo, hi = self._grid_domain()
+            core.esys_watch((0.5 * self._verlet) ** 2, lo, hi)
+            self._watching = True
+        # the forces a step used (checkpoints, force savers): kept for the step into a save
         track = bool(self._checkpointers) or any(s.prms.fieldName.lower() == "force" for s in self._savers)
-        if track and self._old is None:
-            self._old = self._positions()
         self._save_due()
         while self._t < target:
-            if self._pre or self._post or track:
+            if self._pre or self._post:
                 n = 1
             else:
-                n = min([target, self._t + CHUNK] + [s for s in self._next_saves() if s is not None]) - self._t
+                n = min([target] + [s for s in self._next_saves() if s is not None]) - self._t
+                if track and n > 1:
+                    n -= 1  # the step into the save goes alone
             if self._pre:
                 self._clock = self._t + 1
                 for r in self._pre:
                     r.run()
-            if track:
-                self._rebuild_check()
+            if track and n == 1:
                 ids, fx, fy, fz = self._columns("fx", "fy", "fz")
                 self._prev_force = (ids, np.column_stack([fx, fy, fz]))
             if n == 1:  # the walls' push on the particles (+ 0.0: no "-0" where nothing touches, as ESyS prints)
                 self._prev_wall_force = {w: 0.0 - np.asarray(self._sim.walls[w].force) for w in self._walls}
             else:  # a chunk: savers and getWallForce fall back to the current forces
                 self._prev_wall_force = {}
-            self._sim.run(n)
-            self._t += n
+            self._t += self._sim.run(n)  # (fewer when a particle left the domain)
             self._clock = self._t
             self._leave_domain()
             self._save_due()
             for r in self._post:
                 r.run()
+        self._check_bonds_held()  # and the meshes
 
     def _next_saves(self):
         return [s.next_after(self._t) for s in (*self._savers, *self._checkpointers)]
@@ -390,23 +507,6 @@ class LsmMpi:
         ids, table = sim.gather(list(names) or ["id"], everywhere=True)  # one exchange for all the arrays
         return (ids, *(table[:, k] for k in range(len(names))))
 
-    def _positions(self):
-        import numpy as np
-
-        return np.column_stack(self._columns("x", "y", "z")[1:])
-
-    def _rebuild_check(self):
-        """ESyS's neighbour-list rule (TSubLattice::checkNeighbors), checked as a step begins: when a particle has
-        moved more than verletDist/2 since the last rebuild, all 'old positions' become the current ones
-        (measured: a checkpoint of step n shows the rebuild of the positions after step n - 1, not n)."""
-        x = self._positions()
-        if len(x) != len(self._old):
-            self._old = x
-            return
-        d = x - self._old
-        if (d * d).sum(axis=1).max(initial=0.0) > (0.5 * self._verlet) ** 2:
-            self._old = x
-
     def _grid_domain(self):
         """ESyS removes a particle once its centre leaves the spatial domain grown to whole cells of gridSpacing,
         centred (measured: [-8, 8] with gridSpacing 2.5 keeps particles up to |x| = 8.75, with 3.0 up to 9)."""
@@ -420,14 +520,17 @@ class LsmMpi:
     def _leave_domain(self):
         """Deletes the particles outside the (grown) spatial domain, as ESyS does at its neighbour updates."""
         (lo, hi), big = self._grid_domain(), 1e30
-        for k, c in enumerate(self._columns("x", "y", "z")[1:]):
+        sim = self._sim
+        # the extremes need no id order: on one rank the particles' own arrays
+        columns = (sim.particles.x, sim.particles.y, sim.particles.z) if sim.ranks == 1 else \
+            self._columns("x", "y", "z")[1:]
+        for k, c in enumerate(columns):
             if len(c) and (c.min() < lo[k] or c.max() > hi[k]):
                 for side in (0, 1):
                     a, b = [-big] * 3, [big] * 3
                     (b if side == 0 else a)[k] = lo[k] if side == 0 else hi[k]
                     self._sim.delete(box=(a, b))
-                if self._old is not None:  # ESyS removes particles at a neighbour rebuild
-                    self._old = self._positions()
+                self._sim._core.esys_watch_reset()  # ESyS removes particles at a neighbour rebuild
                 return self._leave_domain()
 
     def _state(self):
@@ -457,12 +560,14 @@ class LsmMpi:
         if self._t == 0:  # before the first step ESyS holds no forces
             state["force"] = np.zeros_like(state["pos"])
             state["walls"] = {n: (pos, np.zeros(3)) for n, (pos, f) in state["walls"].items()}
-        state["old"] = self._old if self._old is not None and len(self._old) == len(ids) else state["pos"]
+        old_ids, old = self._sim._core.esys_watch_reference()
+        state["old"] = old if np.array_equal(old_ids, ids) else state["pos"]
         if self._rotational:
             state["angvel"] = np.column_stack([c["wx"], c["wy"], c["wz"]])
             if self._checkpointers:
                 state["quat"] = np.column_stack([c["qw"], c["qx"], c["qy"], c["qz"]])
-        if self._checkpointers and self._bond_groups:  # collective: read on every rank, written by rank 0
+        counts = any(s.prms.kind == "InteractionScalarFieldSaverPrms" for s in self._savers)
+        if (self._checkpointers or counts) and self._bond_groups:  # collective: read on every rank, rank 0 writes
             state["broken_bonds"] = {(int(i), int(j)): int(s) for i, j, s in self._sim.broken_bond_pairs().tolist()}
         return state
 

@@ -77,10 +77,16 @@ class CheckPointer(_Schedule):
 
         group = lsm._bond_groups[0]
         kind = "Bonded" if isinstance(group, NRotBondPrms) else "RotBonded"  # RotBond, BrittleBeam (measured)
-        broken, present = state.get("broken_bonds", {}), set(state["id"].tolist())
-        bonds = sorted(b for b in set(lsm._bonds) if b[2] == group.tag and broken.get((b[0], b[1]), t) >= t - 1
-                       and b[0] in present and b[1] in present)
+        bonds = listed_bonds(lsm, group, t, state)
         return f"1\n{kind}\n{len(bonds)}\n" + "".join(f"{i} {j} {tag}\n" for i, j, tag in bonds)
+
+
+def listed_bonds(lsm, group, t, state):
+    """The bonds of a bond group ESyS holds at step t, sorted: a bond Basalt broke at step s is held up to step
+    s + 1 (ESyS finds it broken in the forces of step s + 1 and removes it as step s + 2 begins; measured)."""
+    broken, present = state.get("broken_bonds", {}), set(state["id"].tolist())
+    return sorted(b for b in set(lsm._bonds) if b[2] == group.tag and broken.get((b[0], b[1]), t) >= t - 1
+                  and b[0] in present and b[1] in present)
 
 
 class FieldSaver(_Schedule):
@@ -92,7 +98,7 @@ class FieldSaver(_Schedule):
 
     def __init__(self, prms, lsm):
         super().__init__(prms)
-        self.prms, self.count = prms, 0
+        self.prms, self.count, self.lsm = prms, 0, lsm
         kind, field, fmt = prms.kind, prms.fieldName, prms.fileFormat
         call = f"LsmMpi.createFieldSaver({kind}(fieldName={field!r}, fileFormat={fmt!r}))"
         if kind == "ParticleScalarFieldSaverPrms":
@@ -107,6 +113,17 @@ class FieldSaver(_Schedule):
                 refuse(call, f"particle vector fields here: {', '.join(self.VECTOR)}")
             if fmt not in ("RAW2", "RAW_WITH_ID"):
                 refuse(call, "particle vector fields are written as RAW2 or RAW_WITH_ID here")
+        elif kind == "InteractionScalarFieldSaverPrms":
+            groups = {g.name: g for g in lsm._bond_groups}
+            if field != "count" or fmt != "SUM":
+                refuse(call, "interaction fields here: count of a bond group's bonds, format SUM (ESyS 2.3.5's "
+                             "potential_energy and the others are not reproduced; Basalt's energy ledger has "
+                             "bond_potential_energy, docs/scenes.md)")
+            if prms.interactionName not in groups:
+                refuse(call + f" on {prms.interactionName!r}", "the count of a bond group's bonds "
+                       "(NRotBondPrms, RotBondPrms, BrittleBeamPrms created before the saver); a contact group's "
+                       "count is not reproduced")
+            self.group = groups[prms.interactionName]
         elif kind == "WallVectorFieldSaverPrms":
             if field not in self.WALL:
                 refuse(call, "wall fields here: Position, Force")
@@ -138,6 +155,9 @@ class FieldSaver(_Schedule):
             with open(f"{p.fileName}.{self.count}.dat", "a") as f:
                 f.write("".join(lines))
             self.count += 1
+        elif p.kind == "InteractionScalarFieldSaverPrms":  # count, SUM: the bonds ESyS holds (listed_bonds),
+            with open(p.fileName, "a") as f:                  # written as ESyS 2.3.5 does (measured): %.10e
+                f.write("%.10e\n" % len(listed_bonds(self.lsm, self.group, t, state)))
         else:
             k = 0 if p.fieldName == "Position" else 1
             row = "".join(" ".join("%.10e" % c for c in state["walls"][w][k]) + "  " for w in p.wallName)

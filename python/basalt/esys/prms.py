@@ -29,6 +29,26 @@ class NRotElasticWallPrms:
         self.name, self.wallName, self.normalK = str(name), str(wallName), float(normalK)
 
 
+class NRotBondedWallPrms:
+    """ESyS's NRotBondedWall: the particles of particleTag near the wall are tied to it by F = -k (u_p - u_w), the
+    particle's displacement since its creation against the wall's since its creation (the full vector), k = pi r
+    normalK (3-D); the group's other particles near the wall get the elastic wall with the same normalK
+    (ESyS's BWallInteraction, BWallInteractionGroup). tagMask: which bits of the tag count (-1: all)."""
+
+    def __init__(self, name, wallName, normalK, particleTag, tagMask=-1):
+        self.name, self.wallName, self.normalK = str(name), str(wallName), float(normalK)
+        self.particleTag, self.tagMask = int(particleTag), int(tagMask)
+
+
+class NRotElasticTriMeshPrms:
+    """ESyS's elastic repulsion of a triangle mesh (readMesh): k = pi r normalK (3-D) times the overlap, along the
+    line from the contact point (on a face, an edge or a corner) to the centre (ESyS's ETriangleInteraction,
+    EEdgeInteraction, ECornerInteraction)."""
+
+    def __init__(self, name, meshName, normalK):
+        self.name, self.meshName, self.normalK = str(name), str(meshName), float(normalK)
+
+
 class GravityPrms:
     def __init__(self, name, acceleration):
         self.name, self.acceleration = str(name), Vec3(acceleration)
@@ -63,6 +83,14 @@ class ParticleScalarFieldSaverPrms(_SaverPrms):
 
 class ParticleVectorFieldSaverPrms(_SaverPrms):
     kind = "ParticleVectorFieldSaverPrms"
+
+
+class InteractionScalarFieldSaverPrms(_SaverPrms):
+    kind = "InteractionScalarFieldSaverPrms"
+
+    def __init__(self, interactionName, fieldName, fileName, fileFormat, beginTimeStep, endTimeStep, timeStepIncr):
+        super().__init__(fieldName, fileName, fileFormat, beginTimeStep, endTimeStep, timeStepIncr)
+        self.interactionName = str(interactionName)
 
 
 class WallVectorFieldSaverPrms(_SaverPrms):

@@ -14,17 +14,13 @@ LSM = {
     "HertzMindlinPrms": _SCENE + 'type = "hertz_mindlin"',
     "HertzMindlinViscoPrms": _SCENE + 'type = "hertz_mindlin"',
     "LinearDashpotPrms": "Basalt has no dashpot pair model; damping is the linear_damping body force",
-    "NRotBondedWallPrms": _SCENE + '[[walls]] interaction = "bonded"',
     "RotBondedWallPrms": _SCENE + '[[walls]] interaction = "bonded"',
     "ViscWallPrms": "Basalt's walls are elastic, frictional, Hertz-Mindlin or bonded (docs/scenes.md)",
-    "InteractionScalarFieldSaverPrms": "Basalt's [[output.fields]] bond_count, broken_bonds and energies "
-                                       "(basalt.Simulation, docs/scenes.md)",
     "InteractionVectorFieldSaverPrms": "Basalt's checkpoints hold the bonds and contacts (basalt.read_checkpoint)",
     "ParticleTensorFieldSaverPrms": "Basalt's [[output.fields]] stress savers (docs/scenes.md)",
     "WallScalarFieldSaverPrms": "WallVectorFieldSaverPrms (Position, Force) or Basalt's wall_force field",
     "MeshReader": "Basalt's mesh walls ([[mesh_walls]], docs/mesh-walls.md)",
     "TriMeshPrms": "Basalt's mesh walls ([[mesh_walls]], docs/mesh-walls.md)",
-    "NRotElasticTriMeshPrms": "Basalt's mesh walls ([[mesh_walls]], docs/mesh-walls.md)",
     "NRotBondedTriMeshPrms": "Basalt's mesh walls ([[mesh_walls]], docs/mesh-walls.md)",
 }
 

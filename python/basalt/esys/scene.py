@@ -5,6 +5,8 @@
                                        rot_friction with scaling = true, Ks = 0 and mu = 0 (no shear force,
                                        no moment: the same normal force), particles.rotation on
     NRotElasticWallPrms             -> the wall's K with stiffness = "esys_pi_r" (k = pi r K)
+    NRotBondedWallPrms              -> interaction = "bonded", bond_tags = [particleTag], the same K and stiffness
+    readMesh + NRotElasticTriMeshPrms -> a [[mesh_walls]] (the .msh written as OFF), elastic, k = r K, one-sided
     a wall without a group          -> K = 0 (ESyS: no force on it)
     RotFrictionPrms, FrictionPrms   -> rot_friction, convention "esys" (FrictionPrms: K = pi E, Ks = pi E/(2(1 + nu)),
                                        scaling); NRotFrictionPrms -> friction, convention "esys", mu = dynamicMu
@@ -18,9 +20,10 @@ import os
 
 from . import prms as P
 from .errors import refuse
+from .mesh import write_off
 
 
-def scene_dict(lsm, geometry_file, output_dir):
+def scene_dict(lsm, geometry_file, output_dir, mesh_files=None):
     interactions, rotation = [], lsm._rotational
     for g in lsm._pair:
         if isinstance(g, P.RotFrictionPrms):  # also FrictionPrms (K = pi E, Ks = pi E / (2 (1 + nu)))
@@ -55,8 +58,20 @@ def scene_dict(lsm, geometry_file, output_dir):
     walls = []
     for name, (posn, normal) in lsm._walls.items():
         k = lsm._wall_k.get(name)
-        walls.append({"name": name, "point": posn.toList(), "normal": normal.toList(),
-                      "K": k.normalK if k else 0.0, "stiffness": "esys_pi_r"})
+        wall = {"name": name, "point": posn.toList(), "normal": normal.toList(), "K": k.normalK if k else 0.0,
+                "stiffness": "esys_pi_r"}
+        if isinstance(k, P.NRotBondedWallPrms):  # k = pi r K for the bond and the elastic part, ESyS's literals
+            wall.update(interaction="bonded", bond_tags=[k.particleTag])
+        walls.append(wall)
+    meshes = []
+    for name in lsm._meshes:
+        k = lsm._mesh_k.get(name)
+        if k is None:  # ESyS: a mesh no interaction group names pushes nothing
+            continue
+        # ESyS 2.3.5 (Debian, measured): k = r K (no pi), faces one-sided along ESyS's normal (the OFF is wound for
+        # it); Basalt's esys_pi_r gives k = 3.141592654 r K', so K' = K / 3.141592654
+        meshes.append({"name": name, "file": mesh_files[name], "interaction": "elastic",
+                       "K": k.normalK / ESYS_WALL_PI, "stiffness": "esys_pi_r", "sides": "one"})
     body = []
     for b in lsm._body:
         if isinstance(b, P.GravityPrms):
@@ -74,13 +89,15 @@ def scene_dict(lsm, geometry_file, output_dir):
                 "force_overlap": True, "energy_check_every": 0},
         "output": {"directory": output_dir},
     }
-    for key, value in (("interactions", interactions), ("walls", walls), ("body_forces", body)):
+    for key, value in (("interactions", interactions), ("walls", walls), ("mesh_walls", meshes),
+                       ("body_forces", body)):
         if value:
             scene[key] = value
     return scene
 
 
 MAX_BOND_SIZES = 64
+ESYS_WALL_PI = 3.141592654  # the literal of Basalt's esys_pi_r elastic wall (models/elastic_wall.hpp)
 
 
 def bond_split(lsm):
@@ -159,7 +176,11 @@ def build(lsm, workdir):
                    mass=np.array([p.getMass() for p in ps]), box_min=lsm._domain_lo, box_max=lsm._domain_hi)
     path = os.path.join(workdir, "particles.h5")
     geo.write(path)
-    sim = Simulation(scene_dict(lsm, path, os.path.join(workdir, "out")))
+    mesh_files = {}
+    for k, (name, (vertices, triangles)) in enumerate(lsm._meshes.items()):
+        mesh_files[name] = os.path.join(workdir, f"mesh{k}.off")
+        write_off(mesh_files[name], vertices, triangles)
+    sim = Simulation(scene_dict(lsm, path, os.path.join(workdir, "out"), mesh_files))
     vel = {p.getId(): p.getVelocity().toList() for p in ps}
     angvel = {p.getId(): p.getAngularVelocity().toList() for p in ps if hasattr(p, "getAngularVelocity")}
     _set_initial_velocities(sim, vel, angvel)

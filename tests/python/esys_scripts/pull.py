@@ -3,7 +3,8 @@
 #   python3 -m basalt.esys pull.py [nrot|rot|beam]      (or: mpirun -np 2 esysparticle pull.py [nrot|rot|beam])
 # nrot: NRotSpheres and NRotBondPrms (breakDistance); rot: RotSpheres and RotBondPrms (a normal breaking force);
 # beam: RotSpheres and BrittleBeamPrms. A checkpoint every step (pull_t=T_0.txt, pull_t=T_1.txt): the bonds'
-# section lists the bonds that have not broken, as ESyS writes it.
+# section lists the bonds that have not broken, as ESyS writes it; nbonds.dat their count at every step
+# (InteractionScalarFieldSaverPrms, count, SUM).
 import sys
 
 from esys.lsm import *
@@ -34,5 +35,8 @@ elif rot:
 else:
     sim.createInteractionGroup(NRotBondPrms(name="b", normalK=100.0, breakDistance=0.005, tag=3, scaling=False))
 sim.createCheckPointer(CheckPointPrms(fileNamePrefix="pull", beginTimeStep=0, endTimeStep=20, timeStepIncr=1))
+sim.createFieldSaver(InteractionScalarFieldSaverPrms(interactionName="b", fieldName="count", fileName="nbonds.dat",
+                                                     fileFormat="SUM", beginTimeStep=0, endTimeStep=20,
+                                                     timeStepIncr=1))
 sim.run()
 sim.exit()

@@ -20,6 +20,7 @@
 #include "basalt/io/checkpoint_rows.hpp"
 #include "basalt/io/geometry.hpp"
 #include "basalt/solver/core/bonds.hpp"
+#include "basalt/solver/core/clock.hpp"
 #include "basalt/solver/core/id_map.hpp"
 #include "basalt/solver/core/ledger.hpp"
 #include "basalt/solver/core/particle_flow.hpp"
@@ -147,10 +148,10 @@ class Simulation {
   void flush_fields(FieldSink* sink);
 
   // State and diagnostics (collective where noted).
-  std::int64_t current_step() const { return step_; }
-  double time() const { return time_; }
+  std::int64_t current_step() const { return clock_.step(); }
+  double time() const { return clock_.time(); }
   /// The time step (run.dt, or run.dt_fraction x the critical step).
-  double dt() const { return scene_.dt; }
+  double dt() const { return clock_.dt(); }
   const Particles<Real>& particles() const { return p_; }
   /// Mutable access (tests, set-up) drops the kinetic energy cached by the last step.
   Particles<Real>& particles() {
@@ -309,9 +310,8 @@ class Simulation {
   void find_fixed();
   /// The run's time step: the integrator's kicks and the models' time step (set_time_step).
   void apply_dt(double dt);
-  /// The time of `step`: step x dt, counted from the last set_dt() (time_base_ at step_base_; both zero
-  /// otherwise, which gives step x dt to the bit).
-  double time_at(std::int64_t step) const { return time_base_ + double(step - step_base_) * scene_.dt; }
+  /// The time of `step` (core/clock.hpp: counted from the last set_dt()).
+  double time_at(std::int64_t step) const { return clock_.time_at(step); }
   double kinetic_energy_local() const;
   /// Bonds of this rank counted once across ranks (a bond to a ghost by the rank owning the lower id).
   std::int64_t local_bond_count() const;
@@ -351,7 +351,8 @@ class Simulation {
   void check_rebuild();
   /// What the balancer reads and moves at this point of the run (LoadBalancer::Run).
   typename LoadBalancer<Real>::Run balance_run() {
-    return {scene_, *dec_, *halo_, p_, bonds_, forces_, times_, n_global_, step_, rebuilds_, ghost_width_};
+    return {scene_, *dec_,     *halo_,        p_,        bonds_,      forces_,
+            times_, n_global_, clock_.step(), rebuilds_, ghost_width_};
   }
   /// x0 = the owned positions relative to skin_origin (of the decomposition box), as float: the skin
   /// criterion's reference, set at every rebuild (and restored after the critical-step estimate).
@@ -472,10 +473,7 @@ class Simulation {
   std::size_t unassigned_bonds_ = 0;
   double rebuild_limit2_ = 0;
   std::int64_t n_global_ = 0;
-  std::int64_t step_ = 0;
-  double time_ = 0;
-  double time_base_ = 0;        ///< time_ at the last set_dt() (time_at)
-  std::int64_t step_base_ = 0;  ///< step_ at the last set_dt()
+  Clock clock_;  ///< the step, its time, dt and the time of any step
   std::int64_t rebuilds_ = 0;
   PhaseTimes times_;
   LoadStats load_stats_;

@@ -28,22 +28,24 @@ class ModelDriver : public ForceCompute<Real> {
   Fields reads() const override { return Model::reads; }
   ModelKind kind() const override { return Model::kind; }
   double max_stiffness(double rmax) const override {
-    double m = 0;
-    for (const auto& p : params_) m = std::max(m, Model::max_stiffness(p, rmax));
-    return m;
+    return largest([rmax](const Params& p) { return Model::max_stiffness(p, rmax); });
   }
   double shear_stiffness(double rmax) const override {
-    double m = 0;
-    for (const auto& p : params_) m = std::max(m, basalt::solver::shear_stiffness<Model>(p, rmax));
-    return m;
+    return largest([rmax](const Params& p) { return basalt::solver::shear_stiffness<Model>(p, rmax); });
   }
   double rolling_stiffness() const override {
-    double m = 0;
-    for (const auto& p : params_) m = std::max(m, basalt::solver::rolling_stiffness<Model>(p));
-    return m;
+    return largest([](const Params& p) { return basalt::solver::rolling_stiffness<Model>(p); });
   }
 
  protected:
+  /// The largest of of(p) over the groups' Params p, and 0 when none is larger (the stiffest spring or the
+  /// farthest reach among the groups: what the critical step and the lists must allow for).
+  template <class Of>
+  double largest(Of of) const {
+    double m = 0;
+    for (const auto& p : params_) m = std::max(m, double(of(p)));
+    return m;
+  }
   /// One more group of the model (the next index in params_ and coeffs_).
   void add_group(const Params& p) {
     params_.push_back(p);

@@ -89,9 +89,7 @@ class PairDriver final : public ContactDriver<Real, Model, PairDriver<Real, Mode
   bool takes_all() const { return uniform_; }
 
   double reach(double rmax) const override {
-    double m = 0;
-    for (const auto& p : params_) m = std::max(m, pair_reach<Model>(p, rmax));
-    return m;
+    return this->largest([rmax](const typename Model::Params& p) { return pair_reach<Model>(p, rmax); });
   }
   double compute(ForceState<Real>& s, Part part, bool energy, bool advance) override {
     const bool own = part == Part::owned;

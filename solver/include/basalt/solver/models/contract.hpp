@@ -13,6 +13,7 @@
 //     whose tangential force does not turn the particles (ESyS's NRotFriction) declares none.
 //   Optional: rolling_stiffness(Params), a rolling couple's stiffness per R*^2 (k_r / R*^2, default none):
 //     it turns a sphere of radius r >= R* at w^2 <= 2.5 rolling_stiffness / m (I = 2/5 m r^2).
+//   (contract::HasShearStiffness and contract::HasRollingStiffness find them.)
 //
 // Pair models (PairDriver, interactions/pair_driver.hpp), one of two laws:
 //   scalar:    force(c, h, rsum, r) and energy(c, h, rsum, r), the force along the line of centres,
@@ -147,6 +148,13 @@ concept HasShearStiffness = requires(const typename M::Params& p) {
   { M::shear_stiffness(p, 1.0) } -> std::convertible_to<double>;
 };
 
+/// The optional rolling_stiffness(): the stiffness of a rolling couple per R*^2 (k_r / R*^2), which the
+/// critical step counts for the turning of the lightest sphere (simulation_stability.cpp).
+template <class M>
+concept HasRollingStiffness = requires(const typename M::Params& p) {
+  { M::rolling_stiffness(p) } -> std::convertible_to<double>;
+};
+
 template <class M, class Real>
 concept HasContactLanes = requires(const typename M::template Coeffs<Real>& c,
                                    ContactLanes<Real, kContactLaneWidth, typename M::History>& b) {
@@ -179,7 +187,7 @@ inline double pair_reach(const typename M::Params& p, double rmax) {
 /// The stiffness of model M's rolling couple per R*^2 (0 without rolling_stiffness()).
 template <class M>
 inline double rolling_stiffness(const typename M::Params& p) {
-  if constexpr (requires { M::rolling_stiffness(p); })
+  if constexpr (contract::HasRollingStiffness<M>)
     return M::rolling_stiffness(p);
   else
     return 0.0;

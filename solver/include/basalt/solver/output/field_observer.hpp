@@ -1,6 +1,7 @@
 #pragma once
-// The field savers' observer (scene.fields, docs/scenes.md): this rank's partials and due mask of the last
-// step a saver was due at, handed to the run's OutputSink and kept for saved_field(); and the FieldRows
+// The field savers' observer (scene.fields, docs/scenes.md): this rank's partials and due mask of the step
+// just observed, handed to the run's OutputSink when a saver was due and read back by saved_field() at that
+// step only (the next step's observe() overwrites them, due or not); and the FieldRows
 // adapter for a caller that steps with a FieldSink (tests, energy_drift, Python), kept across calls because a
 // row may still be in flight. What a saver computes is the Simulation's to say (field_partials).
 #include <cstddef>
@@ -40,8 +41,8 @@ class FieldObserver {
   }
 
  private:
-  std::vector<double> local_;  ///< this rank's partials at step_
-  std::vector<char> due_;      ///< which columns were due at step_
+  std::vector<double> local_;  ///< this rank's partials at the step just observed (step_ when one was due)
+  std::vector<char> due_;      ///< which columns were due then
   std::int64_t step_ = -1;     ///< the last step a saver was due at
   std::unique_ptr<FieldRows> rows_;
 };
