@@ -27,6 +27,8 @@ void bind_checkpoint(pybind11::module_& m);
 void bind_pack(pybind11::module_& m);
 /// Simulation: a run driven from Python (solver/simulation.hpp, basalt-run's start-up and output).
 void bind_simulation(pybind11::module_& m);
+/// gengeo_fit: the simplex fit of the ESyS front end's GenGeo packing (python/basalt/esys/gengeo.py).
+void bind_gengeo(pybind11::module_& m);
 
 /// A geometry as the dict basalt.Geometry is built from: numpy arrays (copies) of the particles and bonds,
 /// the box, units, provenance and statistics.

@@ -13,4 +13,5 @@ PYBIND11_MODULE(_core, m) {
   basalt::python::bind_checkpoint(m);
   basalt::python::bind_pack(m);
   basalt::python::bind_simulation(m);
+  basalt::python::bind_gengeo(m);
 }

@@ -316,6 +316,29 @@ def test_random_box_packer_slope_fail_box_is_esys_packing(tmp_path):
     assert digest == "21b8273227e68885e1d6da65f1b5c09c54802b70a156ac206fd58ed5f211c8ba"
 
 
+def _gengeo_reference(name):
+    """A file GenGeo wrote (tests/python/esys_scripts/data/), without the header lines naming its command."""
+    text = (SCRIPTS / "data" / name).read_text()
+    return "".join(line for line in text.splitlines(keepends=True) if not line.startswith("# "))
+
+
+def test_gengeo_box_packing_is_gengeos_byte_for_byte(tmp_path):
+    """Our gengeo_box.py (a GenGeo script) through the front end: its whole output (GenGeo's messages, every
+    sphere's id, position, radius and tag at 17 digits, the volume) and its .geo files (spheres in GenGeo's order,
+    bonds, header) and .vtu are GenGeo 1.4's, byte for byte: a plain box, a box with its faces as planes (spheres fitted
+    to them, tag 2), the old seeding and the planes box clustered (spheres tagged by the closest seed, bonds
+    tagged inside and between clusters), packed one after the other (GenGeo's random stream and ids go on)."""
+    out = front(SCRIPTS / "gengeo_box.py", tmp_path, "plain", "planes", "old", "cluster").stdout
+    ref = _gengeo_reference("gengeo_box.txt")
+    assert out.splitlines() == ref.splitlines()
+    for case in ("plain", "planes", "old", "cluster"):
+        got = (tmp_path / f"gengeo_box_{case}.geo").read_text()
+        assert got == _gengeo_reference(f"gengeo_box_{case}.geo.txt"), case
+    for case in ("planes", "cluster"):
+        got = (tmp_path / f"gengeo_box_{case}.vtu").read_text()
+        assert got == _gengeo_reference(f"gengeo_box_{case}.vtu.txt"), case
+
+
 def test_random_box_packer_block_slumps_on_the_floor(tmp_path):
     """slope_collapse.py (slope_fail in small): the 600 packed spheres, given to createParticle one by one, become
     particles with their ids, radii, tags (2 near the floor) and masses r^3 (the checkpoint at step 0), fall onto
@@ -421,6 +444,16 @@ REFUSED = {
         ("Colors.Aquamarine", "RgbColor(red, green, blue)"),
     "from esys.lsm.vis import povray\npovray.Scene().getCamera().setLightSource(None)":
         ("LightedCamera.setLightSource", "at the camera's position"),
+    # gengeo: GenGeo's box packing only (docs/esys.md, "GenGeo"); other volumes and packers refused, never
+    # packed differently under GenGeo's names
+    "from gengeo import *\nCylinderVol(Vector3(0, 0, 0), Vector3(0, 1, 0), 1.0, 1.0)":
+        ("gengeo.CylinderVol", "BoxWithPlanes3D", "basalt.pack"),
+    "import gengeo\ngengeo.HexAggregateInsertGenerator3D(0.2, 1.0, 100, 100, 1e-6)":
+        ("gengeo.HexAggregateInsertGenerator3D", "basalt.pack"),
+    "from gengeo import *\nt = MNTable3D(Vector3(0, 0, 0), Vector3(2, 2, 2), 2.5, 1)\nt.write('x.txt', 3)":
+        ("MNTable3D.write(..., 3)", ".geo", ".vtu"),
+    "from gengeo import *\nt = MNTable3D(Vector3(0, 0, 0), Vector3(2, 2, 2), 2.5, 2)\nt.tagParticlesInSphere(0, 1)":
+        ("MNTable3D.tagParticlesInSphere", "BoxWithPlanes3D", "basalt.pack"),
 }
 
 
@@ -612,6 +645,18 @@ def test_no_esys_outside_the_runner(tmp_path):
     assert p.stdout.strip() in ("no esys", "real")
     if not pathlib.Path("/usr/lib/python3/dist-packages/esys").exists():
         assert p.stdout.strip() == "no esys"
+
+
+def test_no_gengeo_outside_the_runner(tmp_path):
+    """The shim's gengeo exists inside `python3 -m basalt.esys` only: imported normally, `import gengeo` finds
+    a real GenGeo (Debian's python3-gengeo) or nothing."""
+    code = ("import basalt, basalt.esys\n"
+            "try:\n    import gengeo\nexcept ImportError:\n    print('no gengeo')\n"
+            "else:\n    print('shim' if 'basalt' in str(gengeo.__path__) else 'real')\n")
+    env = {**os.environ, "PYTHONPATH": PACKAGE_DIR}
+    p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path, timeout=60, env=env)
+    assert p.returncode == 0, p.stderr
+    assert p.stdout.strip() in ("no gengeo", "real")
 
 
 def test_basalt_esys_launcher(tmp_path):
