@@ -525,8 +525,11 @@ class LsmMpi:
         columns = (sim.particles.x, sim.particles.y, sim.particles.z) if sim.ranks == 1 else \
             self._columns("x", "y", "z")[1:]
         for k, c in enumerate(columns):
-            if len(c) and (c.min() < lo[k] or c.max() > hi[k]):
-                for side in (0, 1):
+            below, above = len(c) and c.min() < lo[k], len(c) and c.max() > hi[k]
+            if below or above:
+                for side, out in ((0, below), (1, above)):
+                    if not out:  # (each delete is a rebuild: only the sides something left by)
+                        continue
                     a, b = [-big] * 3, [big] * 3
                     (b if side == 0 else a)[k] = lo[k] if side == 0 else hi[k]
                     self._sim.delete(box=(a, b))
