@@ -7,8 +7,10 @@
 // has moved more than verletDist/2 since the last rebuild, every particle's "position at the last rebuild"
 // becomes its current one. A checkpoint written after step n shows the rule applied to the positions after
 // step n - 1: so the positions a check after step n finds are held back (pending) and become the reference
-// at the next check. The domain: a particle outside ESyS's grown spatial domain ends the run after the step
-// (the front end deletes it, as ESyS does, and resets the reference).
+// at the next check. The domain: ESyS removes the particles outside its grown spatial domain at a rebuild
+// (measured: a particle crossing it is listed until the step whose positions trigger the next rebuild, and
+// gone from the step after), so a check that finds a rebuild due while a particle is outside ends the run
+// after that step: the front end writes that step's output, deletes the particle and resets the reference.
 //
 // Collective: every rank keeps every particle's reference (ids sorted, three coordinates each); a check is
 // two reductions, and a rebuild one all_gather of the positions.
@@ -39,7 +41,8 @@ class EsysWatch {
   }
 
   /// Collective, after each step: the held-back rebuild taken, the rule checked on the current positions,
-  /// the domain checked. False when a particle is outside the domain (the run stops after this step).
+  /// the domain checked. False when a rebuild is due and a particle is outside the domain (the run stops
+  /// after this step).
   bool check(const solver::Particles<Real>& p, const solver::Comm& comm) {
     if (pending_) {
       std::swap(ids_, next_ids_);
@@ -67,8 +70,11 @@ class EsysWatch {
       positions(p, comm, next_ids_, next_ref_);
       pending_ = true;
     }
-    return outside == 0;
+    return !(pending_ && outside != 0);
   }
+
+  /// A rebuild found due by the last check, taken at the next one (or by reset()).
+  bool rebuild_due() const { return pending_; }
 
   /// The references in id order: ids and 3 coordinates each.
   const std::vector<std::int64_t>& ids() const { return ids_; }

@@ -147,6 +147,8 @@ class Run {
   virtual void esys_watch_reset() = 0;
   /// The positions at ESyS's last neighbour-list rebuild: (ids, (n, 3) positions) in id order.
   virtual py::tuple esys_watch_reference() const = 0;
+  /// Whether the last step's positions make ESyS rebuild its lists as the next step begins.
+  virtual bool esys_watch_rebuild_due() const = 0;
   /// What the time step risks now, one sentence each (Simulation::step_warnings).
   virtual std::vector<std::string> step_warnings() const = 0;
   virtual std::string close() = 0;
@@ -199,6 +201,7 @@ class RunOf final : public Run {
     if (!watch_) throw RunError("esys_watch_reset before esys_watch");
     watch_->reset(sim_->particles(), comm_);
   }
+  bool esys_watch_rebuild_due() const override { return watch_ && watch_->rebuild_due(); }
   py::tuple esys_watch_reference() const override {
     if (!watch_) throw RunError("esys_watch_reference before esys_watch");
     const auto& ids = watch_->ids();
@@ -707,6 +710,7 @@ void bind_simulation(py::module_& m) {
       .def("esys_watch", [](PySimulation& s, double limit2, const std::array<double, 3>& lo,
                             const std::array<double, 3>& hi) { s.run().esys_watch(limit2, lo, hi); })
       .def("esys_watch_reset", [](PySimulation& s) { s.run().esys_watch_reset(); })
+      .def("esys_watch_rebuild_due", [](PySimulation& s) { return s.run().esys_watch_rebuild_due(); })
       .def("esys_watch_reference", [](PySimulation& s) { return s.run().esys_watch_reference(); })
       .def_property_readonly("step_warnings", [](PySimulation& s) { return s.run().step_warnings(); })
       .def("checkpoint", [](PySimulation& s) { s.run().checkpoint(); })

@@ -11,10 +11,6 @@ def _g(v):
     return "%g" % v  # C++'s default ostream: 6 significant digits (particle fields)
 
 
-def _g9(v):
-    return "%.9g" % v  # the checkpoints' particle lines: 9 significant digits
-
-
 class _Schedule:
     def __init__(self, prms):
         self.begin, self.end, self.incr = prms.beginTimeStep, prms.endTimeStep, max(prms.timeStepIncr, 1)
@@ -45,15 +41,18 @@ class CheckPointer(_Schedule):
             f.write(f"V 3\n{lsm._num_steps}\n{_g(lsm._dt)}\n{t}\nESyS-Particle_2.3.4_bzr_rev. \n"
                     f"BoundingBox {' '.join(_g(v) for v in (*lo, *hi))}\nPeriodicBoundaries 0 0 0\n"
                     f"Dimension 3D\n{data}")
-        rows = [f"{len(state['id'])}\n"]
-        for i in range(len(state["id"])):
-            nums = [*state["pos"][i], state["radius"][i]]
-            head = " ".join(_g9(v) for v in nums)
-            tail = " ".join(_g9(v) for v in (state["mass"][i], *state["init"][i], *state["old"][i],
-                                              *state["vel"][i], *state["force"][i], 0, 0, 0))
-            if "quat" in state:  # RotSphere (ESyS 2.3.5, measured): orientation w x y z, angular velocity
-                tail += " " + " ".join(_g9(v) for v in (*state["quat"][i], *state["angvel"][i]))
-            rows.append(f"{head} {int(state['id'][i])} {int(state['tag'][i])} {tail}\n")
+        import numpy as np
+
+        n = len(state["id"])
+        # a row: position, radius, id, tag, mass, initial position, position at the last rebuild, velocity,
+        # force, three zeros; RotSphere (ESyS 2.3.5, measured): orientation w x y z, angular velocity
+        columns = [state["pos"], state["radius"][:, None], state["id"][:, None], state["tag"][:, None],
+                   state["mass"][:, None], state["init"], state["old"], state["vel"], state["force"], np.zeros((n, 3))]
+        if "quat" in state:
+            columns += [state["quat"], state["angvel"]]
+        table = np.hstack([np.asarray(c, dtype=np.float64).reshape(n, -1) for c in columns]).tolist()
+        line = " ".join(["%.9g"] * 4 + ["%d"] * 2 + ["%.9g"] * (len(table[0]) - 6 if n else 0)) + "\n"
+        rows = [f"{n}\n", *(line % tuple(r) for r in table)]  # 9 significant digits, as ESyS
         rows.append(self._bond_section(t, state))
         rows.append("TMIG 0\n")
         with open(data, "w") as f:
