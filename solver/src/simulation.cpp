@@ -316,6 +316,7 @@ void Simulation<Real>::set_dt(double dt) {
     scene_.dt = dt;
     try {
       judge_step(fmt::format("dt (set at step {})", clock_.step()));
+      stability_.warn = stability_.fraction > scene_.dt_safety;  // (not run.dt_fraction's choice any more)
     } catch (const InputError&) {
       scene_.dt = before;
       stability_ = stability;

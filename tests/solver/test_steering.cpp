@@ -190,6 +190,15 @@ TEST(Steering, SetDtAboveTheCriticalStepIsRefusedWithNothingChanged) {
   EXPECT_TRUE(sim.step_warnings().empty());
 }
 
+TEST(Steering, SetDtAboveTheSafeFractionWarnsInADtFractionScene) {
+  // run.dt_fraction's own step is chosen knowingly and not warned of; a step a script sets later is.
+  auto sim = make("dt_fraction = 0.9");
+  EXPECT_TRUE(sim.step_warnings().empty());
+  sim.set_dt(0.95 * sim.stability().dt_critical);
+  ASSERT_EQ(sim.step_warnings().size(), 1u);
+  EXPECT_NE(sim.step_warnings()[0].find("above the safe fraction"), std::string::npos);
+}
+
 TEST(Steering, SetDtAboveTheCriticalStepIsTakenWhenForced) {
   auto sim = make("dt = 2e-3\nforce_dt = true");
   const double critical = sim.stability().dt_critical;
