@@ -1233,3 +1233,16 @@ def test_checkpoint_after_a_bond_broke_lists_the_bonds_left(tmp_path, mode):
         assert stretch > 0.005
         assert at[0][16] == pytest.approx(100.0 * stretch, rel=1e-6)
         assert after[0][16] == 0.0
+
+
+def test_slope_runout_reads_the_quantities_of_a_checkpoint(tmp_path):
+    """tools/esys/slope_runout.py: particles left, mean height and runout from a checkpoint's rows (three spheres at
+    horizontal distances 0, 5 and 13 from the axis, heights 1, 2 and 6)."""
+    run = tmp_path / "run"
+    run.mkdir()
+    rows = ["0 1 0 0.5 0 0", "3 2 4 0.5 1 0", "-5 6 12 0.5 2 0"]
+    (run / "slope_data_t=100_1.txt").write_text("3\n" + "\n".join(rows) + "\nTMIG 0\n")
+    p = subprocess.run([sys.executable, str(ROOT / "tools" / "esys" / "slope_runout.py"), "--step", "100", str(run)],
+                       capture_output=True, text=True, check=True)
+    last = p.stdout.strip().splitlines()[-1]
+    assert [c.strip() for c in last.split("|")[2:-1]] == ["3", "3", "13", "13"]
