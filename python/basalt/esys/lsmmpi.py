@@ -444,7 +444,8 @@ class LsmMpi:
 
         # ESyS's neighbour-list rule (the checkpoints' 'position at the last rebuild') and its spatial domain,
         # checked after every step in C++ (python/src/esys_watch.hpp): a run goes in chunks between the steps
-        # Python must see (savers, Runnables), and stops early at a step a particle left the domain
+        # Python must see (savers, Runnables), and stops early at a step whose positions make ESyS rebuild while a
+        # particle is outside the domain (the rebuild removes it)
         core = self._sim._core
         if not self._watching:
             lo, hi = self._grid_domain()
