@@ -316,7 +316,10 @@ PY
       sleep 0.1
     done
     mkdir -p "$W/kept" && cp "$W/out/ckpt_000020.h5" "$W/kept/"
-    rm -rf "$W/out"
+    # Gone at once: renamed, then removed (an rm -rf alone raced the I/O rank's next file and could leave the
+    # folder in place: "Directory not empty", and the run went on).
+    mv "$W/out" "$W/out.removed"
+    rm -rf "$W/out.removed" || true
     wait "$mpirun_pid"
     code=$?
     cat "$W/last.log"
