@@ -70,7 +70,32 @@ def _x_offset(a, b, r):
     return row[b % 6]
 
 
-class _ClosePackBlock:
+class SphereCollection:
+    """Spheres as ESyS's blocks and SimpleSphereCollection hold them: iterable, len, getNumSpheres, translate,
+    rotate (a block fills self._spheres; a packer's collection is handed its list)."""
+
+    def __init__(self, spheres=()):
+        self._spheres = list(spheres)
+
+    def __iter__(self):
+        return iter(self._spheres)
+
+    def __len__(self):
+        return len(self._spheres)
+
+    def getNumSpheres(self):
+        return len(self._spheres)
+
+    def rotate(self, axis, axisPt):
+        for s in self._spheres:
+            s.rotate(axis, axisPt)
+
+    def translate(self, translation):
+        for s in self._spheres:
+            s.translate(translation)
+
+
+class _ClosePackBlock(SphereCollection):
     """ESyS's ClosePackIterator: sphere (i, j, k) at offsets(i, j, k) + (2r i, r sqrt(3) j, r sqrt(8/3) k) along the
     axes (x, z, y) of the default orientation, i fastest; ids from 0 in that order."""
 
@@ -94,22 +119,6 @@ class _ClosePackBlock:
                     centre[dim[2]] = 0.0 + k * (r * _SQRT_8_OVER_3)
                     self._spheres.append(SimpleSphere(len(self._spheres), Vec3(0.0, 0.0, 0.0) + Vec3(centre), r))
 
-    def __iter__(self):
-        return iter(self._spheres)
-
-    def __len__(self):
-        return len(self._spheres)
-
-    def getNumSpheres(self):
-        return len(self._spheres)
-
-    def rotate(self, axis, axisPt):
-        for s in self._spheres:
-            s.rotate(axis, axisPt)
-
-    def translate(self, translation):
-        for s in self._spheres:
-            s.translate(translation)
 
 
 class CubicBlock(_ClosePackBlock):

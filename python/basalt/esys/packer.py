@@ -23,7 +23,7 @@ import math
 
 import numpy as np
 
-from .blocks import SimpleSphere
+from .blocks import SimpleSphere, SphereCollection
 from .errors import refuse
 from .vec3 import Vec3
 
@@ -194,30 +194,6 @@ def _fill_in_wall(ip1, ip2, ip3, o, d, r1, r2, r3):
     return (ox + m[0], oy + m[1], oz + m[2]), r
 
 
-class SphereCollection:
-    """The packer's spheres (ESyS's SimpleSphereCollection): iterable, len, getNumSpheres, translate, rotate."""
-
-    def __init__(self, spheres):
-        self._spheres = spheres
-
-    def __iter__(self):
-        return iter(self._spheres)
-
-    def __len__(self):
-        return len(self._spheres)
-
-    def getNumSpheres(self):
-        return len(self._spheres)
-
-    def rotate(self, axis, axisPt):
-        for s in self._spheres:
-            s.rotate(axis, axisPt)
-
-    def translate(self, translation):
-        for s in self._spheres:
-            s.translate(translation)
-
-
 class RandomBoxPacker:
     """RandomBoxPacker(minRadius, maxRadius, cubicPackRadius, maxInsertFails, bBox, circDimList=[False]*3,
     tolerance=0.001): ESyS's random packing of a 3-D box without periodic axes, reproduced (module docstring)."""
@@ -258,7 +234,7 @@ class RandomBoxPacker:
         self._spheres = spheres
 
     def getSimpleSphereCollection(self):
-        return SphereCollection(list(self._spheres or []))
+        return SphereCollection(self._spheres or [])
 
     def getSimpleSphereIterator(self):
         return iter(list(self._spheres or []))
