@@ -39,7 +39,7 @@ void Simulation<Real>::start(const Scene& scene) {
   if (scene.bonds.size() > 254) throw InputError("interactions: at most 254 bond groups");
   apply_dt(scene_.dt);
   clock_.set_base(scene_.clock_base.step, scene_.clock_base.time);
-  rebuild_limit2_ = 0.25 * scene.skin * scene.skin;
+  schedule_.configure(scene.skin);
 }
 
 template <class Real>
@@ -257,27 +257,18 @@ const std::vector<double>& Simulation<Real>::compute_forces(bool ghosts_in_fligh
     ghost_wait_ += sw.lap();
   }
   forces_.add(state, Part::ghost, Energy, advance, [] {});
-  hold_fixed();
+  fixed_.hold(p_);
   if (!bonds_.parted.empty()) {
     // The lists must learn that the pairs are unbonded: at once where they list bonded pairs, else by
     // a rebuild before the next force computation.
     if (forces_.lists_mark_bonds())
       forces_.unbond(bonds_.parted);
     else
-      bond_broke_ = true;
+      schedule_.bond_parted();
     bonds_.parted.clear();
   }
   for (std::size_t k = before; k < broken_.size(); ++k) broken_[k].step = clock_.step();
   return forces_.potentials();
-}
-
-template <class Real>
-void Simulation<Real>::hold_fixed() {
-  // Fixed particles feel forces (walls and savers see them) but neither kick moves or turns them.
-  for (const auto i : fixed_) {
-    p_.fx[i] = p_.fy[i] = p_.fz[i] = 0;
-    if (p_.with_rotation) p_.tx[i] = p_.ty[i] = p_.tz[i] = 0;
-  }
 }
 
 template <class Real>
@@ -332,22 +323,11 @@ void Simulation<Real>::set_dt(double dt) {
 template <class Real>
 void Simulation<Real>::set_fixed_tags(std::vector<std::int64_t> tags) {
   scene_.fixed_tags = std::move(tags);
-  find_fixed();
-  // Held from now on: at rest, and the forces of this step (the next kick's) zeroed as hold_fixed() does.
-  for (const auto i : fixed_) {
-    p_.vx[i] = p_.vy[i] = p_.vz[i] = 0;
-    if (p_.with_rotation) p_.wx[i] = p_.wy[i] = p_.wz[i] = 0;
-  }
-  hold_fixed();
-}
-
-template <class Real>
-void Simulation<Real>::find_fixed() {
-  fixed_.clear();
-  if (!scene_.fixed_tags.empty())
-    for (std::size_t i = 0; i < p_.n_owned; ++i)
-      if (std::find(scene_.fixed_tags.begin(), scene_.fixed_tags.end(), p_.tag[i]) != scene_.fixed_tags.end())
-        fixed_.push_back(static_cast<std::uint32_t>(i));
+  fixed_.find(p_, scene_.fixed_tags);
+  // Held from now on: at rest, and the forces of this step (the next kick's) zeroed as after every force
+  // computation.
+  fixed_.stop(p_);
+  fixed_.hold(p_);
 }
 
 template <class Real>

@@ -23,8 +23,8 @@ SimulationFrame<Real>::SimulationFrame(const Simulation<Real>& sim, std::uint32_
   // Owned particles now are those of the last rebuild (only a rebuild migrates or reorders them).
   h.with_rebuild = (kinds & io::kFrameCheckpoint) && p.with_exact_rebuild && p.xr.size() == p.n_owned;
   if (h.with_rebuild) {
-    h.rebuild_step = sim.rebuild_step_;
-    h.rebuild_pending = sim.bond_broke_;
+    h.rebuild_step = sim.schedule_.last_step();
+    h.rebuild_pending = sim.schedule_.pending();
   }
   // The cuts in force since the last rebuild: a restart on as many ranks rebuilds this decomposition.
   if ((kinds & io::kFrameCheckpoint) && sim.comm().rank() == 0)

@@ -105,7 +105,7 @@ void Simulation<Real>::rebuild() {
   const bool parallel = comm().size() > 1;
   if (parallel) error = comm().agree_error(error);
   if (error) stop(*error);
-  if (parallel && scene_.balance == "pairs" && !balancer_.paused() && rebuilds_ > 0)
+  if (parallel && scene_.balance == "pairs" && !balancer_.paused() && schedule_.count() > 0)
     balancer_.weigh_pairs(balance_run());
   times_.communication += sw.lap();
   forces_.save_history(p_);  // before the ghosts (and the pairs' ids) go
@@ -115,8 +115,7 @@ void Simulation<Real>::rebuild() {
   if (flow) exchange_flow();
   times_.neighbor += sw.lap();
   if (parallel) {
-    error = halo_->migrate(p_, bonds_, forces_.pending_history(), far_moves_);
-    far_moves_ = false;
+    error = halo_->migrate(p_, bonds_, forces_.pending_history(), schedule_.take_far_moves());
     error = comm().agree_error(error);
     if (error) stop(*error);
     const long long total = comm().sum(static_cast<long long>(p_.n_owned));
@@ -139,10 +138,8 @@ void Simulation<Real>::rebuild() {
     p_.yr.assign(p_.y.begin(), p_.y.begin() + static_cast<std::ptrdiff_t>(p_.n_owned));
     p_.zr.assign(p_.z.begin(), p_.z.begin() + static_cast<std::ptrdiff_t>(p_.n_owned));
   }
-  find_fixed();
-  rebuild_step_ = clock_.step();
-  bond_broke_ = false;
-  ++rebuilds_;
+  fixed_.find(p_, scene_.fixed_tags);
+  schedule_.rebuilt(clock_.step());
   check_rebuild();
   if (std::getenv("BASALT_DEBUG_REBUILD"))
     fmt::print(stderr, "rank {} rebuild at step {} owned {} ghosts {} bonds {} (both owned {}) pairs {}+{}\n",

@@ -35,7 +35,7 @@ void Simulation<Real>::begin_restart(std::size_t particles, double dt, const Res
   apply_dt(scene_.clock_base.dt > 0 ? scene_.clock_base.dt : scene_.dt);
   // (a staged run's dt change, replayed: stages.hpp)
   clock_.set_base(scene_.clock_base.step, scene_.clock_base.time);
-  rebuild_limit2_ = 0.25 * scene_.skin * scene_.skin;
+  schedule_.configure(scene_.skin);
 }
 
 template <class Real>
@@ -331,7 +331,7 @@ void Simulation<Real>::replay_rebuild(const io::Checkpoint& c) {
     halo_->begin_update_ghosts(p_);
     halo_->end_update_ghosts(p_);
   }
-  bond_broke_ = c.rebuild_pending;  // a bond broke at the checkpoint step: the next step rebuilds
+  schedule_.set_pending(c.rebuild_pending);  // a bond broke at the checkpoint step: the next step rebuilds
 }
 
 template <class Real>

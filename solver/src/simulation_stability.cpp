@@ -173,7 +173,7 @@ void Simulation<Real>::estimate_critical_step(bool fresh) {
     const std::vector<std::int32_t> damage_at_start =
         breakable ? p_.bonds_broken : std::vector<std::int32_t>{};
     const std::size_t broken_at_start = broken_.size();
-    const bool bond_broke_at_start = bond_broke_;
+    const bool rebuild_pending_at_start = schedule_.pending();
     auto marks_at_start = breakable ? forces_.bond_marks() : decltype(forces_.bond_marks()){};
     compute_forces<false>();
     // F(x) once for all products (120 force evaluations became 61: half the start-up of a large run,
@@ -290,7 +290,7 @@ void Simulation<Real>::estimate_critical_step(bool fresh) {
       bonds_ = bonds_at_start;
       p_.bonds_broken = damage_at_start;
       broken_.erase(broken_.begin() + static_cast<std::ptrdiff_t>(broken_at_start), broken_.end());
-      bond_broke_ = bond_broke_at_start;
+      schedule_.set_pending(rebuild_pending_at_start);
       forces_.set_bond_marks(std::move(marks_at_start));
     }
     st.perturbation = delta;
@@ -546,7 +546,7 @@ void Simulation<Real>::check_blowup() {
   }
   auto hit = blocked_path(fast, true);
   if (!hit) {
-    far_moves_ = true;  // the rebuild's migration may carry them across several ranks' regions
+    schedule_.allow_far_moves();  // the rebuild's migration may carry them across several ranks' regions
     return;
   }
   // "<index>: reason": the owner of that fast particle writes the message.

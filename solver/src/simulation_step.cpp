@@ -63,15 +63,15 @@ bool Simulation<Real>::refresh_neighbours(double moved2) {
   const bool flow =
       (!scene_.inserts.empty() || !scene_.deletes.empty()) && flow_.queue(scene_, clock_.step());
   double need =
-      bond_broke_ || balance_due || flow
-          ? std::numeric_limits<double>::infinity()
-          : std::max(moved2, forces_.walls().empty() ? 0.0 : forces_.walls().moved2_since_rebuild());
+      schedule_.need(std::max(moved2, forces_.walls().empty() ? 0.0 : forces_.walls().moved2_since_rebuild()),
+                     balance_due || flow);
   if (parallel) need = comm().max(need);
   times_.communication += sw.lap();
-  if (!(need <= rebuild_limit2_)) {
+  if (schedule_.exceeded(need)) {
     check_blowup();  // simulation_stability.cpp: stops a run that moved absurdly far in this step
     rebuild();       // times itself
-    rebuild_step_ = clock_.step() + 1;  // the positions it used are those of the step being completed
+    schedule_.set_last_step(clock_.step() +
+                            1);  // the positions it used are those of the step being completed
     return false;
   }
   if (!parallel) return false;

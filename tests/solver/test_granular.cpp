@@ -20,6 +20,7 @@
 #include "basalt/solver/interactions/pair_driver.hpp"
 #include "basalt/solver/models/friction.hpp"
 #include "basalt/solver/models/hertz_mindlin.hpp"
+#include "basalt/solver/models/lanes.hpp"
 #include "basalt/solver/models/rolling_friction.hpp"
 #include "basalt/solver/simulation.hpp"
 #include "geometries.hpp"
@@ -480,18 +481,22 @@ TEST(HertzMindlin, LanesFirstParticlesByPermutationAreTheirOwnFloat) {
   expect_first_ends_are_the_lanes_particles<float>();
 }
 
-TEST(HertzMindlin, LanesMatchTheScalarContact) {
+/// tol: the largest difference between a lane and contact(), relative to the force, torque or history;
+/// tol_dissipated, relative to the dissipation (a difference of two spring energies when the contact slides:
+/// in float it loses digits, 1.2e-4 seen). Double at 1e-12 and 1e-11, float at 1e-5 and 1e-3.
+template <class Real>
+void expect_pair_lanes_match_the_scalar_contact(double tol, double tol_dissipated) {
   constexpr int W = kContactLaneWidth;
-  using Lanes = ContactLanes<double, W, HertzMindlin::History>;
-  const auto c = HertzMindlin::coeffs<double>(HertzMindlin::Params{{1.0e7, 0.25}, 0.5, 0.5});
+  using Lanes = ContactLanes<Real, W, HertzMindlin::History>;
+  const auto c = HertzMindlin::coeffs<Real>(HertzMindlin::Params{{1.0e7, 0.25}, 0.5, 0.5});
   const auto u = [](std::uint64_t k) { return 0.5 * basalt::test::hash_unit(k); };  // [-0.5, 0.5)
   struct Case {
-    ContactKinematics<double> k;
+    ContactKinematics<Real> k;
     HertzMindlin::History h;
   };
   const auto random_case = [&](std::uint64_t s) {
     Case q{};
-    auto& k = q.k;
+    ContactKinematics<double> k{};
     k.ri = 1e-3 * (1 + u(s)), k.rj = 1e-3 * (1 + u(s + 1));
     const double nx = u(s + 2), ny = u(s + 3), nz = u(s + 4), nn = std::sqrt(nx * nx + ny * ny + nz * nz);
     k.r = (k.ri + k.rj) * (1 - 1e-3 * (0.01 + u(s + 5) + 0.5));  // overlaps 1e-5 .. 1e-3 of the radii sum
@@ -504,6 +509,9 @@ TEST(HertzMindlin, LanesMatchTheScalarContact) {
     k.dt = 1e-5;
     if (s % 3 != 0)  // a third without history (a new contact)
       q.h = {v * 2e-5 * u(s + 17) * double(s % 5), v * 2e-5 * u(s + 18), v * 2e-5 * u(s + 19)};
+    q.k = {Real(k.dx),  Real(k.dy),  Real(k.dz),  Real(k.r),   Real(k.ri),  Real(k.rj),
+           Real(k.imi), Real(k.imj), Real(k.vx),  Real(k.vy),  Real(k.vz),  Real(k.wix),
+           Real(k.wiy), Real(k.wiz), Real(k.wjx), Real(k.wjy), Real(k.wjz), Real(k.dt)};
     return q;
   };
   const auto load = [&](Lanes& L, int l, const Case& q) {
@@ -516,8 +524,8 @@ TEST(HertzMindlin, LanesMatchTheScalarContact) {
     L.h[l] = q.h;
     L.dt = k.dt;
   };
-  const auto near = [](double got, double want, double scale) {
-    return std::abs(got - want) <= 1e-12 * scale;
+  const auto near = [tol](double got, double want, double scale) {
+    return std::abs(got - want) <= tol * scale;
   };
   int sliding = 0, sticking = 0;
   for (const bool advance : {true, false}) {
@@ -532,20 +540,21 @@ TEST(HertzMindlin, LanesMatchTheScalarContact) {
       for (int l = 0; l < W; ++l) {
         auto q = cases[l];
         q.k.r = std::sqrt(L.r2[l]);  // as the driver gives it
-        ContactForce<double> f;
+        ContactForce<Real> f;
         if (advance)
           HertzMindlin::contact<true>(c, q.h, q.k, f);
         else
           HertzMindlin::contact<false>(c, q.h, q.k, f);
-        const double F = std::sqrt(f.fx * f.fx + f.fy * f.fy + f.fz * f.fz);
+        const double F = std::sqrt(double(f.fx) * f.fx + double(f.fy) * f.fy + double(f.fz) * f.fz);
         const double H = std::sqrt(q.h.x * q.h.x + q.h.y * q.h.y + q.h.z * q.h.z) + 1e-300;
         SCOPED_TRACE(::testing::Message() << "advance " << advance << " batch " << batch << " lane " << l);
         EXPECT_TRUE(near(L.fx[l], f.fx, F) && near(L.fy[l], f.fy, F) && near(L.fz[l], f.fz, F))
             << L.fx[l] << " " << f.fx << " " << L.fy[l] << " " << f.fy << " " << L.fz[l] << " " << f.fz;
         // Torques as the scalar loop makes them from the arm: (c - x_i) x F, (c - x_j) x (-F).
-        const double si = -f.arm_i / q.k.r, sj = (q.k.r - f.arm_i) / q.k.r;
-        const double cx = q.k.dy * f.fz - q.k.dz * f.fy, cy = q.k.dz * f.fx - q.k.dx * f.fz,
-                     cz = q.k.dx * f.fy - q.k.dy * f.fx;
+        const double si = -double(f.arm_i) / q.k.r, sj = (double(q.k.r) - f.arm_i) / q.k.r;
+        const double cx = double(q.k.dy) * f.fz - double(q.k.dz) * f.fy,
+                     cy = double(q.k.dz) * f.fx - double(q.k.dx) * f.fz,
+                     cz = double(q.k.dx) * f.fy - double(q.k.dy) * f.fx;
         const double T = F * q.k.r;
         EXPECT_TRUE(near(L.tix[l], si * cx, T) && near(L.tiy[l], si * cy, T) && near(L.tiz[l], si * cz, T));
         EXPECT_TRUE(near(L.tjx[l], -sj * cx, T) && near(L.tjy[l], -sj * cy, T) &&
@@ -553,7 +562,7 @@ TEST(HertzMindlin, LanesMatchTheScalarContact) {
         EXPECT_EQ(L.sliding[l] != 0, f.sliding);
         if (advance) {
           EXPECT_TRUE(near(L.h[l].x, q.h.x, H) && near(L.h[l].y, q.h.y, H) && near(L.h[l].z, q.h.z, H));
-          EXPECT_NEAR(L.dissipated[l], f.dissipated, 1e-11 * std::abs(f.dissipated) + 1e-300);
+          EXPECT_NEAR(L.dissipated[l], f.dissipated, tol_dissipated * std::abs(f.dissipated) + 1e-300);
         } else {
           EXPECT_EQ(L.h[l].x, cases[l].h.x);  // left alone
         }
@@ -563,7 +572,8 @@ TEST(HertzMindlin, LanesMatchTheScalarContact) {
   }
   EXPECT_GT(sliding, 200);  // both regimes covered
   EXPECT_GT(sticking, 200);
-  std::printf("lanes against contact(): %d sliding, %d sticking contacts\n", sliding, sticking);
+  std::printf("lanes against contact() (%s): %d sliding, %d sticking contacts\n",
+              sizeof(Real) == 4 ? "float" : "double", sliding, sticking);
   // One contact in every lane, the others different: bitwise the same result in each.
   const Case one = random_case(4242);
   std::array<double, 7> want{};
@@ -579,24 +589,33 @@ TEST(HertzMindlin, LanesMatchTheScalarContact) {
   }
 }
 
+TEST(HertzMindlin, LanesMatchTheScalarContact) {
+  expect_pair_lanes_match_the_scalar_contact<double>(1e-12, 1e-11);
+}
+TEST(HertzMindlin, LanesMatchTheScalarContactInFloat) {
+  expect_pair_lanes_match_the_scalar_contact<float>(1e-5, 1e-3);
+}
+
 // A Hertz-Mindlin wall evaluates kContactLaneWidth contacts at once too (HertzMindlinWall::contact_lanes,
 // WallDriver::lanes). On random wall contacts (sticking, sliding, with and without shear history, rotating,
 // history tilted out of the tangent plane, any wall normal) the lanes must give contact()'s force, history,
 // dissipation and sliding flag, and the torque the scalar loop makes from its arm, to rounding; and a
 // contact's result must not depend on its lane.
-TEST(HertzMindlinWall, LanesMatchTheScalarContact) {
+/// tol and tol_dissipated as for the pair lanes (expect_pair_lanes_match_the_scalar_contact).
+template <class Real>
+void expect_wall_lanes_match_the_scalar_contact(double tol, double tol_dissipated) {
   constexpr int W = kContactLaneWidth;
-  using Lanes = WallLanes<double, W, HertzMindlinWall::History>;
+  using Lanes = WallLanes<Real, W, HertzMindlinWall::History>;
   const auto c =
-      HertzMindlinWall::coeffs<double>(HertzMindlinWall::Params{{1.0e7, 0.25}, {4.0e7, 0.3}, 0.5, 0.5});
+      HertzMindlinWall::coeffs<Real>(HertzMindlinWall::Params{{1.0e7, 0.25}, {4.0e7, 0.3}, 0.5, 0.5});
   const auto u = [](std::uint64_t k) { return 0.5 * basalt::test::hash_unit(k); };  // [-0.5, 0.5)
   struct Case {
-    WallKinematics<double> k;
+    WallKinematics<Real> k;
     HertzMindlinWall::History h;
   };
   const auto random_case = [&](std::uint64_t s, const std::array<double, 3>& n) {
     Case q{};
-    auto& k = q.k;
+    WallKinematics<double> k{};
     k.nx = n[0], k.ny = n[1], k.nz = n[2];
     k.r = 1e-3 * (1 + u(s));
     k.d = k.r * (1 - 1e-3 * (0.01 + u(s + 1) + 0.5));  // overlaps 1e-5 .. 1e-3 of the radius
@@ -607,6 +626,8 @@ TEST(HertzMindlinWall, LanesMatchTheScalarContact) {
     k.dt = 1e-5;
     if (s % 3 != 0)  // a third without history (a new contact)
       q.h = {v * 2e-5 * u(s + 9) * double(s % 5), v * 2e-5 * u(s + 10), v * 2e-5 * u(s + 11)};
+    q.k = {Real(k.nx), Real(k.ny), Real(k.nz), Real(k.d),  Real(k.r),  Real(k.im), Real(k.vx),
+           Real(k.vy), Real(k.vz), Real(k.wx), Real(k.wy), Real(k.wz), Real(k.dt)};
     return q;
   };
   const auto load = [](Lanes& L, int l, const Case& q) {
@@ -616,8 +637,8 @@ TEST(HertzMindlinWall, LanesMatchTheScalarContact) {
     L.h[l] = q.h;
     L.nx = k.nx, L.ny = k.ny, L.nz = k.nz, L.dt = k.dt;
   };
-  const auto near = [](double got, double want, double scale) {
-    return std::abs(got - want) <= 1e-12 * scale;
+  const auto near = [tol](double got, double want, double scale) {
+    return std::abs(got - want) <= tol * scale;
   };
   int sliding = 0, sticking = 0;
   for (const bool advance : {true, false}) {
@@ -635,28 +656,29 @@ TEST(HertzMindlinWall, LanesMatchTheScalarContact) {
         HertzMindlinWall::contact_lanes<false>(c, L);
       for (int l = 0; l < W; ++l) {
         auto q = cases[l];
-        ContactForce<double> f;
+        ContactForce<Real> f;
         if (advance)
           HertzMindlinWall::contact<true>(c, q.h, q.k, f);
         else
           HertzMindlinWall::contact<false>(c, q.h, q.k, f);
-        const double F = std::sqrt(f.fx * f.fx + f.fy * f.fy + f.fz * f.fz);
+        const double F = std::sqrt(double(f.fx) * f.fx + double(f.fy) * f.fy + double(f.fz) * f.fz);
         const double H = std::sqrt(q.h.x * q.h.x + q.h.y * q.h.y + q.h.z * q.h.z) + 1e-300;
         SCOPED_TRACE(::testing::Message() << "advance " << advance << " batch " << batch << " lane " << l);
         EXPECT_TRUE(near(L.fx[l], f.fx, F) && near(L.fy[l], f.fy, F) && near(L.fz[l], f.fz, F))
             << L.fx[l] << " " << f.fx << " " << L.fy[l] << " " << f.fy << " " << L.fz[l] << " " << f.fz;
         // The torque as the scalar loop makes it: (c - x) x F + couple, c - x = -arm n.
         const auto& k = q.k;
-        const double tx = -f.arm_i * (k.ny * f.fz - k.nz * f.fy) + f.mx,
-                     ty = -f.arm_i * (k.nz * f.fx - k.nx * f.fz) + f.my,
-                     tz = -f.arm_i * (k.nx * f.fy - k.ny * f.fx) + f.mz;
+        const double arm = f.arm_i;
+        const double tx = -arm * (double(k.ny) * f.fz - double(k.nz) * f.fy) + f.mx,
+                     ty = -arm * (double(k.nz) * f.fx - double(k.nx) * f.fz) + f.my,
+                     tz = -arm * (double(k.nx) * f.fy - double(k.ny) * f.fx) + f.mz;
         const double T = F * k.r;
         EXPECT_TRUE(near(L.tx[l], tx, T) && near(L.ty[l], ty, T) && near(L.tz[l], tz, T))
             << L.tx[l] << " " << tx << " " << L.ty[l] << " " << ty << " " << L.tz[l] << " " << tz;
         EXPECT_EQ(L.sliding[l] != 0, f.sliding);
         if (advance) {
           EXPECT_TRUE(near(L.h[l].x, q.h.x, H) && near(L.h[l].y, q.h.y, H) && near(L.h[l].z, q.h.z, H));
-          EXPECT_NEAR(L.dissipated[l], f.dissipated, 1e-11 * std::abs(f.dissipated) + 1e-300);
+          EXPECT_NEAR(L.dissipated[l], f.dissipated, tol_dissipated * std::abs(f.dissipated) + 1e-300);
         } else {
           EXPECT_EQ(L.h[l].x, cases[l].h.x);  // left alone
         }
@@ -666,7 +688,8 @@ TEST(HertzMindlinWall, LanesMatchTheScalarContact) {
   }
   EXPECT_GT(sliding, 200);  // both regimes covered
   EXPECT_GT(sticking, 200);
-  std::printf("wall lanes against contact(): %d sliding, %d sticking contacts\n", sliding, sticking);
+  std::printf("wall lanes against contact() (%s): %d sliding, %d sticking contacts\n",
+              sizeof(Real) == 4 ? "float" : "double", sliding, sticking);
   // One contact in every lane, the others different: bitwise the same result in each.
   const std::array<double, 3> floor{0, 0, 1};
   const Case one = random_case(4242, floor);
@@ -681,6 +704,13 @@ TEST(HertzMindlinWall, LanesMatchTheScalarContact) {
     for (std::size_t k = 0; k < got.size(); ++k)
       EXPECT_EQ(got[k], want[k]) << "lane " << at << " value " << k;
   }
+}
+
+TEST(HertzMindlinWall, LanesMatchTheScalarContact) {
+  expect_wall_lanes_match_the_scalar_contact<double>(1e-12, 1e-11);
+}
+TEST(HertzMindlinWall, LanesMatchTheScalarContactInFloat) {
+  expect_wall_lanes_match_the_scalar_contact<float>(1e-5, 1e-3);
 }
 
 // WallDriver::lanes finds a wall's candidates in contact first, evaluates them 16 at a time, and clears

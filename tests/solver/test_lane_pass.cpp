@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "basalt/solver/interactions/lane_pass.hpp"
+#include "basalt/solver/models/lanes.hpp"
 
 using namespace basalt::solver;
 

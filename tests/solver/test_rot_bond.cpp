@@ -94,7 +94,7 @@ TEST(RotBondLaw, FastAcosMatchesAcosToRounding) {
   EXPECT_EQ(beam::acos_near_one(0.999f), std::acos(0.999f));
 }
 
-// The bond loop evaluates 8 bonds at once (evaluate_lanes). On random small deformations its loads must be
+// The bond loop evaluates 16 bonds at once (evaluate_lanes). On random small deformations its loads must be
 // evaluate()'s to rounding; a bond's result must not depend on its lane; the special cases (a bond at rest,
 // an angle beyond the acos series, 0.1 rad) must be flagged for evaluate() and the others not.
 /// W bonds for evaluate_lanes: bond l between particles 2l (its first end) and 2l + 1.
@@ -141,11 +141,12 @@ RotBond::Geometry<double> deformed_bond(std::uint64_t seed, double size) {
   return g;
 }
 
-// With angles = "atan2" (atan_series in the lanes, std::atan2 in evaluate()) as with ESyS's acos angles.
-TEST(RotBondLaw, LanesMatchTheScalarEvaluation) {
+// With angles = "atan2" (atan_series in the lanes, std::atan2 in evaluate()) as with ESyS's acos angles; W
+// lanes (the driver's RotBondDriver::kLanes is 16).
+template <int W>
+void expect_lanes_match_the_scalar_evaluation() {
   for (const bool atan2 : {false, true}) {
     SCOPED_TRACE(atan2 ? "atan2 angles" : "esys angles");
-    constexpr int W = 8;
     LaneBatch<W> B;
     auto& L = B.L;
     RotBond::Params pr;
@@ -235,6 +236,9 @@ TEST(RotBondLaw, LanesMatchTheScalarEvaluation) {
     for (int l = 4; l < W; ++l) EXPECT_EQ(L.general[l], 0.0) << l;
   }
 }
+
+TEST(RotBondLaw, LanesMatchTheScalarEvaluation) { expect_lanes_match_the_scalar_evaluation<8>(); }
+TEST(RotBondLaw, LanesMatchTheScalarEvaluation16Wide) { expect_lanes_match_the_scalar_evaluation<16>(); }
 
 // atan_series, the lanes' atan2 for small angles: std::atan2 to rounding over the tangents it takes (|t| <=
 // 0.1), odd, exactly 0 at 0, in double and float.

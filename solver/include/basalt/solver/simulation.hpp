@@ -21,6 +21,7 @@
 #include "basalt/io/geometry.hpp"
 #include "basalt/solver/core/bonds.hpp"
 #include "basalt/solver/core/clock.hpp"
+#include "basalt/solver/core/fixed_particles.hpp"
 #include "basalt/solver/core/id_map.hpp"
 #include "basalt/solver/core/ledger.hpp"
 #include "basalt/solver/core/particle_flow.hpp"
@@ -28,6 +29,7 @@
 #include "basalt/solver/core/particles.hpp"
 #include "basalt/solver/integrate/verlet.hpp"
 #include "basalt/solver/interactions/force_field.hpp"
+#include "basalt/solver/neighbor/rebuild_schedule.hpp"
 #include "basalt/solver/neighbor/verlet_list.hpp"
 #include "basalt/solver/output/field_observer.hpp"
 #include "basalt/solver/output/field_rows.hpp"
@@ -172,9 +174,9 @@ class Simulation {
   std::vector<std::string> step_warnings() const;
   /// The collisions seen at the rebuilds (contact models with a closed form: RebuildChecks::impacts).
   const ImpactReport& impacts() const { return checks_.impact_report(); }
-  std::int64_t rebuilds() const { return rebuilds_; }
+  std::int64_t rebuilds() const { return schedule_.count(); }
   /// Step of the last neighbour-list rebuild.
-  std::int64_t last_rebuild_step() const { return rebuild_step_; }
+  std::int64_t last_rebuild_step() const { return schedule_.last_step(); }
   std::int64_t total_particles() const { return n_global_; }
   double ghost_width() const { return ghost_width_; }
   /// The force computes, one per model the scene uses (bond, pair, wall models in that order).
@@ -304,10 +306,6 @@ class Simulation {
   void distribute(io::Geometry& g, const GeometryExtent& e);
   /// Which optional particle fields the scene needs (both constructors, before any particle exists).
   void configure_particles();
-  /// Zeroes the forces and torques of fixed particles (scene particles.fixed_tags).
-  void hold_fixed();
-  /// fixed_ from the owned particles' tags (at rebuilds, and when the fixed tags change).
-  void find_fixed();
   /// The run's time step: the integrator's kicks and the models' time step (set_time_step).
   void apply_dt(double dt);
   /// The time of `step` (core/clock.hpp: counted from the last set_dt()).
@@ -351,8 +349,9 @@ class Simulation {
   void check_rebuild();
   /// What the balancer reads and moves at this point of the run (LoadBalancer::Run).
   typename LoadBalancer<Real>::Run balance_run() {
-    return {scene_, *dec_,     *halo_,        p_,        bonds_,      forces_,
-            times_, n_global_, clock_.step(), rebuilds_, ghost_width_};
+    return {
+        scene_,      *dec_, *halo_, p_, bonds_, forces_, times_, n_global_, clock_.step(), schedule_.count(),
+        ghost_width_};
   }
   /// x0 = the owned positions relative to skin_origin (of the decomposition box), as float: the skin
   /// criterion's reference, set at every rebuild (and restored after the critical-step estimate).
@@ -464,24 +463,20 @@ class Simulation {
   EnergyGuard guard_{scene_, forces_.ledger()};  ///< the ledger's reference and balance
   std::vector<BrokenBond> broken_;
   FieldObserver fields_;  ///< the field savers' last row, and the FieldRows of step()/run() given a FieldSink
-  std::vector<std::uint32_t> fixed_;  ///< owned particles of a fixed tag (from the last rebuild)
-  bool bond_broke_ = false;
+  FixedParticles fixed_;  ///< owned particles of a fixed tag (from the last rebuild), held
 
   VelocityVerlet<Real> integrator_;
   double ghost_width_ = 0;
   double contact_cutoff_ = 0;
   std::size_t unassigned_bonds_ = 0;
-  double rebuild_limit2_ = 0;
   std::int64_t n_global_ = 0;
   Clock clock_;  ///< the step, its time, dt and the time of any step
-  std::int64_t rebuilds_ = 0;
   PhaseTimes times_;
   LoadStats load_stats_;
   double ghost_wait_ = 0;
   StabilityReport stability_;
-  OutputSink* output_ = nullptr;   ///< the output of the step being made (run(), step())
-  std::int64_t rebuild_step_ = 0;  ///< step of the last rebuild (checkpoints store it with p_.xr, yr, zr)
-  bool far_moves_ = false;  ///< check_blowup let fast particles go on: the next migration goes any distance
+  OutputSink* output_ = nullptr;  ///< the output of the step being made (run(), step())
+  RebuildSchedule schedule_;  ///< when the lists are rebuilt next (skin, a bond broke), and the last rebuild
   RebuildChecks<Real> checks_;   ///< what the rebuilds' collision and rounding checks saw and said
   LoadBalancer<Real> balancer_;  ///< run.balance: its state between rebuilds (parallel/load_balancer.hpp)
   bool mixed_ = false;           ///< run.precision = "mixed" (set by configure_particles())

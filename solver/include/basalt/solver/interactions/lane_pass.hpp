@@ -20,6 +20,7 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "basalt/solver/models/lanes.hpp"
 #include "basalt/solver/models/model.hpp"
 
 namespace basalt::solver {

@@ -21,6 +21,7 @@
 #include "basalt/solver/interactions/history_records.hpp"
 #include "basalt/solver/interactions/lane_pass.hpp"
 #include "basalt/solver/models/contract.hpp"
+#include "basalt/solver/models/lanes.hpp"
 
 namespace basalt::solver {
 

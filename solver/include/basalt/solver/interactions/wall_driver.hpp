@@ -18,6 +18,7 @@
 #include "basalt/solver/interactions/driver_base.hpp"
 #include "basalt/solver/interactions/history_records.hpp"
 #include "basalt/solver/interactions/lane_pass.hpp"
+#include "basalt/solver/models/lanes.hpp"
 
 namespace basalt::solver {
 

@@ -33,7 +33,7 @@
 //       reach of the scene's pair models.
 //     dissipation_term on a scalar law: its parting energies go to that ledger term.
 //     contact_lanes<Advance>(c, ContactLanes&): the kinematic law for kContactLaneWidth pairs at once
-//       (a model with lanes keeps the default touching()).
+//       (models/lanes.hpp; a model with lanes keeps the default touching()).
 // Bond models (BondDriver / RotBondDriver): force and energy of (c, history-free bond geometry), or
 //   evaluate() for rotational bonds; broken() / failure() where bonds break; pulls_when_broken(c) (optional,
 //   default false): the forces that find a bond broken still take its pull once (ESyS's NRotBond).
@@ -46,6 +46,7 @@
 #include <string_view>
 #include <type_traits>
 
+#include "basalt/solver/models/lanes.hpp"
 #include "basalt/solver/models/model.hpp"
 #include "basalt/solver/scene/table_reader.hpp"
 

@@ -17,6 +17,7 @@
 #include <string_view>
 #include <type_traits>
 
+#include "basalt/solver/models/lanes.hpp"
 #include "basalt/solver/models/model.hpp"
 #include "basalt/solver/scene/table_reader.hpp"
 

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <string_view>
 
+#include "basalt/solver/models/lanes.hpp"
 #include "basalt/solver/models/model.hpp"
 #include "basalt/solver/scene/table_reader.hpp"
 

@@ -18,6 +18,7 @@
 #include <numbers>
 #include <string_view>
 
+#include "basalt/solver/models/lanes.hpp"
 #include "basalt/solver/models/model.hpp"
 #include "basalt/solver/scene/table_reader.hpp"
 #include "basalt/solver/stability/impact.hpp"
@@ -344,7 +345,7 @@ struct HertzMindlin {
     const Real R = k.ri * k.rj * inv_sum, m = Real(1) / (k.imi + k.imj);
     hertz::law<Advance>(c, h, R, m, k.ri + k.rj - k.r, nx, ny, nz, ux, uy, uz, k.dt, f);
   }
-  /// contact() for W pairs at once (model.hpp, ContactLanes), in four passes over the lanes (hertz::Stage).
+  /// contact() for W pairs at once (lanes.hpp, ContactLanes), in four passes over the lanes (hertz::Stage).
   template <bool Advance, class Real, int W>
   BASALT_WIDE_LANES static void contact_lanes(const Coeffs<Real>& c, ContactLanes<Real, W, History>& b) {
     const Real dt = b.dt, one = 1;
@@ -461,7 +462,7 @@ struct HertzMindlinWall {
                uz = k.vz - k.d * (k.wx * k.ny - k.wy * k.nx);
     hertz::law<Advance>(c, h, k.r, Real(1) / k.im, k.r - k.d, k.nx, k.ny, k.nz, ux, uy, uz, k.dt, f);
   }
-  /// contact() for W particles at once (model.hpp, WallLanes), in the passes of the pair's contact_lanes.
+  /// contact() for W particles at once (lanes.hpp, WallLanes), in the passes of the pair's contact_lanes.
   template <bool Advance, class Real, int W>
   BASALT_WIDE_LANES static void contact_lanes(const Coeffs<Real>& c, WallLanes<Real, W, History>& b) {
     const Real dt = b.dt, one = 1, nx = b.nx, ny = b.ny, nz = b.nz;

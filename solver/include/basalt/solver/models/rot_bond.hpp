@@ -47,6 +47,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "basalt/solver/models/lanes.hpp"
 #include "basalt/solver/models/model.hpp"
 #include "basalt/solver/scene/table_reader.hpp"
 
