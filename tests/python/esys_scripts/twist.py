@@ -46,4 +46,3 @@ for field, name in (("potential_energy", "epot.dat"), ("count", "nbonds.dat")):
 sim.createFieldSaver(ParticleScalarFieldSaverPrms(fieldName="e_kin", fileName="ekin.dat", fileFormat="SUM",
                                                   beginTimeStep=0, endTimeStep=steps, timeStepIncr=1))
 sim.run()
-sim.exit()
