@@ -315,7 +315,20 @@ class RunOf final : public Run {
   void checkpoint() override { sim_->checkpoint_now(*sink_); }
 
   py::dict energies() override {
+    // The recomputation's forces and moments are put back as they were: they are the step's, except that the
+    // bonds the step's forces found broken are gone from it (and with them the last pull the next step
+    // applies).
+    auto& p = sim_->particles();
+    std::vector<std::vector<Real>> kept;
+    const auto arrays = [&p] {
+      std::vector<decltype(&p.fx)> a{&p.fx, &p.fy, &p.fz};
+      if (p.with_rotation) a.insert(a.end(), {&p.tx, &p.ty, &p.tz});
+      return a;
+    }();
+    for (const auto* a : arrays) kept.emplace_back(a->begin(), a->end());
     const auto values = sim_->ledger_values();
+    for (std::size_t k = 0; k < arrays.size(); ++k)
+      std::copy(kept[k].begin(), kept[k].end(), arrays[k]->begin());
     py::dict d;
     const auto& ledger = sim_->ledger();
     for (std::size_t t = 0; t < ledger.size(); ++t) d[py::str(ledger[t].name)] = values[t];

@@ -301,6 +301,8 @@ class LsmMpi:
         if name not in self._walls:
             raise ValueError(f"LsmMpi.moveWallBy: no wall named {name!r}")
         d = Vec3(d)
+        if not any(d.toList()):  # no move (WallLoader's first steps): the forces stay as the step computed them
+            return              # (a recomputation would lose the last pull of the bonds they found broken)
         if self._sim is None:
             posn, normal = self._walls[name]
             self._walls[name] = (posn + d, normal)

@@ -200,10 +200,14 @@ def _set_initial_velocities(sim, vel, angvel):
 
     part = sim.particles
     ids = np.asarray(part.id)
+    written = False
     for table, names in ((vel, ("vx", "vy", "vz")), (angvel, ("wx", "wy", "wz"))):
         if not table or not any(any(v) for v in table.values()):
             continue
         values = np.array([table[int(i)] for i in ids], dtype=float).reshape(len(ids), 3)
         for k, name in enumerate(names):
             getattr(part, name)[:] = values[:, k]
-    sim._core.state_changed(advance_history=True)
+        written = True
+    # (only then: a recomputation has no bond the start's forces broke, whose last pull ESyS's step 1 applies)
+    if written:
+        sim._core.state_changed(advance_history=True)
