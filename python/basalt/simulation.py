@@ -380,6 +380,12 @@ class Simulation:
         """Collective: the bonds broken so far."""
         return self._core.broken_bonds()
 
+    def saved_field(self, name):
+        """Collective: the value the scene's [[output.fields]] saver of column `name` (a fields.csv column, e.g.
+        "bond_potential_energy") computed at this step, summed over the compute ranks, as fields.csv holds it;
+        None when that saver was not due at this step. KeyError when no saver has that column."""
+        return self._core.saved_field(name)
+
     @staticmethod
     def _region_keys(box, cylinder):
         if (box is None) == (cylinder is None):

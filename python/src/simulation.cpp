@@ -135,6 +135,10 @@ class Run {
   /// Collective: the bonds broken so far, every rank's, on every rank: rows (id, id, step it broke at), the
   /// smaller id first, sorted.
   virtual py::array broken_bond_pairs() = 0;
+  /// Collective: the value fields.csv's column `name` got at this step (the scene's [[output.fields]] saver,
+  /// summed over the compute ranks), None when that saver was not due at this step; KeyError for no such
+  /// column.
+  virtual py::object saved_field(const std::string& name) = 0;
   virtual std::array<std::int64_t, 2> flow_totals() const = 0;
   /// Collective: a checkpoint of the current step now.
   virtual void checkpoint() = 0;
@@ -273,6 +277,15 @@ class RunOf final : public Run {
         parse_keys(keys, "delete", [](solver::TableReader& t) { return solver::parse_delete(t); }));
   }
   std::int64_t bond_count() override { return sim_->bond_count(); }
+  py::object saved_field(const std::string& name) override {
+    const auto columns = solver::field_columns(scene_);
+    const auto at = std::find(columns.begin(), columns.end(), name);
+    if (at == columns.end())
+      throw py::key_error("saved_field: no fields.csv column " + name +
+                          " (the scene's [[output.fields]] give them)");
+    const auto v = sim_->saved_field(static_cast<std::size_t>(at - columns.begin()));
+    return v ? py::object(py::float_(*v)) : py::object(py::none());
+  }
   py::array broken_bond_pairs() override {
     std::vector<double> mine;  // each break is recorded by one rank
     for (const auto& b : sim_->broken_bonds()) {
@@ -302,7 +315,20 @@ class RunOf final : public Run {
   void checkpoint() override { sim_->checkpoint_now(*sink_); }
 
   py::dict energies() override {
+    // The recomputation's forces and moments are put back as they were: they are the step's, except that the
+    // bonds the step's forces found broken are gone from it (and with them the last pull the next step
+    // applies).
+    auto& p = sim_->particles();
+    std::vector<std::vector<Real>> kept;
+    const auto arrays = [&p] {
+      std::vector<decltype(&p.fx)> a{&p.fx, &p.fy, &p.fz};
+      if (p.with_rotation) a.insert(a.end(), {&p.tx, &p.ty, &p.tz});
+      return a;
+    }();
+    for (const auto* a : arrays) kept.emplace_back(a->begin(), a->end());
     const auto values = sim_->ledger_values();
+    for (std::size_t k = 0; k < arrays.size(); ++k)
+      std::copy(kept[k].begin(), kept[k].end(), arrays[k]->begin());
     py::dict d;
     const auto& ledger = sim_->ledger();
     for (std::size_t t = 0; t < ledger.size(); ++t) d[py::str(ledger[t].name)] = values[t];
@@ -705,6 +731,7 @@ void bind_simulation(py::module_& m) {
       .def("bond_count", [](PySimulation& s) { return s.run().bond_count(); })
       .def("broken_bonds", [](PySimulation& s) { return s.run().broken_bonds(); })
       .def("broken_bond_pairs", [](PySimulation& s) { return s.run().broken_bond_pairs(); })
+      .def("saved_field", [](PySimulation& s, const std::string& name) { return s.run().saved_field(name); })
       .def("flow_totals", [](PySimulation& s) { return s.run().flow_totals(); })
       .def_property_readonly("critical_dt", [](PySimulation& s) { return s.run().critical_dt(); })
       .def("esys_watch", [](PySimulation& s, double limit2, const std::array<double, 3>& lo,

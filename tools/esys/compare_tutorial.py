@@ -4,7 +4,7 @@
 
     /usr/bin/python3 tools/esys/compare_tutorial.py [--scripts collide fall settle] [--workdir DIR]
         [--tolerance 1e-6] [--build build | --pythonpath DIR] [--esys esysparticle] [--doc docs/esys.md]
-        [--args ARG...] [--spread-args ARG...]
+        [--args ARG...] [--spread-args ARG...] [--num-time-steps N] [--spread-replace OLD NEW]
 
 The scripts are ours (tests/python/esys_scripts/), in the style of ESyS's tutorial. ESyS runs as
 `mpirun -np 2 esysparticle SCRIPT` (1 master + 1 worker), Basalt as `python3 -m basalt.esys SCRIPT`, each in
@@ -16,6 +16,12 @@ with --doc writes it into docs/esys.md between the compare_tutorial markers) and
 --args passes arguments to every script (block_large.py's block size); with --spread-args ESyS runs a second
 time with those arguments (a perturbed run, e.g. block_large.py's nudge) and a quantity above the tolerance
 still passes when Basalt is no further from ESyS than ESyS is from itself.
+A script may be given as ESyS's source holds the tutorial's (Doc/Tutorial/examples/NAME.py.tex, LaTeX-wrapped):
+its verbatim block is run, from a copy in DIR/scripts/ beside the copies of the other examples it imports
+(rot_compress.py.tex and its WallLoader.py.tex). With --num-time-steps N every script runs from such a copy whose
+setNumTimeSteps(...) argument is N (a shortened run; the script is otherwise unchanged), and with --spread-replace
+the perturbed ESyS run takes a copy with the text OLD replaced by NEW (e.g. a wall's position nudged by 1e-9, for
+a script that takes no arguments).
 Exit 1 on a mismatch; exit 3 (after Basalt's runs, nothing compared) when ESyS-Particle is not installed.
 """
 
@@ -51,6 +57,46 @@ def run(cmd, cwd, env, timeout):
     if p.returncode != 0:
         return None, wall, f"exit {p.returncode}: {p.stderr[-2000:]}"
     return p.stdout, wall, ""
+
+
+def verbatim(path):
+    """A tutorial example's Python: the verbatim block of ESyS's NAME.py.tex, or the file itself."""
+    with open(path) as f:
+        text = f.read()
+    if not path.endswith(".tex"):
+        return text
+    m = re.search(r"\\begin\{verbatim\}\n(.*?)\\end\{verbatim\}", text, re.S)
+    if not m:
+        sys.exit(f"{path}: no verbatim block")
+    return m.group(1)
+
+
+def script_copy(script, folder, steps=None, replace=None):
+    """The script (a .py or ESyS's .py.tex) written into folder as NAME.py with the modules it imports from its own
+    folder (.py or .py.tex); its setNumTimeSteps(...) argument set to steps, and replace = (OLD, NEW) applied, when
+    given. Returns the copy's path."""
+    os.makedirs(folder, exist_ok=True)
+    text = verbatim(script)
+    if steps is not None:
+        text, n = re.subn(r"(setNumTimeSteps\s*\(\s*)\d+(\s*\))", rf"\g<1>{steps}\g<2>", text)
+        if n == 0:
+            sys.exit(f"{script}: no setNumTimeSteps(N) to shorten")
+    if replace is not None:
+        if replace[0] not in text:
+            sys.exit(f"{script}: --spread-replace text {replace[0]!r} not found")
+        text = text.replace(replace[0], replace[1])
+    home = os.path.dirname(os.path.abspath(script))
+    for module in re.findall(r"^\s*(?:from|import)\s+(\w+)", text, re.M):
+        for ext in (".py", ".py.tex"):
+            if os.path.exists(os.path.join(home, module + ext)):
+                with open(os.path.join(folder, module + ".py"), "w") as f:
+                    f.write(verbatim(os.path.join(home, module + ext)))
+                break
+    name = re.sub(r"\.py(\.tex)?$", "", os.path.basename(script))
+    path = os.path.join(folder, name + ".py")
+    with open(path, "w") as f:
+        f.write(text)
+    return path
 
 
 def printed_rows(stdout):
@@ -162,6 +208,9 @@ def main():
     ap.add_argument("--args", nargs="*", default=[], help="arguments for every script (both codes)")
     ap.add_argument("--spread-args", nargs="*", help="also run ESyS with these arguments (a perturbed run) and "
                     "report how far ESyS spreads from itself; a quantity within that spread passes")
+    ap.add_argument("--num-time-steps", type=int, help="run copies of the scripts with setNumTimeSteps(N)")
+    ap.add_argument("--spread-replace", nargs=2, metavar=("OLD", "NEW"), help="the perturbed ESyS run takes a copy "
+                    "of the script with OLD replaced by NEW")
     ap.add_argument("--esys", default="esysparticle", help="ESyS-Particle's interpreter (default esysparticle)")
     ap.add_argument("--doc", help="write the table into this file between the compare_tutorial markers")
     args = ap.parse_args()
@@ -173,8 +222,15 @@ def main():
               "(Debian: apt-get install --no-install-recommends esys-particle); Basalt's runs only")
     rows, times, failed = [], [], False
     for name in args.scripts:
-        script = os.path.join(SCRIPTS, name + ".py") if not name.endswith(".py") else os.path.abspath(name)
-        name = os.path.splitext(os.path.basename(script))[0]
+        script = os.path.abspath(name) if name.endswith((".py", ".py.tex")) else os.path.join(SCRIPTS, name + ".py")
+        name = re.sub(r"\.py(\.tex)?$", "", os.path.basename(script))
+        perturbed = script
+        if args.num_time_steps is not None or script.endswith(".tex") or args.spread_replace:
+            copies = os.path.abspath(os.path.join(args.workdir, "scripts"))
+            original = script
+            script = script_copy(original, os.path.join(copies, name), args.num_time_steps)
+            perturbed = script if not args.spread_replace else script_copy(
+                original, os.path.join(copies, name + "-perturbed"), args.num_time_steps, args.spread_replace)
         dir_b = os.path.abspath(os.path.join(args.workdir, "basalt", name))
         out_b, wall_b, err = run([sys.executable, "-m", "basalt.esys", script, *args.args], dir_b, env_b, args.timeout)
         if err:
@@ -192,9 +248,10 @@ def main():
             failed = True
             continue
         spread = {}
-        if args.spread_args is not None:
+        if args.spread_args is not None or args.spread_replace:
             dir_s = dir_e + "-perturbed"
-            out_s, _, err = run(bt.mpirun(2) + [args.esys, script, *args.spread_args], dir_s, bt.esys_env(),
+            spread_args = args.args if args.spread_args is None else args.spread_args
+            out_s, _, err = run(bt.mpirun(2) + [args.esys, perturbed, *spread_args], dir_s, bt.esys_env(),
                                 args.timeout)
             if err:
                 print(f"{name}: the perturbed ESyS-Particle run failed: {err}")
@@ -216,6 +273,9 @@ def main():
             rows.append((name, quantity, str(n), f"{dev:.1e}", "-" if own is None else f"{own:.1e}", verdict))
     lines = [f"Tolerance: {args.tolerance:g} of each quantity's range over ESyS's rows"
              + (f"; ESyS against itself with arguments {' '.join(args.spread_args)}" if args.spread_args else "")
+             + (f"; ESyS against itself with {args.spread_replace[0]!r} replaced by {args.spread_replace[1]!r}"
+                if args.spread_replace else "")
+             + (f"; setNumTimeSteps({args.num_time_steps})" if args.num_time_steps is not None else "")
              + (f"; script arguments {' '.join(args.args)}" if args.args else "") + ".", "",
              "| script | quantity | rows | max deviation / range | ESyS vs perturbed ESyS | verdict |",
              "| --- | --- | --- | --- | --- | --- |"]

@@ -68,6 +68,7 @@ class LsmMpi:
         self._watching = False          # ESyS's neighbour-list rule and domain watched (esys_watch.hpp)
         self._prev_force = None         # (ids, forces) the last step used (ESyS's stored force)
         self._prev_wall_force = {}      # wall name -> the force the last step's particles got from it
+        self._prev_bond_energy = 0.0    # the bonds' potential energy of the last step's forces (ESyS's saver)
         self._rotational = False
 
     # -- set-up ---------------------------------------------------------------------------------------------
@@ -300,6 +301,8 @@ class LsmMpi:
         if name not in self._walls:
             raise ValueError(f"LsmMpi.moveWallBy: no wall named {name!r}")
         d = Vec3(d)
+        if not any(d.toList()):  # no move (WallLoader's first steps): the forces stay as the step computed them
+            return              # (a recomputation would lose the last pull of the bonds they found broken)
         if self._sim is None:
             posn, normal = self._walls[name]
             self._walls[name] = (posn + d, normal)
@@ -453,14 +456,17 @@ class LsmMpi:
             self._watching = True
         # the forces a step used (checkpoints, force savers): kept for the step into a save
         track = bool(self._checkpointers) or any(s.prms.fieldName.lower() == "force" for s in self._savers)
+        epot = self._bond_energy_saved()
         self._save_due()
         while self._t < target:
             if self._pre or self._post:
                 n = 1
             else:
                 n = min([target] + [s for s in self._next_saves() if s is not None]) - self._t
-                if track and n > 1:
+                if (track or epot) and n > 1:
                     n -= 1  # the step into the save goes alone
+            if epot and n == 1:  # before the Runnables (a moveWallBy recomputes the forces)
+                self._prev_bond_energy = self._bond_energy_now()
             if self._pre:
                 self._clock = self._t + 1
                 for r in self._pre:
@@ -480,6 +486,19 @@ class LsmMpi:
             if core.esys_watch_rebuild_due():  # ESyS's rebuild as the next step begins removes them
                 self._leave_domain()
         self._check_bonds_held()  # and the meshes
+
+    def _bond_energy_saved(self):
+        return any(s.prms.kind == "InteractionScalarFieldSaverPrms" and s.prms.fieldName == "potential_energy"
+                   for s in self._savers)
+
+    def _bond_energy_now(self):
+        """Collective: the bonds' potential energy of this step's force computation, ESyS's definition (rot_bond's
+        energy: Fn^2/2kn + Fs^2/2ks + Mt^2/2kt + Mb^2/2kb of the loads it computed, a bond that broke in it
+        included), from the scene's bond_potential_energy saver (scene.py); before the first step, the forces of
+        the start recomputed (the same positions). ESyS's saver at step t + 1 writes it: ESyS computes the forces
+        from the positions after step t at the start of step t + 1, Basalt at the end of step t (docs/esys.md)."""
+        v = self._sim.saved_field("bond_potential_energy")
+        return self._sim.energies()["bond_potential_energy"] if v is None else v
 
     def _next_saves(self):
         return [s.next_after(self._t) for s in (*self._savers, *self._checkpointers)]
@@ -563,6 +582,8 @@ class LsmMpi:
         else:
             state["force"] = np.column_stack([c["fx"], c["fy"], c["fz"]])
         state["walls"] = {n: (pos, self._prev_wall_force.get(n, -f)) for n, (pos, f) in state["walls"].items()}
+        if self._bond_energy_saved():  # ESyS's bonds hold the loads of its last force computation (0 at first)
+            state["bond_energy"] = self._prev_bond_energy if self._t > 0 else 0.0
         if self._t == 0:  # before the first step ESyS holds no forces
             state["force"] = np.zeros_like(state["pos"])
             state["walls"] = {n: (pos, np.zeros(3)) for n, (pos, f) in state["walls"].items()}

@@ -94,6 +94,7 @@ class FieldSaver(_Schedule):
     SCALAR = ("e_kin", "e_kin_linear")
     VECTOR = ("velocity", "displacement", "position", "force")
     WALL = ("Position", "Force")
+    INTERACTION = ("count", "potential_energy")
 
     def __init__(self, prms, lsm):
         super().__init__(prms)
@@ -114,15 +115,27 @@ class FieldSaver(_Schedule):
                 refuse(call, "particle vector fields are written as RAW2 or RAW_WITH_ID here")
         elif kind == "InteractionScalarFieldSaverPrms":
             groups = {g.name: g for g in lsm._bond_groups}
-            if field != "count" or fmt != "SUM":
-                refuse(call, "interaction fields here: count of a bond group's bonds, format SUM (ESyS 2.3.5's "
-                             "potential_energy and the others are not reproduced; Basalt's energy ledger has "
-                             "bond_potential_energy, docs/scenes.md)")
+            if field not in self.INTERACTION or fmt != "SUM":
+                refuse(call, "interaction fields here: count of a bond group's bonds and potential_energy of a "
+                             "RotBondPrms or BrittleBeamPrms group, format SUM (ESyS 2.3.5's other fields are not "
+                             "reproduced; Basalt's energy ledger has bond_potential_energy, docs/scenes.md)")
             if prms.interactionName not in groups:
-                refuse(call + f" on {prms.interactionName!r}", "the count of a bond group's bonds "
+                refuse(call + f" on {prms.interactionName!r}", f"the {field} of a bond group's bonds "
                        "(NRotBondPrms, RotBondPrms, BrittleBeamPrms created before the saver); a contact group's "
-                       "count is not reproduced")
+                       f"{field} is not reproduced")
             self.group = groups[prms.interactionName]
+            if field == "potential_energy":
+                from .prms import NRotBondPrms
+
+                if isinstance(self.group, NRotBondPrms):
+                    refuse(call + f" on the NRotBondPrms group {prms.interactionName!r}",
+                           "the potential_energy of RotBondPrms and BrittleBeamPrms groups (ESyS's NRotBond counts "
+                           "a bond in the step its forces find it broken, Basalt's linear_bond does not: not "
+                           "reproduced yet); Basalt's energy ledger has bond_potential_energy, docs/scenes.md")
+                if len(lsm._bond_groups) > 1:
+                    refuse(call + f" with {len(lsm._bond_groups)} bond groups",
+                           "the potential_energy of the run's one bond group (Basalt's bond_potential_energy sums "
+                           "every bond model of the run)")
         elif kind == "WallVectorFieldSaverPrms":
             if field not in self.WALL:
                 refuse(call, "wall fields here: Position, Force")
@@ -154,9 +167,13 @@ class FieldSaver(_Schedule):
             with open(f"{p.fileName}.{self.count}.dat", "a") as f:
                 f.write("".join(lines))
             self.count += 1
-        elif p.kind == "InteractionScalarFieldSaverPrms":  # count, SUM: the bonds ESyS holds (listed_bonds),
-            with open(p.fileName, "a") as f:                  # written as ESyS 2.3.5 does (measured): %.10e
-                f.write("%.10e\n" % len(listed_bonds(self.lsm, self.group, t, state)))
+        elif p.kind == "InteractionScalarFieldSaverPrms":  # SUM, written as ESyS 2.3.5 does (measured): %.10e
+            if p.fieldName == "count":  # the bonds ESyS holds (listed_bonds)
+                value = len(listed_bonds(self.lsm, self.group, t, state))
+            else:  # potential_energy: the sum over the group's bonds of ESyS's
+                value = state["bond_energy"]  # Fn^2/2kn + Fs^2/2ks + Mt^2/2kt + Mb^2/2kb (below)
+            with open(p.fileName, "a") as f:
+                f.write("%.10e\n" % value)
         else:
             k = 0 if p.fieldName == "Position" else 1
             row = "".join(" ".join("%.10e" % c for c in state["walls"][w][k]) + "  " for w in p.wallName)

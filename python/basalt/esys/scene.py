@@ -12,6 +12,8 @@
                                        scaling); NRotFrictionPrms -> friction, convention "esys", mu = dynamicMu
     GravityPrms, LinDampingPrms,    -> [[body_forces]] gravity, linear_damping, rotational_damping (ESyS's
     RotDampingPrms                     iterative rule)
+    InteractionScalarFieldSaverPrms -> [[output.fields]] bond_potential_energy every step (rot_bond's energy is
+    (potential_energy)                 ESyS's, read by LsmMpi through saved_field)
     always                          -> symplectic Euler (ESyS's integrator), masses as given, skin = verletDist,
                                        no energy check and no start-up overlap/dt refusal (ESyS has neither)
 """
@@ -89,6 +91,9 @@ def scene_dict(lsm, geometry_file, output_dir, mesh_files=None):
                 "force_overlap": True, "energy_check_every": 0},
         "output": {"directory": output_dir},
     }
+    if any(sv.prms.kind == "InteractionScalarFieldSaverPrms" and sv.prms.fieldName == "potential_energy"
+           for sv in lsm._savers):  # the bonds' energy of each step's forces, read by LsmMpi (saved_field)
+        scene["output"]["fields"] = [{"type": "bond_potential_energy", "every": 1}]
     for key, value in (("interactions", interactions), ("walls", walls), ("mesh_walls", meshes),
                        ("body_forces", body)):
         if value:
@@ -195,10 +200,14 @@ def _set_initial_velocities(sim, vel, angvel):
 
     part = sim.particles
     ids = np.asarray(part.id)
+    written = False
     for table, names in ((vel, ("vx", "vy", "vz")), (angvel, ("wx", "wy", "wz"))):
         if not table or not any(any(v) for v in table.values()):
             continue
         values = np.array([table[int(i)] for i in ids], dtype=float).reshape(len(ids), 3)
         for k, name in enumerate(names):
             getattr(part, name)[:] = values[:, k]
-    sim._core.state_changed(advance_history=True)
+        written = True
+    # (only then: a recomputation has no bond the start's forces broke, whose last pull ESyS's step 1 applies)
+    if written:
+        sim._core.state_changed(advance_history=True)
