@@ -180,6 +180,34 @@ def test_domain_is_grown_to_whole_grid_cells(tmp_path):
     assert out == "gone 1754\n"  # x = 7 + n dt passes 8.75 at step 1751 (not 8 at step 1001), 3 steps before
 
 
+def test_particles_leaving_by_several_sides_go_at_the_same_rebuild(tmp_path):
+    """Four spheres cross four different sides of the grown domain (x above, x below, y above, z below) at the
+    same step: ESyS removes them all at its next neighbour update, and so does the front end (one deletion of
+    every side's particles, esys_watch_leave): the count drops from 6 to 2 at one step, the two spheres inside
+    stay."""
+    script = tmp_path / "leave4.py"
+    script.write_text(
+        "from esys.lsm import *\nfrom esys.lsm.util import Vec3, BoundingBox\n"
+        "sim = LsmMpi(numWorkerProcesses=1, mpiDimList=[1, 1, 1])\n"
+        "sim.initNeighbourSearch(particleType='NRotSphere', gridSpacing=2.5, verletDist=0.5)\n"
+        "sim.setNumTimeSteps(1800)\nsim.setTimeStepSize(0.001)\n"
+        "sim.setSpatialDomain(BoundingBox(Vec3(-8, -8, -8), Vec3(8, 8, 8)))\n"
+        "for i, (x, v) in enumerate([((7.0, 0, 0), (1.0, 0, 0)), ((-7.0, 0, 0), (-1.0, 0, 0)),\n"
+        "                            ((0, 7.0, 0), (0, 1.0, 0)), ((0, 0, -7.0), (0, 0, -1.0)),\n"
+        "                            ((0, 0, 0), (0, 0, 0)), ((3.0, 3.0, 3.0), (0, 0, 0))]):\n"
+        "    p = NRotSphere(id=i, posn=Vec3(*x), radius=0.5, mass=1.0)\n"
+        "    p.setLinearVelocity(Vec3(*v))\n    sim.createParticle(p)\n"
+        "class W(Runnable):\n"
+        "    def __init__(self, sim):\n        Runnable.__init__(self)\n        self.sim, self.n = sim, 6\n"
+        "    def run(self):\n"
+        "        ids = [p.getId() for p in self.sim.getParticleList()]\n"
+        "        if len(ids) != self.n:\n            print('gone', self.sim.getTimeStep(), ids)\n"
+        "            self.n = len(ids)\n"
+        "w = W(sim)\nsim.addPostTimeStepRunnable(w)\nsim.run()\n")
+    out = front(script, tmp_path).stdout
+    assert out == "gone 1754 [4, 5]\n"
+
+
 def test_wall_savers_raw_series(fall):
     d, _ = fall
     pos = (d / "floor_Position.dat").read_text().splitlines()
