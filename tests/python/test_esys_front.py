@@ -345,6 +345,18 @@ def test_random_box_packer_slope_fail_box_is_esys_packing(tmp_path):
     assert digest == "21b8273227e68885e1d6da65f1b5c09c54802b70a156ac206fd58ed5f211c8ba"
 
 
+def test_random_box_packer_without_a_positive_radius_is_an_error(tmp_path):
+    """minRadius sizes the packer's cell table (8 minRadius): 0 or a maxRadius below it is a clear error naming
+    the call, not a crash of the compiled packer."""
+    script = tmp_path / "bad_packer.py"
+    script.write_text("from esys.lsm.util import Vec3, BoundingBox\nfrom esys.lsm.geometry import RandomBoxPacker\n"
+                      "RandomBoxPacker(minRadius=0.0, maxRadius=0.5, cubicPackRadius=2.2, maxInsertFails=100,\n"
+                      "                bBox=BoundingBox(Vec3(0, 0, 0), Vec3(4, 4, 4))).generate()\n")
+    p = front(script, tmp_path, check=False)
+    assert p.returncode != 0
+    assert "RandomBoxPacker(minRadius=0.0, maxRadius=0.5): give 0 < minRadius <= maxRadius" in p.stderr
+
+
 def _gengeo_reference(name):
     """A file GenGeo wrote (tests/python/esys_scripts/data/), without the header lines naming its command."""
     text = (SCRIPTS / "data" / name).read_text()

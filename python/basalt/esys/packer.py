@@ -37,6 +37,9 @@ class RandomBoxPacker:
             refuse("esys.lsm.geometry.RandomBoxPacker with a 2-D box (zero size along z)",
                    "Basalt reproduces ESyS's packing of a 3-D box; basalt.pack packs 3-D boxes")
         self._rmin, self._rmax = float(minRadius), float(maxRadius)
+        if not self._rmin > 0.0 or not self._rmax >= self._rmin:
+            raise ValueError(f"esys.lsm.geometry.RandomBoxPacker(minRadius={minRadius}, maxRadius={maxRadius}): "
+                             "give 0 < minRadius <= maxRadius")
         self._cubic = float(cubicPackRadius)
         self._max_fails = int(maxInsertFails)
         self._tol = float(tolerance)
