@@ -29,6 +29,10 @@ void bind_pack(pybind11::module_& m);
 void bind_simulation(pybind11::module_& m);
 /// gengeo_fit: the simplex fit of the ESyS front end's GenGeo packing (python/basalt/esys/gengeo.py).
 void bind_gengeo(pybind11::module_& m);
+/// EsysBoxPacker, EsysStream: the ESyS front end's RandomBoxPacker (python/basalt/esys/packer.py).
+void bind_esys_packer(pybind11::module_& m);
+/// esys_format_rows: the ESyS front end's checkpoint rows (python/basalt/esys/output.py).
+void bind_esys_format(pybind11::module_& m);
 
 /// A geometry as the dict basalt.Geometry is built from: numpy arrays (copies) of the particles and bonds,
 /// the box, units, provenance and statistics.

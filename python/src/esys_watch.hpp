@@ -73,6 +73,38 @@ class EsysWatch {
     return !(pending_ && outside != 0);
   }
 
+  /// Collective: the boxes beyond the domain's sides that particles lie past now (one per side, in the order
+  /// x below, x above, y below, ... ; each reaching 1e30 beyond the domain): ESyS removes those particles at
+  /// its rebuild, all at once.
+  std::vector<std::array<std::array<double, 3>, 2>> outside_boxes(const solver::Particles<Real>& p,
+                                                                  const solver::Comm& comm) const {
+    constexpr double kFar = 1e30;
+    std::vector<std::array<std::array<double, 3>, 2>> boxes;
+    for (std::size_t k = 0; k < 3; ++k) {
+      const auto& c = k == 0 ? p.x : k == 1 ? p.y : p.z;
+      double below = 0, above = 0;
+      for (std::size_t i = 0; i < p.n_owned; ++i) {
+        if (double(c[i]) < lo_[k]) below = 1;
+        if (double(c[i]) > hi_[k]) above = 1;
+      }
+      if (comm.size() > 1) {
+        below = comm.max(below);
+        above = comm.max(above);
+      }
+      for (const bool low : {true, false}) {
+        if ((low ? below : above) == 0) continue;
+        std::array<std::array<double, 3>, 2> box = {{{-kFar, -kFar, -kFar}, {kFar, kFar, kFar}}};
+        if (low) {
+          box[1][k] = lo_[k];
+        } else {
+          box[0][k] = hi_[k];
+        }
+        boxes.push_back(box);
+      }
+    }
+    return boxes;
+  }
+
   /// A rebuild found due by the last check, taken at the next one (or by reset()).
   bool rebuild_due() const { return pending_; }
 

@@ -14,4 +14,6 @@ PYBIND11_MODULE(_core, m) {
   basalt::python::bind_pack(m);
   basalt::python::bind_simulation(m);
   basalt::python::bind_gengeo(m);
+  basalt::python::bind_esys_packer(m);
+  basalt::python::bind_esys_format(m);
 }

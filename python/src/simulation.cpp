@@ -149,6 +149,9 @@ class Run {
   virtual void esys_watch(double limit2, const std::array<double, 3>& lo,
                           const std::array<double, 3>& hi) = 0;
   virtual void esys_watch_reset() = 0;
+  /// Collective: the particles outside the watched domain removed in one rebuild (as ESyS removes them at its
+  /// neighbour-list rebuild), the references taken again; how many.
+  virtual std::int64_t esys_watch_leave() = 0;
   /// The positions at ESyS's last neighbour-list rebuild: (ids, (n, 3) positions) in id order.
   virtual py::tuple esys_watch_reference() const = 0;
   /// Whether the last step's positions make ESyS rebuild its lists as the next step begins.
@@ -204,6 +207,21 @@ class RunOf final : public Run {
   void esys_watch_reset() override {
     if (!watch_) throw RunError("esys_watch_reset before esys_watch");
     watch_->reset(sim_->particles(), comm_);
+  }
+  std::int64_t esys_watch_leave() override {
+    if (!watch_) throw RunError("esys_watch_leave before esys_watch");
+    std::vector<solver::DeleteSpec> specs;
+    for (const auto& box : watch_->outside_boxes(sim_->particles(), comm_)) {
+      solver::DeleteSpec spec;
+      spec.name = "esys_domain";
+      spec.region.lo = box[0];
+      spec.region.hi = box[1];
+      specs.push_back(std::move(spec));
+    }
+    if (specs.empty()) return 0;  // (the rebuild stays pending: taken at the next check)
+    const std::int64_t removed = sim_->remove_particles(std::move(specs));
+    watch_->reset(sim_->particles(), comm_);
+    return removed;
   }
   bool esys_watch_rebuild_due() const override { return watch_ && watch_->rebuild_due(); }
   py::tuple esys_watch_reference() const override {
@@ -737,6 +755,7 @@ void bind_simulation(py::module_& m) {
       .def("esys_watch", [](PySimulation& s, double limit2, const std::array<double, 3>& lo,
                             const std::array<double, 3>& hi) { s.run().esys_watch(limit2, lo, hi); })
       .def("esys_watch_reset", [](PySimulation& s) { s.run().esys_watch_reset(); })
+      .def("esys_watch_leave", [](PySimulation& s) { return s.run().esys_watch_leave(); })
       .def("esys_watch_rebuild_due", [](PySimulation& s) { return s.run().esys_watch_rebuild_due(); })
       .def("esys_watch_reference", [](PySimulation& s) { return s.run().esys_watch_reference(); })
       .def_property_readonly("step_warnings", [](PySimulation& s) { return s.run().step_warnings(); })

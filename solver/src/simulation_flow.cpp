@@ -40,8 +40,17 @@ std::int64_t Simulation<Real>::insert_particles(InsertSpec spec) {
 
 template <class Real>
 std::int64_t Simulation<Real>::remove_particles(DeleteSpec spec) {
-  if (mixed_) spec.region.shift(origin_);
-  flow_.queue(std::move(spec));
+  std::vector<DeleteSpec> specs;
+  specs.push_back(std::move(spec));
+  return remove_particles(std::move(specs));
+}
+
+template <class Real>
+std::int64_t Simulation<Real>::remove_particles(std::vector<DeleteSpec> specs) {
+  for (auto& spec : specs) {
+    if (mixed_) spec.region.shift(origin_);
+    flow_.queue(std::move(spec));
+  }
   flow_now();
   return flow_.last()[1];
 }
@@ -55,11 +64,12 @@ void Simulation<Real>::flow_now() {
   if (flow_.changed()) rebase_ledger(pe);
 }
 
-#define BASALT_INSTANTIATE(R)                                        \
-  template void Simulation<R>::include_flow(GeometrySummary&) const; \
-  template void Simulation<R>::exchange_flow();                      \
-  template std::int64_t Simulation<R>::insert_particles(InsertSpec); \
-  template std::int64_t Simulation<R>::remove_particles(DeleteSpec); \
+#define BASALT_INSTANTIATE(R)                                                     \
+  template void Simulation<R>::include_flow(GeometrySummary&) const;              \
+  template void Simulation<R>::exchange_flow();                                   \
+  template std::int64_t Simulation<R>::insert_particles(InsertSpec);              \
+  template std::int64_t Simulation<R>::remove_particles(DeleteSpec);              \
+  template std::int64_t Simulation<R>::remove_particles(std::vector<DeleteSpec>); \
   template void Simulation<R>::flow_now();
 BASALT_INSTANTIATE(double)
 BASALT_INSTANTIATE(float)

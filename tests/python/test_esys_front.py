@@ -180,6 +180,34 @@ def test_domain_is_grown_to_whole_grid_cells(tmp_path):
     assert out == "gone 1754\n"  # x = 7 + n dt passes 8.75 at step 1751 (not 8 at step 1001), 3 steps before
 
 
+def test_particles_leaving_by_several_sides_go_at_the_same_rebuild(tmp_path):
+    """Four spheres cross four different sides of the grown domain (x above, x below, y above, z below) at the
+    same step: ESyS removes them all at its next neighbour update, and so does the front end (one deletion of
+    every side's particles, esys_watch_leave): the count drops from 6 to 2 at one step, the two spheres inside
+    stay."""
+    script = tmp_path / "leave4.py"
+    script.write_text(
+        "from esys.lsm import *\nfrom esys.lsm.util import Vec3, BoundingBox\n"
+        "sim = LsmMpi(numWorkerProcesses=1, mpiDimList=[1, 1, 1])\n"
+        "sim.initNeighbourSearch(particleType='NRotSphere', gridSpacing=2.5, verletDist=0.5)\n"
+        "sim.setNumTimeSteps(1800)\nsim.setTimeStepSize(0.001)\n"
+        "sim.setSpatialDomain(BoundingBox(Vec3(-8, -8, -8), Vec3(8, 8, 8)))\n"
+        "for i, (x, v) in enumerate([((7.0, 0, 0), (1.0, 0, 0)), ((-7.0, 0, 0), (-1.0, 0, 0)),\n"
+        "                            ((0, 7.0, 0), (0, 1.0, 0)), ((0, 0, -7.0), (0, 0, -1.0)),\n"
+        "                            ((0, 0, 0), (0, 0, 0)), ((3.0, 3.0, 3.0), (0, 0, 0))]):\n"
+        "    p = NRotSphere(id=i, posn=Vec3(*x), radius=0.5, mass=1.0)\n"
+        "    p.setLinearVelocity(Vec3(*v))\n    sim.createParticle(p)\n"
+        "class W(Runnable):\n"
+        "    def __init__(self, sim):\n        Runnable.__init__(self)\n        self.sim, self.n = sim, 6\n"
+        "    def run(self):\n"
+        "        ids = [p.getId() for p in self.sim.getParticleList()]\n"
+        "        if len(ids) != self.n:\n            print('gone', self.sim.getTimeStep(), ids)\n"
+        "            self.n = len(ids)\n"
+        "w = W(sim)\nsim.addPostTimeStepRunnable(w)\nsim.run()\n")
+    out = front(script, tmp_path).stdout
+    assert out == "gone 1754 [4, 5]\n"
+
+
 def test_wall_savers_raw_series(fall):
     d, _ = fall
     pos = (d / "floor_Position.dat").read_text().splitlines()
@@ -315,6 +343,18 @@ def test_random_box_packer_slope_fail_box_is_esys_packing(tmp_path):
     assert got[0] == "sphere 0 -2.7999999999999998 2.2000000000000002 -2.7999999999999998 0.4444171075709164 0"
     digest = hashlib.sha256(("\n".join(got) + "\n").encode()).hexdigest()
     assert digest == "21b8273227e68885e1d6da65f1b5c09c54802b70a156ac206fd58ed5f211c8ba"
+
+
+def test_random_box_packer_without_a_positive_radius_is_an_error(tmp_path):
+    """minRadius sizes the packer's cell table (8 minRadius): 0 or a maxRadius below it is a clear error naming
+    the call, not a crash of the compiled packer."""
+    script = tmp_path / "bad_packer.py"
+    script.write_text("from esys.lsm.util import Vec3, BoundingBox\nfrom esys.lsm.geometry import RandomBoxPacker\n"
+                      "RandomBoxPacker(minRadius=0.0, maxRadius=0.5, cubicPackRadius=2.2, maxInsertFails=100,\n"
+                      "                bBox=BoundingBox(Vec3(0, 0, 0), Vec3(4, 4, 4))).generate()\n")
+    p = front(script, tmp_path, check=False)
+    assert p.returncode != 0
+    assert "RandomBoxPacker(minRadius=0.0, maxRadius=0.5): give 0 < minRadius <= maxRadius" in p.stderr
 
 
 def _gengeo_reference(name):

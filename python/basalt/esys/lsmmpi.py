@@ -540,23 +540,9 @@ class LsmMpi:
 
     def _leave_domain(self):
         """Deletes the particles outside the (grown) spatial domain, as ESyS does at its neighbour-list rebuilds
-        (measured, docs/esys.md: listed up to the step whose positions trigger the rebuild, gone from the next)."""
-        (lo, hi), big = self._grid_domain(), 1e30
-        sim = self._sim
-        # the extremes need no id order: on one rank the particles' own arrays
-        columns = (sim.particles.x, sim.particles.y, sim.particles.z) if sim.ranks == 1 else \
-            self._columns("x", "y", "z")[1:]
-        for k, c in enumerate(columns):
-            below, above = len(c) and c.min() < lo[k], len(c) and c.max() > hi[k]
-            if below or above:
-                for side, out in ((0, below), (1, above)):
-                    if not out:  # (each delete is a rebuild: only the sides something left by)
-                        continue
-                    a, b = [-big] * 3, [big] * 3
-                    (b if side == 0 else a)[k] = lo[k] if side == 0 else hi[k]
-                    self._sim.delete(box=(a, b))
-                self._sim._core.esys_watch_reset()  # ESyS removes particles at a neighbour rebuild
-                return self._leave_domain()
+        (measured, docs/esys.md: listed up to the step whose positions trigger the rebuild, gone from the next):
+        all of them in one rebuild, the references taken again (esys_watch.hpp)."""
+        self._sim._core.esys_watch_leave()
 
     def _state(self):
         import numpy as np

@@ -50,13 +50,14 @@ class CheckPointer(_Schedule):
                    state["mass"][:, None], state["init"], state["old"], state["vel"], state["force"], np.zeros((n, 3))]
         if "quat" in state:
             columns += [state["quat"], state["angvel"]]
-        table = np.hstack([np.asarray(c, dtype=np.float64).reshape(n, -1) for c in columns]).tolist()
-        line = " ".join(["%.9g"] * 4 + ["%d"] * 2 + ["%.9g"] * (len(table[0]) - 6 if n else 0)) + "\n"
-        rows = [f"{n}\n", *(line % tuple(r) for r in table)]  # 9 significant digits, as ESyS
-        rows.append(self._bond_section(t, state))
-        rows.append("TMIG 0\n")
-        with open(data, "w") as f:
-            f.write("".join(rows))
+        table = np.hstack([np.asarray(c, dtype=np.float64).reshape(n, -1) for c in columns])
+        # "%.9g" (9 significant digits, as ESyS), id and tag "%d": formatted in C++ (python/src/esys_format.cpp)
+        from .._core_loader import core
+
+        rows = core().esys_format_rows(table, "gggg" + "dd" + "g" * (table.shape[1] - 6))  # bytes
+        tail = self._bond_section(t, state) + "TMIG 0\n"
+        with open(data, "wb") as f:
+            f.write(f"{n}\n".encode() + rows + tail.encode())
 
 
     def _bond_section(self, t, state):

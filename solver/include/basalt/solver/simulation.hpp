@@ -251,6 +251,8 @@ class Simulation {
   /// Removes the particles of spec's tags (all when empty) whose centre lies in spec.region now, with their
   /// bonds; returns how many.
   std::int64_t remove_particles(DeleteSpec spec);
+  /// Removes the particles of every spec at once (one rebuild); returns how many.
+  std::int64_t remove_particles(std::vector<DeleteSpec> specs);
   /// Particles inserted and removed since the start of this process's run (restarts count from there).
   const std::array<std::int64_t, 2>& flow_totals() const { return flow_.totals(); }
   /// The id the next inserted particle gets (checkpoints keep it: attribute next_particle_id).
