@@ -20,6 +20,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <cmath>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -285,9 +286,12 @@ int run_compute(const Cli& cli, Scene& scene, const io::RankLayout& layout, io::
           "critical step: {:.4g} {} (2/omega_max, {} Lanczos iterations on the network: {:.4g}; one new "
           "contact "
           "of the lightest particle: {:.4g}); bound {:.4g} (omega^2 <= max_i 2 sum_j k_ij / m_i); former "
-          "estimate 2 sqrt(m_min/k_max) = {:.4g} (m_min = {:.4g}, k_max = {:.4g}){}\n",
+          "estimate 2 sqrt(m_min/k_max) = {:.4g} (m_min = {:.4g}, k_max = {:.4g}){}{}\n",
           st.dt_critical, scene.units.time, st.iterations, st.dt_power, st.dt_contact, st.dt_bound,
           st.dt_pair, st.m_min, st.k_max,
+          std::isfinite(st.dt_broken)
+              ? fmt::format("; breakable bonds as stiff as the contacts: {:.4g}", st.dt_broken)
+              : std::string(),
           st.retries > 0 ? fmt::format("; perturbation {:.3g}, {}x smaller than the first, which broke bonds",
                                        st.perturbation, 1 << (3 * st.retries))
                          : std::string());

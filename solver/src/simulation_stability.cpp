@@ -298,10 +298,25 @@ void Simulation<Real>::estimate_critical_step(bool fresh) {
     if (broke == 0) break;
   }
   st.dt_power = stability::critical_step(lambda);
+  // Bonds that break become contacts of the scene's pair model (a broken bond's pair is a contact): the
+  // fragments' network is the start's with contacts in place of bonds. With contacts stiffer than the bonds
+  // its omega^2 is up to k_pair / k_bond times the start's (every spring scaled by that ratio: the walls and
+  // the start's contacts too, on the safe side). A bonded block shattered on a wall with contacts 10x its
+  // bonds reached 0.894 of the start's step while the fragments were pressed together (docs/stability.md,
+  // "A bonded cascade"); the term gives 0.79.
+  st.dt_broken = std::numeric_limits<double>::infinity();
+  if (lambda > 0 && forces_.bonds_can_break()) {
+    double k_pair = 0, k_bond = std::numeric_limits<double>::infinity();
+    for (const auto& c : forces_.computes()) {
+      if (c->kind() == ModelKind::pair) k_pair = std::max(k_pair, c->max_stiffness(flow_.rmax()));
+      if (c->kind() == ModelKind::bond) k_bond = std::min(k_bond, c->max_stiffness(flow_.rmax()));
+    }
+    if (k_bond > 0 && k_pair > k_bond) st.dt_broken = stability::critical_step(lambda * k_pair / k_bond);
+  }
   // The power iterations approach omega_max from below (2 / omega_power >= the true step, by a few
   // per cent at most once converged, docs/stability.md); the bound is safe but often ~2x too strict.
   // Contacts that do not exist yet count too (particles that start apart and collide later).
-  st.dt_critical = std::min(lambda > 0 ? st.dt_power : st.dt_bound, st.dt_contact);
+  st.dt_critical = std::min({lambda > 0 ? st.dt_power : st.dt_bound, st.dt_contact, st.dt_broken});
   if (!std::isfinite(st.dt_critical)) st.dt_critical = 0;  // no stiffness: nothing to check
 
   st.dt_fraction = scene_.dt_fraction;
@@ -338,10 +353,14 @@ void Simulation<Real>::judge_step(const std::string& what) {
   if (st.fraction > 1 && !(scene_.force_dt || options_.force_dt))
     throw InputError(fmt::format(
         "{} = {:.6g} is {:.3g} times the critical time step {:.6g} (2 / omega_max of the network, {} power "
-        "iterations, {:.6g}; the bound gives {:.6g}; one new contact of the lightest particle {:.6g}): the "
+        "iterations, {:.6g}; the bound gives {:.6g}; one new contact of the lightest particle {:.6g}{}): the "
         "run would be unstable. Lower dt (a safe choice is <= {} x critical, e.g. run.dt_fraction = {}), or "
         "set run.force_dt = true / --force-dt to run anyway",
         what, scene_.dt, st.fraction, st.dt_critical, st.iterations, st.dt_power, st.dt_bound, st.dt_contact,
+        std::isfinite(st.dt_broken)
+            ? fmt::format("; the network with its breakable bonds as stiff as the contacts {:.6g}",
+                          st.dt_broken)
+            : std::string(),
         scene_.dt_safety, scene_.dt_safety));
 }
 

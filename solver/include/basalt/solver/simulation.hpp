@@ -59,7 +59,7 @@ struct RunOptions {
 
 /// The critical time step estimate and what the guard decided (solver/src/simulation_stability.cpp,
 /// docs/stability.md). dt_critical = 2 / omega_max of the network of bonds, contacts and walls
-/// (dt_power), or dt_contact (a contact that forms later) if that is smaller.
+/// (dt_power), or dt_contact (a contact that forms later) or dt_broken (bonds turned contacts) if smaller.
 struct StabilityReport {
   double m_min = 0, k_max = 0, dt_critical = 0, fraction = 0;
   bool warn = false;
@@ -69,6 +69,10 @@ struct StabilityReport {
   /// One new contact of a lightest particle: 2 / sqrt(2 k_pair / m_min) or (wall) k_wall / m_min; with
   /// rotation a tangential spring ks counts as 3.5 ks (the contact point's compliance 1/m + r^2/I = 3.5/m).
   double dt_contact = 0;
+  /// Breakable bonds with contacts stiffer than them (a broken bond's pair becomes a contact): the network of
+  /// the start with every spring k_pair / k_bond times stiffer, 2 / sqrt(omega_power^2 k_pair / k_bond);
+  /// infinite otherwise.
+  double dt_broken = std::numeric_limits<double>::infinity();
   int iterations = 0;       ///< power iterations done
   double perturbation = 0;  ///< the largest displacement of the products K u the estimate took
   int retries = 0;          ///< times the perturbation was made 8x smaller because it broke bonds
