@@ -22,6 +22,7 @@
 #include "basalt/solver/simulation.hpp"
 #include "extremes_helpers.hpp"
 #include "geometries.hpp"
+#include "held_pile.hpp"
 #include "scene_runs.hpp"
 #include "test_support.hpp"
 
@@ -206,54 +207,8 @@ INSTANTIATE_TEST_SUITE_P(BondCascade, CascadeVariant, ::testing::Values(0, 1, 2,
 // settled for 3e5 steps, then held for 1e5 steps in double, float and mixed precision.
 namespace {
 
-constexpr double kSpacing = 1.2;
-
-Geometry pile(int side, int layers) {
-  Geometry g;
-  std::int64_t id = 1;
-  for (int k = 0; k < layers; ++k)
-    for (int j = 0; j < side; ++j)
-      for (int i = 0; i < side; ++i, ++id) {
-        const auto u = static_cast<std::uint64_t>(id);
-        g.add_particle(
-            id,
-            {kSpacing * (i + 0.5) + 0.02 * basalt::test::hash_unit(3 * u),
-             kSpacing * (j + 0.5) + 0.02 * basalt::test::hash_unit(3 * u + 1), kSpacing * (k + 0.5)},
-            0.5 + 0.075 * basalt::test::hash_unit(7 * u + 5));
-      }
-  g.sort_by_id();
-  return g;
-}
-
-std::string pile_wall(const char* name, std::array<double, 3> point, std::array<double, 3> normal) {
-  return fmt::format(
-      "[[walls]]\nname = \"{}\"\npoint = [{}, {}, {}]\nnormal = [{}, {}, {}]\ninteraction = "
-      "\"hertz_mindlin\"\nE = 1.0e5\nnu = 0.25\ne = 0.5\nmu = 0.5\n",
-      name, point[0], point[1], point[2], normal[0], normal[1], normal[2]);
-}
-
-std::string pile_scene(int side, const std::string& precision) {
-  const double w = kSpacing * side;
-  return fmt::format(R"([run]
-dt = 1e-3
-steps = 0
-skin = 0.1
-precision = "{}"
-[[interactions]]
-type = "hertz_mindlin"
-E = 1.0e5
-nu = 0.25
-e = 0.5
-mu = 0.5
-[[body_forces]]
-type = "gravity"
-acceleration = [0.0, 0.0, -1.0]
-)",
-                     precision) +
-         pile_wall("floor", {0, 0, 0}, {0, 0, 1}) + pile_wall("x0", {0, 0, 0}, {1, 0, 0}) +
-         pile_wall("x1", {w, 0, 0}, {-1, 0, 0}) + pile_wall("y0", {0, 0, 0}, {0, 1, 0}) +
-         pile_wall("y1", {0, w, 0}, {0, -1, 0});
-}
+using basalt::bench::pile;
+using basalt::bench::pile_scene;
 
 struct Held {
   double ke_settled = 0, ke_end = 0, ke_max = 0;  ///< over N m g r (m, r the means)

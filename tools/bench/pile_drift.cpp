@@ -26,77 +26,14 @@
 #include "basalt/io/geometry.hpp"
 #include "basalt/solver/scene/scene.hpp"
 #include "basalt/solver/simulation.hpp"
+#include "held_pile.hpp"
 
 namespace {
 
 using basalt::io::Geometry;
 using namespace basalt::solver;
-
-/// The same hash as the tests' (tests/support/geometries.hpp): a value in [-1, 1) from an integer.
-double hash_unit(std::uint64_t k) {
-  k += 0x9E3779B97F4A7C15ull;
-  k = (k ^ (k >> 30)) * 0xBF58476D1CE4E5B9ull;
-  k = (k ^ (k >> 27)) * 0x94D049BB133111EBull;
-  k ^= k >> 31;
-  return double(k >> 11) * 0x1.0p-53 * 2.0 - 1.0;
-}
-
-constexpr double kSpacing = 1.2;  // lattice spacing: the largest diameter is 1.15
-
-Geometry pile(int side, int layers) {
-  Geometry g;
-  std::int64_t id = 1;
-  for (int k = 0; k < layers; ++k)
-    for (int j = 0; j < side; ++j)
-      for (int i = 0; i < side; ++i, ++id) {
-        const auto u = static_cast<std::uint64_t>(id);
-        g.add_particle(id,
-                       {kSpacing * (i + 0.5) + 0.02 * hash_unit(3 * u),
-                        kSpacing * (j + 0.5) + 0.02 * hash_unit(3 * u + 1), kSpacing * (k + 0.5)},
-                       0.5 + 0.075 * hash_unit(7 * u + 5));
-      }
-  g.sort_by_id();
-  return g;
-}
-
-std::string wall(const char* name, std::array<double, 3> point, std::array<double, 3> normal) {
-  return fmt::format(R"([[walls]]
-name = "{}"
-point = [{}, {}, {}]
-normal = [{}, {}, {}]
-interaction = "hertz_mindlin"
-E = 1.0e5
-nu = 0.25
-e = 0.5
-mu = 0.5
-)",
-                     name, point[0], point[1], point[2], normal[0], normal[1], normal[2]);
-}
-
-std::string pile_scene(int side, const std::string& precision) {
-  const double w = kSpacing * side;
-  return fmt::format(R"([geometry]
-file = "unused.geo"
-[run]
-dt = 1e-3
-steps = 0
-skin = 0.1
-precision = "{}"
-[[interactions]]
-type = "hertz_mindlin"
-E = 1.0e5
-nu = 0.25
-e = 0.5
-mu = 0.5
-[[body_forces]]
-type = "gravity"
-acceleration = [0.0, 0.0, -1.0]
-)",
-                     precision) +
-         wall("floor", {0, 0, 0}, {0, 0, 1}) + wall("x0", {0, 0, 0}, {1, 0, 0}) +
-         wall("x1", {w, 0, 0}, {-1, 0, 0}) + wall("y0", {0, 0, 0}, {0, 1, 0}) +
-         wall("y1", {0, w, 0}, {0, -1, 0});
-}
+using basalt::bench::pile;
+using basalt::bench::pile_scene;
 
 double slope_per_million(const std::vector<double>& t, const std::vector<double>& y) {
   const double n = double(t.size());
@@ -117,8 +54,9 @@ void run(const std::string& precision, int side, int layers, std::int64_t settle
   const double scale = double(g.size()) * m * 1.0 * r;  // N m g r
   RunOptions opt;
   opt.quiet = true;
-  Simulation<Real> sim(parse_scene_text(pile_scene(side, precision), "pile_drift.toml", "."), g,
-                       MPI_COMM_SELF, opt);
+  Simulation<Real> sim(parse_scene_text("[geometry]\nfile = \"unused.geo\"\n" + pile_scene(side, precision),
+                                        "pile_drift.toml", "."),
+                       g, MPI_COMM_SELF, opt);
   const auto start = std::chrono::steady_clock::now();
   sim.run(settle);
   const auto kinetic = [&] { return sim.kinetic_energy() / scale; };  // translational + rotational
